@@ -1,0 +1,22 @@
+// Errors that come from data (a file, a scene description, user input), as opposed to programming
+// mistakes, which are asserts. Library code throws InputError; the CLI turns it into one line on stderr
+// and exit code 1. Nothing in src/ calls exit() or abort() because of what a file contains.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace pointrast {
+
+class InputError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// The GPU lacks a feature a method needs (an extension, 64-bit atomics, memory). Also one clear line.
+class UnsupportedError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+} // namespace pointrast

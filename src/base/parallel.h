@@ -1,0 +1,57 @@
+// Deterministic parallel loops over index ranges. Work is cut into fixed-size blocks whose boundaries
+// do not depend on the number of threads, so a body that seeds its random numbers from the block index
+// gives the same result on 2 cores and on 128.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace pointrast {
+
+inline unsigned hardwareThreads() {
+  unsigned n = std::thread::hardware_concurrency();
+  return n ? n : 1;
+}
+
+// Calls body(blockIndex, begin, end) for consecutive blocks [begin, end) of at most blockSize indices
+// covering [0, count), on all hardware threads. The first exception thrown by a body is rethrown.
+template <class Body> void parallelBlocks(uint64_t count, uint64_t blockSize, Body&& body) {
+  if (count == 0) return;
+  uint64_t blocks = (count + blockSize - 1) / blockSize;
+  unsigned threads = static_cast<unsigned>(std::min<uint64_t>(hardwareThreads(), blocks));
+  std::atomic<uint64_t> next{0};
+  std::exception_ptr error;
+  std::mutex errorMutex;
+  auto worker = [&] {
+    for (;;) {
+      uint64_t b = next.fetch_add(1);
+      if (b >= blocks) return;
+      try {
+        uint64_t begin = b * blockSize;
+        body(b, begin, std::min(count, begin + blockSize));
+      } catch (...) {
+        std::lock_guard lock(errorMutex);
+        if (!error) error = std::current_exception();
+        next = blocks;
+        return;
+      }
+    }
+  };
+  if (threads <= 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    pool.reserve(threads - 1);
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+} // namespace pointrast

@@ -1,0 +1,49 @@
+// Reading point clouds from files. Every reader treats its input as hostile: counts and sizes are
+// checked against the file size before anything is allocated, NaN/Inf coordinates are dropped and
+// counted, and a truncated or lying file throws InputError with one clear sentence naming the file.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cloud/cloud.h"
+
+namespace pointrast::io {
+
+enum class Format { Unknown, Las, Laz, Ply, Xyz, Mmpld };
+const char* formatName(Format format);
+
+// Decides by content (magic bytes) first, by extension second. Throws InputError if the file cannot be
+// opened.
+Format detectFormat(const std::filesystem::path& path);
+
+// Header-level facts for `pointrast info`, without reading every point where the format allows.
+struct FileInfo {
+  Format format = Format::Unknown;
+  std::string formatDetail;        // "LAS 1.2, point format 3 (34 B records)", "PLY binary_little_endian"
+  uint64_t pointCount = 0;         // as stated by the header (LAS/PLY) or counted (XYZ)
+  Bounds bounds;                   // header bounds where the format has them, else computed
+  bool boundsFromHeader = false;
+  glm::dvec3 scale{0}, offset{0};  // LAS only
+  bool hasColor = false;
+  int colorBits = 0;               // 8 or 16 for LAS RGB (detected from the values), 8 for PLY uchar...
+  std::vector<std::pair<std::string, std::string>> extra; // ordered (key, value) lines for display
+};
+
+struct ReadOptions {
+  bool progress = true;            // progress line on stderr when it is a terminal
+  bool keepAttributes = true;      // intensity, classification, return number
+};
+
+// Reads the whole file into a PointCloud (bounds computed from the points). Throws InputError.
+PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& options = {});
+FileInfo probeFile(const std::filesystem::path& path);
+
+// Per format (readCloud dispatches to these).
+PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options = {});
+PointCloud readPly(const std::filesystem::path& path, const ReadOptions& options = {});
+PointCloud readXyz(const std::filesystem::path& path, const ReadOptions& options = {});
+
+} // namespace pointrast::io
