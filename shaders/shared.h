@@ -55,14 +55,14 @@ struct RasterPush {
   uint pad0;
 };
 
-// Push constants of the per-pixel passes: resolve (framebuffer -> RGBA8 image, then clear) and clear.
+// Push constants of the resolve pass (framebuffer words -> RGBA8 image).
 struct ResolvePush {
   uint64_t framebuffer; // uint64_t[width * height]
   uint64_t image;       // uint[width * height], RGBA8, row 0 = top
   uint width;
   uint height;
   uint background;      // RGBA8 written where no point landed
-  uint clearAfter;      // 1: reset the framebuffer to kEmptyPixel after reading it
+  uint groupsX;         // workgroups per row of the 2D dispatch
 };
 
 PR_NAMESPACE_END

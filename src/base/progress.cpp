@@ -25,9 +25,9 @@ std::string humanCount(double value) {
   return buf;
 }
 
-Progress::Progress(std::string label, uint64_t total, std::string unit)
+Progress::Progress(std::string label, uint64_t total, std::string unit, bool show)
     : label_(std::move(label)), unit_(std::move(unit)), total_(total),
-      start_(std::chrono::steady_clock::now()), tty_(isatty(STDERR_FILENO) != 0) {}
+      start_(std::chrono::steady_clock::now()), tty_(isatty(STDERR_FILENO) != 0), show_(show) {}
 
 Progress::~Progress() { finish(); }
 
@@ -37,7 +37,7 @@ double Progress::seconds() const {
 
 void Progress::advance(uint64_t units) {
   done_.fetch_add(units, std::memory_order_relaxed);
-  if (!tty_ || !gEnabled) return;
+  if (!tty_ || !show_ || !gEnabled) return;
   int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
                     std::chrono::steady_clock::now().time_since_epoch())
                     .count();
@@ -67,7 +67,8 @@ void Progress::draw(bool final) {
 void Progress::finish() {
   if (finished_) return;
   finished_ = true;
-  if (gEnabled) draw(true);
+  // The summary line is for work long enough to care about (it also reports throughput in logs).
+  if (show_ && gEnabled && (seconds() >= 0.5 || lastDrawNs_.load() != 0)) draw(true);
 }
 
 } // namespace pointrast

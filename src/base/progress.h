@@ -12,8 +12,9 @@ namespace pointrast {
 
 class Progress {
 public:
-  // total: units of work (points, bytes); label: what is being done ("reading autzen.las").
-  Progress(std::string label, uint64_t total, std::string unit = "points");
+  // total: units of work (points, bytes); label: what is being done ("reading autzen.las");
+  // show = false keeps it silent (the caller asked for no progress).
+  Progress(std::string label, uint64_t total, std::string unit = " points", bool show = true);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -38,6 +39,7 @@ private:
   std::chrono::steady_clock::time_point start_;
   std::mutex drawMutex_;
   bool tty_;
+  bool show_;
   bool finished_ = false;
 };
 

@@ -1,0 +1,251 @@
+#include "cloud/cloud.h"
+
+#include <array>
+#include <atomic>
+#include <cassert>
+#include <cmath>
+
+#include "base/parallel.h"
+#include "cloud/detail.h"
+
+namespace pointrast {
+
+namespace detail {
+
+namespace {
+// 1 M points per block: large enough that thread start-up is noise, small enough to balance 2..128 cores.
+constexpr uint64_t kBlock = uint64_t(1) << 20;
+} // namespace
+
+QuantBox quantBox(const int32_t* positions, uint64_t first, uint64_t count) {
+  QuantBox box;
+  const int32_t* p = positions + 3 * first;
+  for (uint64_t i = 0; i < count; ++i, p += 3) {
+    for (int a = 0; a < 3; ++a) {
+      box.min[a] = std::min(box.min[a], p[a]);
+      box.max[a] = std::max(box.max[a], p[a]);
+    }
+  }
+  return box;
+}
+
+QuantBox quantBoxParallel(const int32_t* positions, uint64_t count) {
+  std::vector<QuantBox> boxes((count + kBlock - 1) / kBlock);
+  parallelBlocks(count, kBlock, [&](uint64_t block, uint64_t begin, uint64_t end) {
+    boxes[block] = quantBox(positions, begin, end - begin);
+  });
+  QuantBox box;
+  for (const QuantBox& b : boxes) box.expand(b);
+  return box;
+}
+
+Bounds worldBounds(const QuantBox& box, const glm::dvec3& scale, const glm::dvec3& offset) {
+  Bounds bounds;
+  if (box.empty()) return bounds;
+  // Both corners: with a negative scale the smallest q gives the largest world coordinate.
+  bounds.expand(glm::dvec3(box.min[0] * scale.x + offset.x, box.min[1] * scale.y + offset.y,
+                           box.min[2] * scale.z + offset.z));
+  bounds.expand(glm::dvec3(box.max[0] * scale.x + offset.x, box.max[1] * scale.y + offset.y,
+                           box.max[2] * scale.z + offset.z));
+  return bounds;
+}
+
+namespace {
+// Turbo, the polynomial approximation published with it (A. Mikhailov, "Turbo, An Improved Rainbow
+// Colormap for Visualization", Google AI blog, 2019): perceptually smoother than jet, dark at both ends.
+std::array<uint32_t, 256> makeTurbo() {
+  std::array<uint32_t, 256> lut{};
+  for (int i = 0; i < 256; ++i) {
+    double x = i / 255.0, x2 = x * x, x3 = x2 * x, x4 = x2 * x2, x5 = x4 * x;
+    double r = 0.13572138 + 4.61539260 * x - 42.66032258 * x2 + 132.13108234 * x3 - 152.94239396 * x4 +
+               59.28637943 * x5;
+    double g = 0.09140261 + 2.19418839 * x + 4.84296658 * x2 - 14.18503333 * x3 + 4.27729857 * x4 +
+               2.82956604 * x5;
+    double b = 0.10667330 + 12.64194608 * x - 60.58204836 * x2 + 110.36276771 * x3 - 89.90310912 * x4 +
+               27.34824973 * x5;
+    auto byte = [](double v) { return static_cast<uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+    lut[i] = packRgba(byte(r), byte(g), byte(b));
+  }
+  return lut;
+}
+} // namespace
+
+uint32_t rampColor(double t) {
+  static const std::array<uint32_t, 256> kTurbo = makeTurbo();
+  if (!(t > 0.0)) return kTurbo[0]; // also NaN
+  if (t >= 1.0) return kTurbo[255];
+  return kTurbo[static_cast<int>(t * 255.0 + 0.5)];
+}
+
+} // namespace detail
+
+void computeBounds(PointCloud& cloud) {
+  cloud.bounds = detail::worldBounds(detail::quantBoxParallel(cloud.positions.data(), cloud.size()),
+                                     cloud.scale, cloud.offset);
+}
+
+void toRelativeFloat(float* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
+                     const glm::dvec3& origin) {
+  assert(first + count <= cloud.size());
+  const int32_t* src = cloud.positions.data();
+  const glm::dvec3 s = cloud.scale, o = cloud.offset;
+  // Each coordinate is the double world value minus the double origin, then a single rounding to float:
+  // UTM northings (~4e6 m) keep their millimetres because they never pass through float on their own.
+  auto convert = [&](uint64_t begin, uint64_t end) {
+    for (uint64_t k = begin; k < end; ++k) {
+      const int32_t* p = src + 3 * (first + k);
+      dst[3 * k + 0] = static_cast<float>((p[0] * s.x + o.x) - origin.x);
+      dst[3 * k + 1] = static_cast<float>((p[1] * s.y + o.y) - origin.y);
+      dst[3 * k + 2] = static_cast<float>((p[2] * s.z + o.z) - origin.z);
+    }
+  };
+  constexpr uint64_t kParallelFrom = uint64_t(1) << 18;
+  if (count < kParallelFrom) {
+    convert(0, count);
+  } else {
+    parallelBlocks(count, detail::kBlock, [&](uint64_t, uint64_t begin, uint64_t end) { convert(begin, end); });
+  }
+}
+
+bool hasUsableColor(const PointCloud& cloud) {
+  const uint64_t n = cloud.colors.size();
+  if (n == 0) return false;
+  const uint32_t* c = cloud.colors.data();
+  // Real colors show up in the first points; only an all-black cloud pays for the full parallel scan.
+  constexpr uint64_t kQuick = 4096;
+  for (uint64_t i = 0; i < std::min(n, kQuick); ++i)
+    if (c[i] & 0x00FFFFFFu) return true;
+  std::atomic<bool> found{false};
+  parallelBlocks(n, detail::kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
+    if (found.load(std::memory_order_relaxed)) return;
+    for (uint64_t i = begin; i < end; ++i) {
+      if (c[i] & 0x00FFFFFFu) {
+        found = true;
+        return;
+      }
+    }
+  });
+  return found;
+}
+
+namespace {
+
+struct Range {
+  double lo = 0, hi = 0;
+};
+
+// The 0.5% and 99.5% percentiles of value(i) over all points, from a histogram of 4096 bins between
+// min and max (bin edges, so at most 1/4096 of the range off). Falls back to [min, max] when the
+// percentiles coincide (most points share one value).
+template <class Value> Range robustRange(uint64_t n, double min, double max, Value value) {
+  if (!(max > min)) return {min, max};
+  constexpr int kBins = 4096;
+  // Few blocks, so the per-block histograms stay small (<= 64 x 32 KiB) whatever n is.
+  const uint64_t blockSize = std::max<uint64_t>(uint64_t(1) << 20, (n + 63) / 64);
+  const uint64_t blocks = (n + blockSize - 1) / blockSize;
+  std::vector<uint64_t> hist(blocks * kBins, 0);
+  const double toBin = kBins / (max - min);
+  parallelBlocks(n, blockSize, [&](uint64_t block, uint64_t begin, uint64_t end) {
+    uint64_t* h = hist.data() + block * kBins;
+    for (uint64_t i = begin; i < end; ++i) {
+      int bin = static_cast<int>((value(i) - min) * toBin);
+      ++h[std::clamp(bin, 0, kBins - 1)];
+    }
+  });
+  std::vector<uint64_t> total(kBins, 0);
+  for (uint64_t b = 0; b < blocks; ++b)
+    for (int k = 0; k < kBins; ++k) total[k] += hist[b * kBins + k];
+  const uint64_t cut = n / 200; // 0.5%
+  int loBin = 0, hiBin = kBins - 1;
+  for (uint64_t acc = 0; loBin < kBins - 1 && acc + total[loBin] <= cut; ++loBin) acc += total[loBin];
+  for (uint64_t acc = 0; hiBin > 0 && acc + total[hiBin] <= cut; --hiBin) acc += total[hiBin];
+  Range r{min + loBin / toBin, min + (hiBin + 1) / toBin};
+  if (!(r.hi > r.lo)) return {min, max};
+  return {std::max(r.lo, min), std::min(r.hi, max)};
+}
+
+} // namespace
+
+DisplayColorMode displayColorMode(const PointCloud& cloud) {
+  DisplayColorMode mode;
+  const uint64_t n = cloud.size();
+  if (hasUsableColor(cloud)) {
+    mode.source = DisplayColorMode::Source::Rgb;
+    return mode;
+  }
+  if (!cloud.intensity.empty()) {
+    const uint16_t* v = cloud.intensity.data();
+    std::vector<std::pair<uint16_t, uint16_t>> ext((n + detail::kBlock - 1) / detail::kBlock,
+                                                   {uint16_t(65535), uint16_t(0)});
+    parallelBlocks(n, detail::kBlock, [&](uint64_t block, uint64_t begin, uint64_t end) {
+      auto [lo, hi] = ext[block];
+      for (uint64_t i = begin; i < end; ++i) {
+        lo = std::min(lo, v[i]);
+        hi = std::max(hi, v[i]);
+      }
+      ext[block] = {lo, hi};
+    });
+    uint16_t lo = 65535, hi = 0;
+    for (auto [l, h] : ext) {
+      lo = std::min(lo, l);
+      hi = std::max(hi, h);
+    }
+    if (hi > lo) {
+      Range r = robustRange(n, lo, hi, [v](uint64_t i) { return double(v[i]); });
+      mode.source = DisplayColorMode::Source::Intensity;
+      mode.lo = r.lo;
+      mode.hi = r.hi;
+      return mode;
+    }
+  }
+  mode.source = DisplayColorMode::Source::Elevation;
+  Bounds b = cloud.bounds;
+  if (b.empty() && n > 0)
+    b = detail::worldBounds(detail::quantBoxParallel(cloud.positions.data(), n), cloud.scale, cloud.offset);
+  if (b.empty()) return mode;
+  const int32_t* p = cloud.positions.data();
+  const double sz = cloud.scale.z, oz = cloud.offset.z;
+  Range r = robustRange(n, b.min.z, b.max.z, [=](uint64_t i) { return p[3 * i + 2] * sz + oz; });
+  mode.lo = r.lo;
+  mode.hi = r.hi;
+  return mode;
+}
+
+void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
+                   const DisplayColorMode& mode) {
+  assert(first + count <= cloud.size());
+  const double span = mode.hi - mode.lo;
+  const double inv = span > 0 ? 1.0 / span : 0.0;
+  auto fill = [&](uint64_t begin, uint64_t end) {
+    switch (mode.source) {
+    case DisplayColorMode::Source::Rgb:
+      for (uint64_t k = begin; k < end; ++k) dst[k] = cloud.colors[first + k] | 0xFF000000u;
+      break;
+    case DisplayColorMode::Source::Intensity:
+      for (uint64_t k = begin; k < end; ++k)
+        dst[k] = span > 0 ? detail::rampColor((cloud.intensity[first + k] - mode.lo) * inv)
+                          : detail::rampColor(0.5);
+      break;
+    case DisplayColorMode::Source::Elevation: {
+      const int32_t* p = cloud.positions.data();
+      const double sz = cloud.scale.z, oz = cloud.offset.z;
+      for (uint64_t k = begin; k < end; ++k)
+        dst[k] = span > 0 ? detail::rampColor((p[3 * (first + k) + 2] * sz + oz - mode.lo) * inv)
+                          : detail::rampColor(0.5);
+      break;
+    }
+    }
+  };
+  constexpr uint64_t kParallelFrom = uint64_t(1) << 18;
+  if (count < kParallelFrom) {
+    fill(0, count);
+  } else {
+    parallelBlocks(count, detail::kBlock, [&](uint64_t, uint64_t begin, uint64_t end) { fill(begin, end); });
+  }
+}
+
+void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count) {
+  displayColors(dst, cloud, first, count, displayColorMode(cloud));
+}
+
+} // namespace pointrast

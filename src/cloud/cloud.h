@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -75,5 +76,19 @@ void toRelativeFloat(float* dst, const PointCloud& cloud, uint64_t first, uint64
 // hasUsableColor() tells which applies; it is false when colors exist but are all black (4_6_crop.las).
 bool hasUsableColor(const PointCloud& cloud);
 void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count);
+
+// What displayColors() maps onto colors. Deciding it takes a pass over the whole cloud (is any color
+// non-black, what range do intensity or elevation span), so a caller converting a large cloud in chunks
+// computes it once and passes it to the overload below; every chunk then uses the same ramp.
+struct DisplayColorMode {
+  enum class Source { Rgb, Intensity, Elevation };
+  Source source = Source::Elevation;
+  // Values mapped to the two ends of the ramp (intensity units or world z). The 0.5% and 99.5%
+  // percentiles rather than min and max, so a few outliers (birds, noise) do not flatten the ramp.
+  double lo = 0.0, hi = 1.0;
+};
+DisplayColorMode displayColorMode(const PointCloud& cloud);
+void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
+                   const DisplayColorMode& mode);
 
 } // namespace pointrast

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Runs on a GPU machine (after scripts/gpu-bundle.sh here; carry .gpu and .vkrt): the GPU tests with the
+# validation layer, the CLI tests, and the checks and benchmarks named by the arguments. Results go to
+# $OUT (default ./gpu-out).
+#   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
+set -uo pipefail
+cd "$(dirname "$0")/.."
+OUT=${OUT:-$PWD/gpu-out}
+mkdir -p "$OUT"
+log="$OUT/gpu-check.log"
+exec > >(tee -a "$log") 2>&1
+
+# Vulkan loader for machines that have the NVIDIA driver but no loader.
+if ! ldconfig -p | grep -q libvulkan.so.1; then
+  for f in .vkrt/*.deb; do dpkg -x "$f" /; done
+  ldconfig
+fi
+for icd in /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json /usr/share/vulkan/icd.d/nvidia_icd.json /etc/vulkan/icd.d/nvidia_icd.json; do
+  if [ -f "$icd" ]; then export VK_DRIVER_FILES=$icd; break; fi
+done
+# Validation layer unpacked aside (never into /).
+if ls .vkrt/layers/*.deb >/dev/null 2>&1; then
+  rm -rf /tmp/vklayer && dpkg -x .vkrt/layers/*.deb /tmp/vklayer
+  export VK_LAYER_PATH=/tmp/vklayer/usr/share/vulkan/explicit_layer.d
+  export LD_LIBRARY_PATH=/tmp/vklayer/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+else
+  export POINTRAST_VALIDATION=0
+fi
+export POINTRAST_BIN=$PWD/.gpu/bin/pointrast POINTRAST_DATA_DIR=$PWD/.gpu/data XDG_RUNTIME_DIR=/tmp
+pr=$POINTRAST_BIN
+
+echo "== machine"
+nvidia-smi -L 2>/dev/null || true
+nproc; free -g | head -2
+$pr info --devices
+
+status=0
+for what in "$@"; do
+  case $what in
+  tests)
+    echo "== GPU tests (validation ${POINTRAST_VALIDATION:-on})"
+    .gpu/bin/gpu_tests --gtest_brief=1 || status=1
+    .gpu/bin/cli_tests --gtest_brief=1 || status=1
+    ;;
+  autzen)
+    echo "== autzen_trim.las"
+    $pr render .gpu/data/las/autzen_trim.las -o "$OUT/autzen.png" --json --frames 50 | tee "$OUT/autzen.json" || status=1
+    ;;
+  big)
+    # 1.2 billion generated points (float32 xyz alone: 14.4 GB) drawn as one upload and as 12 separately
+    # uploaded scenes of 100 M points; the two images must be identical.
+    echo "== 1.2 G points, one upload"
+    POINTRAST_VALIDATION=0 $pr render terrain --points 1.2G -o "$OUT/big.png" --json --frames 20 | tee "$OUT/big.json" || status=1
+    echo "== 1.2 G points, 12 parts"
+    POINTRAST_VALIDATION=0 $pr render terrain --points 1.2G -o "$OUT/big12.png" --json --frames 20 --parts 12 | tee "$OUT/big12.json" || status=1
+    if cmp "$OUT/big.png" "$OUT/big12.png"; then echo "big: images identical"; else echo "big: IMAGES DIFFER"; status=1; fi
+    ;;
+  *)
+    echo "unknown check '$what' (tests, autzen, big)"; status=1 ;;
+  esac
+done
+echo "gpu-check: exit $status"
+exit $status

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Builds pointrast and runs every test: all tests on the default Vulkan device (lavapipe without a GPU)
+# with the Khronos validation layer on, then the parser and data-preparation tests again under
+# AddressSanitizer + UBSan (truncation sweeps must never read out of bounds).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+jobs=$(nproc)
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
+
+echo "== tests (warnings as errors, validation layer on)"
+# Optimized, but with asserts on (no -DNDEBUG): the push-constant size checks are asserts.
+cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g" -DPOINTRAST_WERROR=ON
+cmake --build build-test -j"$jobs"
+
+echo "== parser and cloud tests under AddressSanitizer"
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPOINTRAST_SANITIZE=ON -DPOINTRAST_WERROR=ON
+cmake --build build-asan -j"$jobs" --target io_tests cloud_tests
+ASAN_OPTIONS=detect_leaks=1 build-asan/tests/io_tests --gtest_brief=1
+ASAN_OPTIONS=detect_leaks=1 build-asan/tests/cloud_tests --gtest_brief=1
+
+echo "== all tests"
+cd build-test
+ctest --output-on-failure -j"$jobs" --timeout 900

@@ -1,0 +1,336 @@
+#include "gpu/context.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "base/error.h"
+
+namespace pointrast::gpu {
+
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+bool envFlag(const char* name) {
+  const char* v = std::getenv(name);
+  return v && *v && std::strcmp(v, "0") != 0;
+}
+
+const char* typeName(VkPhysicalDeviceType type) {
+  switch (type) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU (software Vulkan)";
+  default: return "other";
+  }
+}
+
+// Preference when no device is named: discrete > integrated > virtual > CPU > other.
+int typeRank(VkPhysicalDeviceType type) {
+  switch (type) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+  case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
+  default: return 0;
+  }
+}
+
+DeviceInfo describe(VkPhysicalDevice physical) {
+  VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+  vkGetPhysicalDeviceProperties2(physical, &props);
+  DeviceInfo info;
+  info.name = props.properties.deviceName;
+  info.type = props.properties.deviceType;
+  info.typeName = typeName(info.type);
+  info.apiVersion = props.properties.apiVersion;
+  info.vendorId = props.properties.vendorID;
+  info.driver = std::string(driver.driverName) + " " + driver.driverInfo;
+  return info;
+}
+
+struct Instance {
+  VkInstance handle = VK_NULL_HANDLE;
+  bool debugUtils = false;
+};
+
+Instance createInstance(bool validation) {
+  loadVulkanLoader();
+  uint32_t version = 0;
+  VK_CHECK(vkEnumerateInstanceVersion(&version));
+  if (version < VK_API_VERSION_1_3)
+    throw UnsupportedError("the Vulkan loader is older than 1.3; install a newer libvulkan1");
+
+  uint32_t count = 0;
+  VK_CHECK(vkEnumerateInstanceExtensionProperties(nullptr, &count, nullptr));
+  std::vector<VkExtensionProperties> available(count);
+  VK_CHECK(vkEnumerateInstanceExtensionProperties(nullptr, &count, available.data()));
+  std::vector<const char*> extensions;
+  Instance result;
+  for (const auto& e : available)
+    if (std::strcmp(e.extensionName, VK_EXT_DEBUG_UTILS_EXTENSION_NAME) == 0) result.debugUtils = true;
+  if (result.debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+
+  std::vector<const char*> layers;
+  if (validation) {
+    VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
+    std::vector<VkLayerProperties> available_layers(count);
+    VK_CHECK(vkEnumerateInstanceLayerProperties(&count, available_layers.data()));
+    bool found = std::any_of(available_layers.begin(), available_layers.end(),
+                             [](const VkLayerProperties& l) { return std::strcmp(l.layerName, kValidationLayer) == 0; });
+    if (!found)
+      throw UnsupportedError("POINTRAST_VALIDATION is set but the Khronos validation layer is not installed "
+                             "(`apt-get install vulkan-validationlayers`)");
+    layers.push_back(kValidationLayer);
+  }
+
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "pointrast";
+  app.apiVersion = VK_API_VERSION_1_3;
+  VkInstanceCreateInfo create{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  create.pApplicationInfo = &app;
+  create.enabledExtensionCount = uint32_t(extensions.size());
+  create.ppEnabledExtensionNames = extensions.data();
+  create.enabledLayerCount = uint32_t(layers.size());
+  create.ppEnabledLayerNames = layers.data();
+  VkResult r = vkCreateInstance(&create, nullptr, &result.handle);
+  if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED)
+    throw UnsupportedError("no Vulkan driver found: install one, e.g. `apt-get install mesa-vulkan-drivers` "
+                           "for software rendering, or your GPU vendor's driver");
+  VK_CHECK(r);
+  loadInstanceFunctions(result.handle);
+  return result;
+}
+
+std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
+  uint32_t count = 0;
+  VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+  std::vector<VkPhysicalDevice> devices(count);
+  VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+  return devices;
+}
+
+} // namespace
+
+std::vector<DeviceInfo> listDevices() {
+  Instance instance = createInstance(false);
+  std::vector<DeviceInfo> result;
+  for (VkPhysicalDevice d : physicalDevices(instance.handle)) result.push_back(describe(d));
+  vkDestroyInstance(instance.handle, nullptr);
+  return result;
+}
+
+Context::Context(const ContextOptions& options) {
+  validation_ = options.validation.value_or(envFlag("POINTRAST_VALIDATION"));
+  Instance instance = createInstance(validation_);
+  instance_ = instance.handle;
+  debugUtils_ = instance.debugUtils && vkCreateDebugUtilsMessengerEXT && vkSetDebugUtilsObjectNameEXT;
+  try {
+    if (debugUtils_ && validation_) {
+      VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+      info.messageSeverity =
+          VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+      info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                         VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                         VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+      info.pfnUserCallback = &Context::debugCallback;
+      info.pUserData = this;
+      VK_CHECK(vkCreateDebugUtilsMessengerEXT(instance_, &info, nullptr, &messenger_));
+    }
+    chooseDevice(options);
+    createDevice();
+  } catch (...) {
+    destroy();
+    throw;
+  }
+  if (options.announce) {
+    std::fprintf(stderr, "device: %s (%s, %s)%s\n", info_.name.c_str(), info_.typeName.c_str(),
+                 info_.driver.c_str(), validation_ ? ", validation on" : "");
+    if (info_.software())
+      std::fprintf(stderr, "note: no GPU found; rendering on the CPU with software Vulkan (lavapipe), "
+                           "which is correct but slow\n");
+  }
+}
+
+Context::~Context() { destroy(); }
+
+void Context::destroy() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    if (fence_) vkDestroyFence(device_, fence_, nullptr);
+    if (commandPool_) vkDestroyCommandPool(device_, commandPool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+    device_ = VK_NULL_HANDLE;
+  }
+  if (messenger_) vkDestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
+  messenger_ = VK_NULL_HANDLE;
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+  instance_ = VK_NULL_HANDLE;
+}
+
+VkBool32 VKAPI_PTR Context::debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                          VkDebugUtilsMessageTypeFlagsEXT,
+                                          const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  auto* self = static_cast<Context*>(user);
+  bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  if (error) self->validationErrors_++;
+  std::fprintf(stderr, "validation %s: %s\n", error ? "error" : "warning", data->pMessage);
+  return VK_FALSE;
+}
+
+void Context::chooseDevice(const ContextOptions& options) {
+  std::vector<VkPhysicalDevice> devices = physicalDevices(instance_);
+  if (devices.empty())
+    throw UnsupportedError("no Vulkan device found: install a driver, e.g. `apt-get install "
+                           "mesa-vulkan-drivers` for software rendering");
+  std::optional<uint32_t> index = options.deviceIndex;
+  if (!index) {
+    if (const char* env = std::getenv("POINTRAST_DEVICE"); env && *env) {
+      char* end = nullptr;
+      unsigned long v = std::strtoul(env, &end, 10);
+      if (*end != '\0') throw InputError(std::string("POINTRAST_DEVICE='") + env + "' is not a device index");
+      index = uint32_t(v);
+    }
+  }
+  if (index) {
+    if (*index >= devices.size())
+      throw InputError("device " + std::to_string(*index) + " does not exist; this machine has " +
+                       std::to_string(devices.size()) + " Vulkan device(s) (see `pointrast info --devices`)");
+    physical_ = devices[*index];
+  } else {
+    physical_ = *std::max_element(devices.begin(), devices.end(), [](VkPhysicalDevice a, VkPhysicalDevice b) {
+      return typeRank(describe(a).type) < typeRank(describe(b).type);
+    });
+  }
+  info_ = describe(physical_);
+  if (info_.apiVersion < VK_API_VERSION_1_3)
+    throw UnsupportedError("device '" + info_.name + "' supports only Vulkan " +
+                           std::to_string(VK_API_VERSION_MAJOR(info_.apiVersion)) + "." +
+                           std::to_string(VK_API_VERSION_MINOR(info_.apiVersion)) + "; pointrast needs 1.3");
+}
+
+void Context::createDevice() {
+  VkPhysicalDeviceMaintenance4Properties m4{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES};
+  VkPhysicalDeviceMaintenance3Properties m3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES, &m4};
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES, &m3};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &subgroup};
+  vkGetPhysicalDeviceProperties2(physical_, &props);
+  properties_ = props.properties;
+  subgroupSize_ = subgroup.subgroupSize;
+  maxAllocation_ = m3.maxMemoryAllocationSize;
+  maxBuffer_ = m4.maxBufferSize;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+  for (uint32_t h = 0; h < memory_.memoryHeapCount; ++h)
+    if (memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) deviceLocalBytes_ += memory_.memoryHeaps[h].size;
+
+  VkPhysicalDeviceVulkan13Features has13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &has13};
+  VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &has12};
+  vkGetPhysicalDeviceFeatures2(physical_, &has);
+  auto require = [&](VkBool32 present, const char* feature) {
+    if (!present)
+      throw UnsupportedError("device '" + info_.name + "' lacks " + feature +
+                             ", which every pointrast method needs");
+  };
+  require(has.features.shaderInt64, "shaderInt64");
+  require(has12.bufferDeviceAddress, "bufferDeviceAddress");
+  require(has12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics (64-bit atomics on buffers)");
+  require(has13.synchronization2, "synchronization2");
+
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, families.data());
+  constexpr VkQueueFlags kWanted = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+  bool found = false;
+  for (uint32_t f = 0; f < familyCount && !found; ++f)
+    if ((families[f].queueFlags & kWanted) == kWanted && families[f].timestampValidBits > 0) {
+      queueFamily_ = f;
+      found = true;
+    }
+  if (!found)
+    throw UnsupportedError("device '" + info_.name + "' has no queue with graphics, compute and timestamps");
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queueInfo.queueFamilyIndex = queueFamily_;
+  queueInfo.queueCount = 1;
+  queueInfo.pQueuePriorities = &priority;
+
+  VkPhysicalDeviceVulkan13Features want13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  want13.synchronization2 = VK_TRUE;
+  want13.maintenance4 = has13.maintenance4;
+  want13.subgroupSizeControl = has13.subgroupSizeControl;
+  want13.computeFullSubgroups = has13.computeFullSubgroups;
+  VkPhysicalDeviceVulkan12Features want12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &want13};
+  want12.bufferDeviceAddress = VK_TRUE;
+  want12.shaderBufferInt64Atomics = VK_TRUE;
+  want12.shaderSharedInt64Atomics = has12.shaderSharedInt64Atomics;
+  want12.scalarBlockLayout = has12.scalarBlockLayout;
+  want12.hostQueryReset = has12.hostQueryReset;
+  want12.shaderSubgroupExtendedTypes = has12.shaderSubgroupExtendedTypes;
+  VkPhysicalDeviceFeatures2 want{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &want12};
+  want.features.shaderInt64 = VK_TRUE;
+  want.features.shaderFloat64 = has.features.shaderFloat64;
+  want.features.vertexPipelineStoresAndAtomics = has.features.vertexPipelineStoresAndAtomics;
+  want.features.fragmentStoresAndAtomics = has.features.fragmentStoresAndAtomics;
+  want.features.largePoints = has.features.largePoints;
+
+  VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &want};
+  create.queueCreateInfoCount = 1;
+  create.pQueueCreateInfos = &queueInfo;
+  VK_CHECK(vkCreateDevice(physical_, &create, nullptr, &device_));
+  loadDeviceFunctions(device_);
+  vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+
+  VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  poolInfo.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  poolInfo.queueFamilyIndex = queueFamily_;
+  VK_CHECK(vkCreateCommandPool(device_, &poolInfo, nullptr, &commandPool_));
+  VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(device_, &fenceInfo, nullptr, &fence_));
+  setName(VK_OBJECT_TYPE_QUEUE, uint64_t(queue_), "main queue");
+  setName(VK_OBJECT_TYPE_COMMAND_POOL, uint64_t(commandPool_), "main command pool");
+}
+
+void Context::setName(VkObjectType type, uint64_t handle, const std::string& name) const {
+  if (!debugUtils_) return;
+  VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
+  info.objectType = type;
+  info.objectHandle = handle;
+  info.pObjectName = name.c_str();
+  VK_CHECK(vkSetDebugUtilsObjectNameEXT(device_, &info));
+}
+
+void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = commandPool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VK_CHECK(vkAllocateCommandBuffers(device_, &alloc, &cmd));
+  struct Free {
+    VkDevice device;
+    VkCommandPool pool;
+    VkCommandBuffer cmd;
+    ~Free() { vkFreeCommandBuffers(device, pool, 1, &cmd); }
+  } freeLater{device_, commandPool_, cmd};
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
+  record(cmd);
+  VK_CHECK(vkEndCommandBuffer(cmd));
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd;
+  VK_CHECK(vkResetFences(device_, 1, &fence_));
+  VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence_));
+  VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+}
+
+} // namespace pointrast::gpu

@@ -1,0 +1,100 @@
+// The headless Vulkan 1.3 context: instance, chosen device, one queue that does compute, graphics and
+// transfer, a command pool, and the optional validation layer. No window, no swapchain.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "gpu/vulkan_api.h"
+
+namespace pointrast::gpu {
+
+struct ContextOptions {
+  // Device index as listed by listDevices(); nullopt = POINTRAST_DEVICE if set, else the best device
+  // (discrete > integrated > virtual > CPU).
+  std::optional<uint32_t> deviceIndex;
+  // Khronos validation layer; nullopt = on when POINTRAST_VALIDATION=1.
+  std::optional<bool> validation;
+  // Print the chosen device (one line on stderr).
+  bool announce = true;
+};
+
+struct DeviceInfo {
+  std::string name;
+  std::string typeName; // "discrete GPU", "integrated GPU", "CPU (software)", ...
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  uint32_t apiVersion = 0;
+  uint32_t vendorId = 0;
+  std::string driver;
+  bool software() const { return type == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+};
+
+class Context {
+public:
+  explicit Context(const ContextOptions& options = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physicalDevice() const { return physical_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queueFamily() const { return queueFamily_; }
+  const DeviceInfo& info() const { return info_; }
+  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
+  uint32_t subgroupSize() const { return subgroupSize_; }
+  // Largest single VkDeviceMemory allocation (VkPhysicalDeviceMaintenance3Properties), and the largest
+  // buffer (maintenance4); scenes are split into parts below both.
+  uint64_t maxAllocationSize() const { return maxAllocation_; }
+  uint64_t maxBufferSize() const { return maxBuffer_; }
+  // Sum of DEVICE_LOCAL heaps: what a scene may at most occupy.
+  uint64_t deviceLocalBytes() const { return deviceLocalBytes_; }
+  // Nanoseconds per timestamp tick.
+  double timestampPeriodNs() const { return properties_.limits.timestampPeriod; }
+  bool validationEnabled() const { return validation_; }
+  // Errors reported by the validation layer so far (tests assert this is zero).
+  uint32_t validationErrors() const { return validationErrors_.load(); }
+
+  // Records commands with `record`, submits them and waits for completion.
+  void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
+
+  // Gives a Vulkan object a name that shows in validation messages and debuggers.
+  void setName(VkObjectType type, uint64_t handle, const std::string& name) const;
+
+private:
+  static VkBool32 VKAPI_PTR debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                          VkDebugUtilsMessageTypeFlagsEXT type,
+                                          const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+  void chooseDevice(const ContextOptions& options);
+  void createDevice();
+  void destroy();
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queueFamily_ = 0;
+  VkCommandPool commandPool_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties properties_{};
+  VkPhysicalDeviceMemoryProperties memory_{};
+  DeviceInfo info_;
+  uint32_t subgroupSize_ = 0;
+  uint64_t maxAllocation_ = 0;
+  uint64_t maxBuffer_ = 0;
+  uint64_t deviceLocalBytes_ = 0;
+  bool validation_ = false;
+  bool debugUtils_ = false;
+  std::atomic<uint32_t> validationErrors_{0};
+};
+
+// All Vulkan devices of this machine, in enumeration order (the indices --device takes).
+std::vector<DeviceInfo> listDevices();
+
+} // namespace pointrast::gpu

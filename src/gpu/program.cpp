@@ -1,0 +1,97 @@
+#include "gpu/program.h"
+
+#include <algorithm>
+
+#include "gpu/context.h"
+#include "gpu/shader_registry.h"
+
+namespace pointrast::gpu {
+
+ComputeProgram::ComputeProgram(Context& context, const std::string& shaderName, std::initializer_list<SpecConstant> spec)
+    : device_(context.device()), name_(shaderName) {
+  std::span<const uint32_t> words = findShader(shaderName);
+  reflection_ = reflectSpirv(words);
+  for (const SpecConstant& s : spec) {
+    assert(std::find(reflection_.specIds.begin(), reflection_.specIds.end(), s.id) != reflection_.specIds.end() &&
+           "specialization constant id not declared by the shader");
+    (void)s;
+  }
+  VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  moduleInfo.codeSize = words.size_bytes();
+  moduleInfo.pCode = words.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateShaderModule(device_, &moduleInfo, nullptr, &module));
+  try {
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantSize};
+    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.pushConstantRangeCount = range.size ? 1 : 0;
+    layoutInfo.pPushConstantRanges = &range;
+    VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
+
+    std::vector<VkSpecializationMapEntry> entries;
+    std::vector<uint32_t> values;
+    for (const SpecConstant& s : spec) {
+      entries.push_back({s.id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+      values.push_back(s.value);
+    }
+    VkSpecializationInfo specInfo{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
+                                  values.data()};
+    VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+    info.layout = layout_;
+    VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
+    context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_), shaderName);
+  } catch (...) {
+    vkDestroyShaderModule(device_, module, nullptr);
+    release();
+    throw;
+  }
+  vkDestroyShaderModule(device_, module, nullptr);
+}
+
+ComputeProgram::~ComputeProgram() { release(); }
+
+void ComputeProgram::release() {
+  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
+  if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
+  pipeline_ = VK_NULL_HANDLE;
+  layout_ = VK_NULL_HANDLE;
+}
+
+ComputeProgram::ComputeProgram(ComputeProgram&& other) noexcept { *this = std::move(other); }
+
+ComputeProgram& ComputeProgram::operator=(ComputeProgram&& other) noexcept {
+  if (this != &other) {
+    release();
+    device_ = other.device_;
+    layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
+    pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
+    reflection_ = other.reflection_;
+    name_ = other.name_;
+  }
+  return *this;
+}
+
+void ComputeProgram::dispatchRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const void* push,
+                                 uint32_t size) const {
+  if (groupsX == 0 || groupsY == 0) return;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  if (size) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, size, push);
+  vkCmdDispatch(cmd, groupsX, groupsY, 1);
+}
+
+Grid gridFor(uint64_t items, uint32_t groupSize) {
+  constexpr uint64_t kMaxX = 65535;
+  uint64_t groups = (items + groupSize - 1) / groupSize;
+  if (groups == 0) return {};
+  if (groups <= kMaxX) return {uint32_t(groups), 1};
+  uint64_t y = (groups + kMaxX - 1) / kMaxX;
+  uint64_t x = (groups + y - 1) / y;
+  return {uint32_t(x), uint32_t(y)};
+}
+
+} // namespace pointrast::gpu

@@ -1,0 +1,267 @@
+// LAS 1.0-1.4 reader, point formats 0-10 (ASPRS LAS 1.4 R15). Point records are read in chunks of
+// ~32 MiB with positional reads (the next chunk is read while the current one is parsed), and each
+// chunk is parsed in parallel blocks straight into the PointCloud arrays, which are sized once from the
+// validated header count: memory is the cloud itself plus two chunk buffers.
+#include <climits>
+#include <future>
+#include <optional>
+
+#include "base/parallel.h"
+#include "base/progress.h"
+#include "io/formats.h"
+#include "io/las_format.h"
+
+namespace pointrast::io {
+
+using namespace detail;
+
+namespace {
+
+constexpr uint64_t kChunkBytes = uint64_t(32) << 20;
+constexpr uint64_t kBlockPoints = uint64_t(1) << 16; // parallel work unit within a chunk
+
+struct BlockStats {
+  int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
+  int32_t qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  uint16_t colorMax = 0;
+};
+
+struct Destination {
+  int32_t* positions = nullptr;
+  uint32_t* colors = nullptr; // null: format has no color
+  uint16_t* intensity = nullptr; // these three are null unless attributes are kept
+  uint8_t* classification = nullptr;
+  uint8_t* returnNumber = nullptr;
+};
+
+// Calls fn(records, firstIndex, count) for consecutive chunks of point records. A helper thread reads
+// chunk k + 1 while fn works on chunk k.
+template <class Fn> void forEachChunk(const InputFile& file, const LasHeader& hd, Fn&& fn) {
+  const uint64_t n = hd.pointCount;
+  const uint64_t stride = hd.recordLength;
+  if (n == 0) return;
+  const uint64_t perChunk = std::min<uint64_t>(n, std::max<uint64_t>(1, kChunkBytes / stride));
+  std::vector<uint8_t> buffers[2];
+  buffers[0].resize(perChunk * stride);
+  if (n > perChunk) buffers[1].resize(perChunk * stride);
+  auto readChunk = [&](int b, uint64_t first) {
+    uint64_t count = std::min(perChunk, n - first);
+    file.readAt(hd.pointOffset + first * stride, buffers[b].data(), count * stride);
+  };
+  readChunk(0, 0);
+  int b = 0;
+  for (uint64_t first = 0; first < n; first += perChunk, b ^= 1) {
+    uint64_t count = std::min(perChunk, n - first);
+    std::future<void> next;
+    if (first + count < n) next = std::async(std::launch::async, readChunk, b ^ 1, first + count);
+    fn(buffers[b].data(), first, count);
+    if (next.valid()) next.get();
+  }
+}
+
+// 8-bit value from a 16-bit LAS color channel: shift is 8 for files with 16-bit colors, else 0.
+inline uint32_t packLasColor(const uint8_t* rgb, int shift) {
+  uint32_t r = (loadLE<uint16_t>(rgb) >> shift) & 0xFF;
+  uint32_t g = (loadLE<uint16_t>(rgb + 2) >> shift) & 0xFF;
+  uint32_t b = (loadLE<uint16_t>(rgb + 4) >> shift) & 0xFF;
+  return packRgba(r, g, b);
+}
+
+// Record layout, R15 section 2.6: X, Y, Z int32 at 0, 4, 8; intensity uint16 at 12; byte 14 holds the
+// return number in bits 0-2 (formats 0-5) or bits 0-3 (formats 6-10); the classification is bits 0-4
+// of byte 15 (formats 0-5) or all of byte 16 (formats 6-10).
+template <bool kExtended>
+void parseBlock(const uint8_t* src, uint64_t stride, uint64_t count, int rgbOffset, int colorShift,
+                const Destination& dst, BlockStats& stats) {
+  BlockStats s;
+  for (uint64_t i = 0; i < count; ++i, src += stride) {
+    int32_t q[3] = {loadLE<int32_t>(src), loadLE<int32_t>(src + 4), loadLE<int32_t>(src + 8)};
+    for (int a = 0; a < 3; ++a) {
+      dst.positions[3 * i + a] = q[a];
+      s.qmin[a] = std::min(s.qmin[a], q[a]);
+      s.qmax[a] = std::max(s.qmax[a], q[a]);
+    }
+    if (dst.colors) {
+      const uint8_t* rgb = src + rgbOffset;
+      uint16_t r = loadLE<uint16_t>(rgb), g = loadLE<uint16_t>(rgb + 2), b = loadLE<uint16_t>(rgb + 4);
+      s.colorMax = std::max({s.colorMax, r, g, b});
+      dst.colors[i] = packRgba((r >> colorShift) & 0xFF, (g >> colorShift) & 0xFF, (b >> colorShift) & 0xFF);
+    }
+    if (dst.intensity) {
+      dst.intensity[i] = loadLE<uint16_t>(src + 12);
+      if constexpr (kExtended) {
+        dst.returnNumber[i] = src[14] & 0x0F;
+        dst.classification[i] = src[16];
+      } else {
+        dst.returnNumber[i] = src[14] & 0x07;
+        dst.classification[i] = src[15] & 0x1F;
+      }
+    }
+  }
+  stats = s;
+}
+
+Destination offsetBy(const Destination& d, uint64_t i) {
+  Destination o;
+  o.positions = d.positions + 3 * i;
+  if (d.colors) o.colors = d.colors + i;
+  if (d.intensity) {
+    o.intensity = d.intensity + i;
+    o.classification = d.classification + i;
+    o.returnNumber = d.returnNumber + i;
+  }
+  return o;
+}
+
+std::string creationDate(const LasHeader& hd) {
+  if (hd.creationYear == 0 && hd.creationDay == 0) return "not set";
+  return strFormat("%u, day %u", hd.creationYear, hd.creationDay);
+}
+
+} // namespace
+
+PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options) {
+  InputFile file(path);
+  const LasHeader hd = readLasHeader(file);
+  const uint64_t n = hd.pointCount;
+  const bool extended = las::isExtended(hd.pointFormat);
+  const int rgbOffset = hd.rgbOffset();
+
+  PointCloud cloud;
+  cloud.source = path.filename().string();
+  cloud.scale = hd.scale;
+  cloud.offset = hd.offset;
+  // n was checked against the bytes present (n * recordLength <= file size), so these allocations are
+  // bounded by the file: at most 20 B per 20 B record.
+  cloud.positions.resize(3 * n);
+  if (hd.hasColor()) cloud.colors.resize(n);
+  if (options.keepAttributes) {
+    cloud.intensity.resize(n);
+    cloud.classification.resize(n);
+    cloud.returnNumber.resize(n);
+  }
+  Destination all;
+  all.positions = cloud.positions.data();
+  all.colors = hd.hasColor() ? cloud.colors.data() : nullptr;
+  if (options.keepAttributes) {
+    all.intensity = cloud.intensity.data();
+    all.classification = cloud.classification.data();
+    all.returnNumber = cloud.returnNumber.data();
+  }
+
+  std::optional<Progress> progress;
+  if (options.progress) progress.emplace("reading " + path.filename().string(), n);
+
+  BlockStats total;
+  bool colors16 = false; // decided per file: any channel above 255 means 16-bit colors
+  std::vector<BlockStats> stats;
+  forEachChunk(file, hd, [&](const uint8_t* records, uint64_t first, uint64_t count) {
+    stats.assign((count + kBlockPoints - 1) / kBlockPoints, BlockStats{});
+    int shift = colors16 ? 8 : 0;
+    parallelBlocks(count, kBlockPoints, [&](uint64_t block, uint64_t begin, uint64_t end) {
+      const uint8_t* src = records + begin * hd.recordLength;
+      Destination d = offsetBy(all, first + begin);
+      if (extended)
+        parseBlock<true>(src, hd.recordLength, end - begin, rgbOffset, shift, d, stats[block]);
+      else
+        parseBlock<false>(src, hd.recordLength, end - begin, rgbOffset, shift, d, stats[block]);
+      if (progress) progress->advance(end - begin);
+    });
+    uint16_t chunkColorMax = 0;
+    for (const BlockStats& s : stats) {
+      for (int a = 0; a < 3; ++a) {
+        total.qmin[a] = std::min(total.qmin[a], s.qmin[a]);
+        total.qmax[a] = std::max(total.qmax[a], s.qmax[a]);
+      }
+      chunkColorMax = std::max(chunkColorMax, s.colorMax);
+    }
+    if (all.colors && !colors16 && chunkColorMax > 255) {
+      // The first value above 255: the file is 16-bit. Earlier chunks held only values <= 255, which
+      // are 0 in 8-bit terms; this chunk is converted again with the 16-bit shift.
+      colors16 = true;
+      std::fill(cloud.colors.begin(), cloud.colors.begin() + static_cast<ptrdiff_t>(first), packRgba(0, 0, 0));
+      parallelBlocks(count, kBlockPoints, [&](uint64_t, uint64_t begin, uint64_t end) {
+        for (uint64_t i = begin; i < end; ++i)
+          all.colors[first + i] = packLasColor(records + i * hd.recordLength + rgbOffset, 8);
+      });
+    }
+  });
+  if (progress) progress->finish();
+
+  if (n > 0) {
+    cloud.bounds = boundsFromQuantized(total.qmin, total.qmax, cloud.scale, cloud.offset);
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(cloud.bounds.min[a]) || !std::isfinite(cloud.bounds.max[a]))
+        fail(path, "coordinates overflow after applying the header's scale and offset");
+  }
+  return cloud;
+}
+
+namespace detail {
+
+FileInfo probeLas(const std::filesystem::path& path) {
+  InputFile file(path);
+  const LasHeader hd = readLasHeader(file);
+  FileInfo info;
+  info.format = Format::Las;
+  uint16_t formatSize = las::kRecordSize[static_cast<size_t>(hd.pointFormat)];
+  info.formatDetail = strFormat("LAS %d.%d, point format %d (%u B records", hd.versionMajor, hd.versionMinor,
+                                hd.pointFormat, hd.recordLength);
+  if (hd.recordLength > formatSize)
+    info.formatDetail += strFormat(": %u + %u extra bytes", formatSize, hd.recordLength - formatSize);
+  info.formatDetail += ")";
+  info.pointCount = hd.pointCount;
+  info.bounds = hd.bounds;
+  info.boundsFromHeader = true;
+  info.scale = hd.scale;
+  info.offset = hd.offset;
+  info.hasColor = hd.hasColor();
+
+  auto& extra = info.extra;
+  if (info.hasColor) {
+    // The bit depth is a property of the values, not the header: scan the color channels.
+    const int rgbOffset = hd.rgbOffset();
+    uint16_t lo = UINT16_MAX, hi = 0;
+    forEachChunk(file, hd, [&](const uint8_t* records, uint64_t, uint64_t count) {
+      for (uint64_t i = 0; i < count; ++i) {
+        const uint8_t* rgb = records + i * hd.recordLength + rgbOffset;
+        for (int c = 0; c < 3; ++c) {
+          uint16_t v = loadLE<uint16_t>(rgb + 2 * c);
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+      }
+    });
+    info.colorBits = hi > 255 ? 16 : 8;
+    if (hd.pointCount > 0) extra.emplace_back("color values", strFormat("%u .. %u", lo, hi));
+  }
+  extra.emplace_back("system identifier", hd.systemId);
+  extra.emplace_back("generating software", hd.software);
+  extra.emplace_back("creation date", creationDate(hd));
+  extra.emplace_back("file source id", std::to_string(hd.fileSourceId));
+  extra.emplace_back("global encoding", strFormat("%u", hd.globalEncoding));
+  extra.emplace_back("header size", strFormat("%u B", hd.headerSize));
+  extra.emplace_back("offset to point data", strFormat("%u", hd.pointOffset));
+  std::string byReturn;
+  int returns = las::isExtended(hd.pointFormat) || hd.versionMinor >= 4 ? 15 : 5;
+  int last = 0;
+  for (int i = 0; i < returns; ++i)
+    if (hd.pointsByReturn[i]) last = i + 1;
+  for (int i = 0; i < std::max(last, 5); ++i)
+    byReturn += (i ? " " : "") + std::to_string(hd.pointsByReturn[i]);
+  extra.emplace_back("points by return (header)", byReturn);
+  std::string vlrs = std::to_string(hd.vlrCount);
+  for (size_t i = 0; i < hd.vlrs.size(); ++i)
+    vlrs += strFormat("%s%s %u (%u B)", i ? ", " : ": ", hd.vlrs[i].userId.c_str(), hd.vlrs[i].recordId,
+                      hd.vlrs[i].length);
+  if (hd.vlrsTruncated) vlrs += strFormat("; the list runs past the point data, %zu listed", hd.vlrs.size());
+  extra.emplace_back("VLRs", vlrs);
+  if (hd.versionMinor >= 4)
+    extra.emplace_back("EVLRs", strFormat("%u at offset %llu", hd.evlrCount,
+                                          static_cast<unsigned long long>(hd.evlrStart)));
+  return info;
+}
+
+} // namespace detail
+
+} // namespace pointrast::io

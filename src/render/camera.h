@@ -1,0 +1,41 @@
+// The camera contract of DESIGN.md: right-handed, OpenGL-style view; eye/target/up in the input's own
+// coordinates; vertical field of view in degrees; clip w = linear view depth; points with w <= near are
+// dropped. Matrices handed to the GPU are built in double relative to a scene origin and rounded once.
+#pragma once
+
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "cloud/cloud.h"
+
+namespace pointrast {
+
+struct Camera {
+  glm::dvec3 eye{0, 0, 1};
+  glm::dvec3 target{0, 0, 0};
+  glm::dvec3 up{0, 0, 1};
+  double fovY = 60.0; // degrees
+  double nearW = 0.0; // 0: automatic, defaultNear(bounds)
+};
+
+// The overview used when no --eye is given: looking at the center of the bounds from the south-west
+// (direction (-1, -1, 1) from the center, i.e. 35.3 degrees above the horizon), z up, at the smallest
+// distance at which all eight corners of the bounding box are inside the image, plus 5 %.
+Camera overviewCamera(const Bounds& bounds, double aspect, double fovY = 60.0);
+
+// 1e-5 of the bounds' diagonal (at least 1e-9): far below any visible point, so it only drops points
+// at or behind the eye.
+double defaultNear(const Bounds& bounds);
+
+// Checks eye != target, up not parallel to the view direction, 0 < fov < 180, finite values. Throws
+// InputError with the reason.
+void validateCamera(const Camera& camera);
+
+// Clip-from-world matrix with world coordinates taken relative to `origin`:
+// clip = P * V * (p - origin). Only rows x, y and w matter (no far plane: depth is linear).
+glm::dmat4 viewProjection(const Camera& camera, const glm::dvec3& origin, double aspect);
+
+std::string describeCamera(const Camera& camera);
+
+} // namespace pointrast
