@@ -39,31 +39,52 @@ PR_CONST kPixelGroupSize = 256;
 // An empty pixel holds all ones, which no point's word can reach (NaN depth bits are never written).
 PR_CONST64 kEmptyPixel = 0xFFFFFFFFFFFFFFFFul;
 
-// Push constants of the point rasterizer: one dispatch draws one part of a scene (a range of points
+// Push constants of the point rasterizers: one dispatch draws one part of a scene (a range of points
 // living in one buffer pair), addressed by buffer device address so parts may be anywhere in memory and
-// scenes may exceed the 4 GiB range of a storage-buffer descriptor.
+// scenes may exceed the 4 GiB range of a storage-buffer descriptor. 128 bytes: the minimum every Vulkan
+// device must allow.
 struct RasterPush {
-  mat4 viewProj;        // world-relative-to-origin -> clip; only rows x, y, w are used
-  uint64_t positions;   // address of float[3 * pointCount]
-  uint64_t colors;      // address of uint[pointCount] (RGBA8)
-  uint64_t framebuffer; // address of uint64_t[width * height]
+  mat4 viewProj;         // world-relative-to-origin -> clip; only rows x, y, w are used
+  uint64_t positions;    // address of float[3 * pointCount]
+  uint64_t colors;       // address of uint[pointCount] (RGBA8)
+  uint64_t framebuffer;  // address of the method's framebuffer (uint64_t per pixel for most methods)
+  uint64_t aux;          // method-specific buffer (HQS accumulators), 0 if none
+  uint64_t viewProjD;    // address of a dmat4: the same matrix in double precision (int40 depth)
   uint pointCount;
   uint width;
   uint height;
-  float nearW;          // points with c.w <= nearW are dropped
-  uint groupsX;         // workgroups per row of a 2D dispatch (a 1D grid may not exceed 65535 groups)
-  uint pad0;
+  float nearW;           // points with c.w <= nearW are dropped
+  uint groupsX;          // workgroups per row of a 2D dispatch (a 1D grid may not exceed 65535 groups)
+  float depthScale;      // int40 depth: integer steps per unit of linear depth (1000: millimetres)
 };
 
-// Push constants of the resolve pass (framebuffer words -> RGBA8 image).
+// Push constants of the resolve passes (framebuffer -> RGBA8 image, and optionally canonical words).
 struct ResolvePush {
-  uint64_t framebuffer; // uint64_t[width * height]
+  uint64_t framebuffer; // the method's framebuffer
   uint64_t image;       // uint[width * height], RGBA8, row 0 = top
+  uint64_t aux;         // method-specific (HQS accumulators)
+  uint64_t words;       // if not 0: uint64_t[width * height] receives depth << 32 | color per pixel
   uint width;
   uint height;
   uint background;      // RGBA8 written where no point landed
   uint groupsX;         // workgroups per row of the 2D dispatch
 };
+
+// Word layout of the int40 depth encoding (the 2019 poster): 40-bit integer depth << 24 | 24-bit RGB.
+PR_CONST kInt40ColorBits = 24;
+PR_CONST64 kInt40MaxDepth = 0xFFFFFFFFFFul; // 2^40 - 1 steps: 1,099 km at 1 mm per step
+
+// Busy-loop method: the framebuffer is two uint arrays (depth bits, then color); the top bit of a depth
+// word is the pixel's lock (linear depth is a positive float, so its sign bit is free).
+PR_CONST kPixelLockBit = 0x80000000u;
+PR_CONST kEmptyDepthBits = 0x7FFFFFFFu; // above every finite positive float
+
+// High-quality splatting (2019): a point is blended into its pixel if its linear depth is within 1 % of
+// the closest point's.
+#define PR_HQS_DEPTH_FACTOR 1.01
+// hqs1r: one 64-bit word per pixel packs r, g, b, count in 16 bits each. 255 points of 255 sum to 65025,
+// below 2^16, so a pixel stays exact up to 255 points; later points go to 32-bit fallback sums.
+PR_CONST kHqs1rMaxCount = 255;
 
 PR_NAMESPACE_END
 

@@ -34,6 +34,20 @@ QuantBox quantBoxParallel(const int32_t* positions, uint64_t count);
 // World bounds of the points a box was taken from, computed exactly as PointCloud::world() would.
 Bounds worldBounds(const QuantBox& box, const glm::dvec3& scale, const glm::dvec3& offset);
 
+// splitmix64 (Steele, Lea, Flood, "Fast splittable pseudorandom number generators", OOPSLA 2014): the
+// state advances by the golden-ratio increment and each output is the state through a bijective mixer,
+// so output number i (from 0) for a seed is splitmixMix(seed + (i + 1) * kSplitmixGamma). Fully
+// specified here, so random orders and scenes are the same with every compiler and standard library.
+constexpr uint64_t kSplitmixGamma = 0x9E3779B97F4A7C15ull;
+constexpr uint64_t splitmixMix(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+constexpr uint64_t splitmixAt(uint64_t seed, uint64_t i) {
+  return splitmixMix(seed + (i + 1) * kSplitmixGamma);
+}
+
 // A perceptual rainbow ("Turbo", Mikhailov 2019, polynomial fit) for t in [0, 1], as packRgba.
 uint32_t rampColor(double t);
 

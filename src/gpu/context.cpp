@@ -222,6 +222,13 @@ void Context::createDevice() {
   vkGetPhysicalDeviceProperties2(physical_, &props);
   properties_ = props.properties;
   subgroupSize_ = subgroup.subgroupSize;
+  constexpr VkSubgroupFeatureFlags kComputeOps = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_VOTE_BIT |
+                                                VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT |
+                                                VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT |
+                                                VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  features_.subgroupCompute = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                              (subgroup.supportedOperations & kComputeOps) == kComputeOps;
+  bool partitioned = subgroup.supportedOperations & VK_SUBGROUP_FEATURE_PARTITIONED_BIT_NV;
   maxAllocation_ = m3.maxMemoryAllocationSize;
   maxBuffer_ = m4.maxBufferSize;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
@@ -281,7 +288,25 @@ void Context::createDevice() {
   want.features.fragmentStoresAndAtomics = has.features.fragmentStoresAndAtomics;
   want.features.largePoints = has.features.largePoints;
 
+  uint32_t extensionCount = 0;
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, nullptr));
+  std::vector<VkExtensionProperties> extensions(extensionCount);
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, extensions.data()));
+  auto hasExtension = [&](const char* name) {
+    return std::any_of(extensions.begin(), extensions.end(),
+                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+  };
+  std::vector<const char*> enabled;
+  features_.float64 = has.features.shaderFloat64;
+  features_.subgroupExtendedTypes = has12.shaderSubgroupExtendedTypes;
+  if (partitioned && hasExtension(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME)) {
+    enabled.push_back(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME);
+    features_.subgroupPartitionedNV = true;
+  }
+
   VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &want};
+  create.enabledExtensionCount = uint32_t(enabled.size());
+  create.ppEnabledExtensionNames = enabled.data();
   create.queueCreateInfoCount = 1;
   create.pQueueCreateInfos = &queueInfo;
   VK_CHECK(vkCreateDevice(physical_, &create, nullptr, &device_));

@@ -32,6 +32,14 @@ struct DeviceInfo {
   bool software() const { return type == VK_PHYSICAL_DEVICE_TYPE_CPU; }
 };
 
+// Optional capabilities, queried once; methods check these and refuse with a clear sentence.
+struct DeviceFeatures {
+  bool float64 = false;               // shaderFloat64 (int40 depth projects in double)
+  bool subgroupCompute = false;       // vote, ballot, shuffle and arithmetic in compute shaders
+  bool subgroupExtendedTypes = false; // 64-bit integers in subgroup operations
+  bool subgroupPartitionedNV = false; // VK_NV_shader_subgroup_partitioned
+};
+
 class Context {
 public:
   explicit Context(const ContextOptions& options = {});
@@ -48,6 +56,7 @@ public:
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
   uint32_t subgroupSize() const { return subgroupSize_; }
+  const DeviceFeatures& features() const { return features_; }
   // Largest single VkDeviceMemory allocation (VkPhysicalDeviceMaintenance3Properties), and the largest
   // buffer (maintenance4); scenes are split into parts below both.
   uint64_t maxAllocationSize() const { return maxAllocation_; }
@@ -86,6 +95,7 @@ private:
   VkPhysicalDeviceMemoryProperties memory_{};
   DeviceInfo info_;
   uint32_t subgroupSize_ = 0;
+  DeviceFeatures features_;
   uint64_t maxAllocation_ = 0;
   uint64_t maxBuffer_ = 0;
   uint64_t deviceLocalBytes_ = 0;

@@ -97,6 +97,11 @@ bool lasLooksCompressed(const InputFile& file);
 // InputError with one sentence; for compressed files, the "LAZ is not supported" sentence.
 LasHeader readLasHeader(const InputFile& file);
 
+// Bytes of point records the LAS reader reads and parses at a time (default 32 MiB). Tests lower it to
+// cross chunk boundaries with small files; 0 restores the default.
+void setLasChunkBytes(uint64_t bytes);
+uint64_t lasChunkBytes();
+
 // The sentence readers and probe give for LAZ/COPC files.
 [[noreturn]] void failCompressed(const std::filesystem::path& path);
 

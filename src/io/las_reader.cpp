@@ -2,6 +2,7 @@
 // ~32 MiB with positional reads (the next chunk is read while the current one is parsed), and each
 // chunk is parsed in parallel blocks straight into the PointCloud arrays, which are sized once from the
 // validated header count: memory is the cloud itself plus two chunk buffers.
+#include <atomic>
 #include <climits>
 #include <future>
 #include <optional>
@@ -17,7 +18,8 @@ using namespace detail;
 
 namespace {
 
-constexpr uint64_t kChunkBytes = uint64_t(32) << 20;
+constexpr uint64_t kDefaultChunkBytes = uint64_t(32) << 20;
+std::atomic<uint64_t> gChunkBytes{kDefaultChunkBytes};
 constexpr uint64_t kBlockPoints = uint64_t(1) << 16; // parallel work unit within a chunk
 
 struct BlockStats {
@@ -40,7 +42,7 @@ template <class Fn> void forEachChunk(const InputFile& file, const LasHeader& hd
   const uint64_t n = hd.pointCount;
   const uint64_t stride = hd.recordLength;
   if (n == 0) return;
-  const uint64_t perChunk = std::min<uint64_t>(n, std::max<uint64_t>(1, kChunkBytes / stride));
+  const uint64_t perChunk = std::min<uint64_t>(n, std::max<uint64_t>(1, lasChunkBytes() / stride));
   std::vector<uint8_t> buffers[2];
   buffers[0].resize(perChunk * stride);
   if (n > perChunk) buffers[1].resize(perChunk * stride);
@@ -113,9 +115,18 @@ Destination offsetBy(const Destination& d, uint64_t i) {
   return o;
 }
 
+// R15 2.4 stores the creation date as year + day of year (1 = January 1st); shown as an ISO date.
 std::string creationDate(const LasHeader& hd) {
-  if (hd.creationYear == 0 && hd.creationDay == 0) return "not set";
-  return strFormat("%u, day %u", hd.creationYear, hd.creationDay);
+  const unsigned year = hd.creationYear, day = hd.creationDay;
+  if (year == 0 && day == 0) return "not set";
+  const bool leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+  const unsigned monthDays[12] = {31, leap ? 29u : 28u, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  unsigned left = day;
+  for (unsigned m = 0; m < 12 && left >= 1; ++m) {
+    if (left <= monthDays[m]) return strFormat("%04u-%02u-%02u (day %u)", year, m + 1, left, day);
+    left -= monthDays[m];
+  }
+  return strFormat("year %u, day %u (not a valid date)", year, day);
 }
 
 } // namespace
@@ -199,6 +210,9 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
 
 namespace detail {
 
+void setLasChunkBytes(uint64_t bytes) { gChunkBytes = bytes ? bytes : kDefaultChunkBytes; }
+uint64_t lasChunkBytes() { return gChunkBytes; }
+
 FileInfo probeLas(const std::filesystem::path& path) {
   InputFile file(path);
   const LasHeader hd = readLasHeader(file);
@@ -248,7 +262,7 @@ FileInfo probeLas(const std::filesystem::path& path) {
   for (int i = 0; i < returns; ++i)
     if (hd.pointsByReturn[i]) last = i + 1;
   for (int i = 0; i < std::max(last, 5); ++i)
-    byReturn += (i ? " " : "") + std::to_string(hd.pointsByReturn[i]);
+    byReturn += strFormat(i ? " %llu" : "%llu", static_cast<unsigned long long>(hd.pointsByReturn[i]));
   extra.emplace_back("points by return (header)", byReturn);
   std::string vlrs = std::to_string(hd.vlrCount);
   for (size_t i = 0; i < hd.vlrs.size(); ++i)

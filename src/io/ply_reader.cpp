@@ -512,16 +512,19 @@ Staged readAsciiVertices(const InputFile& file, const PlyHeader& h, Progress* pr
 
 std::string describeElements(const PlyHeader& h) {
   std::string s;
-  for (const auto& e : h.elements) s += (s.empty() ? "" : ", ") + e.name + " " + std::to_string(e.count);
+  for (const auto& e : h.elements)
+    s += strFormat(s.empty() ? "%s %llu" : ", %s %llu", e.name.c_str(), static_cast<unsigned long long>(e.count));
   return s;
 }
 
 std::string describeVertex(const PlyHeader& h) {
   std::string s;
   for (const auto& p : h.vertexElement().properties) {
-    s += s.empty() ? "" : ", ";
-    s += p.isList ? "list " + std::string(typeName(p.countType)) + " " + typeName(p.type) : typeName(p.type);
-    s += " " + p.name;
+    if (!s.empty()) s += ", ";
+    if (p.isList)
+      s += strFormat("list %s %s %s", typeName(p.countType), typeName(p.type), p.name.c_str());
+    else
+      s += strFormat("%s %s", typeName(p.type), p.name.c_str());
   }
   return s;
 }

@@ -22,7 +22,7 @@ using namespace detail;
 namespace {
 
 struct Sink {
-  PartialFile* file;
+  PartialFile* file = nullptr;
   bool failed = false;
   std::string error;
 };
@@ -51,7 +51,8 @@ void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height
     rgb[3 * i + 2] = static_cast<uint8_t>(rgba[i] >> 16);
   }
   PartialFile out(path);
-  Sink sink{&out};
+  Sink sink;
+  sink.file = &out;
   int ok = stbi_write_png_to_func(writeToSink, &sink, static_cast<int>(width), static_cast<int>(height), 3,
                                   rgb.data(), static_cast<int>(width * 3));
   if (sink.failed) throw InputError(sink.error);

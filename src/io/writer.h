@@ -15,7 +15,7 @@ enum class LasFlavor {
   Las14Pf7, // LAS 1.4, point format 7 (64-bit counts): 36 B records
 };
 
-// Writes the cloud with its own scale/offset. Colors are written 16-bit (8-bit value << 8). LAS 1.2
+// Writes the cloud with its own scale/offset. Colors are written 16-bit (v * 257 = v << 8 | v). LAS 1.2
 // can hold at most 2^32 - 1 points; more needs Las14Pf7 (InputError otherwise).
 void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFlavor flavor);
 

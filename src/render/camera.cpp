@@ -24,16 +24,18 @@ Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
   double tanY = std::tan(glm::radians(fovY) / 2), tanX = tanY * aspect;
   // A corner at offset v is inside when |v.right| <= tanX * (D - v.back) and the same for up; solve for
   // the eye distance D along `back`.
-  double distance = 0;
+  double distance = 0, deepest = 0;
   for (int i = 0; i < 8; ++i) {
     glm::dvec3 corner{i & 1 ? bounds.max.x : bounds.min.x, i & 2 ? bounds.max.y : bounds.min.y,
                       i & 4 ? bounds.max.z : bounds.min.z};
     glm::dvec3 v = corner - center;
     double along = glm::dot(v, back);
+    deepest = std::max(deepest, along);
     distance = std::max({distance, std::abs(glm::dot(v, right)) / tanX + along,
                          std::abs(glm::dot(v, upv)) / tanY + along});
   }
-  distance = std::max(distance * 1.05, 1e-6 + bounds.diagonal());
+  // Keep every corner in front of the eye even for degenerate (flat or single-point) bounds.
+  distance = std::max(distance * 1.05, deepest + 1e-3 * bounds.diagonal() + 1e-6);
   camera.target = center;
   camera.eye = center + back * distance;
   return camera;

@@ -1,107 +1,163 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <cstring>
 
 #include "base/error.h"
 #include "gpu/context.h"
-#include "gpu/shared_types.h"
 #include "gpu/timer.h"
+#include "render/method.h"
 
 namespace pointrast {
 
 namespace {
 
+// bytesPerPoint: 12 B position + 4 B color read by every closest-point method; HQS reads positions and
+// colors in both passes (the depth pass shares the closest-point shader): 32 B.
 constexpr MethodInfo kMethods[] = {
-    {Method::AtomicMin, "atomicmin", "one 64-bit atomicMin of depth<<32|color per point (2019)"},
+    {Method::AtomicMin, "atomicmin", "one 64-bit atomicMin of depth<<32|color per point (2019)", true, true, 16},
+    {Method::EarlyZ, "earlyz", "read the pixel first, atomicMin only if closer (2021)", true, true, 16},
+    {Method::Reduce, "reduce", "subgroup minimum when a subgroup hits one pixel, else pairs (2021)", true, true, 16},
+    {Method::ReduceEarlyZ, "reduce-earlyz", "reduce and early-z (2021)", true, true, 16},
+    {Method::Dedup, "dedup", "one atomic per distinct pixel of a subgroup, VK_NV_shader_subgroup_partitioned, "
+                             "with early-z (2021)", true, true, 16},
+    {Method::DedupBallot, "dedup-ballot", "dedup from portable subgroup ballots, with early-z", true, true, 16},
+    {Method::BusyLoop, "busyloop", "per-pixel lock in the depth word, then color (2013), with early-z", true, false, 16},
+    {Method::JustSet, "justset", "plain stores, no depth test: a speed reference, not a correct image", false, true, 16},
+    {Method::Hqs, "hqs", "high-quality splatting: blend points within 1% of the closest depth (2019)", false, false, 32},
+    {Method::Hqs1r, "hqs1r", "HQS with one packed 64-bit atomicAdd and overflow fallback (2022)", false, false, 32},
 };
 
 // 16384 x 16384 pixels: 2 GiB of framebuffer words, the most a single allocation is guaranteed to hold
 // on common devices.
 constexpr uint32_t kMaxSide = 16384;
 
+template <class T> std::string choices(std::span<const T> items) {
+  std::string known;
+  for (const T& m : items) known += (known.empty() ? "" : ", ") + std::string(m.name);
+  return known;
+}
+
 } // namespace
 
 std::span<const MethodInfo> methodTable() { return kMethods; }
 
-Method parseMethod(std::string_view name) {
-  std::string known;
-  for (const MethodInfo& m : kMethods) {
-    if (name == m.name) return m.method;
-    known += known.empty() ? "" : ", ";
-    known += m.name;
-  }
-  throw InputError("unknown method '" + std::string(name) + "'; choose one of: " + known);
+const MethodInfo& methodInfo(Method method) {
+  for (const MethodInfo& m : kMethods)
+    if (m.method == method) return m;
+  return kMethods[0];
 }
 
-const char* methodName(Method method) {
+Method parseMethod(std::string_view name) {
   for (const MethodInfo& m : kMethods)
-    if (m.method == method) return m.name;
-  return "?";
+    if (name == m.name) return m.method;
+  throw InputError("unknown method '" + std::string(name) + "'; choose one of: " + choices(methodTable()));
+}
+
+const char* methodName(Method method) { return methodInfo(method).name; }
+
+DepthMode parseDepthMode(std::string_view name) {
+  if (name == "float") return DepthMode::Float;
+  if (name == "int40") return DepthMode::Int40;
+  throw InputError("unknown depth encoding '" + std::string(name) + "'; choose float or int40");
+}
+
+const char* depthModeName(DepthMode mode) { return mode == DepthMode::Int40 ? "int40" : "float"; }
+
+shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer, uint32_t groupSize) {
+  shared::ResolvePush push{};
+  push.framebuffer = framebuffer;
+  push.image = targets.image.address();
+  push.words = frame.settings.captureWords ? targets.words.address() : 0;
+  push.width = targets.width;
+  push.height = targets.height;
+  push.background = frame.settings.background;
+  push.groupsX = gpu::gridFor(targets.pixels(), groupSize).x;
+  return push;
+}
+
+bool Renderer::supports(gpu::Context& context, Method method, std::string* why) {
+  const gpu::DeviceFeatures& f = context.features();
+  std::string reason;
+  bool subgroups = f.subgroupCompute && f.subgroupExtendedTypes;
+  switch (method) {
+  case Method::Reduce:
+  case Method::ReduceEarlyZ:
+  case Method::DedupBallot:
+    if (!subgroups) reason = "needs subgroup vote/ballot/shuffle/arithmetic on 64-bit integers in compute shaders";
+    break;
+  case Method::Dedup:
+    if (!subgroups || !f.subgroupPartitionedNV)
+      reason = "needs VK_NV_shader_subgroup_partitioned (NVIDIA); use dedup-ballot, the portable variant";
+    break;
+  default:
+    break;
+  }
+  if (!reason.empty() && why) *why = std::string(methodName(method)) + " is not available on '" + context.info().name + "': " + reason;
+  return reason.empty();
 }
 
 Renderer::Renderer(gpu::Context& context, uint32_t width, uint32_t height)
-    : context_(context), width_(width), height_(height) {
+    : context_(context), targets_(std::make_unique<Targets>()) {
   if (width == 0 || height == 0 || width > kMaxSide || height > kMaxSide)
     throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
                      " is out of range (1.." + std::to_string(kMaxSide) + " per side)");
-  uint64_t pixels = uint64_t(width) * height;
-  framebuffer_ = gpu::Buffer(context, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
-  image_ = gpu::Buffer(context, pixels * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "image");
-  atomicMin_ = gpu::ComputeProgram(context, "raster_atomicmin.comp");
-  resolve_ = gpu::ComputeProgram(context, "resolve.comp");
+  Targets& t = *targets_;
+  t.width = width;
+  t.height = height;
+  t.framebuffer = gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
+  t.image = gpu::Buffer(context, t.pixels() * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "image");
+  t.words = gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
 }
 
 Renderer::~Renderer() = default;
 
-void Renderer::recordFrame(VkCommandBuffer cmd, std::span<const GpuScene* const> scenes, const Camera& camera,
-                           const RenderSettings& settings) {
-  uint64_t pixels = uint64_t(width_) * height_;
-  // Clear: all ones is kEmptyPixel.
-  gpu::vkCmdFillBuffer(cmd, framebuffer_.handle(), 0, pixels * 8, 0xFFFFFFFFu);
-  gpu::fullBarrier(cmd);
-  double aspect = double(width_) / double(height_);
-  for (const GpuScene* scene : scenes) {
-    shared::RasterPush push{};
-    push.viewProj = glm::mat4(viewProjection(camera, scene->origin(), aspect));
-    push.framebuffer = framebuffer_.address();
-    push.width = width_;
-    push.height = height_;
-    push.nearW = float(camera.nearW > 0 ? camera.nearW : defaultNear(scene->bounds()));
-    for (const ScenePart& part : scene->parts()) {
-      gpu::Grid grid = gpu::gridFor(part.count, atomicMin_.groupSize());
-      push.positions = part.positions.address();
-      push.colors = part.colors.address();
-      push.pointCount = uint32_t(part.count);
-      push.groupsX = grid.x;
-      switch (settings.method) {
-      case Method::AtomicMin: atomicMin_.dispatch(cmd, grid.x, grid.y, push); break;
-      }
-    }
-  }
-  gpu::fullBarrier(cmd);
-  shared::ResolvePush resolve{};
-  resolve.framebuffer = framebuffer_.address();
-  resolve.image = image_.address();
-  resolve.width = width_;
-  resolve.height = height_;
-  resolve.background = settings.background;
-  gpu::Grid grid = gpu::gridFor(pixels, resolve_.groupSize());
-  resolve.groupsX = grid.x;
-  resolve_.dispatch(cmd, grid.x, grid.y, resolve);
-  gpu::fullBarrier(cmd);
+uint32_t Renderer::width() const { return targets_->width; }
+uint32_t Renderer::height() const { return targets_->height; }
+
+PointMethod& Renderer::method(const RenderSettings& settings) {
+  const MethodInfo& info = methodInfo(settings.method);
+  if (settings.depth == DepthMode::Int40 && !info.int40)
+    throw InputError(std::string(info.name) + " has no int40 depth encoding; use --depth float");
+  if (settings.depth == DepthMode::Int40 && !context_.features().float64)
+    throw UnsupportedError("--depth int40 needs double precision in shaders (shaderFloat64), which '" +
+                           context_.info().name + "' lacks");
+  std::string why;
+  if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
+  auto key = std::make_pair(settings.method, settings.depth);
+  auto found = methods_.find(key);
+  if (found != methods_.end()) return *found->second;
+  std::unique_ptr<PointMethod> created;
+  if (settings.method == Method::Hqs || settings.method == Method::Hqs1r)
+    created = createHqsMethod(context_, settings.method, targets_->width, targets_->height);
+  else
+    created = createClosestMethod(context_, settings.method, settings.depth);
+  return *methods_.emplace(key, std::move(created)).first->second;
 }
 
 FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camera& camera,
                             const RenderSettings& settings) {
   validateCamera(camera);
+  PointMethod& m = method(settings);
+  Targets& t = *targets_;
+  // Double-precision copies of each scene's matrix, for the int40 path.
+  uint64_t matrixBytes = std::max<size_t>(1, scenes.size()) * sizeof(glm::dmat4);
+  if (!t.matrices || t.matrices.size() < matrixBytes)
+    t.matrices = gpu::Buffer(context_, matrixBytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "double matrices");
+  double aspect = double(t.width) / double(t.height);
+  for (size_t s = 0; s < scenes.size(); ++s) {
+    glm::dmat4 vp = viewProjection(camera, scenes[s]->origin(), aspect);
+    std::memcpy(static_cast<char*>(t.matrices.mapped()) + s * sizeof(glm::dmat4), &vp, sizeof vp);
+  }
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
-    for (uint32_t w = 0; w < settings.warmup; ++w) recordFrame(cmd, scenes, camera, settings);
+    Frame frame{cmd, scenes, camera, settings};
+    for (uint32_t w = 0; w < settings.warmup; ++w) m.recordFrame(frame, t);
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);
-      recordFrame(cmd, scenes, camera, settings);
+      m.recordFrame(frame, t);
       timestamps.end(cmd, f);
     }
   });
@@ -116,14 +172,14 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
 }
 
 std::vector<uint32_t> Renderer::image() {
-  std::vector<uint32_t> pixels(uint64_t(width_) * height_);
-  gpu::readBuffer(context_, image_, 0, pixels.data(), pixels.size() * 4);
+  std::vector<uint32_t> pixels(targets_->pixels());
+  gpu::readBuffer(context_, targets_->image, 0, pixels.data(), pixels.size() * 4);
   return pixels;
 }
 
 std::vector<uint64_t> Renderer::framebufferWords() {
-  std::vector<uint64_t> words(uint64_t(width_) * height_);
-  gpu::readBuffer(context_, framebuffer_, 0, words.data(), words.size() * 8);
+  std::vector<uint64_t> words(targets_->pixels());
+  gpu::readBuffer(context_, targets_->words, 0, words.data(), words.size() * 8);
   return words;
 }
 

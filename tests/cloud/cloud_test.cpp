@@ -59,17 +59,18 @@ TEST(ToRelativeFloat, IsOneFloatRoundingOfTheDoubleDifference) {
   for (int k = 0; k < 3000; ++k) ASSERT_EQ(part[k], rel[3 * 12345 + k]);
 }
 
-TEST(ToRelativeFloat, NaiveFloatWouldLoseMillimetres) {
-  // Guards the reason for the double path: the same point through float world coordinates is off by
-  // more than 10 cm at a northing of 4000 km, while ours is exact to float rounding.
+TEST(ToRelativeFloat, KeepsMillimetresWhereFloatWorldCoordinatesCannot) {
+  // Two points 1 mm apart at a northing of 4000 km: in float world coordinates they coincide (the ulp
+  // there is 0.5 m); relative to the origin in double they stay 1 mm apart.
   PointCloud cloud;
   cloud.offset = {500000.0, 4000000.0, 0.0};
   cloud.positions = {123, 456789, 1, 124, 456790, 2};
   computeBounds(cloud);
+  EXPECT_EQ(static_cast<float>(cloud.world(0).y), static_cast<float>(cloud.world(1).y));
   float rel[6];
   toRelativeFloat(rel, cloud, 0, 2, cloud.origin());
   EXPECT_FLOAT_EQ(rel[4] - rel[1], 0.001f);
-  EXPECT_NEAR(rel[0], -0.0005, 1e-6);
+  EXPECT_FLOAT_EQ(rel[1], -0.0005f);
 }
 
 TEST(HasUsableColor, FalseWithoutColorsOrWhenAllBlack) {

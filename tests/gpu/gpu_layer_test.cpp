@@ -10,12 +10,12 @@
 namespace pointrast::test {
 
 TEST(SpirvReflection, PushConstantSizesMatchSharedStructs) {
-  EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("raster_atomicmin.comp")).pushConstantSize, sizeof(shared::RasterPush));
+  EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("raster_closest.comp")).pushConstantSize, sizeof(shared::RasterPush));
   EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("resolve.comp")).pushConstantSize, sizeof(shared::ResolvePush));
 }
 
 TEST(SpirvReflection, LocalSizesMatchSharedConstants) {
-  EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("raster_atomicmin.comp")).localSize[0], shared::kPointGroupSize);
+  EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("raster_closest.comp")).localSize[0], shared::kPointGroupSize);
   EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("resolve.comp")).localSize[0], shared::kPixelGroupSize);
 }
 

@@ -39,7 +39,9 @@ std::vector<uint64_t> renderWords(gpu::Context& context, const PointCloud& cloud
                                   uint32_t h, const UploadOptions& upload = {}) {
   GpuScene scene(context, cloud, upload);
   Renderer renderer(context, w, h);
-  renderer.render(scene, camera, {});
+  RenderSettings settings;
+  settings.captureWords = true;
+  renderer.render(scene, camera, settings);
   return renderer.framebufferWords();
 }
 
@@ -194,7 +196,9 @@ TEST_F(GpuTest, PartsAndSeparateScenesGiveIdenticalFramebuffers) {
   }
   const GpuScene* drawn[] = {scenes[0].get(), scenes[1].get(), scenes[2].get()};
   Renderer renderer(*context, 256, 128);
-  renderer.render(drawn, camera, {});
+  RenderSettings settings;
+  settings.captureWords = true;
+  renderer.render(drawn, camera, settings);
   EXPECT_EQ(renderer.framebufferWords(), whole);
 }
 

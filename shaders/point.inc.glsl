@@ -1,0 +1,36 @@
+// Fetches point i of the current part (RasterPush pc) and computes its pixel and framebuffer word.
+// DEPTH_INT40 (a #define of the entry file, since double precision needs the Float64 capability):
+//   0: word = floatBits(c.w) << 32 | RGBA8          (order-preserving: c.w > 0)
+//   1: word = uint40(c.w * depthScale) << 24 | RGB24 (the 2019 poster; projection in double precision)
+#include "project.inc.glsl"
+
+#if DEPTH_INT40
+#extension GL_ARB_gpu_shader_fp64 : require
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer DMat4Ref { dmat4 m; };
+#endif
+
+vec3 loadPosition(uint i) {
+  FloatArray pos = FloatArray(pc.positions);
+  return vec3(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2]);
+}
+
+bool pointWord(uint i, out uint pixel, out uint64_t word) {
+  vec3 p = loadPosition(i);
+  uint color = UintArray(pc.colors).v[i];
+#if DEPTH_INT40
+  dvec4 c = DMat4Ref(pc.viewProjD).m * dvec4(dvec3(p), 1.0lf);
+  if (!(c.w > double(pc.nearW))) return false;
+  double fx = (c.x / c.w + 1.0lf) * 0.5lf * double(pc.width);
+  double fy = (1.0lf - c.y / c.w) * 0.5lf * double(pc.height);
+  if (!(fx >= 0.0lf && fx < double(pc.width) && fy >= 0.0lf && fy < double(pc.height))) return false;
+  pixel = min(uint(fy), pc.height - 1) * pc.width + min(uint(fx), pc.width - 1);
+  double steps = min(c.w * double(pc.depthScale), double(kInt40MaxDepth));
+  word = (uint64_t(steps) << kInt40ColorBits) | uint64_t(color & 0xFFFFFFu);
+  return true;
+#else
+  uint depthBits;
+  if (!projectPoint(pc.viewProj, p, pc.width, pc.height, pc.nearW, pixel, depthBits)) return false;
+  word = (uint64_t(depthBits) << 32) | uint64_t(color);
+  return true;
+#endif
+}

@@ -1,0 +1,45 @@
+#version 460
+// The per-pixel lock of the 2013 GPGPU point pipeline (Guenther et al.), as evaluated in the 2021 paper:
+// the framebuffer is a depth array and a color array; a point takes the pixel's lock by compare-and-swap
+// of the lock bit in the depth word, writes its color, and releases by storing its depth. Early-z: a
+// point farther than the stored depth gives up without locking (depth only ever decreases).
+//
+// Why it cannot deadlock, even on hardware that runs a subgroup in lockstep (lavapipe, pre-Volta GPUs):
+// a lane that wins the lock finishes its critical section and releases in the same loop iteration, so
+// no lane ever waits on a lock held by a lane of its own subgroup that cannot advance.
+#include "common.inc.glsl"
+
+layout(local_size_x = kPointGroupSize) in;
+layout(push_constant) uniform Push { RasterPush pc; };
+#define DEPTH_INT40 0
+#include "point.inc.glsl"
+
+layout(buffer_reference, std430, buffer_reference_align = 4) coherent buffer CoherentUintArray { uint v[]; };
+
+void main() {
+  uint i = linearInvocation(pc.groupsX, kPointGroupSize);
+  if (i >= pc.pointCount) return;
+  uint pixel;
+  uint64_t word;
+  if (!pointWord(i, pixel, word)) return;
+  uint depthBits = uint(word >> 32);
+  uint color = uint(word);
+  CoherentUintArray depth = CoherentUintArray(pc.framebuffer);
+  CoherentUintArray colors = CoherentUintArray(pc.framebuffer + uint64_t(pc.width) * pc.height * 4);
+
+  bool done = false;
+  while (!done) {
+    uint old = atomicOr(depth.v[pixel], 0u); // an atomic read of the current word
+    uint oldDepth = old & ~kPixelLockBit;
+    if (depthBits > oldDepth) {
+      done = true; // early-z: farther than what is (or is being) stored
+    } else if ((old & kPixelLockBit) == 0u && atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit) == old) {
+      // Locked. Ties in depth go to the smaller color, as with the 64-bit atomicMin methods.
+      bool closer = depthBits < oldDepth || color < colors.v[pixel];
+      if (closer) colors.v[pixel] = color;
+      memoryBarrierBuffer();
+      atomicExchange(depth.v[pixel], closer ? depthBits : oldDepth); // release
+      done = true;
+    }
+  }
+}

@@ -1,0 +1,84 @@
+// The closest-point family of the 2021 paper (Schuetz, Kerbl, Wimmer, "Rendering Point Clouds with
+// Compute Shaders and Vertex Order Optimization"), one thread per point. All variants write the same
+// framebuffer: the minimum of (depth << 32 | color) per pixel, whatever order points arrive in.
+//   EARLY_Z   read the pixel first and skip the atomic if the point is not closer (most points in dense
+//             views are hidden, and a read is cheaper than an atomic)
+//   REDUCE    0: none
+//             1: subgroup reduction: if the whole subgroup hits one pixel, one atomic of the subgroup
+//                minimum; otherwise neighbouring pairs that share a pixel combine first (clustered)
+//             2: dedup from ballots: one atomic per distinct pixel of the subgroup (portable)
+//   JUST_SET  plain stores without any depth test: a speed reference, not a correct image
+// DEDUP_NV (entry-file #define): dedup with VK_NV_shader_subgroup_partitioned instead of REDUCE.
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_vote : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_shuffle : require
+#extension GL_EXT_shader_subgroup_extended_types_int64 : require
+#if DEDUP_NV
+#extension GL_NV_shader_subgroup_partitioned : require
+#endif
+#include "common.inc.glsl"
+
+layout(local_size_x = kPointGroupSize) in;
+layout(push_constant) uniform Push { RasterPush pc; };
+layout(constant_id = 0) const uint EARLY_Z = 0;
+layout(constant_id = 1) const uint REDUCE = 0;
+layout(constant_id = 2) const uint JUST_SET = 0;
+
+#include "point.inc.glsl"
+
+const uint kNoPixel = 0xFFFFFFFFu;
+
+void writeClosest(uint pixel, uint64_t word) {
+  Uint64Array fb = Uint64Array(pc.framebuffer);
+  if (EARLY_Z != 0 && word >= fb.v[pixel]) return;
+  atomicMin(fb.v[pixel], word);
+}
+
+void main() {
+  uint i = linearInvocation(pc.groupsX, kPointGroupSize);
+  uint pixel = kNoPixel;
+  uint64_t word = kEmptyPixel;
+  // No early return: the subgroup operations below need every lane of the subgroup active.
+  if (i < pc.pointCount && !pointWord(i, pixel, word)) pixel = kNoPixel;
+  bool valid = pixel != kNoPixel;
+
+  if (JUST_SET != 0) {
+    if (valid) Uint64Array(pc.framebuffer).v[pixel] = word;
+    return;
+  }
+#if DEDUP_NV
+  uvec4 same = subgroupPartitionNV(pixel);
+  uint64_t least = subgroupPartitionedMinNV(word, same);
+  if (valid && gl_SubgroupInvocationID == subgroupBallotFindLSB(same)) writeClosest(pixel, least);
+#else
+  if (REDUCE == 1) {
+    if (subgroupAllEqual(pixel)) {
+      uint64_t least = subgroupMin(word);
+      if (valid && subgroupElect()) writeClosest(pixel, least);
+      return;
+    }
+    uint otherPixel = subgroupShuffleXor(pixel, 1);
+    uint64_t otherWord = subgroupShuffleXor(word, 1);
+    if (otherPixel == pixel) {
+      word = min(word, otherWord);
+      if ((gl_SubgroupInvocationID & 1u) != 0u) return; // the even lane of the pair writes
+    }
+    if (valid) writeClosest(pixel, word);
+  } else if (REDUCE == 2) {
+    bool pending = valid;
+    // One round per distinct pixel: the lowest pending lane's pixel is settled by one atomic.
+    while (subgroupAny(pending)) {
+      uint leader = subgroupBallotFindLSB(subgroupBallot(pending));
+      uint leaderPixel = subgroupShuffle(pixel, leader);
+      bool mine = pending && pixel == leaderPixel;
+      uint64_t least = subgroupMin(mine ? word : kEmptyPixel);
+      if (gl_SubgroupInvocationID == leader) writeClosest(leaderPixel, least);
+      if (mine) pending = false;
+    }
+  } else if (valid) {
+    writeClosest(pixel, word);
+  }
+#endif
+}

@@ -1,0 +1,76 @@
+// The interface every rendering method implements (internal to src/render). A method owns its programs
+// and any buffers beyond the shared targets, and records one whole frame: clear, draw every part of every
+// scene, resolve into the RGBA8 image. The Renderer times frames and owns the targets.
+#pragma once
+
+#include <memory>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "gpu/buffer.h"
+#include "gpu/program.h"
+#include "gpu/shared_types.h"
+#include "render/renderer.h"
+
+namespace pointrast {
+
+namespace gpu {
+class Context;
+}
+
+struct Targets {
+  uint32_t width = 0, height = 0;
+  gpu::Buffer framebuffer; // 8 B per pixel; methods choose the layout
+  gpu::Buffer image;       // RGBA8 per pixel
+  gpu::Buffer words;       // canonical depth << 32 | color per pixel, filled when non-empty
+  gpu::Buffer matrices;    // host-visible dmat4 per scene (double-precision projection)
+  uint64_t pixels() const { return uint64_t(width) * height; }
+};
+
+struct Frame {
+  VkCommandBuffer cmd;
+  std::span<const GpuScene* const> scenes;
+  const Camera& camera;
+  const RenderSettings& settings;
+};
+
+class PointMethod {
+public:
+  virtual ~PointMethod() = default;
+  virtual void recordFrame(const Frame& frame, Targets& targets) = 0;
+  // Whether the method fills targets.words (closest-point methods); HQS blends and has no single word.
+  virtual bool hasCanonicalWords() const { return true; }
+};
+
+// Calls draw(push, grid) for every part of every scene, with `base` completed for that part: the matrix
+// relative to the scene's origin (float, and the double copy in targets.matrices), the part's addresses
+// and point count, and the workgroup grid. `base` brings the method's framebuffer/aux addresses.
+template <class Draw>
+void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize, shared::RasterPush base, Draw&& draw) {
+  double aspect = double(targets.width) / double(targets.height);
+  base.width = targets.width;
+  base.height = targets.height;
+  for (size_t s = 0; s < frame.scenes.size(); ++s) {
+    const GpuScene& scene = *frame.scenes[s];
+    base.viewProj = glm::mat4(viewProjection(frame.camera, scene.origin(), aspect));
+    base.viewProjD = targets.matrices.address() + s * sizeof(glm::dmat4);
+    base.nearW = float(frame.camera.nearW > 0 ? frame.camera.nearW : defaultNear(scene.bounds()));
+    for (const ScenePart& part : scene.parts()) {
+      gpu::Grid grid = gpu::gridFor(part.count, groupSize);
+      base.positions = part.positions.address();
+      base.colors = part.colors.address();
+      base.pointCount = uint32_t(part.count);
+      base.groupsX = grid.x;
+      draw(base, grid);
+    }
+  }
+}
+
+// The resolve push for the shared targets; words are captured when settings ask for them.
+shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer, uint32_t groupSize);
+
+std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, Method method, DepthMode depth);
+std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height);
+
+} // namespace pointrast

@@ -1,0 +1,63 @@
+// High-quality splatting: a depth pass (the early-z closest-point shader), an accumulation pass that
+// blends every point within 1 % of the closest depth, and a resolve that divides.
+#include "base/error.h"
+#include "gpu/context.h"
+#include "render/method.h"
+
+namespace pointrast {
+
+namespace {
+
+class HqsMethod : public PointMethod {
+public:
+  HqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height) : oneRound_(method == Method::Hqs1r) {
+    uint64_t pixels = uint64_t(width) * height;
+    // hqs: 2 uint64 sums per pixel. hqs1r: 1 packed uint64 + 2 uint64 fallback sums per pixel.
+    accumulators_ = gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
+                                oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
+    depth_ = gpu::ComputeProgram(context, "raster_closest.comp", {{/* EARLY_Z= */ 0, 1}});
+    accumulate_ = gpu::ComputeProgram(context, "raster_hqs.comp", {{/* ONE_ROUND= */ 0, oneRound_}});
+    resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, oneRound_}});
+  }
+
+  void recordFrame(const Frame& frame, Targets& targets) override {
+    VkCommandBuffer cmd = frame.cmd;
+    uint64_t pixels = targets.pixels();
+    gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 8, 0xFFFFFFFFu);
+    gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
+    gpu::fullBarrier(cmd);
+    shared::RasterPush base{};
+    base.framebuffer = targets.framebuffer.address();
+    base.aux = accumulators_.address();
+    forEachPart(frame, targets, depth_.groupSize(), base, [&](const shared::RasterPush& push, gpu::Grid grid) {
+      depth_.dispatch(cmd, grid.x, grid.y, push);
+    });
+    gpu::fullBarrier(cmd);
+    forEachPart(frame, targets, accumulate_.groupSize(), base, [&](const shared::RasterPush& push, gpu::Grid grid) {
+      accumulate_.dispatch(cmd, grid.x, grid.y, push);
+    });
+    gpu::fullBarrier(cmd);
+    shared::ResolvePush resolve = resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
+    resolve.aux = accumulators_.address();
+    resolve.words = 0;
+    resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
+    gpu::fullBarrier(cmd);
+  }
+
+  bool hasCanonicalWords() const override { return false; }
+
+private:
+  bool oneRound_;
+  gpu::Buffer accumulators_;
+  gpu::ComputeProgram depth_;
+  gpu::ComputeProgram accumulate_;
+  gpu::ComputeProgram resolve_;
+};
+
+} // namespace
+
+std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height) {
+  return std::make_unique<HqsMethod>(context, method, width, height);
+}
+
+} // namespace pointrast

@@ -1,0 +1,9 @@
+// libFuzzer target for the Ply reader: readPly and its probe on arbitrary bytes.
+#include "fuzz_input.h"
+#include "io/formats.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  return fuzz::run(
+      data, size, [](const auto& path, const auto& options) { return pointrast::io::readPly(path, options); },
+      [](const auto& path) { pointrast::io::detail::probePly(path); });
+}
