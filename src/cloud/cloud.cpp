@@ -35,7 +35,8 @@ QuantBox quantBoxParallel(const int32_t* positions, uint64_t count) {
     boxes[block] = quantBox(positions, begin, end - begin);
   });
   QuantBox box;
-  for (const QuantBox& b : boxes) box.expand(b);
+  for (const QuantBox& b : boxes)
+    box.expand(b);
   return box;
 }
 
@@ -59,8 +60,8 @@ std::array<uint32_t, 256> makeTurbo() {
     double x = i / 255.0, x2 = x * x, x3 = x2 * x, x4 = x2 * x2, x5 = x4 * x;
     double r = 0.13572138 + 4.61539260 * x - 42.66032258 * x2 + 132.13108234 * x3 - 152.94239396 * x4 +
                59.28637943 * x5;
-    double g = 0.09140261 + 2.19418839 * x + 4.84296658 * x2 - 14.18503333 * x3 + 4.27729857 * x4 +
-               2.82956604 * x5;
+    double g =
+        0.09140261 + 2.19418839 * x + 4.84296658 * x2 - 14.18503333 * x3 + 4.27729857 * x4 + 2.82956604 * x5;
     double b = 0.10667330 + 12.64194608 * x - 60.58204836 * x2 + 110.36276771 * x3 - 89.90310912 * x4 +
                27.34824973 * x5;
     auto byte = [](double v) { return static_cast<uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
@@ -103,7 +104,8 @@ void toRelativeFloat(float* dst, const PointCloud& cloud, uint64_t first, uint64
   if (count < kParallelFrom) {
     convert(0, count);
   } else {
-    parallelBlocks(count, detail::kBlock, [&](uint64_t, uint64_t begin, uint64_t end) { convert(begin, end); });
+    parallelBlocks(count, detail::kBlock,
+                   [&](uint64_t, uint64_t begin, uint64_t end) { convert(begin, end); });
   }
 }
 
@@ -130,35 +132,33 @@ bool hasUsableColor(const PointCloud& cloud) {
 
 namespace {
 
+// displayColorMode() looks at a regular sample of at most this many points, serially: a few
+// milliseconds whatever the cloud's size, so callers that convert chunk by chunk with the
+// four-argument displayColors() (each call deciding the mode again) stay linear, and calls from inside
+// parallelBlocks() start no threads of their own. A million samples pin the percentiles far closer than
+// one ramp step.
+constexpr uint64_t kModeSamples = uint64_t(1) << 20;
+
 struct Range {
   double lo = 0, hi = 0;
 };
 
-// The 0.5% and 99.5% percentiles of value(i) over all points, from a histogram of 4096 bins between
+// The 0.5% and 99.5% percentiles of value(k) over k in [0, n), from a histogram of 4096 bins between
 // min and max (bin edges, so at most 1/4096 of the range off). Falls back to [min, max] when the
-// percentiles coincide (most points share one value).
+// percentiles coincide (most values equal).
 template <class Value> Range robustRange(uint64_t n, double min, double max, Value value) {
   if (!(max > min)) return {min, max};
   constexpr int kBins = 4096;
-  // Few blocks, so the per-block histograms stay small (<= 64 x 32 KiB) whatever n is.
-  const uint64_t blockSize = std::max<uint64_t>(uint64_t(1) << 20, (n + 63) / 64);
-  const uint64_t blocks = (n + blockSize - 1) / blockSize;
-  std::vector<uint64_t> hist(blocks * kBins, 0);
+  std::vector<uint64_t> hist(kBins, 0);
   const double toBin = kBins / (max - min);
-  parallelBlocks(n, blockSize, [&](uint64_t block, uint64_t begin, uint64_t end) {
-    uint64_t* h = hist.data() + block * kBins;
-    for (uint64_t i = begin; i < end; ++i) {
-      int bin = static_cast<int>((value(i) - min) * toBin);
-      ++h[std::clamp(bin, 0, kBins - 1)];
-    }
-  });
-  std::vector<uint64_t> total(kBins, 0);
-  for (uint64_t b = 0; b < blocks; ++b)
-    for (int k = 0; k < kBins; ++k) total[k] += hist[b * kBins + k];
+  for (uint64_t k = 0; k < n; ++k)
+    ++hist[std::clamp(static_cast<int>((value(k) - min) * toBin), 0, kBins - 1)];
   const uint64_t cut = n / 200; // 0.5%
   int loBin = 0, hiBin = kBins - 1;
-  for (uint64_t acc = 0; loBin < kBins - 1 && acc + total[loBin] <= cut; ++loBin) acc += total[loBin];
-  for (uint64_t acc = 0; hiBin > 0 && acc + total[hiBin] <= cut; --hiBin) acc += total[hiBin];
+  for (uint64_t acc = 0; loBin < kBins - 1 && acc + hist[loBin] <= cut; ++loBin)
+    acc += hist[loBin];
+  for (uint64_t acc = 0; hiBin > 0 && acc + hist[hiBin] <= cut; --hiBin)
+    acc += hist[hiBin];
   Range r{min + loBin / toBin, min + (hiBin + 1) / toBin};
   if (!(r.hi > r.lo)) return {min, max};
   return {std::max(r.lo, min), std::min(r.hi, max)};
@@ -173,25 +173,18 @@ DisplayColorMode displayColorMode(const PointCloud& cloud) {
     mode.source = DisplayColorMode::Source::Rgb;
     return mode;
   }
+  // Sample k is point k * stride.
+  const uint64_t stride = std::max<uint64_t>(1, (n + kModeSamples - 1) / kModeSamples);
+  const uint64_t samples = (n + stride - 1) / stride;
   if (!cloud.intensity.empty()) {
     const uint16_t* v = cloud.intensity.data();
-    std::vector<std::pair<uint16_t, uint16_t>> ext((n + detail::kBlock - 1) / detail::kBlock,
-                                                   {uint16_t(65535), uint16_t(0)});
-    parallelBlocks(n, detail::kBlock, [&](uint64_t block, uint64_t begin, uint64_t end) {
-      auto [lo, hi] = ext[block];
-      for (uint64_t i = begin; i < end; ++i) {
-        lo = std::min(lo, v[i]);
-        hi = std::max(hi, v[i]);
-      }
-      ext[block] = {lo, hi};
-    });
     uint16_t lo = 65535, hi = 0;
-    for (auto [l, h] : ext) {
-      lo = std::min(lo, l);
-      hi = std::max(hi, h);
+    for (uint64_t k = 0; k < samples; ++k) {
+      lo = std::min(lo, v[k * stride]);
+      hi = std::max(hi, v[k * stride]);
     }
-    if (hi > lo) {
-      Range r = robustRange(n, lo, hi, [v](uint64_t i) { return double(v[i]); });
+    if (hi > lo) { // a constant intensity carries no picture: use elevation instead
+      Range r = robustRange(samples, lo, hi, [=](uint64_t k) { return double(v[k * stride]); });
       mode.source = DisplayColorMode::Source::Intensity;
       mode.lo = r.lo;
       mode.hi = r.hi;
@@ -201,11 +194,12 @@ DisplayColorMode displayColorMode(const PointCloud& cloud) {
   mode.source = DisplayColorMode::Source::Elevation;
   Bounds b = cloud.bounds;
   if (b.empty() && n > 0)
-    b = detail::worldBounds(detail::quantBoxParallel(cloud.positions.data(), n), cloud.scale, cloud.offset);
+    b = detail::worldBounds(detail::quantBox(cloud.positions.data(), 0, n), cloud.scale, cloud.offset);
   if (b.empty()) return mode;
   const int32_t* p = cloud.positions.data();
   const double sz = cloud.scale.z, oz = cloud.offset.z;
-  Range r = robustRange(n, b.min.z, b.max.z, [=](uint64_t i) { return p[3 * i + 2] * sz + oz; });
+  Range r =
+      robustRange(samples, b.min.z, b.max.z, [=](uint64_t k) { return p[3 * k * stride + 2] * sz + oz; });
   mode.lo = r.lo;
   mode.hi = r.hi;
   return mode;
@@ -219,7 +213,8 @@ void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint6
   auto fill = [&](uint64_t begin, uint64_t end) {
     switch (mode.source) {
     case DisplayColorMode::Source::Rgb:
-      for (uint64_t k = begin; k < end; ++k) dst[k] = cloud.colors[first + k] | 0xFF000000u;
+      for (uint64_t k = begin; k < end; ++k)
+        dst[k] = cloud.colors[first + k] | 0xFF000000u;
       break;
     case DisplayColorMode::Source::Intensity:
       for (uint64_t k = begin; k < end; ++k)

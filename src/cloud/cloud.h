@@ -77,14 +77,16 @@ void toRelativeFloat(float* dst, const PointCloud& cloud, uint64_t first, uint64
 bool hasUsableColor(const PointCloud& cloud);
 void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count);
 
-// What displayColors() maps onto colors. Deciding it takes a pass over the whole cloud (is any color
-// non-black, what range do intensity or elevation span), so a caller converting a large cloud in chunks
-// computes it once and passes it to the overload below; every chunk then uses the same ramp.
+// What displayColors() maps onto colors, decided from the whole cloud so every chunk of it gets the same
+// ramp. Deciding costs a few milliseconds (ranges come from a regular sample of at most 2^20 points;
+// only an all-black color array is scanned in full), so a caller converting a large cloud in many chunks
+// should compute it once and pass it to the overload below rather than call the four-argument form.
 struct DisplayColorMode {
   enum class Source { Rgb, Intensity, Elevation };
   Source source = Source::Elevation;
-  // Values mapped to the two ends of the ramp (intensity units or world z). The 0.5% and 99.5%
+  // Values mapped to the two ends of the ramp (intensity units or world z): the 0.5% and 99.5%
   // percentiles rather than min and max, so a few outliers (birds, noise) do not flatten the ramp.
+  // Intensity counts as constant (elevation is used) when the sample shows one value.
   double lo = 0.0, hi = 1.0;
 };
 DisplayColorMode displayColorMode(const PointCloud& cloud);

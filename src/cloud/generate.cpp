@@ -26,9 +26,13 @@ Scene parseScene(std::string_view name) {
   throw InputError("unknown scene '" + std::string(name) + "' (choices: terrain, tls)");
 }
 
-bool isSceneName(std::string_view name) { return name == kSceneNames[0] || name == kSceneNames[1]; }
+bool isSceneName(std::string_view name) {
+  return name == kSceneNames[0] || name == kSceneNames[1];
+}
 
-const char* sceneName(Scene scene) { return kSceneNames[static_cast<int>(scene)]; }
+const char* sceneName(Scene scene) {
+  return kSceneNames[static_cast<int>(scene)];
+}
 
 namespace detail {
 std::unique_ptr<SceneGenerator> makeScene(Scene scene, uint64_t points, uint64_t seed) {
@@ -41,12 +45,14 @@ PointCloud generateScene(Scene scene, const GenerateOptions& options) {
   const std::string what = std::string(sceneName(scene)) + ", " + std::to_string(n) + " points, seed " +
                            std::to_string(options.seed);
   if (n > kMaxPoints)
-    throw InputError("cannot generate " + what + ": at most 2^40 (" + std::to_string(kMaxPoints) + ") points");
+    throw InputError("cannot generate " + what + ": at most 2^40 (" + std::to_string(kMaxPoints) +
+                     ") points");
   // Refuse up front what cannot fit in physical memory, rather than being killed half way.
   const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
   if (pages > 0 && pageSize > 0 && double(n) * kBytesPerPoint > double(pages) * double(pageSize))
     throw InputError("cannot generate " + what + ": needs " + humanCount(double(n) * kBytesPerPoint) +
-                     "B, more than this machine's memory (" + humanCount(double(pages) * double(pageSize)) + "B)");
+                     "B, more than this machine's memory (" + humanCount(double(pages) * double(pageSize)) +
+                     "B)");
 
   PointCloud cloud;
   cloud.scale = glm::dvec3(detail::SceneGenerator::kScale);

@@ -3,16 +3,19 @@
 //
 // Every order is a sort of the point indices by a 64-bit key with ties broken by index, so results are
 // deterministic and independent of the thread count:
-//   Morton         key = 63-bit Morton code over the cubic bounds (Morton 1966; the Z-order curve)
+//   Morton         key = 63-bit Morton code (Z-order) over the cubic bounds
 //   Shuffled       key = the i-th output of splitmix64 seeded with `seed` (Steele, Lea, Flood, "Fast
 //                  splittable pseudorandom number generators", OOPSLA 2014); distinct for distinct i
 //                  because its mixing function is a bijection, so sorting by it is a random permutation
 //   ShuffledMorton Morton order, then its runs of kShuffleRun points sorted by the splitmix64 key of
 //                  the run index (the paper's "shuffled Morton": local patches kept, patches scattered)
 //
-// The sort (sortByKey) is a parallel sample sort that needs no more memory than its output: keys are
-// recomputed from the points instead of stored, so computeOrder costs 8 B/point (the order itself) plus
-// per-thread buckets of a few MB.
+// The sort (sortByKey) is a parallel sample sort (splitters from a regular sample, one counting and one
+// scattering pass into ~4096 buckets, then an LSD radix sort inside each bucket) that needs little more
+// memory than its output: keys are recomputed from the points instead of stored, so computeOrder costs
+// the order itself (8 B/point), a 2 B/point bucket id while it runs, and per-thread buckets of a few MB.
+// (Morton: G. M. Morton, "A computer oriented geodetic data base and a new technique in file
+// sequencing", IBM, 1966.)
 #include "cloud/order.h"
 
 #include <algorithm>
@@ -53,7 +56,6 @@ inline uint64_t spreadBits3(uint32_t v) {
 struct KeyIndex {
   uint64_t key;
   uint64_t index;
-  bool operator<(const KeyIndex& o) const { return key < o.key || (key == o.key && index < o.index); }
 };
 
 // Stable LSD radix sort of a by key, 8 bits per pass, skipping the bits all keys share and the passes
@@ -71,7 +73,8 @@ void radixSortPairs(std::vector<KeyIndex>& a, std::vector<KeyIndex>& b) {
   const int passes = (bits + 7) / 8;
   std::vector<uint64_t> count(size_t(passes) * 256, 0);
   for (const KeyIndex& p : a)
-    for (int d = 0; d < passes; ++d) ++count[d * 256 + ((p.key >> (8 * d)) & 255)];
+    for (int d = 0; d < passes; ++d)
+      ++count[d * 256 + ((p.key >> (8 * d)) & 255)];
   b.resize(n);
   for (int d = 0; d < passes; ++d) {
     uint64_t* c = count.data() + d * 256;
@@ -82,7 +85,8 @@ void radixSortPairs(std::vector<KeyIndex>& a, std::vector<KeyIndex>& b) {
       c[k] = sum;
       sum += t;
     }
-    for (const KeyIndex& p : a) b[c[(p.key >> (8 * d)) & 255]++] = p;
+    for (const KeyIndex& p : a)
+      b[c[(p.key >> (8 * d)) & 255]++] = p;
     a.swap(b);
   }
 }
@@ -110,7 +114,8 @@ public:
     table_.resize((size_t(1) << kTableBits) + 1);
     size_t j = 0;
     for (size_t p = 0; p < (size_t(1) << kTableBits); ++p) {
-      while (j < count_ && (splitters_[j] >> shift_) < p) ++j;
+      while (j < count_ && (splitters_[j] >> shift_) < p)
+        ++j;
       table_[p] = static_cast<uint16_t>(j);
     }
     table_.back() = static_cast<uint16_t>(count_);
@@ -140,15 +145,24 @@ private:
   size_t count_ = 0;
 };
 
+// Per-thread bucket buffers, reused across the buckets a worker sorts (fresh allocations would fault in
+// new pages for every bucket).
+struct Scratch {
+  std::vector<KeyIndex> a, b;
+};
+thread_local Scratch tScratch;
+
 // order[0..n) = indices sorted by (key(i), i). key must be a pure function of i.
 template <class Key> void sortByKey(uint64_t* order, uint64_t n, const Key& key) {
   // Below this a single sort is faster than setting up buckets.
   constexpr uint64_t kSerialBelow = uint64_t(1) << 16;
   if (n < kSerialBelow) {
     std::vector<KeyIndex> a(n), b;
-    for (uint64_t i = 0; i < n; ++i) a[i] = {key(i), i};
+    for (uint64_t i = 0; i < n; ++i)
+      a[i] = {key(i), i};
     radixSortPairs(a, b);
-    for (uint64_t i = 0; i < n; ++i) order[i] = a[i].index;
+    for (uint64_t i = 0; i < n; ++i)
+      order[i] = a[i].index;
     return;
   }
   // Up to 4096 buckets of >= 4096 points: ~250 k points (8 MB of scratch per thread) at a billion.
@@ -156,7 +170,8 @@ template <class Key> void sortByKey(uint64_t* order, uint64_t n, const Key& key)
   const uint64_t sampleSize = std::min<uint64_t>(n, uint64_t(64) * target);
   std::vector<uint64_t> sample(sampleSize);
   parallelBlocks(sampleSize, 4096, [&](uint64_t, uint64_t begin, uint64_t end) {
-    for (uint64_t j = begin; j < end; ++j) sample[j] = key(j * n / sampleSize); // j * n < 2^58
+    for (uint64_t j = begin; j < end; ++j)
+      sample[j] = key(j * n / sampleSize); // j * n < 2^58
   });
   const Buckets bucketOf(std::move(sample), target, Key::kBits);
   const size_t buckets = bucketOf.size();
@@ -190,18 +205,21 @@ template <class Key> void sortByKey(uint64_t* order, uint64_t n, const Key& key)
   bucketStart[buckets] = sum;
   parallelBlocks(n, blockSize, [&](uint64_t block, uint64_t begin, uint64_t end) {
     uint64_t* c = offset.data() + block * buckets;
-    for (uint64_t i = begin; i < end; ++i) order[c[bucketId[i]]++] = i;
+    for (uint64_t i = begin; i < end; ++i)
+      order[c[bucketId[i]]++] = i;
   });
   std::vector<uint16_t>().swap(bucketId);
 
   // Sort inside buckets, largest first for load balance.
   std::vector<uint32_t> byCount(buckets);
-  for (size_t k = 0; k < buckets; ++k) byCount[k] = static_cast<uint32_t>(k);
+  for (size_t k = 0; k < buckets; ++k)
+    byCount[k] = static_cast<uint32_t>(k);
   std::stable_sort(byCount.begin(), byCount.end(), [&](uint32_t a, uint32_t b) {
     return bucketStart[a + 1] - bucketStart[a] > bucketStart[b + 1] - bucketStart[b];
   });
   parallelBlocks(buckets, 1, [&](uint64_t job, uint64_t, uint64_t) {
-    thread_local std::vector<KeyIndex> a, b;
+    std::vector<KeyIndex>& a = tScratch.a;
+    std::vector<KeyIndex>& b = tScratch.b;
     const uint32_t k = byCount[job];
     const uint64_t begin = bucketStart[k], end = bucketStart[k + 1];
     if (end - begin < 2 || (k & 1)) return; // odd buckets hold one key value, already in index order
@@ -213,16 +231,18 @@ template <class Key> void sortByKey(uint64_t* order, uint64_t n, const Key& key)
       a[i - begin] = {key(order[i]), order[i]};
     }
     radixSortPairs(a, b); // stable, and the indices arrived ascending: ties stay in index order
-    for (uint64_t i = begin; i < end; ++i) order[i] = a[i - begin].index;
+    for (uint64_t i = begin; i < end; ++i)
+      order[i] = a[i - begin].index;
   });
+  tScratch = {}; // the calling thread was one of the workers: give its buffers back
 }
 
 // Maps quantized positions to 21-bit cells of the cubic bounds.
 struct MortonKey {
   static constexpr int kBits = 63;
   const int32_t* positions;
-  int64_t ref[3];   // quantized coordinate of the cube's corner on each axis
-  double mul[3];    // cells per quantization step (signed with the axis scale)
+  int64_t ref[3]; // quantized coordinate of the cube's corner on each axis
+  double mul[3];  // cells per quantization step (signed with the axis scale)
 
   MortonKey(const PointCloud& cloud) : positions(cloud.positions.data()) {
     detail::QuantBox box = detail::quantBoxParallel(cloud.positions.data(), cloud.size());
@@ -265,7 +285,9 @@ Order parseOrder(std::string_view name) {
                    "' (choices: original, morton, shuffled, shuffled-morton)");
 }
 
-const char* orderName(Order order) { return kOrderNames[static_cast<int>(order)]; }
+const char* orderName(Order order) {
+  return kOrderNames[static_cast<int>(order)];
+}
 
 uint64_t mortonCode(uint32_t x, uint32_t y, uint32_t z) {
   assert(x < (1u << 21) && y < (1u << 21) && z < (1u << 21));
@@ -280,7 +302,8 @@ void computeOrder(std::vector<uint64_t>& order, const PointCloud& cloud, Order k
   switch (kind) {
   case Order::Original:
     parallelBlocks(n, uint64_t(1) << 20, [&](uint64_t, uint64_t begin, uint64_t end) {
-      for (uint64_t i = begin; i < end; ++i) order[i] = i;
+      for (uint64_t i = begin; i < end; ++i)
+        order[i] = i;
     });
     return;
   case Order::Morton:
@@ -314,15 +337,15 @@ void computeOrder(std::vector<uint64_t>& order, const PointCloud& cloud, Order k
 }
 
 namespace {
-template <class T, size_t kPer>
-void gather(std::vector<T>& data, const std::vector<uint64_t>& order) {
+template <class T, size_t kPer> void gather(std::vector<T>& data, const std::vector<uint64_t>& order) {
   if (data.empty()) return;
   const uint64_t n = order.size();
   assert(data.size() == n * kPer && "attribute array length differs from the point count");
   std::vector<T> out(data.size());
   parallelBlocks(n, uint64_t(1) << 18, [&](uint64_t, uint64_t begin, uint64_t end) {
     for (uint64_t i = begin; i < end; ++i)
-      for (size_t k = 0; k < kPer; ++k) out[i * kPer + k] = data[order[i] * kPer + k];
+      for (size_t k = 0; k < kPer; ++k)
+        out[i * kPer + k] = data[order[i] * kPer + k];
   });
   data.swap(out);
 }
@@ -330,6 +353,15 @@ void gather(std::vector<T>& data, const std::vector<uint64_t>& order) {
 
 void applyOrder(PointCloud& cloud, const std::vector<uint64_t>& order) {
   assert(order.size() == cloud.size());
+#ifndef NDEBUG
+  {
+    std::vector<bool> seen(order.size(), false);
+    for (uint64_t i : order) {
+      assert(i < order.size() && !seen[i] && "order is not a permutation");
+      seen[i] = true;
+    }
+  }
+#endif
   // One array at a time, so the peak is one copy of the largest attribute (positions, 12 B/point).
   gather<int32_t, 3>(cloud.positions, order);
   gather<uint32_t, 1>(cloud.colors, order);

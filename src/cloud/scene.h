@@ -47,7 +47,9 @@ inline uint32_t hash2(int32_t x, int32_t y, uint32_t salt) {
   h ^= h >> 16;
   return h;
 }
-inline uint32_t hash1(int32_t x, uint32_t salt) { return hash2(x, 0x5bd1e995, salt); }
+inline uint32_t hash1(int32_t x, uint32_t salt) {
+  return hash2(x, 0x5bd1e995, salt);
+}
 
 // floor() as an integer, for |v| < 2^31. std::floor is a library call on baseline x86-64 (no SSE4.1
 // roundsd), and the scenes take several per point.
@@ -57,9 +59,13 @@ inline int32_t floorInt(double v) {
 }
 
 // [0, 1) from the top 24 bits of a hash.
-inline double unit(uint32_t h) { return (h >> 8) * (1.0 / 16777216.0); }
+inline double unit(uint32_t h) {
+  return (h >> 8) * (1.0 / 16777216.0);
+}
 // [0, 1) from bits [shift, shift + 16) of a 64-bit random value.
-inline double unit16(uint64_t r, int shift) { return ((r >> shift) & 0xffff) * (1.0 / 65536.0); }
+inline double unit16(uint64_t r, int shift) {
+  return ((r >> shift) & 0xffff) * (1.0 / 65536.0);
+}
 
 // Value noise on a unit lattice with smoothstep interpolation, in [-1, 1], with its gradient
 // (Perlin, "An image synthesizer", SIGGRAPH 1985, the value-noise variant).
@@ -104,13 +110,17 @@ struct Rgb {
   Rgb operator*(double s) const { return {r * s, g * s, b * s}; }
   Rgb operator+(const Rgb& o) const { return {r + o.r, g + o.g, b + o.b}; }
 };
-inline Rgb mix(const Rgb& a, const Rgb& b, double t) { return a * (1 - t) + b * t; }
+inline Rgb mix(const Rgb& a, const Rgb& b, double t) {
+  return a * (1 - t) + b * t;
+}
 inline uint32_t toRgba(const Rgb& c) {
   auto byte = [](double v) { return static_cast<uint32_t>(std::clamp(v, 0.0, 255.0) + 0.5); };
   return packRgba(byte(c.r), byte(c.g), byte(c.b));
 }
 
 // Scene metres (relative to the offset) to quantization steps of SceneGenerator::kScale (1 mm).
-inline int32_t quantize(double v) { return floorInt(v * 1000.0 + 0.5); }
+inline int32_t quantize(double v) {
+  return floorInt(v * 1000.0 + 0.5);
+}
 
 } // namespace pointrast::detail

@@ -16,21 +16,21 @@
 namespace pointrast::detail {
 namespace {
 
-constexpr double kDensity = 20.0;           // pulses per m^2 of a strip, a typical survey density
-constexpr double kMinSide = 40.0;           // tiny clouds still show a patch of land
-constexpr double kMaxSide = 10000.0;        // past ~2 G points density rises instead of area
-constexpr double kMaxStripSpacing = 400.0;  // m between flight lines
-constexpr double kOverlap = 0.3;            // side overlap of neighbouring strips
-constexpr double kTanMaxScan = 0.36397;     // tan(20 deg): half the field of view
-constexpr double kBaseElevation = 180.0;    // m above the datum
+constexpr double kDensity = 20.0;          // pulses per m^2 of a strip, a typical survey density
+constexpr double kMinSide = 40.0;          // tiny clouds still show a patch of land
+constexpr double kMaxSide = 10000.0;       // past ~2 G points density rises instead of area
+constexpr double kMaxStripSpacing = 400.0; // m between flight lines
+constexpr double kOverlap = 0.3;           // side overlap of neighbouring strips
+constexpr double kTanMaxScan = 0.36397;    // tan(20 deg): half the field of view
+constexpr double kBaseElevation = 180.0;   // m above the datum
 constexpr double kBuildingCell = 30.0;
-constexpr double kBuildingMargin = 4.0;     // footprint to cell border; > kRoadHalfWidth
+constexpr double kBuildingMargin = 4.0; // footprint to cell border; > kRoadHalfWidth
 constexpr double kRoadHalfWidth = 3.0;
 constexpr double kTreeCell = 7.0;
 constexpr double kCrownReach[2] = {-2.5, 9.5}; // a crown stays within this span of its cell (m)
-constexpr double kMaxTreeTop = 30.0;        // above the ground under the pulse, bounds the cells visited
+constexpr double kMaxTreeTop = 30.0;           // above the ground under the pulse, bounds the cells visited
 constexpr double kMaxRoofTop = 40.0;
-constexpr double kCrownPassThrough = 0.25;  // share of pulses that reach the ground through a crown
+constexpr double kCrownPassThrough = 0.25; // share of pulses that reach the ground through a crown
 
 const glm::dvec3 kSun = glm::normalize(glm::dvec3(-1.0, 1.0, 1.6)); // from the north-west, ~50 deg up
 
@@ -52,6 +52,7 @@ struct Tree {
 
 // Direct-mapped memo of per-cell parameters. Consecutive pulses of a scan line visit the same few cells,
 // so a cell's parameters (which include a ground-height evaluation) are computed about once per line.
+// It memoizes a pure function, so results never depend on what the cache held before.
 template <class T, int kBits> class CellCache {
 public:
   template <class F> const T& get(int32_t x, int32_t y, const F& compute) {
@@ -85,7 +86,9 @@ inline double smoothstep(double a, double b, double x) {
 }
 
 // Lambert-like shade, 1 for a level surface, never below 0.55 so shadowed sides keep their color.
-inline double shade(const glm::dvec3& n) { return 0.55 + 0.45 * std::max(0.0, glm::dot(n, kSun)) / kSun.z; }
+inline double shade(const glm::dvec3& n) {
+  return 0.55 + 0.45 * std::max(0.0, glm::dot(n, kSun)) / kSun.z;
+}
 
 class TerrainScene final : public SceneGenerator {
 public:
@@ -114,14 +117,13 @@ private:
   Tree tree(int32_t tx, int32_t ty) const;
   Rgb groundColor(double x, double y, double gx, double gy, uint64_t rnd, NoiseCells& cells) const;
 
-  uint64_t points_;
-  double side_;           // of the surveyed square (m)
-  uint64_t strips_;       // K
-  uint64_t samples_;      // S pulses per scan line
-  uint64_t lines_;        // G scan lines in all
-  double stripSpacing_;   // m between flight lines
-  double stripWidth_;     // swath width on the ground
-  double flightHeight_;   // above the ground, so the swath edge is at the maximum scan angle
+  double side_;         // of the surveyed square (m)
+  uint64_t strips_;     // K
+  uint64_t samples_;    // S pulses per scan line
+  uint64_t lines_;      // G scan lines in all
+  double stripSpacing_; // m between flight lines
+  double stripWidth_;   // swath width on the ground
+  double flightHeight_; // above the ground, so the swath edge is at the maximum scan angle
   double landCell_, invLandCell_;
   int32_t centerRoad_[2];
   uint64_t seedKey_;
@@ -129,9 +131,10 @@ private:
   uint64_t saltBuilding_, saltTree_;
 };
 
-TerrainScene::TerrainScene(uint64_t points, uint64_t seed) : points_(points) {
+TerrainScene::TerrainScene(uint64_t points, uint64_t seed) {
   seedKey_ = splitmixMix(seed ^ 0x7465727261696eull); // "terrain"
-  for (int k = 0; k < 5; ++k) saltNoise_[k] = uint32_t(splitmixAt(seedKey_, k));
+  for (int k = 0; k < 5; ++k)
+    saltNoise_[k] = uint32_t(splitmixAt(seedKey_, k));
   saltLand_ = uint32_t(splitmixAt(seedKey_, 10));
   saltRoadX_ = uint32_t(splitmixAt(seedKey_, 11));
   saltRoadY_ = uint32_t(splitmixAt(seedKey_, 12));
@@ -225,7 +228,8 @@ Building TerrainScene::building(int32_t bx, int32_t by) const {
   }
   static const Rgb kRoofs[] = {{172, 84, 60}, {140, 62, 48}, {82, 84, 90}, {104, 108, 118}, {118, 82, 62}};
   static const Rgb kFlatRoofs[] = {{150, 148, 140}, {120, 120, 118}, {170, 165, 150}};
-  static const Rgb kWalls[] = {{226, 214, 192}, {204, 192, 170}, {236, 232, 222}, {182, 160, 138}, {152, 84, 64}};
+  static const Rgb kWalls[] = {
+      {226, 214, 192}, {204, 192, 170}, {236, 232, 222}, {182, 160, 138}, {152, 84, 64}};
   const uint32_t h = uint32_t(r2);
   b.roofColor = b.roof ? kRoofs[h % 5] : kFlatRoofs[h % 3];
   b.wallColor = kWalls[(h >> 8) % 5];
@@ -283,7 +287,8 @@ Rgb TerrainScene::groundColor(double x, double y, double gx, double gy, uint64_t
     const NoiseSample patch = valueNoise(x * 0.2, y * 0.2, saltNoise_[4], cells[4]); // 5 m patches
     switch (land) {
     case Land::Field: {
-      static const Rgb kCrops[] = {{196, 176, 104}, {112, 142, 62}, {128, 98, 72}, {104, 136, 66}, {160, 150, 80}};
+      static const Rgb kCrops[] = {
+          {196, 176, 104}, {112, 142, 62}, {128, 98, 72}, {104, 136, 66}, {160, 150, 80}};
       const uint32_t h = hash2(lx, ly, saltLand_ ^ 0x55u);
       const double coord = (h & 1) ? x : y; // rows run along one axis per field
       const double phase = coord / 2.4 - floorInt(coord / 2.4);
@@ -358,8 +363,9 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
     double best = 0;
     enum { kGround, kRoof, kWall, kCrown } kind = kGround;
     glm::dvec3 normal(0, 0, 1);
-    const Building* hitBuilding = nullptr;
-    const Tree* hitTree = nullptr;
+    // Copies, not pointers: a later cache lookup may evict the cell that was hit.
+    Rgb surface{};
+    Tree hitTree;
 
     {
       const double xa = std::min(x, x - t * kMaxRoofTop), xb = std::max(x, x - t * kMaxRoofTop);
@@ -397,16 +403,30 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
         }
         if (lo > hi || hi <= best) continue;
         best = hi;
-        hitBuilding = &b;
         kind = face <= 1 ? kWall : kRoof;
+        surface = face <= 1 ? b.wallColor * 0.9 : b.roofColor;
         switch (face) {
-        case 0: normal = {-1, 0, 0}; break;
-        case 1: normal = {1, 0, 0}; break;
-        case 3: normal = glm::normalize(glm::dvec3(0, m, 1)); break;
-        case 4: normal = glm::normalize(glm::dvec3(0, -m, 1)); break;
-        case 5: normal = glm::normalize(glm::dvec3(m, 0, 1)); break;
-        case 6: normal = glm::normalize(glm::dvec3(-m, 0, 1)); break;
-        default: normal = {0, 0, 1}; break;
+        case 0:
+          normal = {-1, 0, 0};
+          break;
+        case 1:
+          normal = {1, 0, 0};
+          break;
+        case 3:
+          normal = glm::normalize(glm::dvec3(0, m, 1));
+          break;
+        case 4:
+          normal = glm::normalize(glm::dvec3(0, -m, 1));
+          break;
+        case 5:
+          normal = glm::normalize(glm::dvec3(m, 0, 1));
+          break;
+        case 6:
+          normal = glm::normalize(glm::dvec3(-m, 0, 1));
+          break;
+        default:
+          normal = {0, 0, 1};
+          break;
         }
       }
     }
@@ -426,7 +446,8 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
           if (tr.conifer) {
             // Cone, apex at zTop: horizontal distance <= k (zTop - z).
             const double kk = tr.radius / (tr.zTop - tr.zBottom), c = tr.zTop - zg;
-            const double qa = t * t - kk * kk, qb = -2 * a * t + 2 * kk * kk * c, qc = a * a + b * b - kk * kk * c * c;
+            const double qa = t * t - kk * kk, qb = -2 * a * t + 2 * kk * kk * c,
+                         qc = a * a + b * b - kk * kk * c * c;
             const double disc = qb * qb - 4 * qa * qc;
             if (disc < 0) continue;
             const double sq = std::sqrt(disc), r1 = (-qb + sq) / (2 * qa), r2 = (-qb - sq) / (2 * qa);
@@ -446,7 +467,7 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
           if (lambda <= best) continue;
           best = lambda;
           kind = kCrown;
-          hitTree = &tr;
+          hitTree = tr;
         }
       }
     }
@@ -463,13 +484,11 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
       c = groundColor(x, y, gx, gy, rnd, cells);
       break;
     case kRoof:
-      c = hitBuilding->roofColor * (shade(normal) * grain);
-      break;
     case kWall:
-      c = hitBuilding->wallColor * (shade(normal) * 0.9 * grain);
+      c = surface * (shade(normal) * grain);
       break;
     case kCrown: {
-      const Tree& tr = *hitTree;
+      const Tree& tr = hitTree;
       const double h = (pz - tr.zBottom) / (tr.zTop - tr.zBottom); // inner, lower parts darker
       glm::dvec3 nr(px - tr.cx, y - tr.cy, 0);
       if (tr.conifer) {
@@ -480,7 +499,8 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
         nr /= tr.radius * tr.radius;
         nr.z = (pz - 0.5 * (tr.zTop + tr.zBottom)) / (rz * rz);
       }
-      c = tr.color * ((0.7 + 0.35 * std::clamp(h, 0.0, 1.0)) * shade(glm::normalize(nr)) * (0.85 + 0.3 * unit16(rnd, 40)));
+      c = tr.color * ((0.7 + 0.35 * std::clamp(h, 0.0, 1.0)) * shade(glm::normalize(nr)) *
+                      (0.85 + 0.3 * unit16(rnd, 40)));
       break;
     }
     }

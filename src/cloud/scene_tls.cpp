@@ -27,7 +27,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kElevationMin = -60.0 * kPi / 180.0;
 constexpr double kElevationMax = 90.0 * kPi / 180.0;
-constexpr double kMaxRange = 120.0;        // m: ground returns end here (the scene's objects are nearer)
+constexpr double kMaxRange = 120.0; // m: ground returns end here (the scene's objects are nearer)
 constexpr uint64_t kMinAzimuthSteps = 8;
 constexpr double kBaseElevation = 150.0;
 constexpr double kPlazaRadius = 26.0;
@@ -59,9 +59,9 @@ struct Candidate {
   Kind kind;
   uint8_t face; // rect from a box: 0 entered through an x face, 1 through a y face
   uint32_t shape;
-  int32_t k0, k1; // elevation steps that hit it
-  double r0, r1, zlo, zhi;   // Rect
-  double rc, zc, a, b;       // Ellipse: centre and half-axes
+  int32_t k0, k1;          // elevation steps that hit it
+  double r0, r1, zlo, zhi; // Rect
+  double rc, zc, a, b;     // Ellipse: centre and half-axes
 };
 
 struct Profile {
@@ -109,7 +109,6 @@ private:
   std::vector<std::array<double, 4>> footprints_; // placed objects, for spacing
 
   uint64_t azimuthSteps_ = 0; // A: steps per turn; the elevation step is the same angle
-  int32_t elevationSteps_ = 0;
   double step_ = 0;
   std::vector<uint64_t> offsets_; // first return of each profile, plus the total
 };
@@ -127,7 +126,8 @@ TlsScene::TlsScene(uint64_t points, uint64_t seed) : points_(points) {
   for (int iteration = 0; iteration < 6; ++iteration) {
     const double t = double(offsets_.back());
     const uint64_t next = std::max<uint64_t>(
-        kMinAzimuthSteps, uint64_t(std::ceil(double(a) * std::sqrt(double(points) * 1.004 / std::max(t, 1.0)))));
+        kMinAzimuthSteps,
+        uint64_t(std::ceil(double(a) * std::sqrt(double(points) * 1.004 / std::max(t, 1.0)))));
     if (next == a) break;
     a = next;
     countReturns(a);
@@ -154,13 +154,14 @@ void TlsScene::layout(Random& rng) {
   };
   // Scanner stations first, in the open square, so no object is placed over one.
   for (int s = 0; s < 4; ++s) {
-    const double angle = s * kPi / 2 + rng.range(-0.4, 0.4), radius = s == 0 ? rng.range(0, 3) : rng.range(11, 17);
+    const double angle = s * kPi / 2 + rng.range(-0.4, 0.4),
+                 radius = s == 0 ? rng.range(0, 3) : rng.range(11, 17);
     const double x = radius * std::cos(angle), y = radius * std::sin(angle), height = rng.range(1.4, 1.8);
     scanners_.push_back({x, y, groundZ(x, y) + height, height, rng.range(0, 2 * kPi)});
     footprints_.push_back({x - 0.5, y - 0.5, x + 0.5, y + 0.5});
   }
   static const Rgb kFacades[] = {{222, 206, 178}, {198, 120, 92}, {236, 230, 214}, {176, 168, 152},
-                                 {214, 186, 120}, {160, 92, 70}, {190, 200, 206}};
+                                 {214, 186, 120}, {160, 92, 70},  {190, 200, 206}};
   for (int k = 0; k < 12; ++k) { // a ring of houses around the square
     const double angle = k * 2 * kPi / 12 + rng.range(-0.15, 0.15), radius = rng.range(34, 46);
     const double w = rng.range(9, 22), d = rng.range(8, 16), h = rng.range(7, 22);
@@ -177,9 +178,11 @@ void TlsScene::layout(Random& rng) {
     const double hx = alongX ? length / 2 : 0.15, hy = alongX ? 0.15 : length / 2;
     if (!place(cx - hx, cy - hy, cx + hx, cy + hy, 1.5)) continue;
     const double z = groundZ(cx, cy) - 0.3;
-    boxes_.push_back({cx - hx, cy - hy, z, cx + hx, cy + hy, z + 0.3 + rng.range(0.9, 1.3), Kind::Wall, {172, 166, 156}});
+    boxes_.push_back(
+        {cx - hx, cy - hy, z, cx + hx, cy + hy, z + 0.3 + rng.range(0.9, 1.3), Kind::Wall, {172, 166, 156}});
   }
-  static const Rgb kCars[] = {{168, 32, 30}, {32, 64, 140}, {190, 192, 196}, {30, 30, 34}, {236, 236, 232}, {40, 110, 70}};
+  static const Rgb kCars[] = {{168, 32, 30}, {32, 64, 140},   {190, 192, 196},
+                              {30, 30, 34},  {236, 236, 232}, {40, 110, 70}};
   for (int k = 0; k < 10; ++k) { // parked cars
     const double angle = rng.range(0, 2 * kPi), radius = rng.range(8, 29);
     const bool alongX = rng.next() < 0.5;
@@ -187,7 +190,8 @@ void TlsScene::layout(Random& rng) {
     const double hx = alongX ? 2.25 : 0.9, hy = alongX ? 0.9 : 2.25;
     if (!place(cx - hx, cy - hy, cx + hx, cy + hy, 1.2)) continue;
     const double z = groundZ(cx, cy) - 0.1;
-    boxes_.push_back({cx - hx, cy - hy, z + 0.25, cx + hx, cy + hy, z + 1.5, Kind::Car, kCars[boxes_.size() % 6]});
+    boxes_.push_back(
+        {cx - hx, cy - hy, z + 0.25, cx + hx, cy + hy, z + 1.5, Kind::Car, kCars[boxes_.size() % 6]});
   }
   for (int k = 0; k < 28; ++k) { // trees: trunk and crown
     const double angle = rng.range(0, 2 * kPi), radius = rng.range(6, 32);
@@ -210,7 +214,8 @@ void TlsScene::layout(Random& rng) {
 
 // Index range of elevation steps whose angles lie in [lo, hi].
 inline std::pair<int32_t, int32_t> stepRange(double lo, double hi, double step, int32_t steps) {
-  const double k0 = std::ceil((lo - kElevationMin) / step - 0.5), k1 = std::floor((hi - kElevationMin) / step - 0.5);
+  const double k0 = std::ceil((lo - kElevationMin) / step - 0.5),
+               k1 = std::floor((hi - kElevationMin) / step - 0.5);
   return {int32_t(std::max(k0, 0.0)), int32_t(std::min(k1, double(steps - 1)))};
 }
 
@@ -229,14 +234,16 @@ void TlsScene::buildProfile(uint64_t profile, uint64_t azimuthSteps, Profile& p)
   // Ground: a ray at elevation e meets the line z = slope r - height at distance
   // height / (slope cos e - sin e), within kMaxRange iff e <= atan(slope) - asin(height / (R sqrt(1+s^2))).
   const double groundMax =
-      std::atan(p.slope) - std::asin(std::min(1.0, sc.height / (kMaxRange * std::sqrt(1 + p.slope * p.slope))));
+      std::atan(p.slope) -
+      std::asin(std::min(1.0, sc.height / (kMaxRange * std::sqrt(1 + p.slope * p.slope))));
   p.groundLast = stepRange(kElevationMin, groundMax, step, steps).second;
   if (p.groundLast >= 0) p.ranges.push_back({0, p.groundLast});
 
   auto addRect = [&](Kind kind, uint32_t shape, uint8_t face, double r0, double r1, double z0, double z1) {
     const double zlo = z0 - sc.z, zhi = z1 - sc.z;
     const double e[4] = {std::atan2(zlo, r0), std::atan2(zhi, r0), std::atan2(zlo, r1), std::atan2(zhi, r1)};
-    auto [k0, k1] = stepRange(std::min({e[0], e[1], e[2], e[3]}), std::max({e[0], e[1], e[2], e[3]}), step, steps);
+    auto [k0, k1] =
+        stepRange(std::min({e[0], e[1], e[2], e[3]}), std::max({e[0], e[1], e[2], e[3]}), step, steps);
     if (k0 > k1) return;
     Candidate c{};
     c.type = Candidate::Rect;
@@ -293,7 +300,8 @@ void TlsScene::buildProfile(uint64_t profile, uint64_t azimuthSteps, Profile& p)
     // tan(e) = tan(e') b / a, which keeps their order.
     const double zs = zc * a / b, dist = std::sqrt(rc * rc + zs * zs);
     const double centre = std::atan2(zs, rc), half = std::asin(std::min(1.0, a / dist));
-    const double lo = std::atan(std::tan(centre - half) * b / a), hi = std::atan(std::tan(centre + half) * b / a);
+    const double lo = std::atan(std::tan(centre - half) * b / a),
+                 hi = std::atan(std::tan(centre + half) * b / a);
     auto [k0, k1] = stepRange(lo, hi, step, steps);
     if (k0 > k1) continue;
     Candidate c{};
@@ -318,13 +326,13 @@ void TlsScene::buildProfile(uint64_t profile, uint64_t azimuthSteps, Profile& p)
       p.ranges[out++] = p.ranges[k];
   }
   p.ranges.resize(out);
-  for (const auto& r : p.ranges) p.hits += uint64_t(r.second - r.first + 1);
+  for (const auto& r : p.ranges)
+    p.hits += uint64_t(r.second - r.first + 1);
 }
 
 void TlsScene::countReturns(uint64_t azimuthSteps) {
   azimuthSteps_ = azimuthSteps;
   step_ = 2 * kPi / double(azimuthSteps);
-  elevationSteps_ = int32_t((kElevationMax - kElevationMin) / step_);
   const uint64_t profiles = scanners_.size() * azimuthSteps;
   offsets_.assign(profiles + 1, 0);
   parallelBlocks(profiles, 256, [&](uint64_t, uint64_t begin, uint64_t end) {
@@ -334,7 +342,8 @@ void TlsScene::countReturns(uint64_t azimuthSteps) {
       offsets_[k + 1] = p.hits;
     }
   });
-  for (uint64_t k = 0; k < profiles; ++k) offsets_[k + 1] += offsets_[k];
+  for (uint64_t k = 0; k < profiles; ++k)
+    offsets_[k + 1] += offsets_[k];
 }
 
 Rgb TlsScene::shadeHit(const Candidate* c, bool top, const glm::dvec3& p, const glm::dvec3& dir, double t,
@@ -373,14 +382,14 @@ Rgb TlsScene::shadeHit(const Candidate* c, bool top, const glm::dvec3& p, const 
   case Kind::Car: {
     const Box& b = boxes_[c->shape];
     color = p.z > b.z0 + 0.6 * (b.z1 - b.z0) ? Rgb{40, 46, 56} : b.color; // windows above the belt line
-    n = top ? glm::dvec3(0, 0, 1)
+    n = top            ? glm::dvec3(0, 0, 1)
         : c->face == 0 ? glm::dvec3(-glm::sign(dir.x), 0, 0)
                        : glm::dvec3(0, -glm::sign(dir.y), 0);
     break;
   }
   case Kind::Wall:
     color = boxes_[c->shape].color;
-    n = top ? glm::dvec3(0, 0, 1)
+    n = top            ? glm::dvec3(0, 0, 1)
         : c->face == 0 ? glm::dvec3(-glm::sign(dir.x), 0, 0)
                        : glm::dvec3(0, -glm::sign(dir.y), 0);
     break;
@@ -401,8 +410,8 @@ Rgb TlsScene::shadeHit(const Candidate* c, bool top, const glm::dvec3& p, const 
   }
   // Returns weaken with incidence angle and range, as TLS intensity-tinted colors do.
   const double incidence = std::abs(glm::dot(n, dir));
-  const double factor = (0.6 + 0.4 * incidence) * (1.0 - 0.25 * std::min(1.0, t / kMaxRange)) *
-                        (0.92 + 0.16 * unit16(rnd, 0));
+  const double factor =
+      (0.6 + 0.4 * incidence) * (1.0 - 0.25 * std::min(1.0, t / kMaxRange)) * (0.92 + 0.16 * unit16(rnd, 0));
   return color * factor;
 }
 
@@ -438,7 +447,9 @@ void TlsScene::generate(uint64_t first, uint64_t count, int32_t* positions, uint
       double t;
       bool viaTop = false;
       if (c.type == Candidate::Rect) {
-        const double zEnter = se > 0 ? c.zlo / se : se < 0 ? c.zhi / se : -std::numeric_limits<double>::infinity();
+        const double zEnter = se > 0   ? c.zlo / se
+                              : se < 0 ? c.zhi / se
+                                       : -std::numeric_limits<double>::infinity();
         t = std::max(c.r0 / ce, zEnter);
         viaTop = zEnter > c.r0 / ce;
       } else {

@@ -32,7 +32,8 @@ void warn(const std::filesystem::path& path, const std::string& message) {
 
 std::string lowerExtension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (char& c : ext)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext;
 }
 
@@ -184,8 +185,10 @@ Quantization chooseQuantization(const std::filesystem::path& path, const Bounds&
       // The smallest power of ten with extent / scale <= kQuantSteps; log10 only gives the start.
       int k = static_cast<int>(std::ceil(std::log10(extent / kQuantSteps)));
       k = std::clamp(k, -300, 300);
-      while (k > -300 && extent / std::pow(10.0, k - 1) <= kQuantSteps) --k;
-      while (k < 300 && extent / std::pow(10.0, k) > kQuantSteps) ++k;
+      while (k > -300 && extent / std::pow(10.0, k - 1) <= kQuantSteps)
+        --k;
+      while (k < 300 && extent / std::pow(10.0, k) > kQuantSteps)
+        ++k;
       scale = std::pow(10.0, k);
     }
     q.scale[a] = scale;

@@ -31,14 +31,19 @@ template <class T> T loadLE(const uint8_t* p) {
 template <class T> T byteSwap(T v) {
   uint8_t b[sizeof(T)];
   std::memcpy(b, &v, sizeof v);
-  for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+  for (size_t i = 0; i < sizeof(T) / 2; ++i)
+    std::swap(b[i], b[sizeof(T) - 1 - i]);
   std::memcpy(&v, b, sizeof v);
   return v;
 }
 
-template <class T> T loadBE(const uint8_t* p) { return byteSwap(loadLE<T>(p)); }
+template <class T> T loadBE(const uint8_t* p) {
+  return byteSwap(loadLE<T>(p));
+}
 
-template <class T> void storeLE(uint8_t* p, T v) { std::memcpy(p, &v, sizeof v); }
+template <class T> void storeLE(uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof v);
+}
 
 // printf-style message; the InputError helpers below prefix it with the file name.
 std::string strFormat(const char* fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -8,12 +8,14 @@ namespace {
 
 std::string fixedString(const uint8_t* p, size_t n) {
   size_t len = 0;
-  while (len < n && p[len] != 0) ++len;
+  while (len < n && p[len] != 0)
+    ++len;
   std::string s(reinterpret_cast<const char*>(p), len);
   // Display only: keep printable ASCII, so a hostile header cannot put control sequences on a terminal.
   for (char& c : s)
     if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
+  while (!s.empty() && s.back() == ' ')
+    s.pop_back();
   return s;
 }
 
@@ -60,10 +62,10 @@ std::vector<LasVlr> walkVlrs(const InputFile& file, uint64_t start, uint32_t cou
 void failCompressed(const std::filesystem::path& path) {
   std::filesystem::path las = path;
   las.replace_extension(".las");
-  fail(path, strFormat("LAZ/COPC compressed files are not supported yet; decompress with "
-                       "`pdal translate %s %s` or `laszip -i %s -o %s`",
-                       path.string().c_str(), las.string().c_str(), path.string().c_str(),
-                       las.string().c_str()));
+  fail(path,
+       strFormat("LAZ/COPC compressed files are not supported yet; decompress with "
+                 "`pdal translate %s %s` or `laszip -i %s -o %s`",
+                 path.string().c_str(), las.string().c_str(), path.string().c_str(), las.string().c_str()));
 }
 
 bool lasLooksCompressed(const InputFile& file) {
@@ -107,7 +109,8 @@ LasHeader readLasHeader(const InputFile& file) {
   hd.pointFormat = hd.pointFormatByte & ~las::kCompressionBits;
   hd.recordLength = loadLE<uint16_t>(h + las::kRecordLength);
   hd.legacyCount = loadLE<uint32_t>(h + las::kLegacyCount);
-  for (int i = 0; i < 5; ++i) hd.pointsByReturn[i] = loadLE<uint32_t>(h + las::kLegacyByReturn + 4 * i);
+  for (int i = 0; i < 5; ++i)
+    hd.pointsByReturn[i] = loadLE<uint32_t>(h + las::kLegacyByReturn + 4 * i);
   for (int a = 0; a < 3; ++a) {
     hd.scale[a] = loadLE<double>(h + las::kScale + 8 * a);
     hd.offset[a] = loadLE<double>(h + las::kOffset + 8 * a);
@@ -116,8 +119,8 @@ LasHeader readLasHeader(const InputFile& file) {
   }
 
   if (hd.versionMajor != 1 || hd.versionMinor > 4)
-    fail(path, strFormat("LAS version %d.%d is not supported (1.0 to 1.4 are)", hd.versionMajor,
-                         hd.versionMinor));
+    fail(path,
+         strFormat("LAS version %d.%d is not supported (1.0 to 1.4 are)", hd.versionMajor, hd.versionMinor));
   if (hd.headerSize < las::kHeaderSize12)
     fail(path, strFormat("header size %u is smaller than the 227 bytes of a LAS header", hd.headerSize));
   if (hd.headerSize > fileSize)
@@ -134,7 +137,8 @@ LasHeader readLasHeader(const InputFile& file) {
     // the 64-bit field is authoritative. Some 1.4 writers leave it 0 with a legacy count: use that.
     uint64_t count64 = loadLE<uint64_t>(h + las::kCount64);
     if (count64 != 0) hd.pointCount = count64;
-    for (int i = 0; i < 15; ++i) hd.pointsByReturn[i] = loadLE<uint64_t>(h + las::kByReturn64 + 8 * i);
+    for (int i = 0; i < 15; ++i)
+      hd.pointsByReturn[i] = loadLE<uint64_t>(h + las::kByReturn64 + 8 * i);
   }
 
   if (hd.pointOffset < hd.headerSize || hd.pointOffset > fileSize)
@@ -142,7 +146,8 @@ LasHeader readLasHeader(const InputFile& file) {
                          hd.pointOffset, hd.headerSize, static_cast<unsigned long long>(fileSize)));
   hd.vlrs = walkVlrs(file, hd.headerSize, hd.vlrCount, hd.pointOffset, hd.vlrsTruncated);
   hd.compressed = (hd.pointFormatByte & las::kCompressionBits) != 0;
-  for (const LasVlr& vlr : hd.vlrs) hd.compressed = hd.compressed || isCompressionVlr(vlr);
+  for (const LasVlr& vlr : hd.vlrs)
+    hd.compressed = hd.compressed || isCompressionVlr(vlr);
   if (hd.compressed) failCompressed(path);
 
   if (hd.pointFormat > las::kMaxPointFormat)

@@ -23,8 +23,8 @@ inline constexpr int kFileSourceId = 4;
 inline constexpr int kGlobalEncoding = 6;
 inline constexpr int kVersionMajor = 24;
 inline constexpr int kVersionMinor = 25;
-inline constexpr int kSystemId = 26;        // char[32]
-inline constexpr int kSoftware = 58;        // char[32]
+inline constexpr int kSystemId = 26; // char[32]
+inline constexpr int kSoftware = 58; // char[32]
 inline constexpr int kCreationDay = 90;
 inline constexpr int kCreationYear = 92;
 inline constexpr int kHeaderSizeField = 94;
@@ -41,7 +41,7 @@ inline constexpr int kWaveformStart = 227;  // 1.3+
 inline constexpr int kEvlrStart = 235;      // 1.4
 inline constexpr int kEvlrCount = 243;
 inline constexpr int kCount64 = 247;
-inline constexpr int kByReturn64 = 255;     // uint64[15]
+inline constexpr int kByReturn64 = 255; // uint64[15]
 
 // Point data record formats 0-10 (R15 section 2.6). Formats 6-10 ("extended") have 4-bit return
 // numbers, the classification in its own byte at 16 and a 16-bit scan angle.
@@ -49,7 +49,9 @@ inline constexpr int kMaxPointFormat = 10;
 inline constexpr std::array<uint16_t, 11> kRecordSize = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
 // Byte offset of the red/green/blue uint16 triple, or -1 when the format has no color.
 inline constexpr std::array<int, 11> kRgbOffset = {-1, -1, 20, 28, -1, 28, -1, 30, 30, -1, 30};
-inline bool isExtended(int pointFormat) { return pointFormat >= 6; }
+inline bool isExtended(int pointFormat) {
+  return pointFormat >= 6;
+}
 
 // Bits 7 and 6 of the point format byte are set by LASzip in compressed files (the format is the low 6).
 inline constexpr uint8_t kCompressionBits = 0xC0;

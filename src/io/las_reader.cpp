@@ -30,7 +30,7 @@ struct BlockStats {
 
 struct Destination {
   int32_t* positions = nullptr;
-  uint32_t* colors = nullptr; // null: format has no color
+  uint32_t* colors = nullptr;    // null: format has no color
   uint16_t* intensity = nullptr; // these three are null unless attributes are kept
   uint8_t* classification = nullptr;
   uint8_t* returnNumber = nullptr;
@@ -129,6 +129,17 @@ std::string creationDate(const LasHeader& hd) {
   return strFormat("year %u, day %u (not a valid date)", year, day);
 }
 
+// R15 2.4, Table 3 note: global encoding bits.
+std::string describeGlobalEncoding(uint16_t bits) {
+  static const char* const kNames[] = {"GPS standard time", "waveform data internal",
+                                       "waveform data external", "synthetic return numbers", "WKT CRS"};
+  std::string s = std::to_string(bits);
+  std::string names;
+  for (int i = 0; i < 5; ++i)
+    if (bits & (1u << i)) names += strFormat(names.empty() ? "%s" : ", %s", kNames[i]);
+  return names.empty() ? s : s + " (" + names + ")";
+}
+
 } // namespace
 
 PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options) {
@@ -190,7 +201,8 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
       // The first value above 255: the file is 16-bit. Earlier chunks held only values <= 255, which
       // are 0 in 8-bit terms; this chunk is converted again with the 16-bit shift.
       colors16 = true;
-      std::fill(cloud.colors.begin(), cloud.colors.begin() + static_cast<ptrdiff_t>(first), packRgba(0, 0, 0));
+      std::fill(cloud.colors.begin(), cloud.colors.begin() + static_cast<ptrdiff_t>(first),
+                packRgba(0, 0, 0));
       parallelBlocks(count, kBlockPoints, [&](uint64_t, uint64_t begin, uint64_t end) {
         for (uint64_t i = begin; i < end; ++i)
           all.colors[first + i] = packLasColor(records + i * hd.recordLength + rgbOffset, 8);
@@ -210,8 +222,12 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
 
 namespace detail {
 
-void setLasChunkBytes(uint64_t bytes) { gChunkBytes = bytes ? bytes : kDefaultChunkBytes; }
-uint64_t lasChunkBytes() { return gChunkBytes; }
+void setLasChunkBytes(uint64_t bytes) {
+  gChunkBytes = bytes ? bytes : kDefaultChunkBytes;
+}
+uint64_t lasChunkBytes() {
+  return gChunkBytes;
+}
 
 FileInfo probeLas(const std::filesystem::path& path) {
   InputFile file(path);
@@ -249,11 +265,11 @@ FileInfo probeLas(const std::filesystem::path& path) {
     info.colorBits = hi > 255 ? 16 : 8;
     if (hd.pointCount > 0) extra.emplace_back("color values", strFormat("%u .. %u", lo, hi));
   }
-  extra.emplace_back("system identifier", hd.systemId);
-  extra.emplace_back("generating software", hd.software);
+  extra.emplace_back("system identifier", hd.systemId.empty() ? "(empty)" : hd.systemId);
+  extra.emplace_back("generating software", hd.software.empty() ? "(empty)" : hd.software);
   extra.emplace_back("creation date", creationDate(hd));
   extra.emplace_back("file source id", std::to_string(hd.fileSourceId));
-  extra.emplace_back("global encoding", strFormat("%u", hd.globalEncoding));
+  extra.emplace_back("global encoding", describeGlobalEncoding(hd.globalEncoding));
   extra.emplace_back("header size", strFormat("%u B", hd.headerSize));
   extra.emplace_back("offset to point data", strFormat("%u", hd.pointOffset));
   std::string byReturn;
@@ -271,8 +287,8 @@ FileInfo probeLas(const std::filesystem::path& path) {
   if (hd.vlrsTruncated) vlrs += strFormat("; the list runs past the point data, %zu listed", hd.vlrs.size());
   extra.emplace_back("VLRs", vlrs);
   if (hd.versionMinor >= 4)
-    extra.emplace_back("EVLRs", strFormat("%u at offset %llu", hd.evlrCount,
-                                          static_cast<unsigned long long>(hd.evlrStart)));
+    extra.emplace_back(
+        "EVLRs", strFormat("%u at offset %llu", hd.evlrCount, static_cast<unsigned long long>(hd.evlrStart)));
   return info;
 }
 

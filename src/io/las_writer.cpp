@@ -21,9 +21,12 @@ struct FlavorInfo {
 
 FlavorInfo flavorInfo(LasFlavor flavor) {
   switch (flavor) {
-  case LasFlavor::Las12Pf2: return {2, 2, las::kHeaderSize12};
-  case LasFlavor::Las12Pf3: return {2, 3, las::kHeaderSize12};
-  case LasFlavor::Las14Pf7: return {4, 7, las::kHeaderSize14};
+  case LasFlavor::Las12Pf2:
+    return {2, 2, las::kHeaderSize12};
+  case LasFlavor::Las12Pf3:
+    return {2, 3, las::kHeaderSize12};
+  case LasFlavor::Las14Pf7:
+    return {4, 7, las::kHeaderSize14};
   }
   return {2, 3, las::kHeaderSize12};
 }
@@ -65,8 +68,10 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
     if (r >= 1 && r <= (extended ? 15 : 5)) ++byReturn[static_cast<size_t>(r - 1)];
   }
   Bounds bounds;
-  if (n > 0) bounds = boundsFromQuantized(qmin, qmax, cloud.scale, cloud.offset);
-  else bounds.min = bounds.max = glm::dvec3(0);
+  if (n > 0)
+    bounds = boundsFromQuantized(qmin, qmax, cloud.scale, cloud.offset);
+  else
+    bounds.min = bounds.max = glm::dvec3(0);
 
   // Public header block, R15 Table 3 (offsets in las_format.h).
   uint8_t h[las::kHeaderSize14] = {};
@@ -90,7 +95,8 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
   // The legacy count fields stay 0 for formats 6-10 (R15 2.4).
   if (!extended) {
     storeLE<uint32_t>(h + las::kLegacyCount, static_cast<uint32_t>(n));
-    for (int i = 0; i < 5; ++i) storeLE<uint32_t>(h + las::kLegacyByReturn + 4 * i, static_cast<uint32_t>(byReturn[i]));
+    for (int i = 0; i < 5; ++i)
+      storeLE<uint32_t>(h + las::kLegacyByReturn + 4 * i, static_cast<uint32_t>(byReturn[i]));
   }
   for (int a = 0; a < 3; ++a) {
     storeLE<double>(h + las::kScale + 8 * a, cloud.scale[a]);
@@ -100,7 +106,8 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
   }
   if (f.minor >= 4) {
     storeLE<uint64_t>(h + las::kCount64, n);
-    for (int i = 0; i < 15; ++i) storeLE<uint64_t>(h + las::kByReturn64 + 8 * i, byReturn[i]);
+    for (int i = 0; i < 15; ++i)
+      storeLE<uint64_t>(h + las::kByReturn64 + 8 * i, byReturn[i]);
   }
 
   PartialFile out(path);
@@ -112,7 +119,8 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
     for (uint64_t k = 0; k < count; ++k) {
       uint64_t i = first + k;
       uint8_t* r = buffer.data() + k * recordLength;
-      for (int a = 0; a < 3; ++a) storeLE<int32_t>(r + 4 * a, cloud.positions[3 * i + a]);
+      for (int a = 0; a < 3; ++a)
+        storeLE<int32_t>(r + 4 * a, cloud.positions[3 * i + a]);
       storeLE<uint16_t>(r + 12, intensity ? cloud.intensity[i] : 0);
       // Number of returns is not kept by PointCloud; writing it equal to the return number keeps the
       // record valid (return number <= number of returns).

@@ -26,18 +26,24 @@ enum class PlyType : uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float3
 size_t typeSize(PlyType t) {
   switch (t) {
   case PlyType::Int8:
-  case PlyType::UInt8: return 1;
+  case PlyType::UInt8:
+    return 1;
   case PlyType::Int16:
-  case PlyType::UInt16: return 2;
+  case PlyType::UInt16:
+    return 2;
   case PlyType::Int32:
   case PlyType::UInt32:
-  case PlyType::Float32: return 4;
-  case PlyType::Float64: return 8;
+  case PlyType::Float32:
+    return 4;
+  case PlyType::Float64:
+    return 8;
   }
   return 0;
 }
 
-bool isFloatType(PlyType t) { return t == PlyType::Float32 || t == PlyType::Float64; }
+bool isFloatType(PlyType t) {
+  return t == PlyType::Float32 || t == PlyType::Float64;
+}
 
 std::optional<PlyType> parseType(std::string_view s) {
   // The original names and the sized aliases (int8 ... float64) used by VTK, Open3D and others.
@@ -57,18 +63,28 @@ const char* typeName(PlyType t) {
   return kNames[static_cast<int>(t)];
 }
 
-template <class T> T loadAs(const uint8_t* p, bool bigEndian) { return bigEndian ? loadBE<T>(p) : loadLE<T>(p); }
+template <class T> T loadAs(const uint8_t* p, bool bigEndian) {
+  return bigEndian ? loadBE<T>(p) : loadLE<T>(p);
+}
 
 double decode(const uint8_t* p, PlyType t, bool bigEndian) {
   switch (t) {
-  case PlyType::Int8: return static_cast<int8_t>(p[0]);
-  case PlyType::UInt8: return p[0];
-  case PlyType::Int16: return loadAs<int16_t>(p, bigEndian);
-  case PlyType::UInt16: return loadAs<uint16_t>(p, bigEndian);
-  case PlyType::Int32: return loadAs<int32_t>(p, bigEndian);
-  case PlyType::UInt32: return loadAs<uint32_t>(p, bigEndian);
-  case PlyType::Float32: return loadAs<float>(p, bigEndian);
-  case PlyType::Float64: return loadAs<double>(p, bigEndian);
+  case PlyType::Int8:
+    return static_cast<int8_t>(p[0]);
+  case PlyType::UInt8:
+    return p[0];
+  case PlyType::Int16:
+    return loadAs<int16_t>(p, bigEndian);
+  case PlyType::UInt16:
+    return loadAs<uint16_t>(p, bigEndian);
+  case PlyType::Int32:
+    return loadAs<int32_t>(p, bigEndian);
+  case PlyType::UInt32:
+    return loadAs<uint32_t>(p, bigEndian);
+  case PlyType::Float32:
+    return loadAs<float>(p, bigEndian);
+  case PlyType::Float64:
+    return loadAs<double>(p, bigEndian);
   }
   return 0;
 }
@@ -76,13 +92,20 @@ double decode(const uint8_t* p, PlyType t, bool bigEndian) {
 // A list count as stored in binary; negative counts (signed count types) are refused by the caller.
 int64_t decodeCount(const uint8_t* p, PlyType t, bool bigEndian) {
   switch (t) {
-  case PlyType::Int8: return static_cast<int8_t>(p[0]);
-  case PlyType::UInt8: return p[0];
-  case PlyType::Int16: return loadAs<int16_t>(p, bigEndian);
-  case PlyType::UInt16: return loadAs<uint16_t>(p, bigEndian);
-  case PlyType::Int32: return loadAs<int32_t>(p, bigEndian);
-  case PlyType::UInt32: return loadAs<uint32_t>(p, bigEndian);
-  default: return -1;
+  case PlyType::Int8:
+    return static_cast<int8_t>(p[0]);
+  case PlyType::UInt8:
+    return p[0];
+  case PlyType::Int16:
+    return loadAs<int16_t>(p, bigEndian);
+  case PlyType::UInt16:
+    return loadAs<uint16_t>(p, bigEndian);
+  case PlyType::Int32:
+    return loadAs<int32_t>(p, bigEndian);
+  case PlyType::UInt32:
+    return loadAs<uint32_t>(p, bigEndian);
+  default:
+    return -1;
   }
 }
 
@@ -106,7 +129,8 @@ struct PlyElement {
   // Bytes per row in binary, for elements without lists.
   uint64_t rowSize() const {
     uint64_t size = 0;
-    for (const auto& p : properties) size += typeSize(p.type);
+    for (const auto& p : properties)
+      size += typeSize(p.type);
     return size;
   }
 };
@@ -119,22 +143,26 @@ struct PlyHeader {
   std::vector<PlyElement> elements;
   std::vector<std::string> comments;
   uint64_t dataOffset = 0;
-  size_t vertex = 0;          // index of the vertex element
-  int xyz[3] = {-1, -1, -1};  // property indices within the vertex element
-  int rgb[3] = {-1, -1, -1};  // -1: no color
+  size_t vertex = 0;         // index of the vertex element
+  int xyz[3] = {-1, -1, -1}; // property indices within the vertex element
+  int rgb[3] = {-1, -1, -1}; // -1: no color
   bool hasColor() const { return rgb[0] >= 0; }
   const PlyElement& vertexElement() const { return elements[vertex]; }
 };
 
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool isBlank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
 
 std::vector<std::string_view> splitWords(std::string_view line) {
   std::vector<std::string_view> words;
   size_t i = 0;
   while (i < line.size()) {
-    while (i < line.size() && isBlank(line[i])) ++i;
+    while (i < line.size() && isBlank(line[i]))
+      ++i;
     size_t start = i;
-    while (i < line.size() && !isBlank(line[i])) ++i;
+    while (i < line.size() && !isBlank(line[i]))
+      ++i;
     if (i > start) words.push_back(line.substr(start, i - start));
   }
   return words;
@@ -145,8 +173,9 @@ bool parseUint(std::string_view s, uint64_t& v) {
   return ec == std::errc() && end == s.data() + s.size();
 }
 
-std::string printable(std::string_view s) {
-  std::string out(s.substr(0, 40));
+// s made safe for a terminal (printable ASCII), cut to max characters.
+std::string printable(std::string_view s, size_t max = 40) {
+  std::string out(s.substr(0, max));
   for (char& c : out)
     if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
   return out;
@@ -165,7 +194,8 @@ PlyHeader readPlyHeader(const InputFile& file) {
     while ((at = text.find("end_header", at)) != std::string::npos) {
       // Must be a line of its own: preceded by a newline, followed by optional blanks and a newline.
       size_t after = at + 10;
-      while (after < text.size() && (text[after] == ' ' || text[after] == '\t' || text[after] == '\r')) ++after;
+      while (after < text.size() && (text[after] == ' ' || text[after] == '\t' || text[after] == '\r'))
+        ++after;
       if (at > 0 && text[at - 1] == '\n' && after < text.size() && text[after] == '\n') {
         headerEnd = after + 1;
         break;
@@ -201,10 +231,13 @@ PlyHeader readPlyHeader(const InputFile& file) {
     std::string_view key = words[0];
     if (key == "comment" || key == "obj_info") {
       size_t start = line.find(key) + key.size();
-      while (start < line.size() && isBlank(line[start])) ++start;
+      while (start < line.size() && isBlank(line[start]))
+        ++start;
       std::string_view rest = line.substr(start);
-      while (!rest.empty() && isBlank(rest.back())) rest.remove_suffix(1);
-      if (h.comments.size() < 16) h.comments.push_back(printable(rest) + (rest.size() > 40 ? "..." : ""));
+      while (!rest.empty() && isBlank(rest.back()))
+        rest.remove_suffix(1);
+      if (h.comments.size() < 16)
+        h.comments.push_back(printable(rest, 200) + (rest.size() > 200 ? "..." : ""));
     } else if (key == "format") {
       if (haveFormat || words.size() != 3) bad("expected one 'format <encoding> 1.0' line");
       if (words[1] == "ascii")
@@ -261,9 +294,8 @@ PlyHeader readPlyHeader(const InputFile& file) {
   if (!found) fail(path, "the PLY file has no vertex element");
   const auto& props = h.vertexElement().properties;
   static const char* const kXyz[3] = {"x", "y", "z"};
-  static const char* const kRgb[3][3] = {{"red", "r", "diffuse_red"},
-                                         {"green", "g", "diffuse_green"},
-                                         {"blue", "b", "diffuse_blue"}};
+  static const char* const kRgb[3][3] = {
+      {"red", "r", "diffuse_red"}, {"green", "g", "diffuse_green"}, {"blue", "b", "diffuse_blue"}};
   for (size_t i = 0; i < props.size(); ++i) {
     for (int a = 0; a < 3; ++a) {
       if (props[i].name == kXyz[a] && h.xyz[a] < 0) {
@@ -283,7 +315,8 @@ PlyHeader readPlyHeader(const InputFile& file) {
 // ---- binary --------------------------------------------------------------------------------------
 
 // Skips one row of an element with lists.
-void skipBinaryRow(BufferedReader& in, const PlyElement& e, bool bigEndian, const std::filesystem::path& path) {
+void skipBinaryRow(BufferedReader& in, const PlyElement& e, bool bigEndian,
+                   const std::filesystem::path& path) {
   for (const auto& p : e.properties) {
     if (!p.isList) {
       in.skip(typeSize(p.type), "a PLY element");
@@ -292,23 +325,28 @@ void skipBinaryRow(BufferedReader& in, const PlyElement& e, bool bigEndian, cons
     size_t cs = typeSize(p.countType);
     int64_t n = decodeCount(in.require(cs, "a PLY list count"), p.countType, bigEndian);
     in.consume(cs);
-    if (n < 0) fail(path, strFormat("negative list length %lld in element %s", static_cast<long long>(n), e.name.c_str()));
+    if (n < 0)
+      fail(path,
+           strFormat("negative list length %lld in element %s", static_cast<long long>(n), e.name.c_str()));
     in.skip(static_cast<uint64_t>(n) * typeSize(p.type), "a PLY list");
   }
 }
 
-void skipBinaryElement(BufferedReader& in, const PlyElement& e, bool bigEndian, const std::filesystem::path& path) {
+void skipBinaryElement(BufferedReader& in, const PlyElement& e, bool bigEndian,
+                       const std::filesystem::path& path) {
   if (!e.hasLists()) {
     uint64_t row = e.rowSize();
     if (row && e.count > in.remaining() / row)
-      fail(path, strFormat("header claims %llu %s elements of %llu bytes but only %llu bytes follow",
-                           static_cast<unsigned long long>(e.count), e.name.c_str(),
-                           static_cast<unsigned long long>(row), static_cast<unsigned long long>(in.remaining())));
+      fail(path,
+           strFormat("header claims %llu %s elements of %llu bytes but only %llu bytes follow",
+                     static_cast<unsigned long long>(e.count), e.name.c_str(),
+                     static_cast<unsigned long long>(row), static_cast<unsigned long long>(in.remaining())));
     in.skip(e.count * row, "a PLY element");
     return;
   }
   // Each row with a list takes at least one byte, so this loop ends at the end of the file at worst.
-  for (uint64_t i = 0; i < e.count; ++i) skipBinaryRow(in, e, bigEndian, path);
+  for (uint64_t i = 0; i < e.count; ++i)
+    skipBinaryRow(in, e, bigEndian, path);
 }
 
 struct Vertex {
@@ -322,7 +360,8 @@ void forEachBinaryVertex(const InputFile& file, const PlyHeader& h, Progress* pr
   const auto& path = file.path();
   const bool be = h.encoding == PlyEncoding::BinaryBE;
   BufferedReader in(file, h.dataOffset);
-  for (size_t i = 0; i < h.vertex; ++i) skipBinaryElement(in, h.elements[i], be, path);
+  for (size_t i = 0; i < h.vertex; ++i)
+    skipBinaryElement(in, h.elements[i], be, path);
   const PlyElement& ve = h.vertexElement();
   const auto& props = ve.properties;
   Vertex v{};
@@ -338,7 +377,8 @@ void forEachBinaryVertex(const InputFile& file, const PlyHeader& h, Progress* pr
     int slots = h.hasColor() ? 6 : 3;
     for (int s = 0; s < slots; ++s) {
       int prop = s < 3 ? h.xyz[s] : h.rgb[s - 3];
-      for (int j = 0; j < prop; ++j) offsets[s] += typeSize(props[static_cast<size_t>(j)].type);
+      for (int j = 0; j < prop; ++j)
+        offsets[s] += typeSize(props[static_cast<size_t>(j)].type);
       types[s] = props[static_cast<size_t>(prop)].type;
     }
     const uint64_t batchRows = std::max<uint64_t>(1, (uint64_t(4) << 20) / row);
@@ -346,8 +386,10 @@ void forEachBinaryVertex(const InputFile& file, const PlyHeader& h, Progress* pr
       uint64_t rows = std::min(batchRows, ve.count - done);
       const uint8_t* p = in.require(static_cast<size_t>(rows * row), "the PLY vertex data");
       for (uint64_t r = 0; r < rows; ++r, p += row) {
-        for (int s = 0; s < 3; ++s) v.xyz[s] = decode(p + offsets[s], types[s], be);
-        for (int s = 3; s < slots; ++s) v.rgb[s - 3] = decode(p + offsets[s], types[s], be);
+        for (int s = 0; s < 3; ++s)
+          v.xyz[s] = decode(p + offsets[s], types[s], be);
+        for (int s = 3; s < slots; ++s)
+          v.rgb[s - 3] = decode(p + offsets[s], types[s], be);
         fn(v);
       }
       in.consume(static_cast<size_t>(rows * row));
@@ -365,8 +407,9 @@ void forEachBinaryVertex(const InputFile& file, const PlyHeader& h, Progress* pr
         size_t cs = typeSize(p.countType);
         int64_t n = decodeCount(in.require(cs, "a PLY list count"), p.countType, be);
         in.consume(cs);
-        if (n < 0) fail(path, strFormat("negative list length %lld in vertex %llu", static_cast<long long>(n),
-                                        static_cast<unsigned long long>(i)));
+        if (n < 0)
+          fail(path, strFormat("negative list length %lld in vertex %llu", static_cast<long long>(n),
+                               static_cast<unsigned long long>(i)));
         in.skip(static_cast<uint64_t>(n) * typeSize(p.type), "a PLY list");
         continue;
       }
@@ -401,8 +444,10 @@ public:
     size_t avail = in_.fill(kMaxTokenBytes + 1);
     const char* p = reinterpret_cast<const char*>(in_.data());
     size_t len = 0;
-    while (len < avail && !isBlank(p[len]) && p[len] != '\n') ++len;
-    if (len > kMaxTokenBytes) fail(path_, strFormat("line %llu: a value longer than %zu characters", line(), kMaxTokenBytes));
+    while (len < avail && !isBlank(p[len]) && p[len] != '\n')
+      ++len;
+    if (len > kMaxTokenBytes)
+      fail(path_, strFormat("line %llu: a value longer than %zu characters", line(), kMaxTokenBytes));
     token = std::string_view(p, len);
     in_.consume(len);
     return true;
@@ -441,7 +486,8 @@ Staged readAsciiVertices(const InputFile& file, const PlyHeader& h, Progress* pr
   {
     std::string head(static_cast<size_t>(h.dataOffset), '\0');
     file.readAt(0, head.data(), head.size());
-    for (char c : head) headerLines += c == '\n';
+    for (char c : head)
+      headerLines += c == '\n';
   }
   Tokens tokens(in, path, headerLines + 1);
   std::string_view t;
@@ -458,8 +504,10 @@ Staged readAsciiVertices(const InputFile& file, const PlyHeader& h, Progress* pr
         if (!p.isList) continue;
         uint64_t n = 0;
         if (!parseUint(t, n))
-          fail(path, strFormat("line %llu: list length '%s' is not a count", tokens.line(), printable(t).c_str()));
-        for (uint64_t k = 0; k < n; ++k) need(e.name.c_str(), r, e.count);
+          fail(path,
+               strFormat("line %llu: list length '%s' is not a count", tokens.line(), printable(t).c_str()));
+        for (uint64_t k = 0; k < n; ++k)
+          need(e.name.c_str(), r, e.count);
       }
   }
   const PlyElement& ve = h.vertexElement();
@@ -479,8 +527,10 @@ Staged readAsciiVertices(const InputFile& file, const PlyHeader& h, Progress* pr
       if (p.isList) {
         uint64_t n = 0;
         if (!parseUint(t, n))
-          fail(path, strFormat("line %llu: list length '%s' is not a count", tokens.line(), printable(t).c_str()));
-        for (uint64_t k = 0; k < n; ++k) need("vertex", r, ve.count);
+          fail(path,
+               strFormat("line %llu: list length '%s' is not a count", tokens.line(), printable(t).c_str()));
+        for (uint64_t k = 0; k < n; ++k)
+          need("vertex", r, ve.count);
         continue;
       }
       int slot = -1;
@@ -513,7 +563,8 @@ Staged readAsciiVertices(const InputFile& file, const PlyHeader& h, Progress* pr
 std::string describeElements(const PlyHeader& h) {
   std::string s;
   for (const auto& e : h.elements)
-    s += strFormat(s.empty() ? "%s %llu" : ", %s %llu", e.name.c_str(), static_cast<unsigned long long>(e.count));
+    s += strFormat(s.empty() ? "%s %llu" : ", %s %llu", e.name.c_str(),
+                   static_cast<unsigned long long>(e.count));
   return s;
 }
 
@@ -577,17 +628,20 @@ PointCloud readPly(const std::filesystem::path& path, const ReadOptions& options
     if (progress) progress->finish();
     warnDropped(path, s.dropped);
     const uint64_t n = s.xyz.size() / 3;
-    for (uint64_t i = 0; i < n; ++i) cloud.bounds.expand(glm::dvec3(s.xyz[3 * i], s.xyz[3 * i + 1], s.xyz[3 * i + 2]));
+    for (uint64_t i = 0; i < n; ++i)
+      cloud.bounds.expand(glm::dvec3(s.xyz[3 * i], s.xyz[3 * i + 1], s.xyz[3 * i + 2]));
     Quantization q = chooseQuantization(path, cloud.bounds);
     cloud.scale = q.scale;
     cloud.offset = q.offset;
     cloud.positions.resize(3 * n);
-    for (uint64_t i = 0; i < 3 * n; ++i) cloud.positions[i] = quantize(s.xyz[i], q.scale[i % 3], q.offset[i % 3]);
+    for (uint64_t i = 0; i < 3 * n; ++i)
+      cloud.positions[i] = quantize(s.xyz[i], q.scale[i % 3], q.offset[i % 3]);
     if (color) {
       cloud.colors.resize(n);
       for (uint64_t i = 0; i < n; ++i)
-        cloud.colors[i] = packRgba(convertColor(s.rgb[3 * i], s.colorRule), convertColor(s.rgb[3 * i + 1], s.colorRule),
-                                   convertColor(s.rgb[3 * i + 2], s.colorRule));
+        cloud.colors[i] =
+            packRgba(convertColor(s.rgb[3 * i], s.colorRule), convertColor(s.rgb[3 * i + 1], s.colorRule),
+                     convertColor(s.rgb[3 * i + 2], s.colorRule));
     }
   } else {
     if (options.progress) progress.emplace("reading " + path.filename().string(), 2 * dataBytes, "B");
@@ -604,10 +658,12 @@ PointCloud readPly(const std::filesystem::path& path, const ReadOptions& options
     forEachBinaryVertex(file, h, p, [&](const Vertex& v) {
       if (!std::isfinite(v.xyz[0]) || !std::isfinite(v.xyz[1]) || !std::isfinite(v.xyz[2])) return;
       if (i == scan.finite) fail(path, "the file changed while it was read");
-      for (int a = 0; a < 3; ++a) cloud.positions[3 * i + a] = quantize(v.xyz[a], q.scale[a], q.offset[a]);
+      for (int a = 0; a < 3; ++a)
+        cloud.positions[3 * i + a] = quantize(v.xyz[a], q.scale[a], q.offset[a]);
       if (color)
-        cloud.colors[i] = packRgba(convertColor(v.rgb[0], scan.colorRule), convertColor(v.rgb[1], scan.colorRule),
-                                   convertColor(v.rgb[2], scan.colorRule));
+        cloud.colors[i] =
+            packRgba(convertColor(v.rgb[0], scan.colorRule), convertColor(v.rgb[1], scan.colorRule),
+                     convertColor(v.rgb[2], scan.colorRule));
       ++i;
     });
     if (progress) progress->finish();
@@ -640,7 +696,8 @@ FileInfo probePly(const std::filesystem::path& path) {
   uint64_t dropped = 0;
   if (h.encoding == PlyEncoding::Ascii) {
     Staged s = readAsciiVertices(file, h, nullptr);
-    for (size_t i = 0; i + 2 < s.xyz.size(); i += 3) info.bounds.expand(glm::dvec3(s.xyz[i], s.xyz[i + 1], s.xyz[i + 2]));
+    for (size_t i = 0; i + 2 < s.xyz.size(); i += 3)
+      info.bounds.expand(glm::dvec3(s.xyz[i], s.xyz[i + 1], s.xyz[i + 2]));
     info.colorBits = info.hasColor ? s.colorRule.bits() : 0;
     dropped = s.dropped;
   } else {
@@ -651,9 +708,14 @@ FileInfo probePly(const std::filesystem::path& path) {
   }
   info.extra.emplace_back("elements", describeElements(h));
   info.extra.emplace_back("vertex properties", describeVertex(h));
-  for (const auto& c : h.comments) info.extra.emplace_back("comment", c);
-  if (dropped)
-    info.extra.emplace_back("dropped (NaN/Inf)", std::to_string(dropped) + " vertices");
+  // One key (extra is shown as a JSON object too, where keys must be unique).
+  std::string comments;
+  for (const auto& c : h.comments) {
+    if (!comments.empty()) comments += " | ";
+    comments += c;
+  }
+  if (!comments.empty()) info.extra.emplace_back("comments", comments);
+  if (dropped) info.extra.emplace_back("dropped (NaN/Inf)", std::to_string(dropped) + " vertices");
   return info;
 }
 

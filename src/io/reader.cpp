@@ -12,12 +12,18 @@ using namespace detail;
 
 const char* formatName(Format format) {
   switch (format) {
-  case Format::Las: return "LAS";
-  case Format::Laz: return "LAZ";
-  case Format::Ply: return "PLY";
-  case Format::Xyz: return "XYZ";
-  case Format::Mmpld: return "MMPLD";
-  case Format::Unknown: break;
+  case Format::Las:
+    return "LAS";
+  case Format::Laz:
+    return "LAZ";
+  case Format::Ply:
+    return "PLY";
+  case Format::Xyz:
+    return "XYZ";
+  case Format::Mmpld:
+    return "MMPLD";
+  case Format::Unknown:
+    break;
   }
   return "unknown";
 }
@@ -26,7 +32,8 @@ Format detectFormat(const std::filesystem::path& path) {
   InputFile file(path);
   uint8_t magic[8] = {};
   size_t got = file.readSome(0, magic, sizeof magic);
-  if (got >= 4 && std::memcmp(magic, "LASF", 4) == 0) return lasLooksCompressed(file) ? Format::Laz : Format::Las;
+  if (got >= 4 && std::memcmp(magic, "LASF", 4) == 0)
+    return lasLooksCompressed(file) ? Format::Laz : Format::Las;
   // "ply" ends its own line (PLY header, first line); trailing spaces and CR LF are tolerated.
   if (got >= 4 && std::memcmp(magic, "ply", 3) == 0 &&
       (magic[3] == '\n' || magic[3] == '\r' || magic[3] == ' ' || magic[3] == '\t'))
@@ -52,20 +59,28 @@ namespace {
 PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& options) {
   Format format = detectFormat(path);
   switch (format) {
-  case Format::Las: return readLas(path, options);
-  case Format::Ply: return readPly(path, options);
-  case Format::Xyz: return readXyz(path, options);
-  default: failUnreadable(path, format);
+  case Format::Las:
+    return readLas(path, options);
+  case Format::Ply:
+    return readPly(path, options);
+  case Format::Xyz:
+    return readXyz(path, options);
+  default:
+    failUnreadable(path, format);
   }
 }
 
 FileInfo probeFile(const std::filesystem::path& path) {
   Format format = detectFormat(path);
   switch (format) {
-  case Format::Las: return probeLas(path);
-  case Format::Ply: return probePly(path);
-  case Format::Xyz: return probeXyz(path);
-  default: failUnreadable(path, format);
+  case Format::Las:
+    return probeLas(path);
+  case Format::Ply:
+    return probePly(path);
+  case Format::Xyz:
+    return probeXyz(path);
+  default:
+    failUnreadable(path, format);
   }
 }
 

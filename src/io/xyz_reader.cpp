@@ -39,7 +39,9 @@ struct XyzData {
   uint64_t lines = 0;
 };
 
-bool isSeparator(char c) { return c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r' || c == '\v' || c == '\f'; }
+bool isSeparator(char c) {
+  return c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r' || c == '\v' || c == '\f';
+}
 
 bool parseDouble(std::string_view t, double& v) {
   const char* b = t.data();
@@ -57,7 +59,9 @@ bool isInteger(std::string_view t) {
   return true;
 }
 
-bool looksFloat(std::string_view t) { return t.find_first_of(".eE") != std::string_view::npos; }
+bool looksFloat(std::string_view t) {
+  return t.find_first_of(".eE") != std::string_view::npos;
+}
 
 std::string printable(std::string_view s) {
   std::string out(s.substr(0, 40));
@@ -105,9 +109,11 @@ XyzData parseXyz(const InputFile& file, Progress* progress) {
 
     tokens.clear();
     for (size_t i = 0; i < line.size();) {
-      while (i < line.size() && isSeparator(line[i])) ++i;
+      while (i < line.size() && isSeparator(line[i]))
+        ++i;
       size_t start = i;
-      while (i < line.size() && !isSeparator(line[i])) ++i;
+      while (i < line.size() && !isSeparator(line[i]))
+        ++i;
       if (i > start) tokens.push_back(line.substr(start, i - start));
     }
     if (tokens.empty()) continue;
@@ -131,8 +137,9 @@ XyzData parseXyz(const InputFile& file, Progress* progress) {
       if (d.columns == 6) d.rgbColumn = 3;
       if (d.columns == 7) d.rgbColumn = 4;
     } else if (static_cast<int>(tokens.size()) != d.columns) {
-      fail(path, strFormat("line %llu has %zu values, but line %llu has %d", static_cast<unsigned long long>(lineNo),
-                           tokens.size(), static_cast<unsigned long long>(firstDataLine), d.columns));
+      fail(path, strFormat("line %llu has %zu values, but line %llu has %d",
+                           static_cast<unsigned long long>(lineNo), tokens.size(),
+                           static_cast<unsigned long long>(firstDataLine), d.columns));
     }
     double v[7];
     auto number = [&](int column) {
@@ -141,10 +148,12 @@ XyzData parseXyz(const InputFile& file, Progress* progress) {
         fail(path, strFormat("line %llu: '%s' is not a number", static_cast<unsigned long long>(lineNo),
                              printable(t).c_str()));
     };
-    for (int c = 0; c < 3; ++c) number(c);
+    for (int c = 0; c < 3; ++c)
+      number(c);
     if (d.intensityColumn >= 0) number(d.intensityColumn);
     if (d.rgbColumn >= 0)
-      for (int c = 0; c < 3; ++c) number(d.rgbColumn + c);
+      for (int c = 0; c < 3; ++c)
+        number(d.rgbColumn + c);
     ++d.lines;
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
       ++d.dropped;
@@ -174,11 +183,16 @@ XyzData parseXyz(const InputFile& file, Progress* progress) {
 
 const char* describeColumns(int columns) {
   switch (columns) {
-  case 3: return "x y z";
-  case 4: return "x y z intensity";
-  case 6: return "x y z r g b";
-  case 7: return "x y z intensity r g b";
-  default: return "x y z + ignored columns";
+  case 3:
+    return "x y z";
+  case 4:
+    return "x y z intensity";
+  case 6:
+    return "x y z r g b";
+  case 7:
+    return "x y z intensity r g b";
+  default:
+    return "x y z + ignored columns";
   }
 }
 
@@ -195,7 +209,8 @@ PointCloud readXyz(const std::filesystem::path& path, const ReadOptions& options
   cloud.source = path.filename().string();
   const uint64_t n = d.xyz.size() / 3;
   Bounds raw;
-  for (uint64_t i = 0; i < n; ++i) raw.expand(glm::dvec3(d.xyz[3 * i], d.xyz[3 * i + 1], d.xyz[3 * i + 2]));
+  for (uint64_t i = 0; i < n; ++i)
+    raw.expand(glm::dvec3(d.xyz[3 * i], d.xyz[3 * i + 1], d.xyz[3 * i + 2]));
   Quantization q = chooseQuantization(path, raw);
   cloud.scale = q.scale;
   cloud.offset = q.offset;
@@ -211,14 +226,16 @@ PointCloud readXyz(const std::filesystem::path& path, const ReadOptions& options
   if (d.rgbColumn >= 0) {
     cloud.colors.resize(n);
     for (uint64_t i = 0; i < n; ++i)
-      cloud.colors[i] = packRgba(convertColor(d.rgb[3 * i], d.colorRule), convertColor(d.rgb[3 * i + 1], d.colorRule),
-                                 convertColor(d.rgb[3 * i + 2], d.colorRule));
+      cloud.colors[i] =
+          packRgba(convertColor(d.rgb[3 * i], d.colorRule), convertColor(d.rgb[3 * i + 1], d.colorRule),
+                   convertColor(d.rgb[3 * i + 2], d.colorRule));
   }
   if (d.intensityColumn >= 0 && options.keepAttributes) {
     cloud.intensity.resize(n);
     const double shift = d.negativeIntensity ? 2048.0 : 0.0;
     for (uint64_t i = 0; i < n; ++i)
-      cloud.intensity[i] = static_cast<uint16_t>(std::clamp(std::nearbyint(d.intensity[i] + shift), 0.0, 65535.0));
+      cloud.intensity[i] =
+          static_cast<uint16_t>(std::clamp(std::nearbyint(d.intensity[i] + shift), 0.0, 65535.0));
   }
   return cloud;
 }
@@ -232,14 +249,16 @@ FileInfo probeXyz(const std::filesystem::path& path) {
   info.format = Format::Xyz;
   info.formatDetail = strFormat("XYZ text, %d columns (%s)", d.columns, describeColumns(d.columns));
   info.pointCount = d.xyz.size() / 3;
-  for (size_t i = 0; i + 2 < d.xyz.size(); i += 3) info.bounds.expand(glm::dvec3(d.xyz[i], d.xyz[i + 1], d.xyz[i + 2]));
+  for (size_t i = 0; i + 2 < d.xyz.size(); i += 3)
+    info.bounds.expand(glm::dvec3(d.xyz[i], d.xyz[i + 1], d.xyz[i + 2]));
   info.hasColor = d.rgbColumn >= 0;
   info.colorBits = info.hasColor ? d.colorRule.bits() : 0;
   info.extra.emplace_back("point lines", std::to_string(d.lines));
   if (d.countLine) info.extra.emplace_back("PTS count line", "yes (skipped)");
   if (d.headerLine) info.extra.emplace_back("header line", "yes (skipped)");
   if (info.hasColor)
-    info.extra.emplace_back("color encoding", d.colorRule.isFloat && d.colorRule.max <= 1.0 ? "float 0..1" : "integer");
+    info.extra.emplace_back("color encoding",
+                            d.colorRule.isFloat && d.colorRule.max <= 1.0 ? "float 0..1" : "integer");
   if (d.intensityColumn >= 0)
     info.extra.emplace_back("intensity", d.negativeIntensity ? "signed (PTS), stored + 2048" : "unsigned");
   if (d.dropped) info.extra.emplace_back("dropped (NaN/Inf)", std::to_string(d.dropped) + " points");

@@ -67,6 +67,9 @@ void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize,
   }
 }
 
+// int40 steps per unit of depth so that 2^40 - 1 steps span [0, farthest bounds corner from the eye].
+double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera);
+
 // The resolve push for the shared targets; words are captured when settings ask for them.
 shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer, uint32_t groupSize);
 

@@ -76,6 +76,20 @@ shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint
   return push;
 }
 
+double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera) {
+  double farthest = 0;
+  for (const GpuScene* scene : scenes) {
+    const Bounds& b = scene->bounds();
+    if (b.empty()) continue;
+    for (int i = 0; i < 8; ++i) {
+      glm::dvec3 corner{i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z};
+      farthest = std::max(farthest, glm::length(corner - camera.eye));
+    }
+  }
+  // The linear depth of a point never exceeds its distance from the eye; 1 % headroom for rounding.
+  return double(shared::kInt40MaxDepth) / std::max(farthest * 1.01, 1e-9);
+}
+
 bool Renderer::supports(gpu::Context& context, Method method, std::string* why) {
   const gpu::DeviceFeatures& f = context.features();
   std::string reason;
@@ -149,11 +163,13 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
     glm::dmat4 vp = viewProjection(camera, scenes[s]->origin(), aspect);
     std::memcpy(static_cast<char*>(t.matrices.mapped()) + s * sizeof(glm::dmat4), &vp, sizeof vp);
   }
+  RenderSettings effective = settings;
+  if (effective.depth == DepthMode::Int40 && effective.depthScale <= 0) effective.depthScale = int40Scale(scenes, camera);
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
-    Frame frame{cmd, scenes, camera, settings};
+    Frame frame{cmd, scenes, camera, effective};
     for (uint32_t w = 0; w < settings.warmup; ++w) m.recordFrame(frame, t);
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);

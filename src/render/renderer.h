@@ -57,7 +57,9 @@ const char* depthModeName(DepthMode mode);
 struct RenderSettings {
   Method method = Method::AtomicMin;
   DepthMode depth = DepthMode::Float;
-  double depthScale = 1000.0;        // int40: steps per unit of linear depth (1000: millimetres for metres)
+  // int40: integer steps per unit of linear depth. 0 (default): the 40 bits span [0, distance from the
+  // eye to the farthest corner of the scene bounds], e.g. 9 nm per step for a scene 10 km deep.
+  double depthScale = 0.0;
   uint32_t background = 0xFF000000u; // RGBA8, opaque black
   uint32_t frames = 1;               // timed frames; the median is reported
   uint32_t warmup = 1;               // untimed frames first (pipeline caches, clocks)

@@ -19,7 +19,8 @@ void expectTiling(const PointCloud& cloud, uint64_t batchSize) {
       ASSERT_EQ(b.count, batchSize);
     }
     Bounds tight;
-    for (uint64_t i = b.first; i < b.first + b.count; ++i) tight.expand(cloud.world(i));
+    for (uint64_t i = b.first; i < b.first + b.count; ++i)
+      tight.expand(cloud.world(i));
     ASSERT_EQ(b.bounds.min, tight.min); // exact, not merely containing
     ASSERT_EQ(b.bounds.max, tight.max);
     next += b.count;

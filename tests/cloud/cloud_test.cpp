@@ -12,7 +12,8 @@ namespace {
 
 Bounds serialBounds(const PointCloud& cloud) {
   Bounds b;
-  for (uint64_t i = 0; i < cloud.size(); ++i) b.expand(cloud.world(i));
+  for (uint64_t i = 0; i < cloud.size(); ++i)
+    b.expand(cloud.world(i));
   return b;
 }
 
@@ -56,7 +57,8 @@ TEST(ToRelativeFloat, IsOneFloatRoundingOfTheDoubleDifference) {
   // A sub-range through the serial path gives the same numbers.
   std::vector<float> part(3 * 1000);
   toRelativeFloat(part.data(), cloud, 12345, 1000, origin);
-  for (int k = 0; k < 3000; ++k) ASSERT_EQ(part[k], rel[3 * 12345 + k]);
+  for (int k = 0; k < 3000; ++k)
+    ASSERT_EQ(part[k], rel[3 * 12345 + k]);
 }
 
 TEST(ToRelativeFloat, KeepsMillimetresWhereFloatWorldCoordinatesCannot) {
@@ -78,32 +80,37 @@ TEST(HasUsableColor, FalseWithoutColorsOrWhenAllBlack) {
   EXPECT_FALSE(hasUsableColor(cloud));
   cloud.colors.assign(cloud.size(), packRgba(0, 0, 0, 255)); // alpha alone does not count
   EXPECT_FALSE(hasUsableColor(cloud));
-  cloud.colors.back() = packRgba(0, 0, 1);                     // past the quick check of the first points
+  cloud.colors.back() = packRgba(0, 0, 1); // past the quick check of the first points
   EXPECT_TRUE(hasUsableColor(cloud));
 }
 
 TEST(DisplayColors, UsesRgbWithOpaqueAlpha) {
   PointCloud cloud = testing::randomCloud(100);
-  for (uint64_t i = 0; i < 100; ++i) cloud.colors.push_back(packRgba(uint32_t(i), 2, 3, 0));
+  for (uint64_t i = 0; i < 100; ++i)
+    cloud.colors.push_back(packRgba(uint32_t(i), 2, 3, 0));
   std::vector<uint32_t> out(100);
   displayColors(out.data(), cloud, 0, 100);
-  for (uint32_t i = 0; i < 100; ++i) EXPECT_EQ(out[i], packRgba(i, 2, 3, 255));
+  for (uint32_t i = 0; i < 100; ++i)
+    EXPECT_EQ(out[i], packRgba(i, 2, 3, 255));
 }
 
 TEST(DisplayColors, RampsOverIntensityThenElevation) {
   PointCloud cloud = testing::randomCloud(1000);
   cloud.colors.assign(1000, 0); // all black: ignored
-  for (uint64_t i = 0; i < 1000; ++i) cloud.intensity.push_back(static_cast<uint16_t>(i * 10));
+  for (uint64_t i = 0; i < 1000; ++i)
+    cloud.intensity.push_back(static_cast<uint16_t>(i * 10));
   DisplayColorMode mode = displayColorMode(cloud);
   EXPECT_EQ(mode.source, DisplayColorMode::Source::Intensity);
   std::vector<uint32_t> out(1000);
   displayColors(out.data(), cloud, 0, 1000);
   EXPECT_NE(out[0], out[999]);
-  for (uint32_t c : out) EXPECT_EQ(c >> 24, 255u);
+  for (uint32_t c : out)
+    EXPECT_EQ(c >> 24, 255u);
   // Chunks with the same mode give what the whole call gives.
   std::vector<uint32_t> chunk(300);
   displayColors(chunk.data(), cloud, 500, 300, mode);
-  for (int k = 0; k < 300; ++k) EXPECT_EQ(chunk[k], out[500 + k]);
+  for (int k = 0; k < 300; ++k)
+    EXPECT_EQ(chunk[k], out[500 + k]);
 
   cloud.intensity.assign(1000, 7); // constant intensity carries no information: elevation instead
   mode = displayColorMode(cloud);
@@ -119,13 +126,25 @@ TEST(DisplayColors, RampsOverIntensityThenElevation) {
 
 TEST(DisplayColorMode, ElevationRangeIgnoresRareOutliers) {
   PointCloud cloud = testing::randomCloud(100'000, 10'000); // z within +-10 m
-  cloud.positions[2] = 1'000'000;                            // one bird at 1 km
+  cloud.positions[2] = 1'000'000;                           // one bird at 1 km
   computeBounds(cloud);
   DisplayColorMode mode = displayColorMode(cloud);
   EXPECT_EQ(mode.source, DisplayColorMode::Source::Elevation);
   EXPECT_LT(mode.lo, -9.0);
   EXPECT_GT(mode.hi, 9.0);
   EXPECT_LT(mode.hi, 20.0);
+}
+
+TEST(DisplayColorMode, LargeCloudRangeFromASample) {
+  // Over 2^20 points the mode looks at every k-th point; the percentiles still land where they belong.
+  PointCloud cloud = testing::randomCloud(2'500'000, 1000);
+  cloud.intensity.resize(cloud.size());
+  for (uint64_t i = 0; i < cloud.size(); ++i)
+    cloud.intensity[i] = uint16_t(i * 7919 % 1000);
+  DisplayColorMode mode = displayColorMode(cloud);
+  EXPECT_EQ(mode.source, DisplayColorMode::Source::Intensity);
+  EXPECT_NEAR(mode.lo, 5.0, 5.0);
+  EXPECT_NEAR(mode.hi, 995.0, 5.0);
 }
 
 TEST(DisplayColorMode, FlatCloudDoesNotDivideByZero) {

@@ -139,7 +139,8 @@ TEST(MortonOrderTest, CubicCellsForAFlatCloud) {
   std::vector<uint64_t> order;
   computeOrder(order, cloud, Order::Morton, 1);
   std::vector<uint64_t> codes = referenceCodes(cloud);
-  for (uint64_t i = 1; i < order.size(); ++i) ASSERT_LE(codes[order[i - 1]], codes[order[i]]);
+  for (uint64_t i = 1; i < order.size(); ++i)
+    ASSERT_LE(codes[order[i - 1]], codes[order[i]]);
 }
 
 TEST(MortonOrderTest, IdenticalPointsKeepTheirOrder) {
@@ -207,7 +208,8 @@ TEST(ShuffledMortonOrder, RunsAreWholeMortonRunsInOrder) {
     }
     // Where each point sits in the Morton order.
     std::vector<uint64_t> rank(n);
-    for (uint64_t i = 0; i < n; ++i) rank[morton[i]] = i;
+    for (uint64_t i = 0; i < n; ++i)
+      rank[morton[i]] = i;
     // Walk the result run by run: each run starts at a multiple of kShuffleRun in the Morton order and
     // continues it point by point for a full run (or to the end of the cloud, for the short last run).
     std::vector<bool> runSeen((n + kShuffleRun - 1) / kShuffleRun, false);
@@ -218,7 +220,8 @@ TEST(ShuffledMortonOrder, RunsAreWholeMortonRunsInOrder) {
       ASSERT_FALSE(runSeen[start / kShuffleRun]);
       runSeen[start / kShuffleRun] = true;
       uint64_t length = std::min(kShuffleRun, n - start);
-      for (uint64_t k = 0; k < length; ++k) ASSERT_EQ(rank[sm[i + k]], start + k);
+      for (uint64_t k = 0; k < length; ++k)
+        ASSERT_EQ(rank[sm[i + k]], start + k);
       i += length;
     }
   }
@@ -268,7 +271,8 @@ TEST(Reorder, OriginalIsANoOpAndMortonSortsTheCloud) {
   EXPECT_EQ(cloud.positions, copy.positions);
   reorder(cloud, Order::Morton, 1);
   std::vector<uint64_t> codes = referenceCodes(cloud);
-  for (uint64_t i = 1; i < codes.size(); ++i) ASSERT_LE(codes[i - 1], codes[i]);
+  for (uint64_t i = 1; i < codes.size(); ++i)
+    ASSERT_LE(codes[i - 1], codes[i]);
 }
 
 } // namespace

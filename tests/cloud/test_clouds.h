@@ -17,7 +17,8 @@ inline PointCloud randomCloud(uint64_t n, int32_t range = 1'000'000, glm::dvec3 
   cloud.positions.resize(3 * n);
   std::mt19937_64 rng(seed);
   const uint64_t span = 2 * uint64_t(range) + 1;
-  for (auto& q : cloud.positions) q = static_cast<int32_t>(int64_t(rng() % span) - range);
+  for (auto& q : cloud.positions)
+    q = static_cast<int32_t>(int64_t(rng() % span) - range);
   computeBounds(cloud);
   return cloud;
 }

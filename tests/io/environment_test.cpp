@@ -4,7 +4,9 @@
 
 #include "base/progress.h"
 
-extern "C" const char* __asan_default_options() { return "max_allocation_size_mb=1024"; }
+extern "C" const char* __asan_default_options() {
+  return "max_allocation_size_mb=1024";
+}
 
 namespace {
 

@@ -15,8 +15,8 @@ using iotest::readOrRefuse;
 namespace {
 
 // Reads every prefix [0, full) at step 1 up to denseEnd, then at stride; returns the refusal count.
-size_t sweepPrefixes(const std::vector<uint8_t>& bytes, const std::string& name, size_t denseEnd, size_t stride,
-                     bool prefixesMustFail, bool wholeMustRead = true) {
+size_t sweepPrefixes(const std::vector<uint8_t>& bytes, const std::string& name, size_t denseEnd,
+                     size_t stride, bool prefixesMustFail, bool wholeMustRead = true) {
   iotest::TempDir dir;
   auto path = dir / name;
   size_t refused = 0;
@@ -42,7 +42,8 @@ void flipBytes(const std::vector<uint8_t>& bytes, const std::string& name, size_
   std::vector<uint8_t> copy = bytes;
   for (size_t i = begin; i < std::min(end, bytes.size()); ++i) {
     std::vector<uint8_t> tries = values;
-    for (uint8_t bit : {0x01, 0x10, 0x80}) tries.push_back(bytes[i] ^ bit);
+    for (uint8_t bit : {0x01, 0x10, 0x80})
+      tries.push_back(bytes[i] ^ bit);
     for (uint8_t v : tries) {
       copy[i] = v;
       iotest::writeBytes(path, copy);
@@ -94,7 +95,8 @@ std::vector<uint8_t> asciiMug(int vertices) {
   std::string text(bytes.begin(), bytes.end());
   size_t headerEnd = text.find("end_header\n") + 11;
   size_t end = headerEnd;
-  for (int i = 0; i < vertices; ++i) end = text.find('\n', end) + 1;
+  for (int i = 0; i < vertices; ++i)
+    end = text.find('\n', end) + 1;
   std::string header = text.substr(0, headerEnd);
   size_t at = header.find("element vertex 20000");
   header.replace(at, 20, "element vertex " + std::to_string(vertices));
@@ -103,18 +105,22 @@ std::vector<uint8_t> asciiMug(int vertices) {
 }
 
 std::vector<uint8_t> binaryPlyWithElements() {
-  std::string h = "ply\nformat binary_little_endian 1.0\ncomment x\nelement cam 2\nproperty float f\n"
-                  "element grid 3\nproperty list uchar int idx\nelement vertex 20\nproperty double x\n"
-                  "property float y\nproperty short z\nproperty list uchar float n\nproperty uchar red\n"
-                  "property uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int v\nend_header\n";
+  std::string h =
+      "ply\nformat binary_little_endian 1.0\ncomment x\nelement cam 2\nproperty float f\n"
+      "element grid 3\nproperty list uchar int idx\nelement vertex 20\nproperty double x\n"
+      "property float y\nproperty short z\nproperty list uchar float n\nproperty uchar red\n"
+      "property uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int v\nend_header\n";
   std::vector<uint8_t> out(h.begin(), h.end());
-  auto put = [&](const void* p, size_t n) { out.insert(out.end(), static_cast<const uint8_t*>(p), static_cast<const uint8_t*>(p) + n); };
+  auto put = [&](const void* p, size_t n) {
+    out.insert(out.end(), static_cast<const uint8_t*>(p), static_cast<const uint8_t*>(p) + n);
+  };
   float f = 1.5f;
   put(&f, 4);
   put(&f, 4);
   for (uint8_t n : {1, 0, 2}) {
     put(&n, 1);
-    for (int32_t k = 0; k < n; ++k) put(&k, 4);
+    for (int32_t k = 0; k < n; ++k)
+      put(&k, 4);
   }
   for (int i = 0; i < 20; ++i) {
     double x = i * 0.5;
@@ -125,13 +131,15 @@ std::vector<uint8_t> binaryPlyWithElements() {
     put(&y, 4);
     put(&z, 2);
     put(&n, 1);
-    for (int k = 0; k < n; ++k) put(&y, 4);
+    for (int k = 0; k < n; ++k)
+      put(&y, 4);
     uint8_t rgb[3] = {static_cast<uint8_t>(i), 100, 200};
     put(rgb, 3);
   }
   uint8_t three = 3;
   put(&three, 1);
-  for (int32_t k = 0; k < 3; ++k) put(&k, 4);
+  for (int32_t k = 0; k < 3; ++k)
+    put(&k, 4);
   return out;
 }
 
@@ -139,11 +147,15 @@ TEST(HostileInput, PlyPrefixes) {
   auto simple = iotest::readBytes(data("ply/simple_binary.ply"));
   sweepPrefixes(simple, "t.ply", simple.size(), 1, true);
   auto withElements = binaryPlyWithElements();
-  ASSERT_EQ(readCloud([&] {
-              static iotest::TempDir dir;
-              iotest::writeBytes(dir / "e.ply", withElements);
-              return dir / "e.ply";
-            }(), quiet()).size(), 20u);
+  ASSERT_EQ(readCloud(
+                [&] {
+                  static iotest::TempDir dir;
+                  iotest::writeBytes(dir / "e.ply", withElements);
+                  return dir / "e.ply";
+                }(),
+                quiet())
+                .size(),
+            20u);
   // The face element after the vertices is never read, so only prefixes that cut the vertices fail.
   size_t refused = sweepPrefixes(withElements, "t.ply", withElements.size(), 1, false);
   EXPECT_GE(refused, withElements.size() - 13);
@@ -194,16 +206,19 @@ TEST(HostileInput, RandomBytes) {
   iotest::Lcg rng(1234);
   for (int trial = 0; trial < 40; ++trial) {
     std::vector<uint8_t> bytes(1 + rng.next() % 3000);
-    for (auto& b : bytes) b = static_cast<uint8_t>(rng.next());
+    for (auto& b : bytes)
+      b = static_cast<uint8_t>(rng.next());
     // Magic bytes in front make the format parsers (not just detection) see the garbage.
     const char* magic[] = {"", "LASF", "ply\n", "ply\nformat binary_little_endian 1.0\n", "MMPLD"};
     const char* names[] = {"r.bin", "r.las", "r.ply", "r.xyz", "r.csv"};
     std::string m = magic[trial % 5];
     std::copy(m.begin(), m.end(), bytes.begin());
-    if (bytes.size() < m.size()) bytes.insert(bytes.end(), m.begin() + static_cast<ptrdiff_t>(bytes.size()), m.end());
+    if (bytes.size() < m.size())
+      bytes.insert(bytes.end(), m.begin() + static_cast<ptrdiff_t>(bytes.size()), m.end());
     auto path = dir / names[(trial / 5) % 5];
     iotest::writeBytes(path, bytes);
     EXPECT_EQ(readOrRefuse(path), Outcome::Refused) << "trial " << trial;
+    EXPECT_THROW(probeFile(path), InputError) << "trial " << trial;
   }
 }
 

@@ -91,7 +91,9 @@ inline Outcome readOrRefuse(const std::filesystem::path& path, std::string* mess
   return outcome;
 }
 
-inline uint8_t channel(uint32_t rgba, int c) { return static_cast<uint8_t>(rgba >> (8 * c)); }
+inline uint8_t channel(uint32_t rgba, int c) {
+  return static_cast<uint8_t>(rgba >> (8 * c));
+}
 
 // Deterministic pseudo-random numbers for generated test data.
 struct Lcg {

@@ -25,18 +25,90 @@ struct LasCase {
 };
 
 const LasCase kCases[] = {
-    {"las/autzen_trim.las", 110000, {636001.76, 848935.20, 406.26}, {637179.22, 849497.90, 520.51}, Color::Bits8, 40, 236},
-    {"las/autzen_trim_7.las", 110000, {636001.76, 848935.20, 406.26}, {637179.22, 849497.90, 520.51}, Color::Bits8, 40, 236},
-    {"las/1.2-with-color.las", 1065, {635619.85, 848899.70, 406.59}, {638982.55, 853535.43, 586.38}, Color::Bits8, 39, 249},
-    {"las/autzen-thin.las", 10653, {635589.01, 848886.45, 406.59}, {638994.75, 853535.43, 593.73}, Color::Bits8, 39, 254},
-    {"las/sample_c.las", 14408, {674521.92, 1206740.08, 627.53}, {674605.32, 1206814.96, 656.23}, Color::Bits16, 35840, 54272},
-    {"las/warsaw_small.las", 3000, {639913.26, 485143.14, 84.70}, {639946.75, 485175.91, 104.55}, Color::Bits16, 9728, 53760},
-    {"las/4_6_crop.las", 23875, {1639600.00, 1454500.02, 7077.92}, {1639799.98, 1454700.00, 7139.70}, Color::Zero, 0, 0},
-    {"las/extrabytes.las", 1065, {635619.85, 848899.70, 406.59}, {638982.55, 853535.43, 586.38}, Color::Bits8, 39, 249},
-    {"las/test1_4.las", 1000, {1694038.45, 1816492.71, 5592.75}, {1694539.68, 1816497.98, 5599.07}, Color::None, 0, 0},
-    {"las/epsg_4326.las", 5380, {-94.683465, 31.036734, 39.08}, {-94.660631, 31.047329, 78.12}, Color::None, 0, 0},
-    {"las/mvk-thin.las", 6280, {2045001.76, 1267501.19, 95.79}, {2049993.92, 1272499.79, 228.73}, Color::None, 0, 0},
-    {"las/hexbin-crop.las", 38367, {393775.82, 3689071.94, 3107.86}, {394069.24, 3689273.10, 3209.32}, Color::None, 0, 0},
+    {"las/autzen_trim.las",
+     110000,
+     {636001.76, 848935.20, 406.26},
+     {637179.22, 849497.90, 520.51},
+     Color::Bits8,
+     40,
+     236},
+    {"las/autzen_trim_7.las",
+     110000,
+     {636001.76, 848935.20, 406.26},
+     {637179.22, 849497.90, 520.51},
+     Color::Bits8,
+     40,
+     236},
+    {"las/1.2-with-color.las",
+     1065,
+     {635619.85, 848899.70, 406.59},
+     {638982.55, 853535.43, 586.38},
+     Color::Bits8,
+     39,
+     249},
+    {"las/autzen-thin.las",
+     10653,
+     {635589.01, 848886.45, 406.59},
+     {638994.75, 853535.43, 593.73},
+     Color::Bits8,
+     39,
+     254},
+    {"las/sample_c.las",
+     14408,
+     {674521.92, 1206740.08, 627.53},
+     {674605.32, 1206814.96, 656.23},
+     Color::Bits16,
+     35840,
+     54272},
+    {"las/warsaw_small.las",
+     3000,
+     {639913.26, 485143.14, 84.70},
+     {639946.75, 485175.91, 104.55},
+     Color::Bits16,
+     9728,
+     53760},
+    {"las/4_6_crop.las",
+     23875,
+     {1639600.00, 1454500.02, 7077.92},
+     {1639799.98, 1454700.00, 7139.70},
+     Color::Zero,
+     0,
+     0},
+    {"las/extrabytes.las",
+     1065,
+     {635619.85, 848899.70, 406.59},
+     {638982.55, 853535.43, 586.38},
+     Color::Bits8,
+     39,
+     249},
+    {"las/test1_4.las",
+     1000,
+     {1694038.45, 1816492.71, 5592.75},
+     {1694539.68, 1816497.98, 5599.07},
+     Color::None,
+     0,
+     0},
+    {"las/epsg_4326.las",
+     5380,
+     {-94.683465, 31.036734, 39.08},
+     {-94.660631, 31.047329, 78.12},
+     Color::None,
+     0,
+     0},
+    {"las/mvk-thin.las",
+     6280,
+     {2045001.76, 1267501.19, 95.79},
+     {2049993.92, 1272499.79, 228.73},
+     Color::None,
+     0,
+     0},
+    {"las/hexbin-crop.las",
+     38367,
+     {393775.82, 3689071.94, 3107.86},
+     {394069.24, 3689273.10, 3209.32},
+     Color::None,
+     0,
+     0},
 };
 
 class LasFiles : public ::testing::TestWithParam<LasCase> {};
@@ -129,7 +201,8 @@ TEST(LasReader, Pf6OddScalesKeptExactly) {
   EXPECT_EQ(cloud.scale.x, 1.16451354e-06);
   EXPECT_EQ(cloud.offset.x, 1692500.352);
   FileInfo info = probeFile(data("las/test1_4.las"));
-  EXPECT_NE(info.formatDetail.find("LAS 1.4, point format 6 (30 B records)"), std::string::npos) << info.formatDetail;
+  EXPECT_NE(info.formatDetail.find("LAS 1.4, point format 6 (30 B records)"), std::string::npos)
+      << info.formatDetail;
 }
 
 TEST(LasReader, NoPointsLoadsEmpty) {
@@ -178,7 +251,8 @@ TEST(LasReader, AttributesKeptOrDropped) {
   ASSERT_EQ(with.intensity.size(), with.size());
   ASSERT_EQ(with.classification.size(), with.size());
   ASSERT_EQ(with.returnNumber.size(), with.size());
-  for (uint8_t r : with.returnNumber) EXPECT_LE(r, 7);
+  for (uint8_t r : with.returnNumber)
+    EXPECT_LE(r, 7);
   ReadOptions options = quiet();
   options.keepAttributes = false;
   PointCloud without = readLas(data("las/1.2-with-color.las"), options);
@@ -196,7 +270,8 @@ TEST(LasReader, ProbeDescribesHeader) {
   EXPECT_NEAR(info.bounds.min.x, 636001.76, 1e-6);
   EXPECT_NEAR(info.bounds.max.z, 520.51, 1e-6);
   std::string all;
-  for (const auto& [key, value] : info.extra) all += key + "=" + value + "\n";
+  for (const auto& [key, value] : info.extra)
+    all += key + "=" + value + "\n";
   EXPECT_NE(all.find("generating software=PDAL 1.0.0 (9e8465)"), std::string::npos) << all;
   EXPECT_NE(all.find("VLRs=5: LASF_Projection 34735"), std::string::npos) << all;
   EXPECT_NE(all.find("color values=40 .. 236"), std::string::npos) << all;
@@ -254,7 +329,8 @@ TEST(LasReader, LateSixteenBitValueRecolorsEarlierChunks) {
     PointCloud back = readLas(dir / "a.las", quiet());
     pointrast::io::detail::setLasChunkBytes(0);
     ASSERT_EQ(back.size(), uint64_t(n));
-    for (int i = 0; i < n - 1; ++i) ASSERT_EQ(back.colors[i], pointrast::packRgba(0, 0, 0)) << i;
+    for (int i = 0; i < n - 1; ++i)
+      ASSERT_EQ(back.colors[i], pointrast::packRgba(0, 0, 0)) << i;
     EXPECT_EQ(back.colors[n - 1], pointrast::packRgba(255, 255, 255));
     EXPECT_EQ(probeFile(dir / "a.las").colorBits, 16);
   }

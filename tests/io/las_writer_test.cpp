@@ -16,7 +16,8 @@ PointCloud makeCloud(uint64_t n, int maxReturn, int maxClass) {
   c.offset = glm::dvec3(637000.0, 849000.0, -5.0);
   for (uint64_t i = 0; i < n; ++i) {
     // Include the int32 extremes: they must survive the round trip.
-    int32_t x = i == 0 ? INT32_MIN : (i == 1 ? INT32_MAX : static_cast<int32_t>(rng.next() % 200000) - 100000);
+    int32_t x =
+        i == 0 ? INT32_MIN : (i == 1 ? INT32_MAX : static_cast<int32_t>(rng.next() % 200000) - 100000);
     c.positions.push_back(x);
     c.positions.push_back(static_cast<int32_t>(rng.next() % 50000));
     c.positions.push_back(-static_cast<int32_t>(rng.next() % 1000));
@@ -26,7 +27,8 @@ PointCloud makeCloud(uint64_t n, int maxReturn, int maxClass) {
     c.returnNumber.push_back(static_cast<uint8_t>(1 + rng.next() % maxReturn));
   }
   c.bounds = pointrast::Bounds{};
-  for (uint64_t i = 0; i < n; ++i) c.bounds.expand(c.world(i));
+  for (uint64_t i = 0; i < n; ++i)
+    c.bounds.expand(c.world(i));
   return c;
 }
 
@@ -64,10 +66,11 @@ TEST_P(LasRoundTrip, ReadBackIsIdentical) {
   EXPECT_EQ(info.bounds.max, cloud.bounds.max);
 }
 
-INSTANTIATE_TEST_SUITE_P(Flavors, LasRoundTrip,
-                         ::testing::Values(FlavorCase{LasFlavor::Las12Pf2, "LAS 1.2, point format 2 (26 B records)", 5, 31},
-                                           FlavorCase{LasFlavor::Las12Pf3, "LAS 1.2, point format 3 (34 B records)", 5, 31},
-                                           FlavorCase{LasFlavor::Las14Pf7, "LAS 1.4, point format 7 (36 B records)", 15, 255}));
+INSTANTIATE_TEST_SUITE_P(
+    Flavors, LasRoundTrip,
+    ::testing::Values(FlavorCase{LasFlavor::Las12Pf2, "LAS 1.2, point format 2 (26 B records)", 5, 31},
+                      FlavorCase{LasFlavor::Las12Pf3, "LAS 1.2, point format 3 (34 B records)", 5, 31},
+                      FlavorCase{LasFlavor::Las14Pf7, "LAS 1.4, point format 7 (36 B records)", 15, 255}));
 
 TEST(LasWriter, RealFileRoundTripsThroughEveryFlavor) {
   iotest::TempDir dir;
@@ -91,9 +94,11 @@ TEST(LasWriter, HeaderCountsByReturn) {
   uint32_t count = 0, byReturn[5] = {}, expected[5] = {};
   std::memcpy(&count, bytes.data() + 107, 4);
   std::memcpy(byReturn, bytes.data() + 111, 20);
-  for (uint8_t r : cloud.returnNumber) ++expected[r - 1];
+  for (uint8_t r : cloud.returnNumber)
+    ++expected[r - 1];
   EXPECT_EQ(count, 500u);
-  for (int i = 0; i < 5; ++i) EXPECT_EQ(byReturn[i], expected[i]);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(byReturn[i], expected[i]);
 }
 
 TEST(LasWriter, EmptyAndColorlessClouds) {

@@ -4,8 +4,8 @@
 #include "io/io_test_util.h"
 
 using pointrast::InputError;
-using pointrast::PointCloud;
 using pointrast::packRgba;
+using pointrast::PointCloud;
 using namespace pointrast::io;
 using iotest::data;
 using iotest::quiet;
@@ -19,9 +19,13 @@ template <class T> void put(std::vector<uint8_t>& out, T v, bool bigEndian = fal
   out.insert(out.end(), b, b + sizeof(T));
 }
 
-std::vector<uint8_t> bytesOf(const std::string& s) { return std::vector<uint8_t>(s.begin(), s.end()); }
+std::vector<uint8_t> bytesOf(const std::string& s) {
+  return std::vector<uint8_t>(s.begin(), s.end());
+}
 
-void append(std::vector<uint8_t>& out, const std::vector<uint8_t>& more) { out.insert(out.end(), more.begin(), more.end()); }
+void append(std::vector<uint8_t>& out, const std::vector<uint8_t>& more) {
+  out.insert(out.end(), more.begin(), more.end());
+}
 
 void expectPoints(const PointCloud& cloud, const std::vector<glm::dvec3>& points, double tolerance = 1e-9) {
   ASSERT_EQ(cloud.size(), points.size());
@@ -102,18 +106,21 @@ TEST(PlyReader, Ascii20kMatchesTheBinaryFile) {
 // A PLY file with the given vertex properties (type name pairs) and rows of values.
 struct PlyBuilder {
   std::string encoding = "binary_little_endian";
-  std::string preamble;  // extra header lines before the vertex element
-  std::vector<uint8_t> preData; // data of elements before vertex
+  std::string preamble;                                        // extra header lines before the vertex element
+  std::vector<uint8_t> preData;                                // data of elements before vertex
   std::vector<std::pair<std::string, std::string>> properties; // (type, name)
   std::vector<std::vector<double>> rows;
   std::string newline = "\n";
   int64_t claimedCount = -1;
 
   std::vector<uint8_t> build() const {
-    std::string h = "ply" + newline + "format " + encoding + " 1.0" + newline + "comment made by a test" + newline;
+    std::string h =
+        "ply" + newline + "format " + encoding + " 1.0" + newline + "comment made by a test" + newline;
     h += preamble;
-    h += "element vertex " + std::to_string(claimedCount >= 0 ? uint64_t(claimedCount) : rows.size()) + newline;
-    for (const auto& [type, name] : properties) h += "property " + type + " " + name + newline;
+    h += "element vertex " + std::to_string(claimedCount >= 0 ? uint64_t(claimedCount) : rows.size()) +
+         newline;
+    for (const auto& [type, name] : properties)
+      h += "property " + type + " " + name + newline;
     h += "element face 0" + newline + "property list uchar int vertex_indices" + newline;
     h += "end_header" + newline;
     std::vector<uint8_t> out = bytesOf(h);
@@ -133,14 +140,22 @@ struct PlyBuilder {
       for (size_t j = 0; j < row.size(); ++j) {
         const std::string& t = properties[j].first;
         double v = row[j];
-        if (t == "char" || t == "int8") put<int8_t>(out, static_cast<int8_t>(v));
-        else if (t == "uchar" || t == "uint8") put<uint8_t>(out, static_cast<uint8_t>(v));
-        else if (t == "short" || t == "int16") put<int16_t>(out, static_cast<int16_t>(v), be);
-        else if (t == "ushort" || t == "uint16") put<uint16_t>(out, static_cast<uint16_t>(v), be);
-        else if (t == "int" || t == "int32") put<int32_t>(out, static_cast<int32_t>(v), be);
-        else if (t == "uint" || t == "uint32") put<uint32_t>(out, static_cast<uint32_t>(v), be);
-        else if (t == "float" || t == "float32") put<float>(out, static_cast<float>(v), be);
-        else put<double>(out, v, be);
+        if (t == "char" || t == "int8")
+          put<int8_t>(out, static_cast<int8_t>(v));
+        else if (t == "uchar" || t == "uint8")
+          put<uint8_t>(out, static_cast<uint8_t>(v));
+        else if (t == "short" || t == "int16")
+          put<int16_t>(out, static_cast<int16_t>(v), be);
+        else if (t == "ushort" || t == "uint16")
+          put<uint16_t>(out, static_cast<uint16_t>(v), be);
+        else if (t == "int" || t == "int32")
+          put<int32_t>(out, static_cast<int32_t>(v), be);
+        else if (t == "uint" || t == "uint32")
+          put<uint32_t>(out, static_cast<uint32_t>(v), be);
+        else if (t == "float" || t == "float32")
+          put<float>(out, static_cast<float>(v), be);
+        else
+          put<double>(out, v, be);
       }
     }
     return out;
@@ -180,7 +195,8 @@ TEST(PlyReader, AllEncodingsAndCoordinateTypes) {
       expectPoints(readBuilt(b), {{1.5, -2.25, 3}, {-4, 5.5, 6.75}, {7, 8, -9.5}});
     }
   for (const char* encoding : {"binary_little_endian", "binary_big_endian", "ascii"})
-    for (const char* type : {"char", "uchar", "short", "ushort", "int", "uint", "int8", "uint8", "int16", "uint16", "int32", "uint32"}) {
+    for (const char* type : {"char", "uchar", "short", "ushort", "int", "uint", "int8", "uint8", "int16",
+                             "uint16", "int32", "uint32"}) {
       SCOPED_TRACE(std::string(encoding) + " " + type);
       PlyBuilder b = xyzRgb(type, "");
       b.encoding = encoding;
@@ -248,7 +264,8 @@ TEST(PlyReader, ElementsBeforeVertexAreSkipped) {
       }
       for (uint8_t n : {2, 0, 3}) {
         put<uint8_t>(b.preData, n);
-        for (int k = 0; k < n; ++k) put<int32_t>(b.preData, k, be);
+        for (int k = 0; k < n; ++k)
+          put<int32_t>(b.preData, k, be);
         put<uint8_t>(b.preData, 1);
       }
     }
@@ -261,7 +278,8 @@ TEST(PlyReader, ElementsBeforeVertexAreSkipped) {
 TEST(PlyReader, ListPropertyInsideVertex) {
   for (const char* encoding : {"binary_little_endian", "ascii"}) {
     SCOPED_TRACE(encoding);
-    std::string h = std::string("ply\nformat ") + encoding + " 1.0\nelement vertex 2\nproperty float x\n"
+    std::string h = std::string("ply\nformat ") + encoding +
+                    " 1.0\nelement vertex 2\nproperty float x\n"
                     "property list uchar float normals\nproperty float y\nproperty float z\nend_header\n";
     std::vector<uint8_t> file = bytesOf(h);
     if (std::string(encoding) == "ascii") {
@@ -269,7 +287,8 @@ TEST(PlyReader, ListPropertyInsideVertex) {
     } else {
       put<float>(file, 1);
       put<uint8_t>(file, 3);
-      for (float v : {0.1f, 0.2f, 0.3f}) put<float>(file, v);
+      for (float v : {0.1f, 0.2f, 0.3f})
+        put<float>(file, v);
       put<float>(file, 2);
       put<float>(file, 3);
       put<float>(file, 4);
@@ -291,8 +310,9 @@ TEST(PlyReader, TolerantHeader) {
   b.encoding = "ascii";
   expectPoints(readBuilt(b), {{1, 2, 3}});
   iotest::TempDir dir;
-  iotest::writeText(dir / "s.ply", "ply  \nformat ascii 1.0 \nobj_info x\ncomment\n\nelement vertex 1 \n"
-                                   "property   float x\nproperty float y\nproperty float z\nend_header  \n1 2 3");
+  iotest::writeText(dir / "s.ply",
+                    "ply  \nformat ascii 1.0 \nobj_info x\ncomment\n\nelement vertex 1 \n"
+                    "property   float x\nproperty float y\nproperty float z\nend_header  \n1 2 3");
   expectPoints(readCloud(dir / "s.ply", quiet()), {{1, 2, 3}});
 }
 
@@ -345,15 +365,22 @@ TEST(PlyReader, BadFilesAreRefused) {
   refusal(pre);
   iotest::TempDir dir;
   iotest::writeText(dir / "nohead.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n");
-  EXPECT_NE([&] { std::string m; iotest::readOrRefuse(dir / "nohead.ply", &m); return m; }().find("end_header"),
-            std::string::npos);
+  EXPECT_NE(
+      [&] {
+        std::string m;
+        iotest::readOrRefuse(dir / "nohead.ply", &m);
+        return m;
+      }()
+          .find("end_header"),
+      std::string::npos);
 }
 
 TEST(PlyReader, NonFiniteVerticesAreDroppedAndCounted) {
   for (const char* encoding : {"binary_little_endian", "ascii"}) {
     PlyBuilder b = xyzRgb("float", "uchar");
     b.encoding = encoding;
-    b.rows = {{1, 2, 3, 10, 10, 10}, {NAN, 0, 0, 20, 20, 20}, {4, INFINITY, 6, 30, 30, 30}, {7, 8, 9, 40, 40, 40}};
+    b.rows = {
+        {1, 2, 3, 10, 10, 10}, {NAN, 0, 0, 20, 20, 20}, {4, INFINITY, 6, 30, 30, 30}, {7, 8, 9, 40, 40, 40}};
     iotest::TempDir dir;
     iotest::writeBytes(dir / "nan.ply", b.build());
     PointCloud cloud = readCloud(dir / "nan.ply", quiet());
@@ -361,7 +388,8 @@ TEST(PlyReader, NonFiniteVerticesAreDroppedAndCounted) {
     EXPECT_EQ(cloud.colors, (std::vector<uint32_t>{packRgba(10, 10, 10), packRgba(40, 40, 40)}));
     FileInfo info = probeFile(dir / "nan.ply");
     bool listed = false;
-    for (const auto& [key, value] : info.extra) listed = listed || (key.find("dropped") != std::string::npos && value.find('2') == 0);
+    for (const auto& [key, value] : info.extra)
+      listed = listed || (key.find("dropped") != std::string::npos && value.find('2') == 0);
     EXPECT_TRUE(listed) << encoding;
   }
 }

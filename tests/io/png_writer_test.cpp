@@ -24,7 +24,8 @@ TEST(PngWriter, WritesRgbWithTopRowFirst) {
   const uint32_t w = 5, h = 3;
   std::vector<uint32_t> pixels(w * h);
   for (uint32_t y = 0; y < h; ++y)
-    for (uint32_t x = 0; x < w; ++x) pixels[y * w + x] = packRgba(10 * x, 100 + y, 7, y == 0 ? 0 : 255);
+    for (uint32_t x = 0; x < w; ++x)
+      pixels[y * w + x] = packRgba(10 * x, 100 + y, 7, y == 0 ? 0 : 255);
   auto path = dir / "img.png";
   writePng(path, w, h, pixels.data());
   EXPECT_FALSE(std::filesystem::exists(dir / "img.png.partial"));
@@ -33,7 +34,9 @@ TEST(PngWriter, WritesRgbWithTopRowFirst) {
   ASSERT_GT(bytes.size(), 33u);
   EXPECT_EQ(std::memcmp(bytes.data(), signature, 8), 0);
   // IHDR: width and height big-endian at 16 and 20, bit depth 8, color type 2 (RGB).
-  auto be32 = [&](size_t at) { return uint32_t(bytes[at]) << 24 | bytes[at + 1] << 16 | bytes[at + 2] << 8 | bytes[at + 3]; };
+  auto be32 = [&](size_t at) {
+    return uint32_t(bytes[at]) << 24 | bytes[at + 1] << 16 | bytes[at + 2] << 8 | bytes[at + 3];
+  };
   EXPECT_EQ(be32(16), w);
   EXPECT_EQ(be32(20), h);
   EXPECT_EQ(bytes[24], 8);

@@ -1,11 +1,12 @@
 // XYZ / CSV / PTS text reader.
 #include <cmath>
+#include <set>
 
 #include "io/io_test_util.h"
 
 using pointrast::InputError;
-using pointrast::PointCloud;
 using pointrast::packRgba;
+using pointrast::PointCloud;
 using namespace pointrast::io;
 using iotest::data;
 using iotest::quiet;
@@ -86,7 +87,8 @@ TEST(XyzReader, CsvWithHeaderCommentsAndBlankLines) {
   EXPECT_NEAR(cloud.world(0).x, 1.5, 1e-9);
   EXPECT_NEAR(cloud.world(1).z, -3, 1e-9);
   EXPECT_NEAR(cloud.world(2).x, 4, 1e-9);
-  EXPECT_EQ(cloud.colors, (std::vector<uint32_t>{packRgba(255, 0, 10), packRgba(1, 2, 3), packRgba(7, 8, 9)}));
+  EXPECT_EQ(cloud.colors,
+            (std::vector<uint32_t>{packRgba(255, 0, 10), packRgba(1, 2, 3), packRgba(7, 8, 9)}));
 }
 
 TEST(XyzReader, ColumnLayouts) {
@@ -129,7 +131,8 @@ TEST(XyzReader, NonFiniteRowsAreDropped) {
   iotest::TempDir dir;
   iotest::writeText(dir / "n.xyz", "1 2 3\nnan 0 0\n");
   bool listed = false;
-  for (const auto& [key, value] : probeFile(dir / "n.xyz").extra) listed = listed || key.find("dropped") != std::string::npos;
+  for (const auto& [key, value] : probeFile(dir / "n.xyz").extra)
+    listed = listed || key.find("dropped") != std::string::npos;
   EXPECT_TRUE(listed);
 }
 
@@ -142,6 +145,28 @@ TEST(XyzReader, OnlyTextExtensionsAreTriedAsText) {
   iotest::writeText(dir / "a.dat", "1 2 3\n");
   EXPECT_EQ(detectFormat(dir / "a.dat"), Format::Unknown);
   EXPECT_THROW(readCloud(dir / "a.dat", quiet()), InputError);
+}
+
+} // namespace
+
+namespace {
+
+// FileInfo::extra is also printed as a JSON object by `pointrast info --json`: keys must be unique.
+TEST(Probe, ExtraKeysAreUniqueForEveryReadableFile) {
+  for (const char* folder : {"las", "las/permutations", "ply", "xyz"})
+    for (const auto& entry : std::filesystem::directory_iterator(data(folder))) {
+      if (!entry.is_regular_file() || entry.path().extension() == ".py") continue;
+      FileInfo info;
+      try {
+        info = probeFile(entry.path());
+      } catch (const InputError&) {
+        continue; // 1.2-no-points.las
+      }
+      std::set<std::string> keys;
+      for (const auto& kv : info.extra)
+        EXPECT_TRUE(keys.insert(kv.first).second) << entry.path() << ": " << kv.first;
+      EXPECT_FALSE(info.formatDetail.empty()) << entry.path();
+    }
 }
 
 } // namespace
