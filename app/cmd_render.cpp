@@ -33,7 +33,7 @@ struct RenderArgs {
 };
 
 int runRender(const RenderArgs& a) {
-  Progress::setEnabled(!a.quiet && !a.json);
+  Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   InputSpec spec;
   spec.source = a.input;
   spec.points = parseCount(a.points, "--points");

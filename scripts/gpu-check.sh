@@ -55,8 +55,14 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 $pr render terrain --points 1.2G -o "$OUT/big12.png" --json --frames 20 --parts 12 | tee "$OUT/big12.json" || status=1
     if cmp "$OUT/big.png" "$OUT/big12.png"; then echo "big: images identical"; else echo "big: IMAGES DIFFER"; status=1; fi
     ;;
+  sweep)
+    # Every method on a 200 M-point generated terrain in Morton order, overview: first look at the family.
+    for m in atomicmin earlyz reduce reduce-earlyz dedup dedup-ballot busyloop justset hqs hqs1r; do
+      POINTRAST_VALIDATION=0 $pr render terrain --points 200M --order morton --method $m -o "$OUT/sweep.png" --json --frames 20 -q | tee -a "$OUT/sweep.json" || status=1
+    done
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, sweep)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

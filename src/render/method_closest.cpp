@@ -18,9 +18,12 @@ public:
     uint32_t justSet = method == Method::JustSet;
     if (method == Method::BusyLoop) {
       raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp");
+    } else if (method == Method::Dedup) {
+      // The NV variant partitions instead of reducing: it has no REDUCE constant.
+      raster_ = gpu::ComputeProgram(context, int40 ? "raster_dedup_nv_int40.comp" : "raster_dedup_nv.comp",
+                                    {{/* EARLY_Z= */ 0, earlyZ}, {/* JUST_SET= */ 2, justSet}});
     } else {
-      std::string shader = method == Method::Dedup ? "raster_dedup_nv" : "raster_closest";
-      raster_ = gpu::ComputeProgram(context, shader + (int40 ? "_int40" : "") + ".comp",
+      raster_ = gpu::ComputeProgram(context, int40 ? "raster_closest_int40.comp" : "raster_closest.comp",
                                     {{/* EARLY_Z= */ 0, earlyZ}, {/* REDUCE= */ 1, reduce}, {/* JUST_SET= */ 2, justSet}});
     }
     uint32_t layout = method == Method::BusyLoop ? 2 : int40 ? 1 : 0;
