@@ -157,7 +157,11 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--background", a->background, "Background color r,g,b (0..255)")->capture_default_str();
   cmd->add_option("--order", a->order, "Vertex order: original, morton, shuffled, shuffled-morton")
       ->capture_default_str();
-  cmd->add_option("--method", a->method, "Rasterization method: atomicmin")->capture_default_str();
+  cmd->add_option(
+         "--method", a->method,
+         "Rasterization method, e.g. atomicmin (compute) or hw-points (the hardware GL_POINTS baseline); "
+         "an unknown name lists them all")
+      ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")->capture_default_str();
   cmd->add_option("--frames", a->frames, "Timed frames; the median GPU time is reported")->capture_default_str();

@@ -14,9 +14,10 @@ vec3 loadPosition(uint i) {
   return vec3(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2]);
 }
 
-bool pointWord(uint i, out uint pixel, out uint64_t word) {
+// withColor = false leaves the payload 0 and skips the color read (depth-only passes read 12 B a point).
+bool pointWord(uint i, bool withColor, out uint pixel, out uint64_t word) {
   vec3 p = loadPosition(i);
-  uint color = UintArray(pc.colors).v[i];
+  uint color = withColor ? UintArray(pc.colors).v[i] : 0u;
 #if DEPTH_INT40
   dvec4 c = DMat4Ref(pc.viewProjD).m * dvec4(dvec3(p), 1.0lf);
   if (!(c.w > double(pc.nearW))) return false;

@@ -8,6 +8,7 @@
 //                minimum; otherwise neighbouring pairs that share a pixel combine first (clustered)
 //             2: dedup from ballots: one atomic per distinct pixel of the subgroup (portable)
 //   JUST_SET  plain stores without any depth test: a speed reference, not a correct image
+//   DEPTH_ONLY the payload is 0 and colors are not read (the depth pass of HQS)
 // DEDUP_NV (entry-file #define): dedup with VK_NV_shader_subgroup_partitioned instead of REDUCE.
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
@@ -25,6 +26,7 @@ layout(push_constant) uniform Push { RasterPush pc; };
 layout(constant_id = 0) const uint EARLY_Z = 0;
 layout(constant_id = 1) const uint REDUCE = 0;
 layout(constant_id = 2) const uint JUST_SET = 0;
+layout(constant_id = 3) const uint DEPTH_ONLY = 0; // payload 0, no color read (HQS depth pass)
 
 #include "point.inc.glsl"
 
@@ -41,7 +43,7 @@ void main() {
   uint pixel = kNoPixel;
   uint64_t word = kEmptyPixel;
   // No early return: the subgroup operations below need every lane of the subgroup active.
-  if (i < pc.pointCount && !pointWord(i, pixel, word)) pixel = kNoPixel;
+  if (i < pc.pointCount && !pointWord(i, DEPTH_ONLY == 0, pixel, word)) pixel = kNoPixel;
   bool valid = pixel != kNoPixel;
 
   if (JUST_SET != 0) {

@@ -271,6 +271,7 @@ void Context::createDevice() {
 
   VkPhysicalDeviceVulkan13Features want13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   want13.synchronization2 = VK_TRUE;
+  want13.dynamicRendering = has13.dynamicRendering; // hw-points draws without render pass objects
   want13.maintenance4 = has13.maintenance4;
   want13.subgroupSizeControl = has13.subgroupSizeControl;
   want13.computeFullSubgroups = has13.computeFullSubgroups;

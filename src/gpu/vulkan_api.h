@@ -36,7 +36,10 @@
   X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) \
   X(vkCreateQueryPool) X(vkDestroyQueryPool) X(vkGetQueryPoolResults) \
   X(vkCmdBindPipeline) X(vkCmdPushConstants) X(vkCmdDispatch) X(vkCmdPipelineBarrier2) \
-  X(vkCmdCopyBuffer) X(vkCmdFillBuffer) X(vkCmdResetQueryPool) X(vkCmdWriteTimestamp2)
+  X(vkCmdCopyBuffer) X(vkCmdFillBuffer) X(vkCmdResetQueryPool) X(vkCmdWriteTimestamp2) \
+  X(vkCreateImage) X(vkDestroyImage) X(vkGetImageMemoryRequirements) X(vkBindImageMemory) \
+  X(vkCreateImageView) X(vkDestroyImageView) X(vkCreateGraphicsPipelines) X(vkCmdBeginRendering) \
+  X(vkCmdEndRendering) X(vkCmdDraw) X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdCopyImageToBuffer)
 // clang-format on
 
 namespace pointrast::gpu {

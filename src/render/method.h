@@ -75,5 +75,6 @@ shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint
 
 std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, Method method, DepthMode depth);
 std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height);
+std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, uint32_t width, uint32_t height);
 
 } // namespace pointrast

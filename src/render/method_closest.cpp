@@ -17,7 +17,9 @@ public:
     uint32_t reduce = method == Method::Reduce || method == Method::ReduceEarlyZ ? 1 : method == Method::DedupBallot ? 2 : 0;
     uint32_t justSet = method == Method::JustSet;
     if (method == Method::BusyLoop) {
-      raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp");
+      // No release barrier on CPU devices: see the shader for why lavapipe needs that.
+      raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp",
+                                    {{/* RELEASE_BARRIER= */ 0, context.info().software() ? 0u : 1u}});
     } else if (method == Method::Dedup) {
       // The NV variant partitions instead of reducing: it has no REDUCE constant.
       raster_ = gpu::ComputeProgram(context, int40 ? "raster_dedup_nv_int40.comp" : "raster_dedup_nv.comp",

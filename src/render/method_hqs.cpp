@@ -15,8 +15,15 @@ public:
     // hqs: 2 uint64 sums per pixel. hqs1r: 1 packed uint64 + 2 uint64 fallback sums per pixel.
     accumulators_ = gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
                                 oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
-    depth_ = gpu::ComputeProgram(context, "raster_closest.comp", {{/* EARLY_Z= */ 0, 1}});
-    accumulate_ = gpu::ComputeProgram(context, "raster_hqs.comp", {{/* ONE_ROUND= */ 0, oneRound_}});
+    // The depth pass is the fastest closest-point method the device has, reading positions only.
+    bool partitioned = context.features().subgroupPartitionedNV;
+    if (partitioned)
+      depth_ = gpu::ComputeProgram(context, "raster_dedup_nv.comp", {{/* EARLY_Z= */ 0, 1}, {/* DEPTH_ONLY= */ 3, 1}});
+    else
+      depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
+                                   {{/* EARLY_Z= */ 0, 1}, {/* REDUCE= */ 1, 1}, {/* DEPTH_ONLY= */ 3, 1}});
+    accumulate_ = gpu::ComputeProgram(context, partitioned ? "raster_hqs_nv.comp" : "raster_hqs.comp",
+                                      {{/* ONE_ROUND= */ 0, oneRound_}});
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, oneRound_}});
   }
 

@@ -12,8 +12,8 @@ namespace pointrast {
 
 namespace {
 
-// bytesPerPoint: 12 B position + 4 B color read by every closest-point method; HQS reads positions and
-// colors in both passes (the depth pass shares the closest-point shader): 32 B.
+// bytesPerPoint: 12 B position + 4 B color read by every closest-point method; HQS reads positions in its
+// depth pass and positions and colors in its blending pass: 28 B.
 constexpr MethodInfo kMethods[] = {
     {Method::AtomicMin, "atomicmin", "one 64-bit atomicMin of depth<<32|color per point (2019)", true, true, 16},
     {Method::EarlyZ, "earlyz", "read the pixel first, atomicMin only if closer (2021)", true, true, 16},
@@ -24,8 +24,10 @@ constexpr MethodInfo kMethods[] = {
     {Method::DedupBallot, "dedup-ballot", "dedup from portable subgroup ballots, with early-z", true, true, 16},
     {Method::BusyLoop, "busyloop", "per-pixel lock in the depth word, then color (2013), with early-z", true, false, 16},
     {Method::JustSet, "justset", "plain stores, no depth test: a speed reference, not a correct image", false, true, 16},
-    {Method::Hqs, "hqs", "high-quality splatting: blend points within 1% of the closest depth (2019)", false, false, 32},
-    {Method::Hqs1r, "hqs1r", "HQS with one packed 64-bit atomicAdd and overflow fallback (2022)", false, false, 32},
+    {Method::Hqs, "hqs", "high-quality splatting: blend points within 1% of the closest depth (2019)", false, false, 28},
+    {Method::Hqs1r, "hqs1r", "HQS with one packed 64-bit atomicAdd and overflow fallback (2022)", false, false, 28},
+    {Method::HwPoints, "hw-points", "Vulkan point-list pipeline, 1-pixel points, hardware depth test: the GL_POINTS "
+                                    "baseline", false, false, 16},
 };
 
 // 16384 x 16384 pixels: 2 GiB of framebuffer words, the most a single allocation is guaranteed to hold
@@ -98,6 +100,8 @@ bool Renderer::supports(gpu::Context& context, Method method, std::string* why) 
   case Method::Reduce:
   case Method::ReduceEarlyZ:
   case Method::DedupBallot:
+  case Method::Hqs:
+  case Method::Hqs1r:
     if (!subgroups) reason = "needs subgroup vote/ballot/shuffle/arithmetic on 64-bit integers in compute shaders";
     break;
   case Method::Dedup:
@@ -144,6 +148,8 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
   std::unique_ptr<PointMethod> created;
   if (settings.method == Method::Hqs || settings.method == Method::Hqs1r)
     created = createHqsMethod(context_, settings.method, targets_->width, targets_->height);
+  else if (settings.method == Method::HwPoints)
+    created = createHwPointsMethod(context_, targets_->width, targets_->height);
   else
     created = createClosestMethod(context_, settings.method, settings.depth);
   return *methods_.emplace(key, std::move(created)).first->second;

@@ -31,6 +31,7 @@ enum class Method {
   JustSet,      // plain stores without depth test: a speed reference only
   Hqs,          // 2019 high-quality splatting: depth pass + two-atomic accumulation + resolve
   Hqs1r,        // 2022 single-atomic HQS (16-bit packed) with overflow fallback
+  HwPoints,     // the hardware point list (GL_POINTS): graphics pipeline, 1-pixel points, depth test
 };
 
 enum class DepthMode {

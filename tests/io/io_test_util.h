@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -50,8 +51,11 @@ private:
   std::filesystem::path path_;
 };
 
+// Throws when the file is missing (a test data file not beside the checkout must fail the test, not
+// hand an empty buffer to code that patches bytes at fixed offsets).
 inline std::vector<uint8_t> readBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("test data missing: " + path.string());
   return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 

@@ -1,0 +1,32 @@
+// The device's buffer-copy bandwidth, measured in the same run as a benchmark so that every method's
+// effective bandwidth can be stated as a fraction of what the memory system delivers (DESIGN.md,
+// "Measuring performance"). vkCmdCopyBuffer between two device-local buffers, timed with timestamp
+// queries after a warm-up, median over the repeats.
+#pragma once
+
+#include <cstdint>
+
+namespace pointrast::gpu {
+
+class Context;
+
+struct CopyBandwidth {
+  uint64_t bytes = 0;          // size of one copy (after clamping)
+  int repeats = 0;             // timed copies
+  double medianMs = 0;         // GPU time of one copy, median over the repeats
+  double bytesPerSecond = 0;   // 2 * bytes / median: read + written (see below)
+};
+
+// What measureCopy() copies when asked for `requested` bytes: at most a quarter of device-local memory
+// (two buffers of it must fit beside whatever else is resident), the largest buffer and allocation,
+// rounded down to 256 B; at least 4 KiB.
+uint64_t copyBytesFor(const Context& context, uint64_t requested);
+
+// A copy moves every byte twice through DRAM (one read, one write), so the figure returned counts
+// bytes read + bytes written per second: it is what a method that only reads its point data could at
+// most stream, and the denominator of "effective bandwidth as a fraction of copy bandwidth".
+// Throws UnsupportedError when the buffers cannot be allocated.
+CopyBandwidth measureCopy(Context& context, uint64_t bytes = uint64_t(1) << 30, int repeats = 10);
+double measureCopyBandwidth(Context& context, uint64_t bytes = uint64_t(1) << 30, int repeats = 10);
+
+} // namespace pointrast::gpu

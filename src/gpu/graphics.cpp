@@ -1,0 +1,164 @@
+#include "gpu/graphics.h"
+
+#include <algorithm>
+#include <span>
+#include <utility>
+
+#include "gpu/context.h"
+#include "gpu/shader_registry.h"
+
+namespace pointrast::gpu {
+
+namespace {
+
+VkShaderModule createModule(VkDevice device, std::span<const uint32_t> words) {
+  VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  info.codeSize = words.size_bytes();
+  info.pCode = words.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateShaderModule(device, &info, nullptr, &module));
+  return module;
+}
+
+} // namespace
+
+GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShader,
+                                 const std::string& fragmentShader, const GraphicsOptions& options)
+    : device_(context.device()), options_(options) {
+  std::span<const uint32_t> vertexWords = findShader(vertexShader);
+  std::span<const uint32_t> fragmentWords = findShader(fragmentShader);
+  SpirvReflection vertex = reflectSpirv(vertexWords);
+  SpirvReflection fragment = reflectSpirv(fragmentWords);
+  // Both stages see the same block from offset 0 (one struct from shared.h), or a stage declares none.
+  assert((vertex.pushConstantSize == 0 || fragment.pushConstantSize == 0 ||
+          vertex.pushConstantSize == fragment.pushConstantSize) &&
+         "vertex and fragment shaders declare different push-constant blocks");
+  // Without maintenance5 a point list rasterizes with an undefined size unless the last vertex stage
+  // writes gl_PointSize.
+  assert((options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST || vertex.usesPointSize) &&
+         "a point-list pipeline needs a vertex shader that writes gl_PointSize");
+  pushConstantSize_ = std::max(vertex.pushConstantSize, fragment.pushConstantSize);
+
+  VkShaderModule modules[2] = {createModule(device_, vertexWords), VK_NULL_HANDLE};
+  try {
+    modules[1] = createModule(device_, fragmentWords);
+    VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                              pushConstantSize_};
+    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.pushConstantRangeCount = range.size ? 1 : 0;
+    layoutInfo.pPushConstantRanges = &range;
+    VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
+
+    VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+                                                 {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = modules[0];
+    stages[0].pName = "main";
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = modules[1];
+    stages[1].pName = "main";
+
+    VkPipelineVertexInputStateCreateInfo vertexInput{
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineInputAssemblyStateCreateInfo assembly{
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    assembly.topology = options.topology;
+    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    viewport.viewportCount = 1;
+    viewport.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    raster.polygonMode = VK_POLYGON_MODE_FILL;
+    raster.cullMode = VK_CULL_MODE_NONE;
+    raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    raster.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo multisample{
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+    VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    depth.depthTestEnable = VK_TRUE;
+    depth.depthWriteEnable = VK_TRUE;
+    depth.depthCompareOp = options.depthCompare;
+    VkPipelineColorBlendAttachmentState blendAttachment{};
+    blendAttachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                     VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    blend.attachmentCount = 1;
+    blend.pAttachments = &blendAttachment;
+    VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dynamic.dynamicStateCount = 2;
+    dynamic.pDynamicStates = dynamicStates;
+    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachmentFormats = &options.colorFormat;
+    rendering.depthAttachmentFormat = options.depthFormat;
+
+    VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &rendering};
+    info.stageCount = 2;
+    info.pStages = stages;
+    info.pVertexInputState = &vertexInput;
+    info.pInputAssemblyState = &assembly;
+    info.pViewportState = &viewport;
+    info.pRasterizationState = &raster;
+    info.pMultisampleState = &multisample;
+    info.pDepthStencilState = &depth;
+    info.pColorBlendState = &blend;
+    info.pDynamicState = &dynamic;
+    info.layout = layout_;
+    VK_CHECK(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
+    context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_), vertexShader + " + " + fragmentShader);
+  } catch (...) {
+    for (VkShaderModule m : modules)
+      if (m) vkDestroyShaderModule(device_, m, nullptr);
+    release();
+    throw;
+  }
+  for (VkShaderModule m : modules)
+    vkDestroyShaderModule(device_, m, nullptr);
+}
+
+GraphicsProgram::~GraphicsProgram() {
+  release();
+}
+
+void GraphicsProgram::release() {
+  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
+  if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
+  pipeline_ = VK_NULL_HANDLE;
+  layout_ = VK_NULL_HANDLE;
+}
+
+GraphicsProgram::GraphicsProgram(GraphicsProgram&& other) noexcept {
+  *this = std::move(other);
+}
+
+GraphicsProgram& GraphicsProgram::operator=(GraphicsProgram&& other) noexcept {
+  if (this != &other) {
+    release();
+    device_ = other.device_;
+    layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
+    pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
+    pushConstantSize_ = other.pushConstantSize_;
+    options_ = other.options_;
+  }
+  return *this;
+}
+
+void GraphicsProgram::drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, const void* push,
+                              uint32_t size) const {
+  if (vertexCount == 0) return;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+  if (size)
+    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, size,
+                       push);
+  vkCmdDraw(cmd, vertexCount, 1, 0, 0);
+}
+
+void setViewport(VkCommandBuffer cmd, uint32_t width, uint32_t height) {
+  VkViewport viewport{0.0f, 0.0f, float(width), float(height), 0.0f, 1.0f};
+  VkRect2D scissor{{0, 0}, {width, height}};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+} // namespace pointrast::gpu

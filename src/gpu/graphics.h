@@ -1,0 +1,64 @@
+// Graphics programs (vertex + fragment) built from embedded SPIR-V, the rasterization-pipeline sibling of
+// ComputeProgram. Like it, the layout comes from the modules: one push-constant range of the reflected
+// size shared by both stages, no descriptor sets and no vertex input bindings (the vertex shader pulls its
+// data by buffer device address with gl_VertexIndex). Pipelines draw with dynamic rendering (Vulkan 1.3),
+// so no render pass objects; viewport and scissor are dynamic state, set with setViewport.
+//
+//   GraphicsProgram points(ctx, "points_hw.vert", "points_hw.frag", {.depthCompare = VK_COMPARE_OP_GREATER});
+//   points.draw(cmd, count, push);  // asserts sizeof(push) == the shaders' push-constant block
+#pragma once
+
+#include <cassert>
+#include <cstdint>
+#include <string>
+
+#include "gpu/spirv_reflect.h"
+#include "gpu/vulkan_api.h"
+
+namespace pointrast::gpu {
+
+class Context;
+
+struct GraphicsOptions {
+  VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_POINT_LIST;
+  VkFormat colorFormat = VK_FORMAT_R8G8B8A8_UNORM;
+  VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
+  VkCompareOp depthCompare = VK_COMPARE_OP_LESS; // with depth writes; GREATER for reverse-Z
+};
+
+class GraphicsProgram {
+public:
+  GraphicsProgram() = default;
+  GraphicsProgram(Context& context, const std::string& vertexShader, const std::string& fragmentShader,
+                  const GraphicsOptions& options = {});
+  ~GraphicsProgram();
+  GraphicsProgram(GraphicsProgram&& other) noexcept;
+  GraphicsProgram& operator=(GraphicsProgram&& other) noexcept;
+  GraphicsProgram(const GraphicsProgram&) = delete;
+  GraphicsProgram& operator=(const GraphicsProgram&) = delete;
+
+  uint32_t pushConstantSize() const { return pushConstantSize_; }
+  const GraphicsOptions& options() const { return options_; }
+
+  // Binds the pipeline, pushes the constants and draws vertexCount vertices (one instance). Must be
+  // recorded between vkCmdBeginRendering and vkCmdEndRendering with attachments of options() formats.
+  template <class Push> void draw(VkCommandBuffer cmd, uint32_t vertexCount, const Push& push) const {
+    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
+    drawRaw(cmd, vertexCount, &push, sizeof(Push));
+  }
+
+private:
+  void drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, const void* push, uint32_t size) const;
+  void release();
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  uint32_t pushConstantSize_ = 0;
+  GraphicsOptions options_;
+};
+
+// Viewport (0, 0)-(width, height) with depth range [0, 1], and the same scissor: the dynamic state every
+// GraphicsProgram expects before its first draw.
+void setViewport(VkCommandBuffer cmd, uint32_t width, uint32_t height);
+
+} // namespace pointrast::gpu
