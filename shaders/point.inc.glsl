@@ -14,10 +14,8 @@ vec3 loadPosition(uint i) {
   return vec3(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2]);
 }
 
-// withColor = false leaves the payload 0 and skips the color read (depth-only passes read 12 B a point).
-bool pointWord(uint i, bool withColor, out uint pixel, out uint64_t word) {
-  vec3 p = loadPosition(i);
-  uint color = withColor ? UintArray(pc.colors).v[i] : 0u;
+// The depth part of point p's framebuffer word (payload 0) and its pixel; false if the point is dropped.
+bool depthWordOf(vec3 p, out uint pixel, out uint64_t word) {
 #if DEPTH_INT40
   dvec4 c = DMat4Ref(pc.viewProjD).m * dvec4(dvec3(p), 1.0lf);
   if (!(c.w > double(pc.nearW))) return false;
@@ -26,12 +24,29 @@ bool pointWord(uint i, bool withColor, out uint pixel, out uint64_t word) {
   if (!(fx >= 0.0lf && fx < double(pc.width) && fy >= 0.0lf && fy < double(pc.height))) return false;
   pixel = min(uint(fy), pc.height - 1) * pc.width + min(uint(fx), pc.width - 1);
   double steps = min(c.w * double(pc.depthScale), double(kInt40MaxDepth));
-  word = (uint64_t(steps) << kInt40ColorBits) | uint64_t(color & 0xFFFFFFu);
+  word = uint64_t(steps) << kInt40ColorBits;
   return true;
 #else
   uint depthBits;
   if (!projectPoint(pc.viewProj, p, pc.width, pc.height, pc.nearW, pixel, depthBits)) return false;
-  word = (uint64_t(depthBits) << 32) | uint64_t(color);
+  word = uint64_t(depthBits) << 32;
   return true;
 #endif
+}
+
+// Adds point i's color as the payload of a depth word.
+uint64_t withColor(uint64_t word, uint i) {
+  uint color = UintArray(pc.colors).v[i];
+#if DEPTH_INT40
+  return word | uint64_t(color & 0xFFFFFFu);
+#else
+  return word | uint64_t(color);
+#endif
+}
+
+// withColor = false leaves the payload 0 and skips the color read (depth-only passes read 12 B a point).
+bool pointWord(uint i, bool color, out uint pixel, out uint64_t word) {
+  if (!depthWordOf(loadPosition(i), pixel, word)) return false;
+  if (color) word = withColor(word, i);
+  return true;
 }

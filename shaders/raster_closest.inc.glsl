@@ -27,6 +27,9 @@ layout(constant_id = 0) const uint EARLY_Z = 0;
 layout(constant_id = 1) const uint REDUCE = 0;
 layout(constant_id = 2) const uint JUST_SET = 0;
 layout(constant_id = 3) const uint DEPTH_ONLY = 0; // payload 0, no color read (HQS depth pass)
+// Points per thread: a workgroup draws kPointGroupSize * POINTS_PER_THREAD consecutive points, each
+// thread loading all its positions before it projects any, for more loads in flight per thread.
+layout(constant_id = 4) const uint POINTS_PER_THREAD = 1;
 
 #include "point.inc.glsl"
 
@@ -38,14 +41,9 @@ void writeClosest(uint pixel, uint64_t word) {
   atomicMin(fb.v[pixel], word);
 }
 
-void main() {
-  uint i = linearInvocation(pc.groupsX, kPointGroupSize);
-  uint pixel = kNoPixel;
-  uint64_t word = kEmptyPixel;
-  // No early return: the subgroup operations below need every lane of the subgroup active.
-  if (i < pc.pointCount && !pointWord(i, DEPTH_ONLY == 0, pixel, word)) pixel = kNoPixel;
+// Settles one point per lane (pixel == kNoPixel: no point) into the framebuffer.
+void settle(uint pixel, uint64_t word) {
   bool valid = pixel != kNoPixel;
-
   if (JUST_SET != 0) {
     if (valid) Uint64Array(pc.framebuffer).v[pixel] = word;
     return;
@@ -56,9 +54,13 @@ void main() {
   if (valid && gl_SubgroupInvocationID == subgroupBallotFindLSB(same)) writeClosest(pixel, least);
 #else
   if (REDUCE == 1) {
-    if (subgroupAllEqual(pixel)) {
+    // Lanes without a point take the pixel of the first lane with one, so they do not spoil the test.
+    uvec4 busy = subgroupBallot(valid);
+    if (subgroupBallotBitCount(busy) == 0) return;
+    uint probe = valid ? pixel : subgroupShuffle(pixel, subgroupBallotFindLSB(busy));
+    if (subgroupAllEqual(probe)) {
       uint64_t least = subgroupMin(word);
-      if (valid && subgroupElect()) writeClosest(pixel, least);
+      if (gl_SubgroupInvocationID == subgroupBallotFindLSB(busy)) writeClosest(pixel, least);
       return;
     }
     uint otherPixel = subgroupShuffleXor(pixel, 1);
@@ -83,4 +85,32 @@ void main() {
     writeClosest(pixel, word);
   }
 #endif
+}
+
+void main() {
+  // No early return anywhere: the subgroup operations in settle() need every lane of the subgroup.
+  uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
+  uint first = group * (kPointGroupSize * POINTS_PER_THREAD) + gl_LocalInvocationIndex;
+  vec3 positions[POINTS_PER_THREAD];
+  for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
+    uint i = first + k * kPointGroupSize;
+    positions[k] = i < pc.pointCount ? loadPosition(i) : vec3(0.0);
+  }
+  for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
+    uint i = first + k * kPointGroupSize;
+    uint pixel = kNoPixel;
+    uint64_t word = kEmptyPixel;
+    if (i < pc.pointCount && depthWordOf(positions[k], pixel, word)) {
+      // Early-z on the word without its payload: if even that cannot win, the color is never read.
+      if (EARLY_Z != 0 && JUST_SET == 0 && word > Uint64Array(pc.framebuffer).v[pixel]) {
+        pixel = kNoPixel;
+      } else if (DEPTH_ONLY == 0) {
+        word = withColor(word, i);
+      }
+    } else {
+      pixel = kNoPixel;
+    }
+    if (pixel == kNoPixel) word = kEmptyPixel;
+    settle(pixel, word);
+  }
 }

@@ -1,0 +1,46 @@
+// Report writers for a BenchRun: one JSON document with everything (results, device, copy bandwidth,
+// command line, date), a Markdown table laid out like Table 1 of the 2021 paper (rows: data set x
+// order, columns: methods, one table per view) and an SVG bar chart written by hand (no plotting
+// library: the binary stays one self-contained file).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/runner.h"
+
+namespace pointrast::bench {
+
+struct ReportInfo {
+  std::string name;        // file stem: <name>.json, <name>.md, <name>.svg
+  std::string title;       // "paper2021 (scale 0.001)", "terrain-20k"
+  std::string commandLine; // as typed, to reproduce the run
+  std::string date;        // ISO 8601, UTC
+};
+
+// One result as a flat object (also the line `pointrast bench --json` prints per result).
+nlohmann::json resultJson(const BenchRun& run, const Result& result);
+nlohmann::json runJson(const BenchRun& run, const ReportInfo& info);
+std::string markdownReport(const BenchRun& run, const ReportInfo& info);
+// Grouped bars of median ms per method for each data set, for the Morton order and the overview view
+// (or the first order/view measured when those were not); log scale when values span more than 20x.
+std::string svgChart(const BenchRun& run, const ReportInfo& info);
+
+struct WrittenFiles {
+  std::filesystem::path json, markdown, svg;
+};
+// Creates `dir` and writes the three files, each through a ".partial" file renamed into place, so an
+// interrupted run leaves no half-written report. Throws InputError when a file cannot be written.
+WrittenFiles writeReports(const BenchRun& run, const ReportInfo& info, const std::filesystem::path& dir);
+
+// "NVIDIA H200" -> "nvidia-h200": lower case, runs of anything but letters and digits become one '-'.
+std::string sanitizeName(std::string_view text);
+// Median milliseconds with three significant digits and no exponent: 1234, 12.3, 1.23, 0.123, 0.0123.
+std::string formatMs(double ms);
+// Now, as 2024-05-01T12:34:56Z.
+std::string utcNow();
+
+} // namespace pointrast::bench

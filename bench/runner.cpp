@@ -1,0 +1,211 @@
+#include "bench/runner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <unistd.h>
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "cloud/generate.h"
+#include "io/reader.h"
+#include "render/scene.h"
+
+namespace pointrast::bench {
+
+namespace {
+
+std::string gib(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t(1) << 30));
+  return text;
+}
+
+uint64_t physicalMemory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && pageSize > 0 ? uint64_t(pages) * uint64_t(pageSize) : 0;
+}
+
+// Points a data set will have, known before it is loaded: generated scenes have exactly the count
+// asked for; files state theirs in the header (counted for XYZ).
+uint64_t expectedPoints(const Dataset& d) { return d.file ? io::probeFile(d.source).pointCount : d.points; }
+
+// Parallel gather in fixed blocks (as everywhere in src/cloud), so it costs a fraction of the sort.
+constexpr uint64_t kGatherBlock = uint64_t(1) << 16;
+
+} // namespace
+
+uint32_t warmupFrames(uint32_t frames) { return std::max(2u, frames / 10); }
+
+std::string MemoryEstimate::describe() const {
+  return "needs " + gib(gpuBytes) + " of GPU memory (device has " + gib(gpuHave) + ") and " + gib(hostBytes) +
+         " of host memory (machine has " + gib(hostHave) + ")";
+}
+
+MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height) {
+  MemoryEstimate m;
+  m.gpuBytes = points * 16 + uint64_t(width) * height * kTargetBytesPerPixel;
+  m.hostBytes = points * kHostBytesPerPoint;
+  if (context.info().software()) m.hostBytes += m.gpuBytes;
+  m.gpuHave = context.deviceLocalBytes();
+  m.hostHave = physicalMemory();
+  return m;
+}
+
+PointCloud loadDataset(const Dataset& dataset, bool progress) {
+  if (!dataset.file) {
+    GenerateOptions options;
+    options.points = dataset.points;
+    options.seed = dataset.seed;
+    options.progress = progress;
+    return generateScene(parseScene(dataset.source), options); // positions and RGB only already
+  }
+  io::ReadOptions options;
+  options.progress = progress;
+  PointCloud cloud = io::readCloud(dataset.source, options);
+  // Decide the display colors once, from the whole cloud, and drop what rendering never reads: every
+  // order then uploads the same colors from 16 B/point, and the reordered copy needs no attributes.
+  DisplayColorMode mode = displayColorMode(cloud);
+  std::vector<uint32_t> colors(cloud.size());
+  displayColors(colors.data(), cloud, 0, cloud.size(), mode);
+  cloud.colors = std::move(colors);
+  cloud.intensity = {};
+  cloud.classification = {};
+  cloud.returnNumber = {};
+  return cloud;
+}
+
+PointCloud reorderedCopy(const PointCloud& src, Order order, uint64_t seed) {
+  std::vector<uint64_t> permutation;
+  computeOrder(permutation, src, order, seed);
+  PointCloud dst;
+  dst.scale = src.scale;
+  dst.offset = src.offset;
+  dst.bounds = src.bounds;
+  dst.source = src.source;
+  dst.positions.resize(src.positions.size());
+  dst.colors.resize(src.colors.size());
+  const bool colors = !src.colors.empty();
+  parallelBlocks(src.size(), kGatherBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
+    for (uint64_t i = begin; i < end; ++i) {
+      const uint64_t from = permutation[i];
+      dst.positions[3 * i] = src.positions[3 * from];
+      dst.positions[3 * i + 1] = src.positions[3 * from + 1];
+      dst.positions[3 * i + 2] = src.positions[3 * from + 2];
+      if (colors) dst.colors[i] = src.colors[from];
+    }
+  });
+  return dst;
+}
+
+BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchCallbacks& callbacks) {
+  const auto start = std::chrono::steady_clock::now();
+  auto note = [&](const std::string& line) {
+    if (callbacks.onNote) callbacks.onNote(line);
+  };
+  BenchRun run;
+  run.device = context.info();
+  run.deviceLocalBytes = context.deviceLocalBytes();
+  run.config = config;
+  run.warmup = warmupFrames(config.frames);
+
+  // Every data set is sized before anything runs, so what will be skipped is said up front.
+  size_t total = 0;
+  for (const Dataset& d : config.datasets) {
+    DatasetOutcome outcome;
+    outcome.dataset = d;
+    outcome.points = expectedPoints(d);
+    outcome.memory = estimateMemory(context, outcome.points, config.width, config.height);
+    if (outcome.points == 0) {
+      outcome.skipped = true;
+      outcome.reason = "it has no points";
+    } else if (!outcome.memory.fits()) {
+      outcome.skipped = true;
+      outcome.reason = "it does not fit: " + outcome.memory.describe();
+    }
+    note(d.label + ": " + (outcome.skipped ? "skipped, " + outcome.reason : outcome.memory.describe()));
+    if (!outcome.skipped) total += config.orders.size() * config.views.size() * config.methods.size();
+    run.datasets.push_back(std::move(outcome));
+  }
+
+  // Before any scene is resident, so the copy buffers may take their full size.
+  run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
+  {
+    char line[160];
+    std::snprintf(line, sizeof line, "copy bandwidth: %.1f GB/s (read + write, %s copied, median of %d)",
+                  run.copy.bytesPerSecond * 1e-9, gib(run.copy.bytes).c_str(), run.copy.repeats);
+    note(line);
+  }
+
+  Renderer renderer(context, config.width, config.height);
+  const double aspect = double(config.width) / double(config.height);
+  size_t done = 0;
+  for (DatasetOutcome& outcome : run.datasets) {
+    if (outcome.skipped) continue;
+    const Dataset& d = outcome.dataset;
+    PointCloud cloud = loadDataset(d, config.progress);
+    outcome.points = cloud.size();
+    outcome.description = cloud.source;
+    for (Order order : config.orders) {
+      std::unique_ptr<GpuScene> scene;
+      std::string failure;
+      {
+        PointCloud ordered;
+        if (order != Order::Original) ordered = reorderedCopy(cloud, order, config.orderSeed);
+        UploadOptions upload;
+        upload.progress = config.progress;
+        try {
+          scene = std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
+        } catch (const UnsupportedError& e) {
+          failure = e.what(); // out of device memory after all: every combination says so
+        }
+      } // the reordered host copy is freed here, before the GPU work
+      for (View view : config.views) {
+        const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
+        for (Method method : config.methods) {
+          Result r;
+          r.dataset = d.name;
+          r.order = order;
+          r.view = view;
+          r.method = method;
+          r.points = cloud.size();
+          r.bytesPerPoint = methodInfo(method).bytesPerPoint;
+          r.camera = describeCamera(camera);
+          std::string why;
+          if (!failure.empty()) {
+            r.status = "unsupported";
+            r.reason = failure;
+          } else if (!Renderer::supports(context, method, &why)) {
+            r.status = "unsupported";
+            r.reason = why;
+          } else {
+            RenderSettings settings;
+            settings.method = method;
+            settings.frames = config.frames;
+            settings.warmup = run.warmup;
+            try {
+              r.stats = renderer.render(*scene, camera, settings);
+            } catch (const UnsupportedError& e) {
+              r.status = "unsupported";
+              r.reason = e.what();
+            }
+          }
+          if (r.ok() && r.stats.medianMs > 0) {
+            const double seconds = r.stats.medianMs * 1e-3;
+            r.pointsPerSecond = double(r.stats.points) / seconds;
+            r.effectiveBytesPerSecond = double(r.stats.points) * r.bytesPerPoint / seconds;
+            r.copyFraction = run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
+          }
+          run.results.push_back(r);
+          ++done;
+          if (callbacks.onResult) callbacks.onResult(run.results.back(), done, total);
+        }
+      }
+    }
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+} // namespace pointrast::bench

@@ -1,0 +1,119 @@
+// The benchmark runner: for each data set, each vertex order, each view and each method, GPU time of
+// whole frames (clear + render + resolve) from timestamp queries after a warm-up, with the device's
+// buffer-copy bandwidth measured in the same run (DESIGN.md, "Measuring performance").
+//
+// Memory: the host holds the data set in its original order (16 B/point: positions and display colors;
+// a file's other attributes are dropped once its colors are decided) plus one reordered copy and its
+// permutation (8 B/point) while that order is uploaded; the GPU holds one order of one data set at a time.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bench/views.h"
+#include "cloud/order.h"
+#include "gpu/bandwidth.h"
+#include "gpu/context.h"
+#include "render/renderer.h"
+
+namespace pointrast::bench {
+
+struct Dataset {
+  std::string name;   // short id for JSON and file names: "retz-like", "terrain-20k", "autzen"
+  std::string label;  // row label of the tables: "retz-like (terrain, 145 M)"
+  std::string source; // a file path or a scene name (terrain, tls)
+  uint64_t points = 0; // points to generate (scenes); ignored for files
+  uint64_t seed = 1;   // scene seed
+  bool file = false;   // source is a file
+};
+
+struct BenchConfig {
+  std::vector<Dataset> datasets;
+  std::vector<Method> methods;
+  std::vector<Order> orders;
+  std::vector<View> views;
+  uint32_t width = 1920, height = 1080;
+  uint32_t frames = 50;      // timed frames per combination; warm-up is warmupFrames(frames)
+  double fovY = 60.0;
+  uint64_t orderSeed = 1;    // for the shuffled orders
+  uint64_t copyBytes = uint64_t(1) << 30;
+  int copyRepeats = 10;
+  bool progress = true;      // generation, reading and upload progress (drawn only on a terminal)
+};
+
+// Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
+uint32_t warmupFrames(uint32_t frames);
+
+// Bytes per pixel of the render targets of every method a Renderer may hold at once: framebuffer (8),
+// image (4), canonical words (8), HQS accumulators (16) and HQS1R's (24), rounded up.
+constexpr uint64_t kTargetBytesPerPixel = 64;
+// Host bytes per point: the original (16 B) + a reordered copy (16 B) + its permutation (8 B).
+constexpr uint64_t kHostBytesPerPoint = 40;
+
+struct MemoryEstimate {
+  uint64_t gpuBytes = 0, hostBytes = 0;   // needed
+  uint64_t gpuHave = 0, hostHave = 0;     // device-local heaps; physical memory of this machine
+  bool fits() const { return gpuBytes <= gpuHave && hostBytes <= hostHave; }
+  std::string describe() const;           // "needs 12.7 GB of GPU memory (has 80.0 GB) and ..."
+};
+// GPU: points x 16 B + targets; host: points x 40 B, plus the GPU bytes on a software device (its
+// "device memory" is host memory).
+MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height);
+
+struct Result {
+  std::string dataset; // Dataset::name
+  Order order = Order::Original;
+  View view = View::Overview;
+  Method method = Method::AtomicMin;
+  std::string status = "ok"; // "ok", or "unsupported" (reason says why: device feature, memory)
+  std::string reason;
+  uint64_t points = 0;
+  FrameStats stats;
+  uint32_t bytesPerPoint = 0;
+  double pointsPerSecond = 0;
+  double effectiveBytesPerSecond = 0; // points x bytesPerPoint / median time
+  double copyFraction = 0;            // effectiveBytesPerSecond / copy bandwidth (read + write)
+  std::string camera;                 // describeCamera(), to reproduce the view with `pointrast render`
+  bool ok() const { return status == "ok"; }
+};
+
+struct DatasetOutcome {
+  Dataset dataset;
+  uint64_t points = 0;      // points of the cloud (from the file header before it is read)
+  std::string description;  // the cloud's source text ("terrain, 4000000 points, seed 1")
+  MemoryEstimate memory;
+  bool skipped = false;
+  std::string reason;       // why it was skipped
+};
+
+struct BenchRun {
+  gpu::DeviceInfo device;
+  uint64_t deviceLocalBytes = 0;
+  gpu::CopyBandwidth copy;
+  BenchConfig config;
+  uint32_t warmup = 0;
+  std::vector<DatasetOutcome> datasets;
+  std::vector<Result> results;
+  double seconds = 0; // wall time of the whole run (not a GPU figure)
+};
+
+struct BenchCallbacks {
+  // After each combination; done counts from 1 to total.
+  std::function<void(const Result&, size_t done, size_t total)> onResult;
+  // Memory statements, skipped data sets, the copy bandwidth: one line each.
+  std::function<void(const std::string&)> onNote;
+};
+
+// Runs the whole matrix. Data sets that do not fit are skipped and say why (DatasetOutcome). Throws
+// InputError for an unreadable file, UnsupportedError if the copy buffers cannot be had.
+BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchCallbacks& callbacks = {});
+
+// The cloud of a data set, ready to upload: positions and display colors only.
+PointCloud loadDataset(const Dataset& dataset, bool progress);
+
+// dst = src with its points permuted into `order` (positions and colors; bounds, scale, offset kept).
+PointCloud reorderedCopy(const PointCloud& src, Order order, uint64_t seed);
+
+} // namespace pointrast::bench
