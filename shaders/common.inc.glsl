@@ -9,8 +9,3 @@
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FloatArray { float v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintArray { uint v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uint64Array { uint64_t v[]; };
-
-// Linear index of this invocation in a 2D grid of 1D workgroups (groupsX groups per row).
-uint linearInvocation(uint groupsX, uint groupSize) {
-  return (gl_WorkGroupID.y * groupsX + gl_WorkGroupID.x) * groupSize + gl_LocalInvocationIndex;
-}

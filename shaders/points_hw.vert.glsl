@@ -14,13 +14,7 @@
 //          a clear of 0, so the point with the smallest c.w wins.
 //   near   points with c.w <= nearW are moved outside the clip volume; Vulkan discards a point whose vertex
 //          is outside it, as it does for points left or right of the image.
-// common.inc.glsl's linearInvocation() names compute built-ins that a vertex stage lacks; it is never
-// called here, so stand-ins let the include compile (the buffer-reference types are what is wanted).
-#define gl_WorkGroupID uvec3(0)
-#define gl_LocalInvocationIndex 0u
 #include "common.inc.glsl"
-#undef gl_WorkGroupID
-#undef gl_LocalInvocationIndex
 
 layout(push_constant) uniform Push { RasterPush pc; };
 layout(location = 0) flat out uint color;

@@ -14,6 +14,7 @@
 // locked). CPU devices need no barrier there: x86 keeps the store before the sequentially consistent
 // atomic that releases. So it is 0 on CPU devices and 1 elsewhere.
 #include "common.inc.glsl"
+#include "grid.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
 layout(push_constant) uniform Push { RasterPush pc; };

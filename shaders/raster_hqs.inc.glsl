@@ -18,6 +18,7 @@
 #extension GL_NV_shader_subgroup_partitioned : require
 #endif
 #include "common.inc.glsl"
+#include "grid.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
 layout(push_constant) uniform Push { RasterPush pc; };

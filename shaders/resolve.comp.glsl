@@ -5,6 +5,7 @@
 //   LAYOUT 1: uint64 words, int40 depth << 24 | RGB24 (alpha restored as 255)
 //   LAYOUT 2: busy-loop arrays: uint depth[pixels], then uint color[pixels]
 #include "common.inc.glsl"
+#include "grid.inc.glsl"
 
 layout(local_size_x = kPixelGroupSize) in;
 layout(push_constant) uniform Push { ResolvePush pc; };

@@ -2,6 +2,7 @@
 // HQS resolve: average color = rounded sum / count, from the two-atomic sums (ONE_ROUND 0) or from the
 // packed 16-bit sums plus the 32-bit fallback sums (ONE_ROUND 1). Both give the same integers.
 #include "common.inc.glsl"
+#include "grid.inc.glsl"
 
 layout(local_size_x = kPixelGroupSize) in;
 layout(push_constant) uniform Push { ResolvePush pc; };

@@ -16,7 +16,9 @@ std::string gib(uint64_t bytes) {
   return text;
 }
 
-uint32_t chooseMemoryType(const Context& context, uint32_t allowed, MemoryKind kind, bool& coherent) {
+} // namespace
+
+uint32_t findMemoryType(const Context& context, uint32_t allowed, MemoryKind kind, bool& coherent) {
   const VkPhysicalDeviceMemoryProperties& mem = context.memoryProperties();
   auto find = [&](VkMemoryPropertyFlags want) -> int {
     for (uint32_t t = 0; t < mem.memoryTypeCount; ++t)
@@ -38,8 +40,6 @@ uint32_t chooseMemoryType(const Context& context, uint32_t allowed, MemoryKind k
   return uint32_t(type);
 }
 
-} // namespace
-
 Buffer::Buffer(Context& context, uint64_t size, VkBufferUsageFlags usage, MemoryKind kind, const std::string& name)
     : device_(context.device()), size_(size) {
   if (size == 0) size = 4; // Vulkan forbids empty buffers; an empty scene part still gets a handle.
@@ -58,7 +58,7 @@ Buffer::Buffer(Context& context, uint64_t size, VkBufferUsageFlags usage, Memory
     flags.flags = (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) ? VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT : 0;
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
     alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = chooseMemoryType(context, req.memoryTypeBits, kind, coherent_);
+    alloc.memoryTypeIndex = findMemoryType(context, req.memoryTypeBits, kind, coherent_);
     VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &memory_);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
       throw UnsupportedError("out of " + std::string(r == VK_ERROR_OUT_OF_DEVICE_MEMORY ? "GPU" : "host") +

@@ -49,6 +49,10 @@ private:
   bool coherent_ = true;
 };
 
+// A memory type of `kind` among the `allowed` bits (VkMemoryRequirements::memoryTypeBits); Device falls
+// back to any allowed type on devices (lavapipe) whose types lack DEVICE_LOCAL. Sets coherent.
+uint32_t findMemoryType(const Context& context, uint32_t allowed, MemoryKind kind, bool& coherent);
+
 // Usage flags every buffer gets: device address, and transfer both ways (fills, copies, readback).
 constexpr VkBufferUsageFlags kBufferUsage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |

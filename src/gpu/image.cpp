@@ -1,5 +1,7 @@
 #include "gpu/image.h"
 
+#include "gpu/buffer.h"
+
 #include <utility>
 
 #include "base/error.h"
@@ -18,17 +20,6 @@ bool isDepthFormat(VkFormat format) {
   default:
     return false;
   }
-}
-
-// Images are only ever device-local attachments; any allowed type is a fallback for devices (lavapipe)
-// whose image types may lack the flag.
-uint32_t deviceLocalType(const Context& context, uint32_t allowed) {
-  const VkPhysicalDeviceMemoryProperties& mem = context.memoryProperties();
-  for (VkMemoryPropertyFlags want :
-       {VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT), VkMemoryPropertyFlags(0)})
-    for (uint32_t t = 0; t < mem.memoryTypeCount; ++t)
-      if ((allowed & (1u << t)) && (mem.memoryTypes[t].propertyFlags & want) == want) return t;
-  throw UnsupportedError("device '" + context.info().name + "' has no memory type for images");
 }
 
 } // namespace
@@ -55,7 +46,7 @@ Image::Image(Context& context, uint32_t width, uint32_t height, VkFormat format,
     vkGetImageMemoryRequirements(device_, image_, &req);
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = deviceLocalType(context, req.memoryTypeBits);
+    alloc.memoryTypeIndex = [&] { bool coherent; return findMemoryType(context, req.memoryTypeBits, MemoryKind::Device, coherent); }();
     VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &memory_);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
       throw UnsupportedError("out of memory allocating the " + std::to_string(width) + "x" +

@@ -39,7 +39,8 @@ class PointMethod {
 public:
   virtual ~PointMethod() = default;
   virtual void recordFrame(const Frame& frame, Targets& targets) = 0;
-  // Whether the method fills targets.words (closest-point methods); HQS blends and has no single word.
+  // Whether the method fills targets.words with depth << 32 | color words (every compute method but
+  // HQS, which blends; justset's words are valid words of some point, not the closest).
   virtual bool hasCanonicalWords() const { return true; }
 };
 

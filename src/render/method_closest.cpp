@@ -64,7 +64,6 @@ public:
     gpu::fullBarrier(cmd);
   }
 
-  bool hasCanonicalWords() const override { return method_ != Method::JustSet; }
 
 private:
   Method method_;

@@ -183,6 +183,7 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
       timestamps.end(cmd, f);
     }
   });
+  wordsCaptured_ = settings.captureWords && m.hasCanonicalWords();
   std::vector<double> ms = timestamps.milliseconds();
   FrameStats stats;
   stats.frames = frames;
@@ -200,6 +201,9 @@ std::vector<uint32_t> Renderer::image() {
 }
 
 std::vector<uint64_t> Renderer::framebufferWords() {
+  if (!wordsCaptured_)
+    throw InputError("no canonical framebuffer words: the last frame was not rendered with captureWords by a "
+                     "closest-point method");
   std::vector<uint64_t> words(targets_->pixels());
   gpu::readBuffer(context_, targets_->words, 0, words.data(), words.size() * 8);
   return words;

@@ -107,6 +107,7 @@ private:
   gpu::Context& context_;
   std::unique_ptr<Targets> targets_;
   std::map<std::pair<Method, DepthMode>, std::unique_ptr<PointMethod>> methods_;
+  bool wordsCaptured_ = false; // the last frame wrote canonical words
 };
 
 } // namespace pointrast

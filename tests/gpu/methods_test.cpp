@@ -47,7 +47,8 @@ Result draw(gpu::Context& context, const GpuScene& scene, const Camera& camera, 
   settings.captureWords = true;
   settings.background = 0;
   renderer.render(scene, camera, settings);
-  return {renderer.framebufferWords(), renderer.image()};
+  bool blends = method == Method::Hqs || method == Method::Hqs1r;
+  return {blends ? std::vector<uint64_t>{} : renderer.framebufferWords(), renderer.image()};
 }
 
 // Three clouds that stress different paths: a random box (few points per pixel), generated terrain (a
