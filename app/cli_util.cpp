@@ -29,8 +29,8 @@ std::vector<double> parseNumbers(std::string_view text, std::string_view option,
     }
     at = comma + 1;
   }
-  throw InputError(std::string(option) + " expects " + std::to_string(count) + " comma-separated numbers, got '" +
-                   std::string(text) + "'");
+  throw InputError(std::string(option) + " expects " + std::to_string(count) +
+                   " comma-separated numbers, got '" + std::string(text) + "'");
 }
 
 } // namespace
@@ -44,7 +44,8 @@ uint32_t parseRgb(std::string_view text, std::string_view option) {
   std::vector<double> v = parseNumbers(text, option, 3);
   for (double c : v)
     if (c < 0 || c > 255 || c != std::floor(c))
-      throw InputError(std::string(option) + " expects three integers 0..255, got '" + std::string(text) + "'");
+      throw InputError(std::string(option) + " expects three integers 0..255, got '" + std::string(text) +
+                       "'");
   return uint32_t(v[0]) | uint32_t(v[1]) << 8 | uint32_t(v[2]) << 16 | 0xFF000000u;
 }
 
@@ -53,10 +54,19 @@ uint64_t parseCount(std::string_view text, std::string_view option) {
   double scale = 1;
   if (!s.empty()) {
     switch (s.back()) {
-    case 'k': case 'K': scale = 1e3; break;
-    case 'M': scale = 1e6; break;
-    case 'G': case 'B': scale = 1e9; break;
-    default: break;
+    case 'k':
+    case 'K':
+      scale = 1e3;
+      break;
+    case 'M':
+      scale = 1e6;
+      break;
+    case 'G':
+    case 'B':
+      scale = 1e9;
+      break;
+    default:
+      break;
     }
     if (scale != 1) s.pop_back();
   }
@@ -72,7 +82,8 @@ uint64_t parseCount(std::string_view text, std::string_view option) {
 uint64_t imageHash(const uint32_t* pixels, uint64_t count) {
   uint64_t h = 0xcbf29ce484222325ull;
   auto bytes = reinterpret_cast<const unsigned char*>(pixels);
-  for (uint64_t i = 0; i < count * 4; ++i) h = (h ^ bytes[i]) * 0x100000001b3ull;
+  for (uint64_t i = 0; i < count * 4; ++i)
+    h = (h ^ bytes[i]) * 0x100000001b3ull;
   return h;
 }
 

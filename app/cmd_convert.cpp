@@ -34,11 +34,12 @@ io::LasFlavor lasFlavorFor(const std::string& output, uint64_t points) {
 Command addConvert(CLI::App& app) {
   auto a = std::make_shared<ConvertArgs>();
   CLI::App* cmd = app.add_subcommand("convert", "Read a point cloud, optionally reorder it, write LAS");
-  cmd->footer("\nOrders (the 2021 paper's vertex orders): original, morton (Z-order over the cubic bounds, 21 bits\n"
-              "per axis), shuffled (random permutation), shuffled-morton (Morton, then runs of 128 points\n"
-              "shuffled as wholes). Output: LAS 1.2 point format 3, or 1.4 format 7 with --las 1.4 or when\n"
-              "the cloud has more than 4,294,967,295 points.\n\n"
-              "Example:\n  pointrast convert scan.ply scan_morton.las --order morton");
+  cmd->footer(
+      "\nOrders (the 2021 paper's vertex orders): original, morton (Z-order over the cubic bounds, 21 bits\n"
+      "per axis), shuffled (random permutation), shuffled-morton (Morton, then runs of 128 points\n"
+      "shuffled as wholes). Output: LAS 1.2 point format 3, or 1.4 format 7 with --las 1.4 or when\n"
+      "the cloud has more than 4,294,967,295 points.\n\n"
+      "Example:\n  pointrast convert scan.ply scan_morton.las --order morton");
   cmd->add_option("IN", a->input, "LAS/PLY/XYZ file")->required();
   cmd->add_option("OUT", a->output, "LAS file to write")->required();
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
@@ -62,7 +63,8 @@ Command addConvert(CLI::App& app) {
     if (a->lasVersion == "1.2" && flavor == io::LasFlavor::Las14Pf7)
       throw InputError("LAS 1.2 cannot hold more than 4,294,967,295 points; use --las 1.4");
     io::writeLas(a->output, cloud, flavor);
-    if (!a->quiet) std::printf("%s: %s points\n", a->output.c_str(), humanCount(double(cloud.size())).c_str());
+    if (!a->quiet)
+      std::printf("%s: %s points\n", a->output.c_str(), humanCount(double(cloud.size())).c_str());
     return 0;
   };
 }

@@ -29,10 +29,11 @@ struct GenerateArgs {
 Command addGenerate(CLI::App& app) {
   auto a = std::make_shared<GenerateArgs>();
   CLI::App* cmd = app.add_subcommand("generate", "Generate a synthetic scene and write it as LAS");
-  cmd->footer("\nScenes: terrain (aerial LiDAR: ground, buildings, trees, flight-strip order), tls (terrestrial\n"
-              "scans from a few scanner positions, in scan-line order). Deterministic for a given seed,\n"
-              "whatever the number of cores. Positions are quantized to 1 mm.\n\n"
-              "Example:\n  pointrast generate terrain --points 100M -o terrain100m.las");
+  cmd->footer(
+      "\nScenes: terrain (aerial LiDAR: ground, buildings, trees, flight-strip order), tls (terrestrial\n"
+      "scans from a few scanner positions, in scan-line order). Deterministic for a given seed,\n"
+      "whatever the number of cores. Positions are quantized to 1 mm.\n\n"
+      "Example:\n  pointrast generate terrain --points 100M -o terrain100m.las");
   cmd->add_option("SCENE", a->scene, "terrain or tls")->required();
   cmd->add_option("-o,--output", a->output, "LAS file to write")->required();
   cmd->add_option("--points", a->points, "Number of points (e.g. 5M, 1.2G)")->capture_default_str();
@@ -51,7 +52,8 @@ Command addGenerate(CLI::App& app) {
     PointCloud cloud = generateScene(scene, options);
     reorder(cloud, order, a->seed);
     io::writeLas(a->output, cloud, lasFlavorFor(a->output, cloud.size()));
-    if (!a->quiet) std::printf("%s: %s points\n", a->output.c_str(), humanCount(double(cloud.size())).c_str());
+    if (!a->quiet)
+      std::printf("%s: %s points\n", a->output.c_str(), humanCount(double(cloud.size())).c_str());
     return 0;
   };
 }

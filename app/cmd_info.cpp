@@ -30,9 +30,11 @@ int listDevicesCommand(bool json) {
                       std::to_string(VK_API_VERSION_MINOR(d.apiVersion)) + "." +
                       std::to_string(VK_API_VERSION_PATCH(d.apiVersion));
     if (json)
-      list.push_back({{"index", i}, {"name", d.name}, {"type", d.typeName}, {"vulkan", api}, {"driver", d.driver}});
+      list.push_back(
+          {{"index", i}, {"name", d.name}, {"type", d.typeName}, {"vulkan", api}, {"driver", d.driver}});
     else
-      std::printf("%zu: %s (%s, Vulkan %s, %s)\n", i, d.name.c_str(), d.typeName.c_str(), api.c_str(), d.driver.c_str());
+      std::printf("%zu: %s (%s, Vulkan %s, %s)\n", i, d.name.c_str(), d.typeName.c_str(), api.c_str(),
+                  d.driver.c_str());
   }
   if (json) std::printf("%s\n", list.dump().c_str());
   return 0;
@@ -60,7 +62,8 @@ int runInfo(const InfoArgs& a) {
     }
     j["has_color"] = info.hasColor;
     if (info.hasColor) j["color_bits"] = info.colorBits;
-    for (const auto& [key, value] : info.extra) j["extra"][key] = value;
+    for (const auto& [key, value] : info.extra)
+      j["extra"][key] = value;
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
@@ -80,7 +83,8 @@ int runInfo(const InfoArgs& a) {
     std::printf("color:   RGB, %d-bit\n", info.colorBits);
   else
     std::printf("color:   none\n");
-  for (const auto& [key, value] : info.extra) std::printf("%-8s %s\n", (key + ":").c_str(), value.c_str());
+  for (const auto& [key, value] : info.extra)
+    std::printf("%-8s %s\n", (key + ":").c_str(), value.c_str());
   return 0;
 }
 
@@ -90,7 +94,8 @@ Command addInfo(CLI::App& app) {
   auto a = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand("info", "Show what a point cloud file holds, or list Vulkan devices");
   cmd->footer("\nReads the header (and for LAS the color values, to tell 8-bit from 16-bit color).\n"
-              "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n  pointrast info --devices");
+              "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n  pointrast info "
+              "--devices");
   cmd->add_option("FILE", a->input, "LAS/PLY/XYZ file");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");

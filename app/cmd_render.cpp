@@ -88,7 +88,8 @@ int runRender(const RenderArgs& a) {
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
   std::vector<const GpuScene*> drawn;
-  for (auto& s : scenes) drawn.push_back(s.get());
+  for (auto& s : scenes)
+    drawn.push_back(s.get());
   FrameStats stats = renderer.render(drawn, camera, settings);
   std::vector<uint32_t> pixels = renderer.image();
   io::writePng(a.output, a.width, a.height, pixels.data());
@@ -120,10 +121,11 @@ int runRender(const RenderArgs& a) {
     j["output"] = a.output;
     std::printf("%s\n", j.dump().c_str());
   } else if (!a.quiet) {
-    std::printf("%s: %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s points/s\n",
-                a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
-                methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
-                humanCount(stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0).c_str());
+    std::printf(
+        "%s: %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s points/s\n",
+        a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
+        methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+        humanCount(stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0).c_str());
   }
   return 0;
 }
@@ -163,8 +165,10 @@ Command addRender(CLI::App& app) {
          "an unknown name lists them all")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
-  cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")->capture_default_str();
-  cmd->add_option("--frames", a->frames, "Timed frames; the median GPU time is reported")->capture_default_str();
+  cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
+      ->capture_default_str();
+  cmd->add_option("--frames", a->frames, "Timed frames; the median GPU time is reported")
+      ->capture_default_str();
   cmd->add_option("--parts", a->parts, "Upload the cloud as N separate scenes drawn into one framebuffer")
       ->capture_default_str();
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");

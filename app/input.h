@@ -10,9 +10,9 @@
 namespace pointrast::app {
 
 struct InputSpec {
-  std::string source;                 // a path, or a scene name ("terrain", "tls"); empty = demo scene
-  uint64_t points = 1'000'000;        // for scenes
-  uint64_t seed = 1;                  // for scenes and shuffled orders
+  std::string source;          // a path, or a scene name ("terrain", "tls"); empty = demo scene
+  uint64_t points = 1'000'000; // for scenes
+  uint64_t seed = 1;           // for scenes and shuffled orders
   Order order = Order::Original;
   bool progress = true;
 };

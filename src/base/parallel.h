@@ -47,9 +47,11 @@ template <class Body> void parallelBlocks(uint64_t count, uint64_t blockSize, Bo
   } else {
     std::vector<std::thread> pool;
     pool.reserve(threads - 1);
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+    for (unsigned t = 1; t < threads; ++t)
+      pool.emplace_back(worker);
     worker();
-    for (auto& t : pool) t.join();
+    for (auto& t : pool)
+      t.join();
   }
   if (error) std::rethrow_exception(error);
 }

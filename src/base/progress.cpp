@@ -9,8 +9,12 @@ namespace {
 std::atomic<bool> gEnabled{true};
 }
 
-void Progress::setEnabled(bool enabled) { gEnabled = enabled; }
-bool Progress::enabled() { return gEnabled; }
+void Progress::setEnabled(bool enabled) {
+  gEnabled = enabled;
+}
+bool Progress::enabled() {
+  return gEnabled;
+}
 
 std::string humanCount(double value) {
   char buf[32];
@@ -29,7 +33,9 @@ Progress::Progress(std::string label, uint64_t total, std::string unit, bool sho
     : label_(std::move(label)), unit_(std::move(unit)), total_(total),
       start_(std::chrono::steady_clock::now()), tty_(isatty(STDERR_FILENO) != 0), show_(show) {}
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 double Progress::seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();

@@ -27,8 +27,12 @@ uint32_t findMemoryType(const Context& context, uint32_t allowed, MemoryKind kin
   };
   int type = -1;
   switch (kind) {
-  case MemoryKind::Device: type = find(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT); break;
-  case MemoryKind::Upload: type = find(VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT); break;
+  case MemoryKind::Device:
+    type = find(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    break;
+  case MemoryKind::Upload:
+    type = find(VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    break;
   case MemoryKind::Readback:
     type = find(VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
     if (type < 0) type = find(VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
@@ -40,11 +44,13 @@ uint32_t findMemoryType(const Context& context, uint32_t allowed, MemoryKind kin
   return uint32_t(type);
 }
 
-Buffer::Buffer(Context& context, uint64_t size, VkBufferUsageFlags usage, MemoryKind kind, const std::string& name)
+Buffer::Buffer(Context& context, uint64_t size, VkBufferUsageFlags usage, MemoryKind kind,
+               const std::string& name)
     : device_(context.device()), size_(size) {
   if (size == 0) size = 4; // Vulkan forbids empty buffers; an empty scene part still gets a handle.
   if (size > context.maxBufferSize() || size > context.maxAllocationSize())
-    throw UnsupportedError("buffer '" + name + "' of " + gib(size) + " exceeds the device's largest buffer (" +
+    throw UnsupportedError("buffer '" + name + "' of " + gib(size) +
+                           " exceeds the device's largest buffer (" +
                            gib(std::min(context.maxBufferSize(), context.maxAllocationSize())) + ")");
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = size;
@@ -55,15 +61,16 @@ Buffer::Buffer(Context& context, uint64_t size, VkBufferUsageFlags usage, Memory
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device_, buffer_, &req);
     VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
-    flags.flags = (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) ? VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT : 0;
+    flags.flags =
+        (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) ? VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT : 0;
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = findMemoryType(context, req.memoryTypeBits, kind, coherent_);
     VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &memory_);
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
       throw UnsupportedError("out of " + std::string(r == VK_ERROR_OUT_OF_DEVICE_MEMORY ? "GPU" : "host") +
-                             " memory allocating " + gib(size) + " for '" + name + "' (device memory: " +
-                             gib(context.deviceLocalBytes()) + ")");
+                             " memory allocating " + gib(size) + " for '" + name +
+                             "' (device memory: " + gib(context.deviceLocalBytes()) + ")");
     VK_CHECK(r);
     VK_CHECK(vkBindBufferMemory(device_, buffer_, memory_, 0));
     if (kind != MemoryKind::Device) VK_CHECK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
@@ -80,7 +87,9 @@ Buffer::Buffer(Context& context, uint64_t size, VkBufferUsageFlags usage, Memory
   }
 }
 
-Buffer::~Buffer() { release(); }
+Buffer::~Buffer() {
+  release();
+}
 
 void Buffer::release() {
   if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
@@ -90,7 +99,9 @@ void Buffer::release() {
   mapped_ = nullptr;
 }
 
-Buffer::Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+Buffer::Buffer(Buffer&& other) noexcept {
+  *this = std::move(other);
+}
 
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
   if (this != &other) {
@@ -119,7 +130,8 @@ void fullBarrier(VkCommandBuffer cmd) {
   barrier.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
   barrier.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
   barrier.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT | VK_PIPELINE_STAGE_2_HOST_BIT;
-  barrier.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT | VK_ACCESS_2_HOST_READ_BIT;
+  barrier.dstAccessMask =
+      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT | VK_ACCESS_2_HOST_READ_BIT;
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.memoryBarrierCount = 1;
   dep.pMemoryBarriers = &barrier;

@@ -54,9 +54,9 @@ private:
 uint32_t findMemoryType(const Context& context, uint32_t allowed, MemoryKind kind, bool& coherent);
 
 // Usage flags every buffer gets: device address, and transfer both ways (fills, copies, readback).
-constexpr VkBufferUsageFlags kBufferUsage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
-                                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+constexpr VkBufferUsageFlags kBufferUsage =
+    VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+    VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 // A full memory barrier between two commands of a command buffer (compute/transfer/host -> all). Passes
 // of this renderer are few and large, so precise barriers would buy nothing measurable.

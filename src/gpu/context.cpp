@@ -21,22 +21,32 @@ bool envFlag(const char* name) {
 
 const char* typeName(VkPhysicalDeviceType type) {
   switch (type) {
-  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
-  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
-  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-  case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU (software Vulkan)";
-  default: return "other";
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+    return "discrete GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+    return "integrated GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+    return "virtual GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_CPU:
+    return "CPU (software Vulkan)";
+  default:
+    return "other";
   }
 }
 
 // Preference when no device is named: discrete > integrated > virtual > CPU > other.
 int typeRank(VkPhysicalDeviceType type) {
   switch (type) {
-  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
-  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
-  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-  case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
-  default: return 0;
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+    return 4;
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+    return 3;
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+    return 2;
+  case VK_PHYSICAL_DEVICE_TYPE_CPU:
+    return 1;
+  default:
+    return 0;
   }
 }
 
@@ -81,8 +91,10 @@ Instance createInstance(bool validation) {
     VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
     std::vector<VkLayerProperties> available_layers(count);
     VK_CHECK(vkEnumerateInstanceLayerProperties(&count, available_layers.data()));
-    bool found = std::any_of(available_layers.begin(), available_layers.end(),
-                             [](const VkLayerProperties& l) { return std::strcmp(l.layerName, kValidationLayer) == 0; });
+    bool found =
+        std::any_of(available_layers.begin(), available_layers.end(), [](const VkLayerProperties& l) {
+          return std::strcmp(l.layerName, kValidationLayer) == 0;
+        });
     if (!found)
       throw UnsupportedError("POINTRAST_VALIDATION is set but the Khronos validation layer is not installed "
                              "(`apt-get install vulkan-validationlayers`)");
@@ -120,7 +132,8 @@ std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
 std::vector<DeviceInfo> listDevices() {
   Instance instance = createInstance(false);
   std::vector<DeviceInfo> result;
-  for (VkPhysicalDevice d : physicalDevices(instance.handle)) result.push_back(describe(d));
+  for (VkPhysicalDevice d : physicalDevices(instance.handle))
+    result.push_back(describe(d));
   vkDestroyInstance(instance.handle, nullptr);
   return result;
 }
@@ -157,7 +170,9 @@ Context::Context(const ContextOptions& options) {
   }
 }
 
-Context::~Context() { destroy(); }
+Context::~Context() {
+  destroy();
+}
 
 void Context::destroy() {
   if (device_) {
@@ -222,10 +237,10 @@ void Context::createDevice() {
   vkGetPhysicalDeviceProperties2(physical_, &props);
   properties_ = props.properties;
   subgroupSize_ = subgroup.subgroupSize;
-  constexpr VkSubgroupFeatureFlags kComputeOps = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_VOTE_BIT |
-                                                VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT |
-                                                VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT |
-                                                VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  constexpr VkSubgroupFeatureFlags kComputeOps =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_VOTE_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT |
+      VK_SUBGROUP_FEATURE_SHUFFLE_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT |
+      VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
   features_.subgroupCompute = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                               (subgroup.supportedOperations & kComputeOps) == kComputeOps;
   bool partitioned = subgroup.supportedOperations & VK_SUBGROUP_FEATURE_PARTITIONED_BIT_NV;
@@ -233,7 +248,8 @@ void Context::createDevice() {
   maxBuffer_ = m4.maxBufferSize;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
   for (uint32_t h = 0; h < memory_.memoryHeapCount; ++h)
-    if (memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) deviceLocalBytes_ += memory_.memoryHeaps[h].size;
+    if (memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      deviceLocalBytes_ += memory_.memoryHeaps[h].size;
 
   VkPhysicalDeviceVulkan13Features has13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &has13};
@@ -294,8 +310,9 @@ void Context::createDevice() {
   std::vector<VkExtensionProperties> extensions(extensionCount);
   VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, extensions.data()));
   auto hasExtension = [&](const char* name) {
-    return std::any_of(extensions.begin(), extensions.end(),
-                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+    return std::any_of(extensions.begin(), extensions.end(), [&](const VkExtensionProperties& e) {
+      return std::strcmp(e.extensionName, name) == 0;
+    });
   };
   std::vector<const char*> enabled;
   features_.float64 = has.features.shaderFloat64;

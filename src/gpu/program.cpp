@@ -7,12 +7,14 @@
 
 namespace pointrast::gpu {
 
-ComputeProgram::ComputeProgram(Context& context, const std::string& shaderName, std::initializer_list<SpecConstant> spec)
+ComputeProgram::ComputeProgram(Context& context, const std::string& shaderName,
+                               std::initializer_list<SpecConstant> spec)
     : device_(context.device()), name_(shaderName) {
   std::span<const uint32_t> words = findShader(shaderName);
   reflection_ = reflectSpirv(words);
   for (const SpecConstant& s : spec) {
-    assert(std::find(reflection_.specIds.begin(), reflection_.specIds.end(), s.id) != reflection_.specIds.end() &&
+    assert(std::find(reflection_.specIds.begin(), reflection_.specIds.end(), s.id) !=
+               reflection_.specIds.end() &&
            "specialization constant id not declared by the shader");
     (void)s;
   }
@@ -53,7 +55,9 @@ ComputeProgram::ComputeProgram(Context& context, const std::string& shaderName, 
   vkDestroyShaderModule(device_, module, nullptr);
 }
 
-ComputeProgram::~ComputeProgram() { release(); }
+ComputeProgram::~ComputeProgram() {
+  release();
+}
 
 void ComputeProgram::release() {
   if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
@@ -62,7 +66,9 @@ void ComputeProgram::release() {
   layout_ = VK_NULL_HANDLE;
 }
 
-ComputeProgram::ComputeProgram(ComputeProgram&& other) noexcept { *this = std::move(other); }
+ComputeProgram::ComputeProgram(ComputeProgram&& other) noexcept {
+  *this = std::move(other);
+}
 
 ComputeProgram& ComputeProgram::operator=(ComputeProgram&& other) noexcept {
   if (this != &other) {

@@ -28,24 +28,29 @@ struct SpecConstant {
 class ComputeProgram {
 public:
   ComputeProgram() = default;
-  ComputeProgram(Context& context, const std::string& shaderName, std::initializer_list<SpecConstant> spec = {});
+  ComputeProgram(Context& context, const std::string& shaderName,
+                 std::initializer_list<SpecConstant> spec = {});
   ~ComputeProgram();
   ComputeProgram(ComputeProgram&& other) noexcept;
   ComputeProgram& operator=(ComputeProgram&& other) noexcept;
   ComputeProgram(const ComputeProgram&) = delete;
   ComputeProgram& operator=(const ComputeProgram&) = delete;
 
-  uint32_t groupSize() const { return reflection_.localSize[0] * reflection_.localSize[1] * reflection_.localSize[2]; }
+  uint32_t groupSize() const {
+    return reflection_.localSize[0] * reflection_.localSize[1] * reflection_.localSize[2];
+  }
   uint32_t pushConstantSize() const { return reflection_.pushConstantSize; }
   const std::string& name() const { return name_; }
 
-  template <class Push> void dispatch(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const Push& push) const {
+  template <class Push>
+  void dispatch(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const Push& push) const {
     assert(sizeof(Push) == reflection_.pushConstantSize && "push-constant struct does not match the shader");
     dispatchRaw(cmd, groupsX, groupsY, &push, sizeof(Push));
   }
 
 private:
-  void dispatchRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const void* push, uint32_t size) const;
+  void dispatchRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const void* push,
+                   uint32_t size) const;
   void release();
   VkDevice device_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

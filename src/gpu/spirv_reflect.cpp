@@ -64,8 +64,13 @@ SpirvReflection reflectSpirv(std::span<const uint32_t> words) {
     case OpExecutionModeId: // local_size_x = aConstant: sizes are ids of constants defined later
       if (op[2] == ExecutionModeLocalSizeId) std::copy(op + 3, op + 6, localSizeIds);
       break;
-    case OpTypeInt: case OpTypeFloat: case OpTypeVector: case OpTypeMatrix: case OpTypeArray:
-    case OpTypeStruct: case OpTypePointer:
+    case OpTypeInt:
+    case OpTypeFloat:
+    case OpTypeVector:
+    case OpTypeMatrix:
+    case OpTypeArray:
+    case OpTypeStruct:
+    case OpTypePointer:
       types[op[1]] = Type{opcode, std::vector<uint32_t>(op + 2, op + count)};
       break;
     case OpConstant:
@@ -94,11 +99,17 @@ SpirvReflection reflectSpirv(std::span<const uint32_t> words) {
   auto sizeOf = [&](auto&& self, uint32_t id, uint32_t matrixStride) -> uint32_t {
     const Type& t = types.at(id);
     switch (t.opcode) {
-    case OpTypeInt: case OpTypeFloat: return t.operands[0] / 8;
-    case OpTypeVector: return t.operands[1] * self(self, t.operands[0], 0);
-    case OpTypeMatrix: return t.operands[1] * (matrixStride ? matrixStride : self(self, t.operands[0], 0));
-    case OpTypeArray: return constants.at(t.operands[1]) * arrayStride.at(id);
-    case OpTypePointer: return 8; // physical storage buffer pointer
+    case OpTypeInt:
+    case OpTypeFloat:
+      return t.operands[0] / 8;
+    case OpTypeVector:
+      return t.operands[1] * self(self, t.operands[0], 0);
+    case OpTypeMatrix:
+      return t.operands[1] * (matrixStride ? matrixStride : self(self, t.operands[0], 0));
+    case OpTypeArray:
+      return constants.at(t.operands[1]) * arrayStride.at(id);
+    case OpTypePointer:
+      return 8; // physical storage buffer pointer
     case OpTypeStruct: {
       uint32_t end = 0;
       for (uint32_t m = 0; m < t.operands.size(); ++m) {
@@ -108,11 +119,14 @@ SpirvReflection reflectSpirv(std::span<const uint32_t> words) {
       }
       return end;
     }
-    default: assert(false && "unexpected type in push constants"); return 0;
+    default:
+      assert(false && "unexpected type in push constants");
+      return 0;
     }
   };
   for (int axis = 0; axis < 3; ++axis)
-    if (localSizeIds[axis]) result.localSize[axis] = constants.count(localSizeIds[axis]) ? constants.at(localSizeIds[axis]) : 0;
+    if (localSizeIds[axis])
+      result.localSize[axis] = constants.count(localSizeIds[axis]) ? constants.at(localSizeIds[axis]) : 0;
   if (pushVariableType) {
     const Type& pointer = types.at(pushVariableType);
     assert(pointer.opcode == OpTypePointer);

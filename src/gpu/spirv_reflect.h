@@ -11,10 +11,10 @@
 namespace pointrast::gpu {
 
 struct SpirvReflection {
-  uint32_t pushConstantSize = 0;    // bytes of the push-constant block (0 if none)
+  uint32_t pushConstantSize = 0;     // bytes of the push-constant block (0 if none)
   uint32_t localSize[3] = {1, 1, 1}; // from LocalSize; 0 if given by specialization constants
-  std::vector<uint32_t> specIds;    // SpecId decorations present
-  bool usesPointSize = false;       // writes gl_PointSize (vertex stage)
+  std::vector<uint32_t> specIds;     // SpecId decorations present
+  bool usesPointSize = false;        // writes gl_PointSize (vertex stage)
 };
 
 // Asserts on a malformed module (embedded modules come from our own build).

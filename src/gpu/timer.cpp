@@ -14,9 +14,13 @@ TimestampPool::TimestampPool(Context& context, uint32_t spans) : context_(contex
   context.setName(VK_OBJECT_TYPE_QUERY_POOL, uint64_t(pool_), "frame timestamps");
 }
 
-TimestampPool::~TimestampPool() { vkDestroyQueryPool(context_.device(), pool_, nullptr); }
+TimestampPool::~TimestampPool() {
+  vkDestroyQueryPool(context_.device(), pool_, nullptr);
+}
 
-void TimestampPool::reset(VkCommandBuffer cmd) { vkCmdResetQueryPool(cmd, pool_, 0, 2 * spans_); }
+void TimestampPool::reset(VkCommandBuffer cmd) {
+  vkCmdResetQueryPool(cmd, pool_, 0, 2 * spans_);
+}
 
 void TimestampPool::begin(VkCommandBuffer cmd, uint32_t span) {
   vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, 2 * span);
@@ -29,7 +33,8 @@ void TimestampPool::end(VkCommandBuffer cmd, uint32_t span) {
 std::vector<double> TimestampPool::milliseconds() {
   std::vector<uint64_t> ticks(2 * spans_);
   VK_CHECK(vkGetQueryPoolResults(context_.device(), pool_, 0, 2 * spans_, ticks.size() * sizeof(uint64_t),
-                                 ticks.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+                                 ticks.data(), sizeof(uint64_t),
+                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   std::vector<double> ms(spans_);
   for (uint32_t s = 0; s < spans_; ++s)
     ms[s] = double(ticks[2 * s + 1] - ticks[2 * s]) * context_.timestampPeriodNs() * 1e-6;

@@ -26,16 +26,16 @@ void loadVulkanLoader() {
                            "driver, e.g. `apt-get install libvulkan1 mesa-vulkan-drivers`");
   getInstanceProcAddr = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(library, "vkGetInstanceProcAddr"));
   if (!getInstanceProcAddr) throw UnsupportedError("libvulkan.so.1 has no vkGetInstanceProcAddr");
-#define PR_VK_LOAD(name)                                                                                  \
-  name = reinterpret_cast<PFN_##name>(getInstanceProcAddr(VK_NULL_HANDLE, #name));                        \
+#define PR_VK_LOAD(name)                                                                                     \
+  name = reinterpret_cast<PFN_##name>(getInstanceProcAddr(VK_NULL_HANDLE, #name));                           \
   if (!name) throw UnsupportedError("the Vulkan loader lacks " #name " (Vulkan 1.3 is required)");
   PR_VK_GLOBAL_FUNCTIONS(PR_VK_LOAD)
 #undef PR_VK_LOAD
 }
 
 void loadInstanceFunctions(VkInstance instance) {
-#define PR_VK_LOAD(name)                                                                                  \
-  name = reinterpret_cast<PFN_##name>(getInstanceProcAddr(instance, #name));                              \
+#define PR_VK_LOAD(name)                                                                                     \
+  name = reinterpret_cast<PFN_##name>(getInstanceProcAddr(instance, #name));                                 \
   if (!name) throw UnsupportedError("the Vulkan loader lacks " #name " (Vulkan 1.3 is required)");
   PR_VK_INSTANCE_FUNCTIONS(PR_VK_LOAD)
 #undef PR_VK_LOAD
@@ -45,8 +45,8 @@ void loadInstanceFunctions(VkInstance instance) {
 }
 
 void loadDeviceFunctions(VkDevice device) {
-#define PR_VK_LOAD(name)                                                                                  \
-  name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device, #name));                                \
+#define PR_VK_LOAD(name)                                                                                     \
+  name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device, #name));                                   \
   if (!name) throw UnsupportedError("the Vulkan driver lacks " #name " (Vulkan 1.3 is required)");
   PR_VK_DEVICE_FUNCTIONS(PR_VK_LOAD)
 #undef PR_VK_LOAD
@@ -54,19 +54,19 @@ void loadDeviceFunctions(VkDevice device) {
 
 const char* resultName(VkResult result) {
   switch (result) {
-#define PR_CASE(r)                                                                                        \
-  case r:                                                                                                 \
+#define PR_CASE(r)                                                                                           \
+  case r:                                                                                                    \
     return #r;
-    PR_CASE(VK_SUCCESS) PR_CASE(VK_NOT_READY) PR_CASE(VK_TIMEOUT) PR_CASE(VK_INCOMPLETE)
-    PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
-    PR_CASE(VK_ERROR_INITIALIZATION_FAILED) PR_CASE(VK_ERROR_DEVICE_LOST) PR_CASE(VK_ERROR_MEMORY_MAP_FAILED)
-    PR_CASE(VK_ERROR_LAYER_NOT_PRESENT) PR_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
-    PR_CASE(VK_ERROR_FEATURE_NOT_PRESENT) PR_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
-    PR_CASE(VK_ERROR_TOO_MANY_OBJECTS) PR_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
-    PR_CASE(VK_ERROR_UNKNOWN) PR_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
+    PR_CASE(VK_SUCCESS)
+    PR_CASE(VK_NOT_READY) PR_CASE(VK_TIMEOUT) PR_CASE(VK_INCOMPLETE) PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
+        PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY) PR_CASE(VK_ERROR_INITIALIZATION_FAILED)
+            PR_CASE(VK_ERROR_DEVICE_LOST) PR_CASE(VK_ERROR_MEMORY_MAP_FAILED)
+                PR_CASE(VK_ERROR_LAYER_NOT_PRESENT) PR_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
+                    PR_CASE(VK_ERROR_FEATURE_NOT_PRESENT) PR_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
+                        PR_CASE(VK_ERROR_TOO_MANY_OBJECTS) PR_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
+                            PR_CASE(VK_ERROR_UNKNOWN) PR_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
 #undef PR_CASE
-  default:
-    return "VkResult(?)";
+                                default : return "VkResult(?)";
   }
 }
 

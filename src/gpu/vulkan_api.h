@@ -72,19 +72,19 @@ const char* resultName(VkResult result);
 } // namespace pointrast::gpu
 
 // Checks a VkResult in every build (benchmarks run in Release). Anything but VK_SUCCESS throws.
-#define VK_CHECK(call)                                                                                    \
-  do {                                                                                                    \
-    VkResult pr_vk_result_ = (call);                                                                      \
-    if (pr_vk_result_ != VK_SUCCESS)                                                                      \
-      throw ::pointrast::gpu::VulkanError(pr_vk_result_, #call, __FILE__, __LINE__);                      \
+#define VK_CHECK(call)                                                                                       \
+  do {                                                                                                       \
+    VkResult pr_vk_result_ = (call);                                                                         \
+    if (pr_vk_result_ != VK_SUCCESS)                                                                         \
+      throw ::pointrast::gpu::VulkanError(pr_vk_result_, #call, __FILE__, __LINE__);                         \
   } while (0)
 
 // The narrow variant for calls where some non-success codes are legal (VK_NOT_READY from a query,
 // VK_TIMEOUT from a wait): returns the result when it is one of the allowed ones.
-#define VK_CHECK_ALLOW(call, ...)                                                                         \
-  [&]() -> VkResult {                                                                                     \
-    VkResult pr_vk_result_ = (call);                                                                      \
-    for (VkResult allowed : {VK_SUCCESS, __VA_ARGS__})                                                    \
-      if (pr_vk_result_ == allowed) return pr_vk_result_;                                                 \
-    throw ::pointrast::gpu::VulkanError(pr_vk_result_, #call, __FILE__, __LINE__);                        \
+#define VK_CHECK_ALLOW(call, ...)                                                                            \
+  [&]() -> VkResult {                                                                                        \
+    VkResult pr_vk_result_ = (call);                                                                         \
+    for (VkResult allowed : {VK_SUCCESS, __VA_ARGS__})                                                       \
+      if (pr_vk_result_ == allowed) return pr_vk_result_;                                                    \
+    throw ::pointrast::gpu::VulkanError(pr_vk_result_, #call, __FILE__, __LINE__);                           \
   }()

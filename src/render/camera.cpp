@@ -10,7 +10,9 @@
 
 namespace pointrast {
 
-double defaultNear(const Bounds& bounds) { return std::max(1e-9, 1e-5 * bounds.diagonal()); }
+double defaultNear(const Bounds& bounds) {
+  return std::max(1e-9, 1e-5 * bounds.diagonal());
+}
 
 Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
   Camera camera;
@@ -31,8 +33,8 @@ Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
     glm::dvec3 v = corner - center;
     double along = glm::dot(v, back);
     deepest = std::max(deepest, along);
-    distance = std::max({distance, std::abs(glm::dot(v, right)) / tanX + along,
-                         std::abs(glm::dot(v, upv)) / tanY + along});
+    distance = std::max(
+        {distance, std::abs(glm::dot(v, right)) / tanX + along, std::abs(glm::dot(v, upv)) / tanY + along});
   }
   // Keep every corner in front of the eye even for degenerate (flat or single-point) bounds.
   distance = std::max(distance * 1.05, deepest + 1e-3 * bounds.diagonal() + 1e-6);
@@ -42,7 +44,9 @@ Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
 }
 
 void validateCamera(const Camera& camera) {
-  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  auto finite = [](const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
   if (!finite(camera.eye) || !finite(camera.target) || !finite(camera.up))
     throw InputError("camera: eye, target and up must be finite numbers");
   glm::dvec3 view = camera.target - camera.eye;
@@ -50,7 +54,8 @@ void validateCamera(const Camera& camera) {
   if (glm::length(camera.up) <= 0) throw InputError("camera: --up must not be zero");
   if (glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) < 1e-9)
     throw InputError("camera: --up is parallel to the view direction; give another --up");
-  if (!(camera.fovY > 0 && camera.fovY < 180)) throw InputError("camera: --fov must be between 0 and 180 degrees");
+  if (!(camera.fovY > 0 && camera.fovY < 180))
+    throw InputError("camera: --fov must be between 0 and 180 degrees");
   if (!(camera.nearW >= 0) || !std::isfinite(camera.nearW)) throw InputError("camera: --near must be >= 0");
 }
 
@@ -64,8 +69,9 @@ glm::dmat4 viewProjection(const Camera& camera, const glm::dvec3& origin, double
 
 std::string describeCamera(const Camera& c) {
   char text[256];
-  std::snprintf(text, sizeof text, "--eye %.17g,%.17g,%.17g --target %.17g,%.17g,%.17g --up %g,%g,%g --fov %g",
-                c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z, c.fovY);
+  std::snprintf(text, sizeof text,
+                "--eye %.17g,%.17g,%.17g --target %.17g,%.17g,%.17g --up %g,%g,%g --fov %g", c.eye.x, c.eye.y,
+                c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z, c.fovY);
   return text;
 }
 

@@ -12,7 +12,8 @@ std::vector<uint64_t> referenceFramebuffer(const PointCloud& cloud, const Camera
                                            uint32_t height) {
   validateCamera(camera);
   std::vector<std::atomic<uint64_t>> fb(uint64_t(width) * height);
-  for (auto& w : fb) w.store(~0ull, std::memory_order_relaxed);
+  for (auto& w : fb)
+    w.store(~0ull, std::memory_order_relaxed);
   glm::dvec3 origin = cloud.origin();
   glm::dmat4 m = viewProjection(camera, origin, double(width) / double(height));
   double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(cloud.bounds);
@@ -33,13 +34,15 @@ std::vector<uint64_t> referenceFramebuffer(const PointCloud& cloud, const Camera
     }
   });
   std::vector<uint64_t> words(fb.size());
-  for (size_t i = 0; i < fb.size(); ++i) words[i] = fb[i].load(std::memory_order_relaxed);
+  for (size_t i = 0; i < fb.size(); ++i)
+    words[i] = fb[i].load(std::memory_order_relaxed);
   return words;
 }
 
 std::vector<uint32_t> resolveWords(const std::vector<uint64_t>& words, uint32_t background) {
   std::vector<uint32_t> image(words.size());
-  for (size_t i = 0; i < words.size(); ++i) image[i] = words[i] == ~0ull ? background : uint32_t(words[i]);
+  for (size_t i = 0; i < words.size(); ++i)
+    image[i] = words[i] == ~0ull ? background : uint32_t(words[i]);
   return image;
 }
 

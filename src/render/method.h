@@ -48,7 +48,8 @@ public:
 // relative to the scene's origin (float, and the double copy in targets.matrices), the part's addresses
 // and point count, and the workgroup grid. `base` brings the method's framebuffer/aux addresses.
 template <class Draw>
-void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize, shared::RasterPush base, Draw&& draw) {
+void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize, shared::RasterPush base,
+                 Draw&& draw) {
   double aspect = double(targets.width) / double(targets.height);
   base.width = targets.width;
   base.height = targets.height;
@@ -72,10 +73,12 @@ void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize,
 double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera);
 
 // The resolve push for the shared targets; words are captured when settings ask for them.
-shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer, uint32_t groupSize);
+shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer,
+                                uint32_t groupSize);
 
 std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, Method method, DepthMode depth);
-std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height);
+std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width,
+                                             uint32_t height);
 std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, uint32_t width, uint32_t height);
 
 } // namespace pointrast

@@ -18,7 +18,9 @@ public:
     bool int40 = depth == DepthMode::Int40;
     uint32_t earlyZ = method == Method::EarlyZ || method == Method::ReduceEarlyZ || method == Method::Dedup ||
                       method == Method::DedupBallot;
-    uint32_t reduce = method == Method::Reduce || method == Method::ReduceEarlyZ ? 1 : method == Method::DedupBallot ? 2 : 0;
+    uint32_t reduce = method == Method::Reduce || method == Method::ReduceEarlyZ ? 1
+                      : method == Method::DedupBallot                            ? 2
+                                                                                 : 0;
     uint32_t justSet = method == Method::JustSet;
     if (method == Method::BusyLoop) {
       // No release barrier on CPU devices: see the shader for why lavapipe needs that.
@@ -28,12 +30,15 @@ public:
     } else if (method == Method::Dedup) {
       // The NV variant partitions instead of reducing: it has no REDUCE constant.
       raster_ = gpu::ComputeProgram(context, int40 ? "raster_dedup_nv_int40.comp" : "raster_dedup_nv.comp",
-                                    {{/* EARLY_Z= */ 0, earlyZ}, {/* JUST_SET= */ 2, justSet},
+                                    {{/* EARLY_Z= */ 0, earlyZ},
+                                     {/* JUST_SET= */ 2, justSet},
                                      {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
       pointsPerGroup_ = raster_.groupSize() * kPointsPerThread;
     } else {
       raster_ = gpu::ComputeProgram(context, int40 ? "raster_closest_int40.comp" : "raster_closest.comp",
-                                    {{/* EARLY_Z= */ 0, earlyZ}, {/* REDUCE= */ 1, reduce}, {/* JUST_SET= */ 2, justSet},
+                                    {{/* EARLY_Z= */ 0, earlyZ},
+                                     {/* REDUCE= */ 1, reduce},
+                                     {/* JUST_SET= */ 2, justSet},
                                      {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
       pointsPerGroup_ = raster_.groupSize() * kPointsPerThread;
     }
@@ -59,11 +64,11 @@ public:
       raster_.dispatch(cmd, grid.x, grid.y, push);
     });
     gpu::fullBarrier(cmd);
-    shared::ResolvePush resolve = resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
+    shared::ResolvePush resolve =
+        resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
     resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
     gpu::fullBarrier(cmd);
   }
-
 
 private:
   Method method_;

@@ -10,15 +10,18 @@ namespace {
 
 class HqsMethod : public PointMethod {
 public:
-  HqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height) : oneRound_(method == Method::Hqs1r) {
+  HqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
+      : oneRound_(method == Method::Hqs1r) {
     uint64_t pixels = uint64_t(width) * height;
     // hqs: 2 uint64 sums per pixel. hqs1r: 1 packed uint64 + 2 uint64 fallback sums per pixel.
-    accumulators_ = gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
-                                oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
+    accumulators_ =
+        gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
+                    oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
     // The depth pass is the fastest closest-point method the device has, reading positions only.
     bool partitioned = context.features().subgroupPartitionedNV;
     if (partitioned)
-      depth_ = gpu::ComputeProgram(context, "raster_dedup_nv.comp", {{/* EARLY_Z= */ 0, 1}, {/* DEPTH_ONLY= */ 3, 1}});
+      depth_ = gpu::ComputeProgram(context, "raster_dedup_nv.comp",
+                                   {{/* EARLY_Z= */ 0, 1}, {/* DEPTH_ONLY= */ 3, 1}});
     else
       depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
                                    {{/* EARLY_Z= */ 0, 1}, {/* REDUCE= */ 1, 1}, {/* DEPTH_ONLY= */ 3, 1}});
@@ -36,15 +39,17 @@ public:
     shared::RasterPush base{};
     base.framebuffer = targets.framebuffer.address();
     base.aux = accumulators_.address();
-    forEachPart(frame, targets, depth_.groupSize(), base, [&](const shared::RasterPush& push, gpu::Grid grid) {
-      depth_.dispatch(cmd, grid.x, grid.y, push);
-    });
+    forEachPart(
+        frame, targets, depth_.groupSize(), base,
+        [&](const shared::RasterPush& push, gpu::Grid grid) { depth_.dispatch(cmd, grid.x, grid.y, push); });
     gpu::fullBarrier(cmd);
-    forEachPart(frame, targets, accumulate_.groupSize(), base, [&](const shared::RasterPush& push, gpu::Grid grid) {
-      accumulate_.dispatch(cmd, grid.x, grid.y, push);
-    });
+    forEachPart(frame, targets, accumulate_.groupSize(), base,
+                [&](const shared::RasterPush& push, gpu::Grid grid) {
+                  accumulate_.dispatch(cmd, grid.x, grid.y, push);
+                });
     gpu::fullBarrier(cmd);
-    shared::ResolvePush resolve = resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
+    shared::ResolvePush resolve =
+        resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
     resolve.aux = accumulators_.address();
     resolve.words = 0;
     resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
@@ -63,7 +68,8 @@ private:
 
 } // namespace
 
-std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height) {
+std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width,
+                                             uint32_t height) {
   return std::make_unique<HqsMethod>(context, method, width, height);
 }
 

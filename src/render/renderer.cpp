@@ -15,19 +15,30 @@ namespace {
 // bytesPerPoint: 12 B position + 4 B color read by every closest-point method; HQS reads positions in its
 // depth pass and positions and colors in its blending pass: 28 B.
 constexpr MethodInfo kMethods[] = {
-    {Method::AtomicMin, "atomicmin", "one 64-bit atomicMin of depth<<32|color per point (2019)", true, true, 16},
+    {Method::AtomicMin, "atomicmin", "one 64-bit atomicMin of depth<<32|color per point (2019)", true, true,
+     16},
     {Method::EarlyZ, "earlyz", "read the pixel first, atomicMin only if closer (2021)", true, true, 16},
-    {Method::Reduce, "reduce", "subgroup minimum when a subgroup hits one pixel, else pairs (2021)", true, true, 16},
+    {Method::Reduce, "reduce", "subgroup minimum when a subgroup hits one pixel, else pairs (2021)", true,
+     true, 16},
     {Method::ReduceEarlyZ, "reduce-earlyz", "reduce and early-z (2021)", true, true, 16},
-    {Method::Dedup, "dedup", "one atomic per distinct pixel of a subgroup, VK_NV_shader_subgroup_partitioned, "
-                             "with early-z (2021)", true, true, 16},
-    {Method::DedupBallot, "dedup-ballot", "dedup from portable subgroup ballots, with early-z", true, true, 16},
-    {Method::BusyLoop, "busyloop", "per-pixel lock in the depth word, then color (2013), with early-z", true, false, 16},
-    {Method::JustSet, "justset", "plain stores, no depth test: a speed reference, not a correct image", false, true, 16},
-    {Method::Hqs, "hqs", "high-quality splatting: blend points within 1% of the closest depth (2019)", false, false, 28},
-    {Method::Hqs1r, "hqs1r", "HQS with one packed 64-bit atomicAdd and overflow fallback (2022)", false, false, 28},
-    {Method::HwPoints, "hw-points", "Vulkan point-list pipeline, 1-pixel points, hardware depth test: the GL_POINTS "
-                                    "baseline", false, false, 16},
+    {Method::Dedup, "dedup",
+     "one atomic per distinct pixel of a subgroup, VK_NV_shader_subgroup_partitioned, "
+     "with early-z (2021)",
+     true, true, 16},
+    {Method::DedupBallot, "dedup-ballot", "dedup from portable subgroup ballots, with early-z", true, true,
+     16},
+    {Method::BusyLoop, "busyloop", "per-pixel lock in the depth word, then color (2013), with early-z", true,
+     false, 16},
+    {Method::JustSet, "justset", "plain stores, no depth test: a speed reference, not a correct image", false,
+     true, 16},
+    {Method::Hqs, "hqs", "high-quality splatting: blend points within 1% of the closest depth (2019)", false,
+     false, 28},
+    {Method::Hqs1r, "hqs1r", "HQS with one packed 64-bit atomicAdd and overflow fallback (2022)", false,
+     false, 28},
+    {Method::HwPoints, "hw-points",
+     "Vulkan point-list pipeline, 1-pixel points, hardware depth test: the GL_POINTS "
+     "baseline",
+     false, false, 16},
 };
 
 // 16384 x 16384 pixels: 2 GiB of framebuffer words, the most a single allocation is guaranteed to hold
@@ -36,13 +47,16 @@ constexpr uint32_t kMaxSide = 16384;
 
 template <class T> std::string choices(std::span<const T> items) {
   std::string known;
-  for (const T& m : items) known += (known.empty() ? "" : ", ") + std::string(m.name);
+  for (const T& m : items)
+    known += (known.empty() ? "" : ", ") + std::string(m.name);
   return known;
 }
 
 } // namespace
 
-std::span<const MethodInfo> methodTable() { return kMethods; }
+std::span<const MethodInfo> methodTable() {
+  return kMethods;
+}
 
 const MethodInfo& methodInfo(Method method) {
   for (const MethodInfo& m : kMethods)
@@ -56,7 +70,9 @@ Method parseMethod(std::string_view name) {
   throw InputError("unknown method '" + std::string(name) + "'; choose one of: " + choices(methodTable()));
 }
 
-const char* methodName(Method method) { return methodInfo(method).name; }
+const char* methodName(Method method) {
+  return methodInfo(method).name;
+}
 
 DepthMode parseDepthMode(std::string_view name) {
   if (name == "float") return DepthMode::Float;
@@ -64,9 +80,12 @@ DepthMode parseDepthMode(std::string_view name) {
   throw InputError("unknown depth encoding '" + std::string(name) + "'; choose float or int40");
 }
 
-const char* depthModeName(DepthMode mode) { return mode == DepthMode::Int40 ? "int40" : "float"; }
+const char* depthModeName(DepthMode mode) {
+  return mode == DepthMode::Int40 ? "int40" : "float";
+}
 
-shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer, uint32_t groupSize) {
+shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer,
+                                uint32_t groupSize) {
   shared::ResolvePush push{};
   push.framebuffer = framebuffer;
   push.image = targets.image.address();
@@ -102,7 +121,8 @@ bool Renderer::supports(gpu::Context& context, Method method, std::string* why) 
   case Method::DedupBallot:
   case Method::Hqs:
   case Method::Hqs1r:
-    if (!subgroups) reason = "needs subgroup vote/ballot/shuffle/arithmetic on 64-bit integers in compute shaders";
+    if (!subgroups)
+      reason = "needs subgroup vote/ballot/shuffle/arithmetic on 64-bit integers in compute shaders";
     break;
   case Method::Dedup:
     if (!subgroups || !f.subgroupPartitionedNV)
@@ -111,7 +131,8 @@ bool Renderer::supports(gpu::Context& context, Method method, std::string* why) 
   default:
     break;
   }
-  if (!reason.empty() && why) *why = std::string(methodName(method)) + " is not available on '" + context.info().name + "': " + reason;
+  if (!reason.empty() && why)
+    *why = std::string(methodName(method)) + " is not available on '" + context.info().name + "': " + reason;
   return reason.empty();
 }
 
@@ -123,15 +144,21 @@ Renderer::Renderer(gpu::Context& context, uint32_t width, uint32_t height)
   Targets& t = *targets_;
   t.width = width;
   t.height = height;
-  t.framebuffer = gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
+  t.framebuffer =
+      gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
   t.image = gpu::Buffer(context, t.pixels() * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "image");
-  t.words = gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
+  t.words =
+      gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
 }
 
 Renderer::~Renderer() = default;
 
-uint32_t Renderer::width() const { return targets_->width; }
-uint32_t Renderer::height() const { return targets_->height; }
+uint32_t Renderer::width() const {
+  return targets_->width;
+}
+uint32_t Renderer::height() const {
+  return targets_->height;
+}
 
 PointMethod& Renderer::method(const RenderSettings& settings) {
   const MethodInfo& info = methodInfo(settings.method);
@@ -163,20 +190,23 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   // Double-precision copies of each scene's matrix, for the int40 path.
   uint64_t matrixBytes = std::max<size_t>(1, scenes.size()) * sizeof(glm::dmat4);
   if (!t.matrices || t.matrices.size() < matrixBytes)
-    t.matrices = gpu::Buffer(context_, matrixBytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "double matrices");
+    t.matrices =
+        gpu::Buffer(context_, matrixBytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "double matrices");
   double aspect = double(t.width) / double(t.height);
   for (size_t s = 0; s < scenes.size(); ++s) {
     glm::dmat4 vp = viewProjection(camera, scenes[s]->origin(), aspect);
     std::memcpy(static_cast<char*>(t.matrices.mapped()) + s * sizeof(glm::dmat4), &vp, sizeof vp);
   }
   RenderSettings effective = settings;
-  if (effective.depth == DepthMode::Int40 && effective.depthScale <= 0) effective.depthScale = int40Scale(scenes, camera);
+  if (effective.depth == DepthMode::Int40 && effective.depthScale <= 0)
+    effective.depthScale = int40Scale(scenes, camera);
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
     Frame frame{cmd, scenes, camera, effective};
-    for (uint32_t w = 0; w < settings.warmup; ++w) m.recordFrame(frame, t);
+    for (uint32_t w = 0; w < settings.warmup; ++w)
+      m.recordFrame(frame, t);
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);
       m.recordFrame(frame, t);
@@ -190,7 +220,8 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   stats.medianMs = gpu::median(ms);
   stats.minMs = *std::min_element(ms.begin(), ms.end());
   stats.maxMs = *std::max_element(ms.begin(), ms.end());
-  for (const GpuScene* scene : scenes) stats.points += scene->pointCount();
+  for (const GpuScene* scene : scenes)
+    stats.points += scene->pointCount();
   return stats;
 }
 

@@ -43,8 +43,8 @@ struct MethodInfo {
   Method method;
   const char* name;
   const char* description;
-  bool closest;        // writes the canonical closest-point framebuffer (bit-identical across methods)
-  bool int40;          // supports --depth int40
+  bool closest;           // writes the canonical closest-point framebuffer (bit-identical across methods)
+  bool int40;             // supports --depth int40
   uint32_t bytesPerPoint; // point data the method must read per point per frame (for effective bandwidth)
 };
 std::span<const MethodInfo> methodTable();
@@ -70,7 +70,7 @@ struct RenderSettings {
 struct FrameStats {
   double medianMs = 0, minMs = 0, maxMs = 0; // GPU time of clear + draw + resolve, timestamp queries
   uint32_t frames = 0;
-  uint64_t points = 0;                       // points submitted per frame
+  uint64_t points = 0; // points submitted per frame
 };
 
 struct Targets;
@@ -84,7 +84,8 @@ public:
 
   // Throws UnsupportedError if the device cannot run the method (missing extension or feature) and
   // InputError for a combination that does not exist (hqs with int40 depth).
-  FrameStats render(std::span<const GpuScene* const> scenes, const Camera& camera, const RenderSettings& settings);
+  FrameStats render(std::span<const GpuScene* const> scenes, const Camera& camera,
+                    const RenderSettings& settings);
   FrameStats render(const GpuScene& scene, const Camera& camera, const RenderSettings& settings) {
     const GpuScene* one[] = {&scene};
     return render(one, camera, settings);

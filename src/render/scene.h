@@ -23,9 +23,9 @@ struct ScenePart {
 };
 
 struct UploadOptions {
-  uint64_t first = 0;                // upload points [first, first + count) of the cloud
-  uint64_t count = UINT64_MAX;       // clamped to the cloud's size
-  uint64_t maxPartPoints = 0;        // 0: largest multiple of 10240 whose positions fit one buffer, <= 64 M
+  uint64_t first = 0;          // upload points [first, first + count) of the cloud
+  uint64_t count = UINT64_MAX; // clamped to the cloud's size
+  uint64_t maxPartPoints = 0;  // 0: largest multiple of 10240 whose positions fit one buffer, <= 64 M
   bool progress = true;
 };
 

@@ -41,8 +41,9 @@ std::string slurp(const fs::path& p) {
 // Runs pointrast with the validation layer on; stdout and stderr captured separately.
 Result run(const std::string& args) {
   fs::path out = tempDir() / "stdout.txt", err = tempDir() / "stderr.txt";
-  std::string command = "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " + pointrast::test::pointrastBinary() + " " + args +
-                        " >" + out.string() + " 2>" + err.string();
+  std::string command = "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
+                        pointrast::test::pointrastBinary() + " " + args + " >" + out.string() + " 2>" +
+                        err.string();
   int status = std::system(command.c_str());
   Result r;
   r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) > 128);
@@ -54,7 +55,8 @@ Result run(const std::string& args) {
 
 int lineCount(const std::string& text) {
   int lines = 0;
-  for (char c : text) lines += c == '\n';
+  for (char c : text)
+    lines += c == '\n';
   return lines;
 }
 
@@ -103,20 +105,27 @@ TEST(Cli, UsageErrorsExitOne) {
   expectCleanFailure("render --eye 1,2 -o " + (tempDir() / "x.png").string(), tempDir() / "x.png");
   expectCleanFailure("render --order zigzag -o " + (tempDir() / "x.png").string(), tempDir() / "x.png");
   expectCleanFailure("render --method nope -o " + (tempDir() / "x.png").string(), tempDir() / "x.png");
-  expectCleanFailure("render --eye 0,0,0 --target 0,0,0 -o " + (tempDir() / "x.png").string(), tempDir() / "x.png");
+  expectCleanFailure("render --eye 0,0,0 --target 0,0,0 -o " + (tempDir() / "x.png").string(),
+                     tempDir() / "x.png");
   expectCleanFailure("render does-not-exist.las -o " + (tempDir() / "x.png").string(), tempDir() / "x.png");
 }
 
 TEST(Cli, BadFilesFailCleanlyForInfoAndRender) {
   std::mt19937 rng(5);
   std::string random(4096, '\0');
-  for (char& c : random) c = char(rng());
+  for (char& c : random)
+    c = char(rng());
   std::string plyLie = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty float x\n"
-                       "property float y\nproperty float z\nend_header\n" + std::string(120, '\0');
-  std::vector<fs::path> files = {
-      kData / "las/permutations/1.2-no-points.las", kData / "laz/autzen_trim.laz", kData / "laz/simple.laz",
-      kData / "laz/lone-star.copc.laz", writeFile("empty.las", ""), writeFile("random.bin", random),
-      writeFile("random.las", random), writeFile("lie.ply", plyLie)};
+                       "property float y\nproperty float z\nend_header\n" +
+                       std::string(120, '\0');
+  std::vector<fs::path> files = {kData / "las/permutations/1.2-no-points.las",
+                                 kData / "laz/autzen_trim.laz",
+                                 kData / "laz/simple.laz",
+                                 kData / "laz/lone-star.copc.laz",
+                                 writeFile("empty.las", ""),
+                                 writeFile("random.bin", random),
+                                 writeFile("random.las", random),
+                                 writeFile("lie.ply", plyLie)};
   fs::path png = tempDir() / "bad.png";
   for (const fs::path& f : files) {
     ASSERT_TRUE(fs::exists(f)) << f;
@@ -151,7 +160,9 @@ TEST(Cli, GenerateConvertAndRenderRoundTrip) {
   fs::path las = tempDir() / "gen.las", morton = tempDir() / "gen_morton.las";
   fs::path a = tempDir() / "a.png", b = tempDir() / "b.png";
   ASSERT_EQ(run("generate tls --points 50k --seed 3 -o " + las.string()).exitCode, 0);
-  ASSERT_EQ(run("convert " + las.string() + " " + morton.string() + " --order shuffled-morton --seed 9").exitCode, 0);
+  ASSERT_EQ(
+      run("convert " + las.string() + " " + morton.string() + " --order shuffled-morton --seed 9").exitCode,
+      0);
   // The same points in another order render the same image (order-independent minimum).
   Result ra = run("render " + las.string() + " -o " + a.string() + " --width 320 --height 200 --json");
   Result rb = run("render " + morton.string() + " -o " + b.string() + " --width 320 --height 200 --json");
@@ -164,7 +175,8 @@ TEST(Cli, GenerateConvertAndRenderRoundTrip) {
 TEST(Cli, PartsGiveTheSameImage) {
   fs::path a = tempDir() / "p1.png", b = tempDir() / "p5.png";
   Result ra = run("render terrain --points 200k -o " + a.string() + " --width 320 --height 200 --json");
-  Result rb = run("render terrain --points 200k -o " + b.string() + " --width 320 --height 200 --json --parts 5");
+  Result rb =
+      run("render terrain --points 200k -o " + b.string() + " --width 320 --height 200 --json --parts 5");
   ASSERT_EQ(ra.exitCode, 0) << ra.err;
   ASSERT_EQ(rb.exitCode, 0) << rb.err;
   EXPECT_EQ(slurp(a), slurp(b));

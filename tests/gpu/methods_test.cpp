@@ -18,8 +18,8 @@ namespace pointrast::test {
 
 namespace {
 
-PointCloud fromPoints(const std::vector<glm::dvec3>& points, const std::vector<uint32_t>& colors, double scale = 1e-4,
-                      glm::dvec3 offset = glm::dvec3(0)) {
+PointCloud fromPoints(const std::vector<glm::dvec3>& points, const std::vector<uint32_t>& colors,
+                      double scale = 1e-4, glm::dvec3 offset = glm::dvec3(0)) {
   PointCloud cloud;
   cloud.scale = glm::dvec3(scale);
   cloud.offset = offset;
@@ -38,8 +38,8 @@ struct Result {
   std::vector<uint32_t> image;
 };
 
-Result draw(gpu::Context& context, const GpuScene& scene, const Camera& camera, uint32_t w, uint32_t h, Method method,
-            DepthMode depth = DepthMode::Float) {
+Result draw(gpu::Context& context, const GpuScene& scene, const Camera& camera, uint32_t w, uint32_t h,
+            Method method, DepthMode depth = DepthMode::Float) {
   Renderer renderer(context, w, h);
   RenderSettings settings;
   settings.method = method;
@@ -93,8 +93,8 @@ std::vector<std::pair<std::string, Camera>> views(const Bounds& bounds, double a
 TEST_F(GpuTest, ClosestPointMethodsAreBitIdentical) {
   // On CPU devices busyloop runs without its release barrier (see its shader); the variant with the
   // barrier is checked on hardware by BusyLoopIsBitIdenticalOnHardware.
-  std::vector<Method> methods = {Method::EarlyZ, Method::Reduce, Method::ReduceEarlyZ, Method::DedupBallot,
-                                 Method::BusyLoop, Method::Dedup};
+  std::vector<Method> methods = {Method::EarlyZ,      Method::Reduce,   Method::ReduceEarlyZ,
+                                 Method::DedupBallot, Method::BusyLoop, Method::Dedup};
   uint32_t w = 160, h = 100;
   for (auto& [cloudName, original] : testClouds()) {
     for (Order order : {Order::Original, Order::Morton, Order::Shuffled, Order::ShuffledMorton}) {
@@ -106,7 +106,8 @@ TEST_F(GpuTest, ClosestPointMethodsAreBitIdentical) {
       for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
         std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
         Result reference = draw(*context, scene, camera, w, h, Method::AtomicMin);
-        size_t lit = std::count_if(reference.words.begin(), reference.words.end(), [](uint64_t v) { return v != ~0ull; });
+        size_t lit = std::count_if(reference.words.begin(), reference.words.end(),
+                                   [](uint64_t v) { return v != ~0ull; });
         EXPECT_GT(lit, 0u) << where;
         for (Method method : methods) {
           std::string why;
@@ -122,7 +123,8 @@ TEST_F(GpuTest, ClosestPointMethodsAreBitIdentical) {
         }
         Result set = draw(*context, scene, camera, w, h, Method::JustSet);
         for (size_t i = 0; i < set.words.size(); ++i)
-          ASSERT_EQ(set.words[i] == ~0ull, reference.words[i] == ~0ull) << "justset lit pixels differ on " << where;
+          ASSERT_EQ(set.words[i] == ~0ull, reference.words[i] == ~0ull)
+              << "justset lit pixels differ on " << where;
       }
     }
   }
@@ -159,9 +161,11 @@ TEST_F(GpuTest, Int40ClosestMethodsAgree) {
   GpuScene scene(*context, cloud, upload);
   Camera camera = overviewCamera(cloud.bounds, 1.6);
   Result reference = draw(*context, scene, camera, 160, 100, Method::AtomicMin, DepthMode::Int40);
-  for (Method method : {Method::EarlyZ, Method::Reduce, Method::ReduceEarlyZ, Method::DedupBallot, Method::Dedup}) {
+  for (Method method :
+       {Method::EarlyZ, Method::Reduce, Method::ReduceEarlyZ, Method::DedupBallot, Method::Dedup}) {
     if (!Renderer::supports(*context, method)) continue;
-    EXPECT_EQ(draw(*context, scene, camera, 160, 100, method, DepthMode::Int40).words, reference.words) << methodName(method);
+    EXPECT_EQ(draw(*context, scene, camera, 160, 100, method, DepthMode::Int40).words, reference.words)
+        << methodName(method);
   }
   // Same pixels lit as with float depth; colors are RGB with alpha restored.
   Result floatDepth = draw(*context, scene, camera, 160, 100, Method::AtomicMin);
@@ -222,8 +226,9 @@ TEST_F(GpuTest, Int40SeparatesSurfacesOneMillimetreApartAtTenKilometres) {
   double float1mm = backSurfaceFraction(*context, 0.001, 10'000.0, DepthMode::Float);
   double floatHalf = backSurfaceFraction(*context, 0.0005, 10'000.0, DepthMode::Float);
   double int40Half = backSurfaceFraction(*context, 0.0005, 10'000.0, DepthMode::Int40);
-  std::printf("back surface visible at 10 km: 1 mm gap: float %.1f %%; 0.5 mm gap: float %.1f %%, int40 %.1f %%\n",
-              100 * float1mm, 100 * floatHalf, 100 * int40Half);
+  std::printf(
+      "back surface visible at 10 km: 1 mm gap: float %.1f %%; 0.5 mm gap: float %.1f %%, int40 %.1f %%\n",
+      100 * float1mm, 100 * floatHalf, 100 * int40Half);
   EXPECT_GT(floatHalf, 0.10) << "float depth was expected to merge surfaces closer than its step";
   EXPECT_EQ(int40Half, 0.0);
 }
@@ -242,7 +247,8 @@ std::vector<uint32_t> cpuHqs(const std::vector<glm::dvec3>& viewPoints, const st
   for (size_t i = 0; i < viewPoints.size(); ++i) {
     uint32_t p = pixels[i];
     if (float(viewPoints[i].z) > closest[p] * 1.01f) continue;
-    for (int c = 0; c < 3; ++c) sum[4 * p + c] += (colors[i] >> (8 * c)) & 0xFF;
+    for (int c = 0; c < 3; ++c)
+      sum[4 * p + c] += (colors[i] >> (8 * c)) & 0xFF;
     sum[4 * p + 3] += 1;
   }
   std::vector<uint32_t> image(n, 0);
@@ -250,7 +256,8 @@ std::vector<uint32_t> cpuHqs(const std::vector<glm::dvec3>& viewPoints, const st
     uint64_t k = sum[4 * p + 3];
     if (!k) continue;
     uint32_t rgb = 0;
-    for (int c = 0; c < 3; ++c) rgb |= uint32_t((sum[4 * p + c] + k / 2) / k) << (8 * c);
+    for (int c = 0; c < 3; ++c)
+      rgb |= uint32_t((sum[4 * p + c] + k / 2) / k) << (8 * c);
     image[p] = rgb | 0xFF000000u;
   }
   return image;
@@ -279,15 +286,18 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
       if ((px * 7 + py * 3) % 11 == 0) continue; // some empty pixels
       double front = 2.0 + 0.5 * std::sin(px * 0.2) + 0.3 * std::cos(py * 0.3);
       int count = 1 + int(rng() % 6);
-      for (int k = 0; k < count; ++k) add(px, py, front * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+      for (int k = 0; k < count; ++k)
+        add(px, py, front * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
       add(px, py, front * 1.03, 0xFF0000FFu); // hidden: beyond 1 %
     }
   // One pixel with 1,500 blended points: past hqs1r's 255-point packed word.
-  for (int k = 0; k < 1500; ++k) add(10, 20, 1.5 * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+  for (int k = 0; k < 1500; ++k)
+    add(10, 20, 1.5 * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
 
   PointCloud cloud = fromPoints(points, colors, 1e-7);
   // The quantized positions move points by < 1e-7: recompute the CPU view depths from them.
-  for (size_t i = 0; i < view.size(); ++i) view[i].z = -cloud.world(i).z;
+  for (size_t i = 0; i < view.size(); ++i)
+    view[i].z = -cloud.world(i).z;
   Camera camera;
   camera.eye = {0, 0, 0};
   camera.target = {0, 0, -1};

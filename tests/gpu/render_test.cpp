@@ -1,19 +1,19 @@
 // GPU methods against the image contract (hand-built cases with known pixels) and against the CPU
 // reference renderer (double precision) on random, generated and real clouds.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
-#include <bit>
 #include <numeric>
 #include <random>
 
 #include "base/error.h"
 #include "cloud/generate.h"
 #include "gpu_fixture.h"
-#include "test_data.h"
 #include "io/reader.h"
 #include "render/cpu_reference.h"
 #include "render/renderer.h"
+#include "test_data.h"
 
 namespace pointrast::test {
 
@@ -35,8 +35,8 @@ PointCloud makeCloud(const std::vector<glm::dvec3>& points, const std::vector<ui
   return cloud;
 }
 
-std::vector<uint64_t> renderWords(gpu::Context& context, const PointCloud& cloud, const Camera& camera, uint32_t w,
-                                  uint32_t h, const UploadOptions& upload = {}) {
+std::vector<uint64_t> renderWords(gpu::Context& context, const PointCloud& cloud, const Camera& camera,
+                                  uint32_t w, uint32_t h, const UploadOptions& upload = {}) {
   GpuScene scene(context, cloud, upload);
   Renderer renderer(context, w, h);
   RenderSettings settings;
@@ -47,7 +47,8 @@ std::vector<uint64_t> renderWords(gpu::Context& context, const PointCloud& cloud
 
 double equalFraction(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
   size_t same = 0;
-  for (size_t i = 0; i < a.size(); ++i) same += a[i] == b[i];
+  for (size_t i = 0; i < a.size(); ++i)
+    same += a[i] == b[i];
   return double(same) / double(a.size());
 }
 
@@ -81,8 +82,9 @@ Camera axisCamera() {
 TEST_F(GpuTest, ContractPixelPlacementAndDepthOrder) {
   // 4x4 image, aspect 1. Points: red at pixel (2,1) depth 1; green behind red on the same pixel; blue at
   // pixel (0,3); one behind the eye; one outside the image; one between eye and near plane.
-  PointCloud cloud = makeCloud({{0.25, 0.25, -1}, {0.5, 0.5, -2}, {-0.9, -0.9, -1}, {0, 0, 1}, {3, 0, -1}, {0, 0, -0.005}},
-                               {kRed, kGreen, kBlue, kGreen, kGreen, kGreen});
+  PointCloud cloud =
+      makeCloud({{0.25, 0.25, -1}, {0.5, 0.5, -2}, {-0.9, -0.9, -1}, {0, 0, 1}, {3, 0, -1}, {0, 0, -0.005}},
+                {kRed, kGreen, kBlue, kGreen, kGreen, kGreen});
   std::vector<uint64_t> words = renderWords(*context, cloud, axisCamera(), 4, 4);
   for (uint32_t i = 0; i < 16; ++i) {
     uint32_t x = i % 4, y = i / 4;
@@ -209,8 +211,9 @@ TEST_F(GpuTest, TwoDimensionalGridReachesEveryPoint) {
   PointCloud cloud;
   cloud.scale = glm::dvec3(1e-3);
   cloud.positions.assign(3 * n, 0);
-  for (uint64_t i = 0; i < n; ++i) cloud.positions[3 * i + 2] = -2000; // z = -2
-  cloud.positions[3 * (n - 1) + 2] = -1000;                             // z = -1: closer
+  for (uint64_t i = 0; i < n; ++i)
+    cloud.positions[3 * i + 2] = -2000;     // z = -2
+  cloud.positions[3 * (n - 1) + 2] = -1000; // z = -1: closer
   cloud.colors.assign(n, kGreen);
   cloud.colors[n - 1] = kRed;
   computeBounds(cloud);
