@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   app::Command render = app::addRender(app);
   app::Command convert = app::addConvert(app);
   app::Command generate = app::addGenerate(app);
+  app::Command bench = app::addBench(app);
 
   try {
     app.parse(argc, argv);
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
       if (sub->get_name() == "render") return render();
       if (sub->get_name() == "convert") return convert();
       if (sub->get_name() == "generate") return generate();
+      if (sub->get_name() == "bench") return bench();
     }
     return 1;
   } catch (const InputError& e) {

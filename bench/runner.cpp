@@ -16,9 +16,9 @@ namespace pointrast::bench {
 
 namespace {
 
-std::string gib(uint64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t(1) << 30));
+std::string printf1(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
   return text;
 }
 
@@ -29,18 +29,33 @@ uint64_t physicalMemory() {
 
 // Points a data set will have, known before it is loaded: generated scenes have exactly the count
 // asked for; files state theirs in the header (counted for XYZ).
-uint64_t expectedPoints(const Dataset& d) { return d.file ? io::probeFile(d.source).pointCount : d.points; }
+uint64_t expectedPoints(const Dataset& d) {
+  return d.file ? io::probeFile(d.source).pointCount : d.points;
+}
 
 // Parallel gather in fixed blocks (as everywhere in src/cloud), so it costs a fraction of the sort.
 constexpr uint64_t kGatherBlock = uint64_t(1) << 16;
 
 } // namespace
 
-uint32_t warmupFrames(uint32_t frames) { return std::max(2u, frames / 10); }
+std::string bytesText(uint64_t bytes) {
+  char text[32];
+  if (bytes >= (uint64_t(1) << 30))
+    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t(1) << 30));
+  else if (bytes >= (uint64_t(1) << 20))
+    std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(uint64_t(1) << 20));
+  else
+    std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / 1024.0);
+  return text;
+}
+
+uint32_t warmupFrames(uint32_t frames) {
+  return std::max(2u, frames / 10);
+}
 
 std::string MemoryEstimate::describe() const {
-  return "needs " + gib(gpuBytes) + " of GPU memory (device has " + gib(gpuHave) + ") and " + gib(hostBytes) +
-         " of host memory (machine has " + gib(hostHave) + ")";
+  return "needs " + bytesText(gpuBytes) + " of GPU memory (device has " + bytesText(gpuHave) + ") and " +
+         bytesText(hostBytes) + " of host memory (machine has " + bytesText(hostHave) + ")";
 }
 
 MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height) {
@@ -134,7 +149,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
   {
     char line[160];
     std::snprintf(line, sizeof line, "copy bandwidth: %.1f GB/s (read + write, %s copied, median of %d)",
-                  run.copy.bytesPerSecond * 1e-9, gib(run.copy.bytes).c_str(), run.copy.repeats);
+                  run.copy.bytesPerSecond * 1e-9, bytesText(run.copy.bytes).c_str(), run.copy.repeats);
     note(line);
   }
 
@@ -144,10 +159,17 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
   for (DatasetOutcome& outcome : run.datasets) {
     if (outcome.skipped) continue;
     const Dataset& d = outcome.dataset;
+    auto since = std::chrono::steady_clock::now();
+    auto secondsSince = [&since] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+    };
+    // Host-side preparation can take minutes at the paper's sizes; a line each keeps a log readable.
     PointCloud cloud = loadDataset(d, config.progress);
     outcome.points = cloud.size();
     outcome.description = cloud.source;
+    note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince()));
     for (Order order : config.orders) {
+      since = std::chrono::steady_clock::now();
       std::unique_ptr<GpuScene> scene;
       std::string failure;
       {
@@ -161,6 +183,8 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
           failure = e.what(); // out of device memory after all: every combination says so
         }
       } // the reordered host copy is freed here, before the GPU work
+      note(d.label + " / " + orderName(order) + ": ordered and uploaded in " +
+           printf1("%.1f s", secondsSince()));
       for (View view : config.views) {
         const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
         for (Method method : config.methods) {
@@ -195,11 +219,12 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
             const double seconds = r.stats.medianMs * 1e-3;
             r.pointsPerSecond = double(r.stats.points) / seconds;
             r.effectiveBytesPerSecond = double(r.stats.points) * r.bytesPerPoint / seconds;
-            r.copyFraction = run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
+            r.copyFraction =
+                run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
           }
           run.results.push_back(r);
           ++done;
-          if (callbacks.onResult) callbacks.onResult(run.results.back(), done, total);
+          if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
         }
       }
     }

@@ -21,9 +21,9 @@
 namespace pointrast::bench {
 
 struct Dataset {
-  std::string name;   // short id for JSON and file names: "retz-like", "terrain-20k", "autzen"
-  std::string label;  // row label of the tables: "retz-like (terrain, 145 M)"
-  std::string source; // a file path or a scene name (terrain, tls)
+  std::string name;    // short id for JSON and file names: "retz-like", "terrain-20k", "autzen"
+  std::string label;   // row label of the tables: "retz-like (terrain, 145 M)"
+  std::string source;  // a file path or a scene name (terrain, tls)
   uint64_t points = 0; // points to generate (scenes); ignored for files
   uint64_t seed = 1;   // scene seed
   bool file = false;   // source is a file
@@ -35,13 +35,16 @@ struct BenchConfig {
   std::vector<Order> orders;
   std::vector<View> views;
   uint32_t width = 1920, height = 1080;
-  uint32_t frames = 50;      // timed frames per combination; warm-up is warmupFrames(frames)
+  uint32_t frames = 50; // timed frames per combination; warm-up is warmupFrames(frames)
   double fovY = 60.0;
-  uint64_t orderSeed = 1;    // for the shuffled orders
+  uint64_t orderSeed = 1; // for the shuffled orders
   uint64_t copyBytes = uint64_t(1) << 30;
   int copyRepeats = 10;
-  bool progress = true;      // generation, reading and upload progress (drawn only on a terminal)
+  bool progress = true; // generation, reading and upload progress (drawn only on a terminal)
 };
+
+// "512 KiB", "3.1 MiB", "12.7 GiB": memory sizes in messages and reports.
+std::string bytesText(uint64_t bytes);
 
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);
@@ -53,10 +56,10 @@ constexpr uint64_t kTargetBytesPerPixel = 64;
 constexpr uint64_t kHostBytesPerPoint = 40;
 
 struct MemoryEstimate {
-  uint64_t gpuBytes = 0, hostBytes = 0;   // needed
-  uint64_t gpuHave = 0, hostHave = 0;     // device-local heaps; physical memory of this machine
+  uint64_t gpuBytes = 0, hostBytes = 0; // needed
+  uint64_t gpuHave = 0, hostHave = 0;   // device-local heaps; physical memory of this machine
   bool fits() const { return gpuBytes <= gpuHave && hostBytes <= hostHave; }
-  std::string describe() const;           // "needs 12.7 GB of GPU memory (has 80.0 GB) and ..."
+  std::string describe() const; // "needs 12.7 GB of GPU memory (has 80.0 GB) and ..."
 };
 // GPU: points x 16 B + targets; host: points x 40 B, plus the GPU bytes on a software device (its
 // "device memory" is host memory).
@@ -81,11 +84,11 @@ struct Result {
 
 struct DatasetOutcome {
   Dataset dataset;
-  uint64_t points = 0;      // points of the cloud (from the file header before it is read)
-  std::string description;  // the cloud's source text ("terrain, 4000000 points, seed 1")
+  uint64_t points = 0;     // points of the cloud (from the file header before it is read)
+  std::string description; // the cloud's source text ("terrain, 4000000 points, seed 1")
   MemoryEstimate memory;
   bool skipped = false;
-  std::string reason;       // why it was skipped
+  std::string reason; // why it was skipped
 };
 
 struct BenchRun {
@@ -100,8 +103,9 @@ struct BenchRun {
 };
 
 struct BenchCallbacks {
-  // After each combination; done counts from 1 to total.
-  std::function<void(const Result&, size_t done, size_t total)> onResult;
+  // After each combination, with the run so far (device, copy bandwidth, settings); done counts from 1
+  // to total.
+  std::function<void(const BenchRun& run, const Result& result, size_t done, size_t total)> onResult;
   // Memory statements, skipped data sets, the copy bandwidth: one line each.
   std::function<void(const std::string&)> onNote;
 };

@@ -25,9 +25,13 @@ constexpr uint64_t kMinScaledPoints = 1000;
 
 } // namespace
 
-std::span<const SuiteEntry> paper2021Suite() { return kPaper2021; }
+std::span<const SuiteEntry> paper2021Suite() {
+  return kPaper2021;
+}
 
-std::vector<std::string> suiteNames() { return {"paper2021"}; }
+std::vector<std::string> suiteNames() {
+  return {"paper2021"};
+}
 
 std::string shortCount(uint64_t points) {
   struct Unit {
@@ -66,7 +70,8 @@ std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_
   for (const std::string& item : replacements) {
     size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      throw InputError("'" + item + "': with --suite, a file replaces a stand-in as NAME=PATH (names: "
+      throw InputError("'" + item +
+                       "': with --suite, a file replaces a stand-in as NAME=PATH (names: "
                        "banyunibo, eclepens, retz, endeavor)");
     std::string name = item.substr(0, eq), path = item.substr(eq + 1);
     bool found = false;
@@ -81,7 +86,8 @@ std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_
       found = true;
     }
     if (!found)
-      throw InputError("'" + name + "' is no data set of suite paper2021 (banyunibo, eclepens, retz, endeavor)");
+      throw InputError("'" + name +
+                       "' is no data set of suite paper2021 (banyunibo, eclepens, retz, endeavor)");
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such file");
   }

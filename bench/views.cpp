@@ -18,9 +18,13 @@ View parseView(std::string_view name) {
   throw InputError("unknown view '" + std::string(name) + "'; choose overview, closeup or outside");
 }
 
-const char* viewName(View view) { return kViewNames[int(view)]; }
+const char* viewName(View view) {
+  return kViewNames[int(view)];
+}
 
-std::span<const View> allViews() { return kViews; }
+std::span<const View> allViews() {
+  return kViews;
+}
 
 Camera viewCamera(View view, const Bounds& bounds, double aspect, double fovY) {
   if (view == View::Overview || bounds.empty()) return overviewCamera(bounds, aspect, fovY);

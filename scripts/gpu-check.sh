@@ -61,8 +61,12 @@ for what in "$@"; do
       POINTRAST_VALIDATION=0 $pr render terrain --points 200M --order morton --method $m -o "$OUT/sweep.png" --json --frames 20 -q | tee -a "$OUT/sweep.json" || status=1
     done
     ;;
+  paper2021)
+    # The 2021 evaluation: 4 stand-ins x all methods x 4 orders x 3 views at 1920x1080, one run.
+    POINTRAST_VALIDATION=0 $pr bench --suite paper2021 --frames 20 --out "$OUT" --name paper2021 || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, sweep)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, sweep, paper2021)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

@@ -17,7 +17,8 @@ constexpr uint64_t kMinBytes = 4096;
 } // namespace
 
 uint64_t copyBytesFor(const Context& context, uint64_t requested) {
-  uint64_t limit = std::min({context.deviceLocalBytes() / 4, context.maxBufferSize(), context.maxAllocationSize()});
+  uint64_t limit =
+      std::min({context.deviceLocalBytes() / 4, context.maxBufferSize(), context.maxAllocationSize()});
   uint64_t bytes = std::min(requested, limit) / 256 * 256;
   return std::max(bytes, kMinBytes);
 }

@@ -11,10 +11,10 @@ namespace pointrast::gpu {
 class Context;
 
 struct CopyBandwidth {
-  uint64_t bytes = 0;          // size of one copy (after clamping)
-  int repeats = 0;             // timed copies
-  double medianMs = 0;         // GPU time of one copy, median over the repeats
-  double bytesPerSecond = 0;   // 2 * bytes / median: read + written (see below)
+  uint64_t bytes = 0;        // size of one copy (after clamping)
+  int repeats = 0;           // timed copies
+  double medianMs = 0;       // GPU time of one copy, median over the repeats
+  double bytesPerSecond = 0; // 2 * bytes / median: read + written (see below)
 };
 
 // What measureCopy() copies when asked for `requested` bytes: at most a quarter of device-local memory

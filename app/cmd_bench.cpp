@@ -1,0 +1,295 @@
+// pointrast bench FILE|SCENE... | --suite paper2021: the method x order x view matrix, timed on the GPU.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "base/error.h"
+#include "base/progress.h"
+#include "bench/report.h"
+#include "bench/runner.h"
+#include "bench/suites.h"
+#include "cli_util.h"
+#include "cloud/generate.h"
+#include "commands.h"
+#include "gpu/context.h"
+#include "input.h"
+
+namespace pointrast::app {
+
+namespace {
+
+const std::vector<Order> kAllOrders = {Order::Original, Order::Morton, Order::Shuffled,
+                                       Order::ShuffledMorton};
+
+struct BenchArgs {
+  std::vector<std::string> inputs;
+  std::string suite, methods = "all", orders = "all", views = "all", points = "1M", copySize = "1G";
+  std::string out, name;
+  double scale = 1.0, fov = 60;
+  uint32_t width = 1920, height = 1080, frames = 50;
+  uint64_t seed = 1;
+  std::optional<uint32_t> device;
+  bool json = false, quiet = false;
+  bool scaleGiven = false, pointsGiven = false;
+};
+
+// "a,b" -> {"a", "b"}, or every choice for "all"; each name parsed (InputError names the choices),
+// duplicates dropped, first occurrence kept.
+template <class T, class Parse>
+std::vector<T> parseList(const std::string& text, const std::string& option, const std::vector<T>& all,
+                         Parse parse) {
+  if (text == "all") return all;
+  std::vector<T> out;
+  size_t at = 0;
+  while (at <= text.size()) {
+    size_t comma = text.find(',', at);
+    std::string item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    item.erase(0, item.find_first_not_of(' '));
+    item.erase(item.find_last_not_of(' ') + 1);
+    if (item.empty())
+      throw InputError(option + " '" + text + "': empty item; give names separated by commas, or all");
+    T value = parse(item);
+    if (std::find(out.begin(), out.end(), value) == out.end()) out.push_back(value);
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  return out;
+}
+
+// The command as typed, for the report (the Linux kernel keeps it NUL-separated).
+std::string commandLine() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string raw{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string line;
+  size_t at = 0;
+  bool first = true;
+  while (at < raw.size()) {
+    size_t end = raw.find('\0', at);
+    std::string arg = raw.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    if (first) arg = std::filesystem::path(arg).filename().string();
+    if (arg.empty() || arg.find_first_of(" \t'\"$\\") != std::string::npos) {
+      std::string quoted = "'";
+      for (char c : arg)
+        quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      arg = quoted + "'";
+    }
+    line += (first ? "" : " ") + arg;
+    first = false;
+    at = end == std::string::npos ? raw.size() : end + 1;
+  }
+  return line.empty() ? "pointrast bench" : line;
+}
+
+std::vector<bench::Dataset> inputDatasets(const BenchArgs& a) {
+  std::vector<std::string> inputs = a.inputs;
+  if (inputs.empty()) inputs.push_back(kDemoScene);
+  uint64_t points = a.inputs.empty() ? kDemoPoints : parseCount(a.points, "--points");
+  std::vector<bench::Dataset> out;
+  for (const std::string& input : inputs) {
+    bench::Dataset d;
+    d.source = input;
+    d.seed = a.seed;
+    std::error_code ec;
+    if (std::filesystem::exists(input, ec)) {
+      d.file = true;
+      d.name = std::filesystem::path(input).stem().string();
+      d.label = std::filesystem::path(input).filename().string();
+    } else if (isSceneName(input)) {
+      if (points == 0) throw InputError("--points must be at least 1");
+      d.points = points;
+      d.name = input + "-" + bench::shortCount(points);
+      d.label = d.name;
+    } else {
+      throw InputError(input + ": no such file, and not a scene name (terrain, tls)");
+    }
+    for (const bench::Dataset& other : out)
+      if (other.name == d.name) throw InputError(input + ": given twice");
+    out.push_back(d);
+  }
+  return out;
+}
+
+int runBench(const BenchArgs& a) {
+  Progress::setEnabled(!a.quiet);
+  if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  if (!(a.fov > 0 && a.fov < 180)) throw InputError("--fov must be between 0 and 180 degrees");
+  if (a.scaleGiven && a.suite.empty())
+    throw InputError("--scale applies to --suite only; use --points for a scene");
+  if (a.pointsGiven && !a.suite.empty()) throw InputError("--points does not apply to --suite; use --scale");
+  if (!a.name.empty() && (a.name.find('/') != std::string::npos || a.name == "." || a.name == ".."))
+    throw InputError("--name '" + a.name + "': give a plain file name without '/'");
+
+  bench::BenchConfig config;
+  std::vector<Method> allMethods;
+  for (const MethodInfo& m : methodTable())
+    allMethods.push_back(m.method);
+  config.methods = parseList(a.methods, "--methods", allMethods, parseMethod);
+  config.orders = parseList(a.orders, "--orders", kAllOrders, parseOrder);
+  std::vector<bench::View> allViews(bench::allViews().begin(), bench::allViews().end());
+  config.views = parseList(a.views, "--views", allViews, bench::parseView);
+  config.width = a.width;
+  config.height = a.height;
+  config.frames = a.frames;
+  config.fovY = a.fov;
+  config.orderSeed = a.seed;
+  config.copyBytes = parseCount(a.copySize, "--copy-size");
+  if (config.copyBytes == 0) throw InputError("--copy-size must be at least 1");
+  config.progress = !a.quiet;
+
+  bench::ReportInfo info;
+  if (!a.suite.empty()) {
+    config.datasets = bench::suiteDatasets(a.suite, a.scale, a.seed, a.inputs);
+    info.name = a.suite;
+    info.title = a.suite;
+    if (a.scale != 1.0) {
+      char text[64];
+      std::snprintf(text, sizeof text, "%g", a.scale);
+      info.name += std::string("-scale") + text;
+      info.title += std::string(" (scale ") + text + ")";
+    }
+  } else {
+    config.datasets = inputDatasets(a);
+    for (const bench::Dataset& d : config.datasets)
+      info.name += (info.name.empty() ? "" : "_") + d.name;
+    info.title = info.name;
+  }
+  if (!a.name.empty()) info.name = a.name;
+  info.commandLine = commandLine();
+  info.date = bench::utcNow();
+
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = a.device;
+  contextOptions.announce = !a.quiet;
+  gpu::Context context(contextOptions);
+
+  // One line per result; on a terminal each replaces the last, so the screen shows where the run is.
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  bool lineOpen = false;
+  auto endLine = [&] {
+    if (lineOpen) std::fprintf(stderr, "\n");
+    lineOpen = false;
+  };
+  bench::BenchCallbacks callbacks;
+  callbacks.onNote = [&](const std::string& line) {
+    if (a.quiet && line.find("skipped") == std::string::npos) return; // a skip is said even when quiet
+    endLine();
+    std::fprintf(stderr, "%s\n", line.c_str());
+  };
+  const std::string device = context.info().name, deviceType = context.info().typeName;
+  callbacks.onResult = [&](const bench::BenchRun& run, const bench::Result& r, size_t done, size_t total) {
+    if (a.json) {
+      nlohmann::json j = bench::resultJson(run, r);
+      j["device"] = device;
+      j["device_type"] = deviceType;
+      std::printf("%s\n", j.dump().c_str());
+      std::fflush(stdout);
+    }
+    if (a.quiet) return;
+    std::string what = r.ok() ? bench::formatMs(r.stats.medianMs) + " ms" : "n/a";
+    std::fprintf(stderr, "%s[%zu/%zu] %s / %s / %s / %s: %s%s", tty ? "\r\033[K" : "", done, total,
+                 r.dataset.c_str(), orderName(r.order), bench::viewName(r.view), methodName(r.method),
+                 what.c_str(), tty ? "" : "\n");
+    lineOpen = tty;
+    std::fflush(stderr);
+  };
+  bench::BenchRun run = bench::runBench(context, config, callbacks);
+  endLine();
+
+  if (context.validationErrors() > 0)
+    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                     " error(s)");
+  bool measured = false;
+  std::string skipped;
+  for (const bench::DatasetOutcome& d : run.datasets) {
+    measured = measured || !d.skipped;
+    if (d.skipped) skipped += (skipped.empty() ? "" : "; ") + d.dataset.label + " " + d.reason;
+  }
+  if (!measured) throw InputError("nothing was measured: " + skipped);
+
+  std::filesystem::path dir = a.out.empty()
+                                  ? std::filesystem::path("bench/results") / bench::sanitizeName(device)
+                                  : std::filesystem::path(a.out);
+  bench::WrittenFiles files = bench::writeReports(run, info, dir);
+  if (!a.quiet || !a.json) {
+    std::FILE* to = a.json ? stderr : stdout;
+    std::fprintf(to, "%zu results in %.1f s; wrote %s, %s, %s\n", run.results.size(), run.seconds,
+                 files.json.string().c_str(), files.markdown.string().c_str(), files.svg.string().c_str());
+  }
+  return 0;
+}
+
+} // namespace
+
+Command addBench(CLI::App& app) {
+  auto a = std::make_shared<BenchArgs>();
+  CLI::App* cmd =
+      app.add_subcommand("bench", "Time every method x vertex order x view on the GPU; JSON, Markdown, SVG");
+  cmd->footer(
+      "\nFor each data set, order, view and method: a warm-up (a tenth of --frames, at least 2), then "
+      "--frames\n"
+      "frames timed with timestamp queries (clear + render + resolve): median, min, max ms, points/s, and "
+      "the\n"
+      "effective bandwidth (points x bytes of point data the method reads / median time) as a fraction of "
+      "the\n"
+      "device's buffer-copy bandwidth, measured in the same run (bytes read + written per second).\n"
+      "Views come from the bounds: overview (whole cloud in frame), closeup (eye at the center looking "
+      "along\n"
+      "+x: most points outside the frustum), outside (eye beyond the cloud looking away: no point in "
+      "frame).\n"
+      "Writes NAME.json, NAME.md (tables like Table 1 of the 2021 paper) and NAME.svg to --out, by default\n"
+      "bench/results/<device>/. Without INPUT, the demo scene (terrain, 1 M points).\n\n"
+      "--suite paper2021 generates stand-ins for the 2021 paper's data sets at its sizes (banyunibo 4 M "
+      "tls,\n"
+      "eclepens 47 M terrain, retz 145 M terrain, endeavor 796 M tls), runs all methods x orders x views at\n"
+      "1920x1080, states the memory each needs and skips what does not fit. --scale 0.001 shrinks every "
+      "size\n"
+      "(4 k .. 796 k points) for a quick smoke run; NAME=PATH arguments replace a stand-in by a file.\n\n"
+      "Examples:\n"
+      "  pointrast bench terrain --points 10M --methods atomicmin,earlyz --orders original,morton\n"
+      "  pointrast bench autzen.las --views overview --frames 100 --json\n"
+      "  pointrast bench --suite paper2021\n"
+      "  pointrast bench --suite paper2021 --scale 0.001 --frames 5 --out /tmp/smoke\n"
+      "  pointrast bench --suite paper2021 retz=/data/retz.las");
+  cmd->add_option("INPUT", a->inputs,
+                  "LAS/PLY/XYZ files or scene names (terrain, tls); with --suite, NAME=PATH");
+  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021");
+  cmd->add_option("--scale", a->scale, "Multiply every size of the suite (e.g. 0.001 for a smoke run)")
+      ->each([a](const std::string&) { a->scaleGiven = true; });
+  cmd->add_option("--methods", a->methods, "Methods, comma-separated, or all (see `pointrast render --help`)")
+      ->capture_default_str();
+  cmd->add_option("--orders", a->orders, "original, morton, shuffled, shuffled-morton, or all")
+      ->capture_default_str();
+  cmd->add_option("--views", a->views, "overview, closeup, outside, or all")->capture_default_str();
+  cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
+  cmd->add_option("--height", a->height, "Image height in pixels")->capture_default_str();
+  cmd->add_option("--frames", a->frames, "Timed frames per combination; the median is reported")
+      ->capture_default_str();
+  cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
+  cmd->add_option("--points", a->points, "Points of generated scenes (e.g. 20k, 10M)")
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->pointsGiven = true; });
+  cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
+  cmd->add_option("--copy-size", a->copySize,
+                  "Bytes per copy of the bandwidth measurement (clamped to the device)")
+      ->capture_default_str();
+  cmd->add_option("--out", a->out, "Folder for the reports (default: bench/results/<device>/)");
+  cmd->add_option("--name", a->name,
+                  "File name of the reports without extension (default: suite or data sets)");
+  cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
+  cmd->add_flag("--json", a->json, "Print one JSON object per result on stdout");
+  cmd->add_flag("-q,--quiet", a->quiet,
+                "No progress, device or memory lines (skipped data sets are still said)");
+  return [a] { return runBench(*a); };
+}
+
+} // namespace pointrast::app

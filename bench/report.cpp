@@ -1,0 +1,441 @@
+#include "bench/report.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+#include "base/error.h"
+
+namespace pointrast::bench {
+
+namespace {
+
+std::string printf1(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+std::string apiVersion(uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+// Results by (data set, order, view, method), for the table cells.
+class ResultIndex {
+public:
+  explicit ResultIndex(const BenchRun& run) {
+    for (const Result& r : run.results)
+      map_[{r.dataset, int(r.order), int(r.view), int(r.method)}] = &r;
+  }
+  const Result* find(const std::string& dataset, Order order, View view, Method method) const {
+    auto it = map_.find({dataset, int(order), int(view), int(method)});
+    return it == map_.end() ? nullptr : it->second;
+  }
+
+private:
+  std::map<std::tuple<std::string, int, int, int>, const Result*> map_;
+};
+
+std::vector<const DatasetOutcome*> measuredDatasets(const BenchRun& run) {
+  std::vector<const DatasetOutcome*> out;
+  for (const DatasetOutcome& d : run.datasets)
+    if (!d.skipped) out.push_back(&d);
+  return out;
+}
+
+// The order and view the chart and the bandwidth table show: Morton / overview when measured.
+Order chartOrder(const BenchConfig& c) {
+  bool morton = std::find(c.orders.begin(), c.orders.end(), Order::Morton) != c.orders.end();
+  return morton || c.orders.empty() ? Order::Morton : c.orders.front();
+}
+View mainView(const BenchConfig& c) {
+  bool overview = std::find(c.views.begin(), c.views.end(), View::Overview) != c.views.end();
+  return overview || c.views.empty() ? View::Overview : c.views.front();
+}
+
+std::string xmlEscape(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+    case '&':
+      out += "&amp;";
+      break;
+    case '<':
+      out += "&lt;";
+      break;
+    case '>':
+      out += "&gt;";
+      break;
+    case '"':
+      out += "&quot;";
+      break;
+    default:
+      out += c;
+    }
+  }
+  return out;
+}
+
+// Table cells must not break the row: '|' is escaped, newlines flattened.
+std::string mdCell(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|')
+      out += "\\|";
+    else if (c == '\n')
+      out += ' ';
+    else
+      out += c;
+  }
+  return out;
+}
+
+void writeAtomically(const std::filesystem::path& path, const std::string& content) {
+  std::filesystem::path partial = path;
+  partial += ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    out << content;
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(partial, ec);
+      throw InputError(path.string() + ": cannot write the file");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(partial, path, ec);
+  if (ec) {
+    std::filesystem::remove(partial, ec);
+    throw InputError(path.string() + ": cannot write the file");
+  }
+}
+
+} // namespace
+
+std::string sanitizeName(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c))) {
+      out += char(std::tolower(static_cast<unsigned char>(c)));
+    } else if (!out.empty() && out.back() != '-') {
+      out += '-';
+    }
+  }
+  while (!out.empty() && out.back() == '-')
+    out.pop_back();
+  return out.empty() ? "device" : out;
+}
+
+std::string formatMs(double ms) {
+  if (!(ms > 0) || !std::isfinite(ms)) return "0";
+  int decimals = std::clamp(2 - int(std::floor(std::log10(ms))), 0, 9);
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, ms);
+  return text;
+}
+
+std::string utcNow() {
+  std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+nlohmann::json resultJson(const BenchRun& run, const Result& r) {
+  nlohmann::json j;
+  j["dataset"] = r.dataset;
+  j["order"] = orderName(r.order);
+  j["view"] = viewName(r.view);
+  j["method"] = methodName(r.method);
+  j["status"] = r.status;
+  if (!r.reason.empty()) j["reason"] = r.reason;
+  j["points"] = r.points;
+  j["width"] = run.config.width;
+  j["height"] = run.config.height;
+  j["frames"] = r.stats.frames;
+  j["warmup"] = run.warmup;
+  j["median_ms"] = r.stats.medianMs;
+  j["min_ms"] = r.stats.minMs;
+  j["max_ms"] = r.stats.maxMs;
+  j["points_per_second"] = r.pointsPerSecond;
+  j["bytes_per_point"] = r.bytesPerPoint;
+  j["effective_gb_per_s"] = r.effectiveBytesPerSecond * 1e-9;
+  j["copy_gb_per_s"] = run.copy.bytesPerSecond * 1e-9;
+  j["copy_fraction"] = r.copyFraction;
+  j["camera"] = r.camera;
+  return j;
+}
+
+nlohmann::json runJson(const BenchRun& run, const ReportInfo& info) {
+  nlohmann::json j;
+  j["name"] = info.name;
+  j["title"] = info.title;
+  j["command_line"] = info.commandLine;
+  j["date"] = info.date;
+  j["wall_seconds"] = run.seconds;
+  j["device"] = {{"name", run.device.name},          {"type", run.device.typeName},
+                 {"driver", run.device.driver},      {"vulkan", apiVersion(run.device.apiVersion)},
+                 {"vendor_id", run.device.vendorId}, {"device_local_bytes", run.deviceLocalBytes}};
+  j["copy_bandwidth"] = {
+      {"bytes", run.copy.bytes},
+      {"repeats", run.copy.repeats},
+      {"median_ms", run.copy.medianMs},
+      {"gb_per_s", run.copy.bytesPerSecond * 1e-9},
+      {"note", "vkCmdCopyBuffer between two device buffers; counts bytes read + bytes written per second, "
+               "since a copy moves every byte through memory twice"}};
+  nlohmann::json settings;
+  settings["width"] = run.config.width;
+  settings["height"] = run.config.height;
+  settings["frames"] = run.config.frames;
+  settings["warmup"] = run.warmup;
+  settings["fov"] = run.config.fovY;
+  settings["order_seed"] = run.config.orderSeed;
+  settings["timing"] =
+      "GPU time of clear + render + resolve per frame from timestamp queries; median, min, max";
+  for (Method m : run.config.methods)
+    settings["methods"].push_back(methodName(m));
+  for (Order o : run.config.orders)
+    settings["orders"].push_back(orderName(o));
+  for (View v : run.config.views)
+    settings["views"].push_back(viewName(v));
+  j["settings"] = settings;
+  j["datasets"] = nlohmann::json::array();
+  for (const DatasetOutcome& d : run.datasets) {
+    nlohmann::json dj;
+    dj["name"] = d.dataset.name;
+    dj["label"] = d.dataset.label;
+    dj["source"] = d.dataset.source;
+    dj["description"] = d.description;
+    dj["points"] = d.points;
+    dj["status"] = d.skipped ? "skipped" : "ok";
+    if (d.skipped) dj["reason"] = d.reason;
+    dj["gpu_bytes_estimate"] = d.memory.gpuBytes;
+    dj["host_bytes_estimate"] = d.memory.hostBytes;
+    j["datasets"].push_back(dj);
+  }
+  j["results"] = nlohmann::json::array();
+  for (const Result& r : run.results)
+    j["results"].push_back(resultJson(run, r));
+  return j;
+}
+
+std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
+  const BenchConfig& c = run.config;
+  const ResultIndex index(run);
+  const auto datasets = measuredDatasets(run);
+  std::ostringstream md;
+  md << "# pointrast bench: " << info.title << "\n\n";
+  md << "- Device: **" << run.device.name << "** (" << run.device.typeName << ", driver " << run.device.driver
+     << ", Vulkan " << apiVersion(run.device.apiVersion) << "), " << bytesText(run.deviceLocalBytes)
+     << " of device-local memory\n";
+  md << "- Copy bandwidth: **" << printf1("%.1f", run.copy.bytesPerSecond * 1e-9)
+     << " GB/s**, measured in this run: vkCmdCopyBuffer of " << bytesText(run.copy.bytes)
+     << " between two device buffers, median of " << run.copy.repeats
+     << ". It counts bytes read + bytes written per second (a copy moves every byte through memory twice): "
+        "the rate at which a method that only reads its points could at most stream them.\n";
+  md << "- Image " << c.width << "x" << c.height << ", vertical field of view " << printf1("%g", c.fovY)
+     << " degrees; each cell is the median GPU time of " << c.frames << " frames after " << run.warmup
+     << " warm-up frames, a frame being clear + render + resolve, timed with timestamp queries.\n";
+  md << "- Ratios between methods of one run are the figures that count; absolute times depend on clocks "
+        "and drivers.\n";
+  md << "- Date: " << info.date << "; the run took " << printf1("%.0f", run.seconds) << " s (wall clock).\n";
+  md << "- Command: `" << info.commandLine << "`\n\n";
+
+  auto table = [&](View view, auto&& cell) {
+    md << "| data set | order |";
+    for (Method m : c.methods)
+      md << " " << methodName(m) << " |";
+    md << "\n| --- | --- |";
+    for (size_t k = 0; k < c.methods.size(); ++k)
+      md << " ---: |";
+    md << "\n";
+    for (const DatasetOutcome* d : datasets) {
+      for (Order o : c.orders) {
+        md << "| " << mdCell(d->dataset.label) << " | " << orderName(o) << " |";
+        for (Method m : c.methods) {
+          const Result* r = index.find(d->dataset.name, o, view, m);
+          md << " " << (!r ? "" : r->ok() ? cell(*r) : std::string("n/a")) << " |";
+        }
+        md << "\n";
+      }
+    }
+    md << "\n";
+  };
+
+  for (View v : c.views) {
+    md << "## " << viewName(v) << ": median GPU time per frame, ms\n\n";
+    table(v, [](const Result& r) { return formatMs(r.stats.medianMs); });
+  }
+
+  const View bandwidthView = mainView(c);
+  if (!c.views.empty()) {
+    md << "## " << viewName(bandwidthView) << ": effective bandwidth, % of copy bandwidth\n\n";
+    md << "Effective bandwidth = points x bytes of point data the method must read per point / median time. "
+          "Bytes per point:";
+    for (size_t k = 0; k < c.methods.size(); ++k)
+      md << (k ? ", " : " ") << methodName(c.methods[k]) << " " << methodInfo(c.methods[k]).bytesPerPoint;
+    md << ".\n\n";
+    table(bandwidthView, [](const Result& r) { return printf1("%.0f%%", r.copyFraction * 100); });
+  }
+
+  md << "## Data sets\n\n";
+  for (const DatasetOutcome& d : run.datasets) {
+    md << "- " << d.dataset.label << ": ";
+    if (d.skipped)
+      md << "**skipped**, " << d.reason << "\n";
+    else
+      md << (d.description.empty() ? d.dataset.source : d.description) << "; " << d.memory.describe() << "\n";
+  }
+  std::set<std::string> reasons;
+  for (const Result& r : run.results)
+    if (!r.ok()) reasons.insert(std::string(methodName(r.method)) + ": " + r.reason);
+  if (!reasons.empty()) {
+    md << "\n## Not measured (n/a)\n\n";
+    for (const std::string& why : reasons)
+      md << "- " << why << "\n";
+  }
+  return md.str();
+}
+
+std::string svgChart(const BenchRun& run, const ReportInfo& info) {
+  const BenchConfig& c = run.config;
+  const ResultIndex index(run);
+  const auto datasets = measuredDatasets(run);
+  const Order order = chartOrder(c);
+  const View view = mainView(c);
+
+  double lo = INFINITY, hi = 0;
+  for (const Result& r : run.results) {
+    if (!r.ok() || r.order != order || r.view != view || !(r.stats.medianMs > 0)) continue;
+    lo = std::min(lo, r.stats.medianMs);
+    hi = std::max(hi, r.stats.medianMs);
+  }
+  const bool any = hi > 0;
+  const bool logScale = any && hi / lo > 20;
+  // Axis range and ticks: powers of ten on a log axis, a 1-2-5 step on a linear one.
+  double axisLo = 0, axisHi = 1;
+  std::vector<double> ticks;
+  if (logScale) {
+    axisLo = std::pow(10.0, std::floor(std::log10(lo)));
+    axisHi = std::pow(10.0, std::ceil(std::log10(hi)));
+    if (axisHi <= axisLo) axisHi = axisLo * 10;
+    // 1-2-5 steps when the axis spans few decades, else one tick per decade.
+    const bool fine = axisHi / axisLo <= 1000.0001;
+    for (double decade = axisLo; decade <= axisHi * 1.0001; decade *= 10)
+      for (double m : {1.0, 2.0, 5.0})
+        if ((m == 1.0 || fine) && decade * m <= axisHi * 1.0001) ticks.push_back(decade * m);
+  } else if (any) {
+    double raw = hi / 5, magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+    double step = magnitude;
+    for (double m : {1.0, 2.0, 5.0, 10.0})
+      if (m * magnitude >= raw) {
+        step = m * magnitude;
+        break;
+      }
+    axisHi = std::ceil(hi / step) * step;
+    for (double t = 0; t <= axisHi * 1.0001; t += step)
+      ticks.push_back(t);
+  }
+
+  const double width = 1000, height = 560, left = 80, right = 190, top = 60, bottom = 90;
+  const double plotW = width - left - right, plotH = height - top - bottom;
+  auto y = [&](double v) {
+    double t = logScale ? (std::log10(v) - std::log10(axisLo)) / (std::log10(axisHi) - std::log10(axisLo))
+                        : (v - axisLo) / (axisHi - axisLo);
+    return top + plotH * (1 - std::clamp(t, 0.0, 1.0));
+  };
+  // Colors that stay apart for up to twelve methods (then they repeat).
+  static const char* kPalette[] = {"#4e79a7", "#f28e2b", "#e15759", "#76b7b2", "#59a14f", "#edc948",
+                                   "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac", "#1f77b4", "#17becf"};
+  auto num = [](double v) { return printf1("%.1f", v); };
+
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" viewBox=\"0 0 " << width << " " << height << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  s << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << left << "\" y=\"24\" font-size=\"16\">" << xmlEscape(info.title)
+    << ": median GPU ms per frame (lower is better)</text>\n";
+  s << "<text x=\"" << left << "\" y=\"44\" fill=\"#555\">" << xmlEscape(run.device.name) << ", " << c.width
+    << "x" << c.height << ", " << orderName(order) << " order, " << viewName(view) << " view"
+    << (logScale ? ", log scale" : "") << "</text>\n";
+  for (double t : ticks) {
+    s << "<line x1=\"" << left << "\" x2=\"" << left + plotW << "\" y1=\"" << num(y(t)) << "\" y2=\""
+      << num(y(t)) << "\" stroke=\"#ddd\"/>\n";
+    s << "<text x=\"" << left - 6 << "\" y=\"" << num(y(t) + 4) << "\" text-anchor=\"end\">"
+      << printf1("%g", t) << "</text>\n";
+  }
+  s << "<text transform=\"translate(18," << num(top + plotH / 2) << ") rotate(-90)\" text-anchor=\"middle\">"
+    << "ms</text>\n";
+  s << "<line x1=\"" << left << "\" x2=\"" << left + plotW << "\" y1=\"" << top + plotH << "\" y2=\""
+    << top + plotH << "\" stroke=\"black\"/>\n";
+
+  const size_t groups = std::max<size_t>(1, datasets.size()), bars = std::max<size_t>(1, c.methods.size());
+  const double groupW = plotW / double(groups), barW = groupW * 0.8 / double(bars);
+  for (size_t g = 0; g < datasets.size(); ++g) {
+    const double x0 = left + g * groupW + groupW * 0.1;
+    for (size_t b = 0; b < c.methods.size(); ++b) {
+      const Result* r = index.find(datasets[g]->dataset.name, order, view, c.methods[b]);
+      const double x = x0 + b * barW;
+      if (r && r->ok() && r->stats.medianMs > 0) {
+        const double yTop = y(r->stats.medianMs);
+        s << "<rect x=\"" << num(x) << "\" y=\"" << num(yTop) << "\" width=\"" << num(barW * 0.9)
+          << "\" height=\"" << num(top + plotH - yTop) << "\" fill=\"" << kPalette[b % std::size(kPalette)]
+          << "\"><title>" << methodName(c.methods[b]) << ": " << formatMs(r->stats.medianMs)
+          << " ms</title></rect>\n";
+      } else if (r) {
+        s << "<text x=\"" << num(x + barW * 0.45) << "\" y=\"" << num(top + plotH - 4)
+          << "\" font-size=\"8\" text-anchor=\"middle\" fill=\"#999\">n/a</text>\n";
+      }
+    }
+    // The label's "(generator, size)" goes on a second line so long names do not run into each other.
+    const std::string& label = datasets[g]->dataset.label;
+    const size_t paren = label.find(" (");
+    const double cx = left + (g + 0.5) * groupW;
+    s << "<text x=\"" << num(cx) << "\" y=\"" << top + plotH + 20 << "\" text-anchor=\"middle\">"
+      << xmlEscape(label.substr(0, paren)) << "</text>\n";
+    if (paren != std::string::npos)
+      s << "<text x=\"" << num(cx) << "\" y=\"" << top + plotH + 36
+        << "\" text-anchor=\"middle\" fill=\"#555\">" << xmlEscape(label.substr(paren + 1)) << "</text>\n";
+  }
+  if (!any)
+    s << "<text x=\"" << left + plotW / 2 << "\" y=\"" << top + plotH / 2
+      << "\" text-anchor=\"middle\" fill=\"#999\">no measurements</text>\n";
+  for (size_t b = 0; b < c.methods.size(); ++b) {
+    const double ly = top + 10 + b * 20.0;
+    s << "<rect x=\"" << left + plotW + 20 << "\" y=\"" << ly - 10 << "\" width=\"12\" height=\"12\" fill=\""
+      << kPalette[b % std::size(kPalette)] << "\"/>\n";
+    s << "<text x=\"" << left + plotW + 38 << "\" y=\"" << ly << "\">" << methodName(c.methods[b])
+      << "</text>\n";
+  }
+  s << "</svg>\n";
+  return s.str();
+}
+
+WrittenFiles writeReports(const BenchRun& run, const ReportInfo& info, const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError(dir.string() + ": cannot create the output folder");
+  WrittenFiles files{dir / (info.name + ".json"), dir / (info.name + ".md"), dir / (info.name + ".svg")};
+  // Everything is rendered before the first file is written, so a failure leaves no mixed set.
+  const std::string json = runJson(run, info).dump(1) + "\n";
+  const std::string markdown = markdownReport(run, info);
+  const std::string svg = svgChart(run, info);
+  writeAtomically(files.json, json);
+  writeAtomically(files.markdown, markdown);
+  writeAtomically(files.svg, svg);
+  return files;
+}
+
+} // namespace pointrast::bench

@@ -1,0 +1,157 @@
+// `pointrast bench` as a user meets it: a tiny matrix end to end through the binary (validation layer
+// on), its three report files, --json lines, the suite's smoke scale, and one-line usage errors.
+// Timings are never asserted: lavapipe on a shared CI machine gives no stable figure.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_data.h"
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exitCode = -1;
+  std::string out, err;
+};
+
+fs::path tempDir() {
+  static fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("pointrast_bench_cli_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+Result run(const std::string& args) {
+  fs::path out = tempDir() / "stdout.txt", err = tempDir() / "stderr.txt";
+  std::string command = "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
+                        pointrast::test::pointrastBinary() + " " + args + " >" + out.string() + " 2>" +
+                        err.string();
+  int status = std::system(command.c_str());
+  Result r;
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+const char* kTiny = "bench terrain --points 20k --methods atomicmin,earlyz --orders original,morton "
+                    "--frames 2 --width 160 --height 100 --copy-size 16M";
+
+TEST(BenchCli, TinyMatrixWritesJsonMarkdownAndSvg) {
+  fs::path out = tempDir() / "tiny";
+  Result r = run(std::string(kTiny) + " --views overview,outside --out " + out.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("[8/8] terrain-20k / morton / outside / earlyz: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("copy bandwidth: "), std::string::npos) << r.err;
+
+  std::ifstream in(out / "terrain-20k.json");
+  ASSERT_TRUE(in) << "no terrain-20k.json in " << out;
+  nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_GT(j["copy_bandwidth"]["gb_per_s"].get<double>(), 0.0);
+  EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
+  EXPECT_FALSE(j["date"].get<std::string>().empty());
+  EXPECT_NE(j["command_line"].get<std::string>().find("--methods atomicmin,earlyz"), std::string::npos);
+  ASSERT_EQ(j["results"].size(), 8u);
+  for (const auto& result : j["results"]) {
+    EXPECT_EQ(result["status"], "ok") << result.dump();
+    EXPECT_EQ(result["points"], 20000);
+    EXPECT_EQ(result["frames"], 2);
+    EXPECT_GT(result["median_ms"].get<double>(), 0.0);
+    EXPECT_LE(result["min_ms"].get<double>(), result["median_ms"].get<double>());
+    EXPECT_GE(result["max_ms"].get<double>(), result["median_ms"].get<double>());
+    EXPECT_GT(result["effective_gb_per_s"].get<double>(), 0.0);
+    EXPECT_GT(result["copy_fraction"].get<double>(), 0.0);
+  }
+
+  std::string md = slurp(out / "terrain-20k.md");
+  EXPECT_NE(md.find("## overview: median GPU time per frame, ms"), std::string::npos) << md;
+  EXPECT_NE(md.find("## outside: median GPU time per frame, ms"), std::string::npos) << md;
+  EXPECT_NE(md.find("| data set | order | atomicmin | earlyz |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| terrain-20k | original |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| terrain-20k | morton |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("n/a"), std::string::npos) << md;
+
+  std::string svg = slurp(out / "terrain-20k.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  for (const auto& entry : fs::directory_iterator(out))
+    EXPECT_EQ(entry.path().extension().string().find("partial"), std::string::npos) << entry.path();
+}
+
+TEST(BenchCli, JsonPrintsOneObjectPerResult) {
+  Result r = run(std::string(kTiny) + " --json --views outside --out " + (tempDir() / "json").string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  int count = 0;
+  while (std::getline(lines, line)) {
+    nlohmann::json j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["view"], "outside");
+    EXPECT_TRUE(j.contains("device"));
+    EXPECT_GT(j["copy_gb_per_s"].get<double>(), 0.0);
+    ++count;
+  }
+  EXPECT_EQ(count, 4);
+}
+
+TEST(BenchCli, SuiteSmokeScaleRunsEveryDataSet) {
+  fs::path out = tempDir() / "suite";
+  Result r =
+      run("bench --suite paper2021 --scale 0.0001 --methods atomicmin --orders morton --views overview "
+          "--frames 1 --width 64 --height 40 --copy-size 16M --out " +
+          out.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::ifstream in(out / "paper2021-scale0.0001.json");
+  ASSERT_TRUE(in);
+  nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["datasets"].size(), 4u);
+  EXPECT_EQ(j["datasets"][0]["name"], "banyunibo-like");
+  EXPECT_EQ(j["datasets"][3]["points"], 79600);
+  EXPECT_EQ(j["results"].size(), 4u);
+  std::string md = slurp(out / "paper2021-scale0.0001.md");
+  EXPECT_NE(md.find("| endeavor-like (tls, 79.6k) | morton |"), std::string::npos) << md;
+  EXPECT_NE(r.err.find("retz-like (terrain, 14.5k): needs "), std::string::npos) << r.err;
+}
+
+TEST(BenchCli, HelpAndUsageErrors) {
+  Result help = run("bench --help");
+  EXPECT_EQ(help.exitCode, 0);
+  EXPECT_NE(help.out.find("Example"), std::string::npos);
+  EXPECT_NE(help.out.find("paper2021"), std::string::npos);
+  fs::path out = tempDir() / "errors";
+  for (std::string args :
+       {"--methods nope", "--orders zigzag", "--views inside", "--frames 0", "--width 0",
+        "--methods atomicmin,,earlyz", "--scale 0.1", "--suite paper1999", "nothing-here.las",
+        "--suite paper2021 --points 10k", "--suite paper2021 --scale -1", "--name a/b"}) {
+    Result r = run("bench terrain --points 1000 " + args + " --out " + out.string());
+    if (args.rfind("--suite", 0) == 0 || args == "nothing-here.las")
+      r = run("bench " + args + " --out " + out.string());
+    EXPECT_EQ(r.exitCode, 1) << args << "\n" << r.err;
+    int errorLines = 0;
+    std::istringstream lines(r.err);
+    std::string line;
+    while (std::getline(lines, line))
+      errorLines += line.rfind("pointrast:", 0) == 0;
+    EXPECT_EQ(errorLines, 1) << args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args << ": a failed run writes nothing";
+  }
+}
+
+} // namespace
