@@ -41,37 +41,41 @@ void writeClosest(uint pixel, uint64_t word) {
   atomicMin(fb.v[pixel], word);
 }
 
-// Settles one point per lane (pixel == kNoPixel: no point) into the framebuffer.
+// Settles one point per lane (pixel == kNoPixel: no point) into the framebuffer. Called once per point
+// of a thread, in a loop: every subgroup operation here runs in uniform control flow and nothing returns
+// early, so all lanes leave together. (With an early return for some lanes, NVIDIA let them reach the
+// next point's ballot and shuffles while their partners were still in this one: the GPU hung.)
 void settle(uint pixel, uint64_t word) {
   bool valid = pixel != kNoPixel;
-  if (JUST_SET != 0) {
-    if (valid) Uint64Array(pc.framebuffer).v[pixel] = word;
-    return;
-  }
+  bool writes = valid;   // whether this lane does an atomic
+  uint64_t value = word; // and with which word
 #if DEDUP_NV
   uvec4 same = subgroupPartitionNV(pixel);
-  uint64_t least = subgroupPartitionedMinNV(word, same);
-  if (valid && gl_SubgroupInvocationID == subgroupBallotFindLSB(same)) writeClosest(pixel, least);
+  value = subgroupPartitionedMinNV(word, same);
+  writes = valid && gl_SubgroupInvocationID == subgroupBallotFindLSB(same);
 #else
-  if (REDUCE == 1) {
-    // Lanes without a point take the pixel of the first lane with one, so they do not spoil the test.
+  if (JUST_SET == 0 && REDUCE == 1) {
     uvec4 busy = subgroupBallot(valid);
-    if (subgroupBallotBitCount(busy) == 0) return;
-    uint probe = valid ? pixel : subgroupShuffle(pixel, subgroupBallotFindLSB(busy));
-    if (subgroupAllEqual(probe)) {
-      uint64_t least = subgroupMin(word);
-      if (gl_SubgroupInvocationID == subgroupBallotFindLSB(busy)) writeClosest(pixel, least);
-      return;
+    if (subgroupBallotBitCount(busy) != 0) {
+      uint leader = subgroupBallotFindLSB(busy);
+      uint leaderPixel = subgroupShuffle(pixel, leader);
+      if (subgroupAll(!valid || pixel == leaderPixel)) {
+        // The whole subgroup hits one pixel: one atomic of the subgroup minimum.
+        value = subgroupMin(word);
+        writes = gl_SubgroupInvocationID == leader;
+      } else {
+        // Otherwise neighbouring pairs that share a pixel combine; the even lane writes.
+        uint otherPixel = subgroupShuffleXor(pixel, 1);
+        uint64_t otherWord = subgroupShuffleXor(word, 1);
+        if (valid && otherPixel == pixel) {
+          value = min(word, otherWord);
+          writes = (gl_SubgroupInvocationID & 1u) == 0u;
+        }
+      }
     }
-    uint otherPixel = subgroupShuffleXor(pixel, 1);
-    uint64_t otherWord = subgroupShuffleXor(word, 1);
-    if (otherPixel == pixel) {
-      word = min(word, otherWord);
-      if ((gl_SubgroupInvocationID & 1u) != 0u) return; // the even lane of the pair writes
-    }
-    if (valid) writeClosest(pixel, word);
-  } else if (REDUCE == 2) {
+  } else if (JUST_SET == 0 && REDUCE == 2) {
     bool pending = valid;
+    writes = false;
     // One round per distinct pixel: the lowest pending lane's pixel is settled by one atomic.
     while (subgroupAny(pending)) {
       uint leader = subgroupBallotFindLSB(subgroupBallot(pending));
@@ -81,10 +85,14 @@ void settle(uint pixel, uint64_t word) {
       if (gl_SubgroupInvocationID == leader) writeClosest(leaderPixel, least);
       if (mine) pending = false;
     }
-  } else if (valid) {
-    writeClosest(pixel, word);
   }
 #endif
+  if (writes) {
+    if (JUST_SET != 0)
+      Uint64Array(pc.framebuffer).v[pixel] = value;
+    else
+      writeClosest(pixel, value);
+  }
 }
 
 void main() {

@@ -70,6 +70,14 @@ struct ResolvePush {
   uint groupsX;         // workgroups per row of the 2D dispatch
 };
 
+// Push constants of the shader copy that measures the device's copy bandwidth (src/gpu/bandwidth.cpp).
+struct CopyPush {
+  uint64_t source;      // uvec4[count]
+  uint64_t destination; // uvec4[count]
+  uint count;           // 16-byte elements
+  uint groupsX;
+};
+
 // Word layout of the int40 depth encoding (the 2019 poster): 40-bit integer depth << 24 | 24-bit RGB.
 PR_CONST kInt40ColorBits = 24;
 PR_CONST64 kInt40MaxDepth = 0xFFFFFFFFFFul; // 2^40 - 1 steps: 1,099 km at 1 mm per step

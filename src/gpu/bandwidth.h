@@ -1,7 +1,9 @@
 // The device's buffer-copy bandwidth, measured in the same run as a benchmark so that every method's
 // effective bandwidth can be stated as a fraction of what the memory system delivers (DESIGN.md,
-// "Measuring performance"). vkCmdCopyBuffer between two device-local buffers, timed with timestamp
-// queries after a warm-up, median over the repeats.
+// "Measuring performance"). Two copies between two device-local buffers, each timed with timestamp
+// queries after a warm-up, median over the repeats: vkCmdCopyBuffer, and a compute shader moving 16 bytes
+// per invocation. The faster is the device's copy bandwidth (on NVIDIA vkCmdCopyBuffer uses a copy
+// engine well below the memory's rate, which would flatter every method measured against it).
 #pragma once
 
 #include <cstdint>
@@ -13,8 +15,10 @@ class Context;
 struct CopyBandwidth {
   uint64_t bytes = 0;        // size of one copy (after clamping)
   int repeats = 0;           // timed copies
-  double medianMs = 0;       // GPU time of one copy, median over the repeats
-  double bytesPerSecond = 0; // 2 * bytes / median: read + written (see below)
+  double medianMs = 0;       // GPU time of one copy by the faster way, median over the repeats
+  double bytesPerSecond = 0; // 2 * bytes / median: read + written (see below), the faster way
+  double transferBytesPerSecond = 0; // vkCmdCopyBuffer alone
+  double shaderBytesPerSecond = 0;   // the compute-shader copy alone
 };
 
 // What measureCopy() copies when asked for `requested` bytes: at most a quarter of device-local memory

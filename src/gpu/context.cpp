@@ -12,6 +12,10 @@ namespace pointrast::gpu {
 
 namespace {
 
+// Generous for software Vulkan on two cores and for 4-billion-point frames; short enough that a hang is
+// reported within a benchmark's time budget.
+constexpr uint64_t kSubmitTimeoutSeconds = 120;
+
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
 bool envFlag(const char* name) {
@@ -373,7 +377,13 @@ void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) 
   submit.pCommandBuffers = &cmd;
   VK_CHECK(vkResetFences(device_, 1, &fence_));
   VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence_));
-  VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+  // Never hang: work that has not finished after kSubmitTimeoutSeconds is a GPU fault (or a shader that
+  // never ends), reported as one clear error instead of a process that waits forever.
+  VkResult waited = VK_CHECK_ALLOW(vkWaitForFences(device_, 1, &fence_, VK_TRUE, kSubmitTimeoutSeconds * 1'000'000'000ull),
+                                   VK_TIMEOUT);
+  if (waited == VK_TIMEOUT)
+    throw UnsupportedError("the GPU did not finish a submission within " + std::to_string(kSubmitTimeoutSeconds) +
+                           " s on '" + info_.name + "' (a hung shader or a device fault)");
 }
 
 } // namespace pointrast::gpu

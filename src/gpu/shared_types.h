@@ -16,5 +16,6 @@ static_assert(offsetof(RasterPush, pointCount) == 104);
 static_assert(offsetof(RasterPush, groupsX) == 120);
 static_assert(sizeof(ResolvePush) == 48);
 static_assert(offsetof(ResolvePush, width) == 32);
+static_assert(sizeof(CopyPush) == 24);
 
 } // namespace pointrast::shared
