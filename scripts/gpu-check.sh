@@ -64,8 +64,9 @@ for what in "$@"; do
   paper2021)
     # The 2021 evaluation: 4 stand-ins x all methods x 4 orders x 3 views at 1920x1080, one run.
     # --json lines are kept as they come, so a run cut short still leaves its results.
-    POINTRAST_VALIDATION=0 timeout "${SUITE_LIMIT:-560}" $pr bench --suite paper2021 --frames 15 --out "$OUT" \
-      --name paper2021 --json > "$OUT/paper2021.jsonl" || status=1
+    # SUITE_METHODS narrows the methods (all by default); SUITE_FRAMES the timed frames.
+    POINTRAST_VALIDATION=0 timeout "${SUITE_LIMIT:-560}" $pr bench --suite paper2021 --frames "${SUITE_FRAMES:-15}" \
+      --methods "${SUITE_METHODS:-all}" --out "$OUT" --name paper2021 --json > "$OUT/paper2021.jsonl" || status=1
     ;;
   *)
     echo "unknown check '$what' (tests, autzen, big, sweep, paper2021)"; status=1 ;;
