@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pointrast: %s\n", e.what());
   } catch (const UnsupportedError& e) {
     std::fprintf(stderr, "pointrast: %s\n", e.what());
+  } catch (const DeviceFault& e) {
+    std::fprintf(stderr, "pointrast: %s\n", e.what());
   } catch (const gpu::VulkanError& e) {
     std::fprintf(stderr, "pointrast: %s\n", e.what());
   } catch (const std::bad_alloc&) {

@@ -172,6 +172,7 @@ nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   j["bytes_per_point"] = r.bytesPerPoint;
   j["effective_gb_per_s"] = r.effectiveBytesPerSecond * 1e-9;
   j["copy_gb_per_s"] = run.copy.bytesPerSecond * 1e-9;
+  if (!run.deviceFault.empty()) j["device_fault"] = run.deviceFault;
   j["copy_fraction"] = r.copyFraction;
   j["camera"] = r.camera;
   return j;
@@ -243,11 +244,13 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
      << " of device-local memory\n";
   md << "- Copy bandwidth: **" << printf1("%.1f", run.copy.bytesPerSecond * 1e-9)
      << " GB/s**, measured in this run: the faster of vkCmdCopyBuffer ("
-     << printf1("%.1f", run.copy.transferBytesPerSecond * 1e-9) << " GB/s) and a compute-shader copy of 16 B per "
+     << printf1("%.1f", run.copy.transferBytesPerSecond * 1e-9)
+     << " GB/s) and a compute-shader copy of 16 B per "
      << "invocation (" << printf1("%.1f", run.copy.shaderBytesPerSecond * 1e-9) << " GB/s), "
      << bytesText(run.copy.bytes) << " between two device buffers, median of " << run.copy.repeats
      << ". It counts bytes read + bytes written per second (a copy moves every byte through memory twice): "
         "the rate at which a method that only reads its points could at most stream them.\n";
+  if (!run.deviceFault.empty()) md << "- **Stopped early**: " << run.deviceFault << ".\n";
   md << "- Image " << c.width << "x" << c.height << ", vertical field of view " << printf1("%g", c.fovY)
      << " degrees; each cell is the median GPU time of " << c.frames << " frames after " << run.warmup
      << " warm-up frames, a frame being clear + render + resolve, timed with timestamp queries.\n";

@@ -156,78 +156,90 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
   Renderer renderer(context, config.width, config.height);
   const double aspect = double(config.width) / double(config.height);
   size_t done = 0;
-  for (DatasetOutcome& outcome : run.datasets) {
-    if (outcome.skipped) continue;
-    const Dataset& d = outcome.dataset;
-    auto since = std::chrono::steady_clock::now();
-    auto secondsSince = [&since] {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-    };
-    // Host-side preparation can take minutes at the paper's sizes; a line each keeps a log readable.
-    PointCloud cloud = loadDataset(d, config.progress);
-    outcome.points = cloud.size();
-    outcome.description = cloud.source;
-    note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince()));
-    for (Order order : config.orders) {
-      since = std::chrono::steady_clock::now();
-      std::unique_ptr<GpuScene> scene;
-      std::string failure;
-      {
-        PointCloud ordered;
-        if (order != Order::Original) ordered = reorderedCopy(cloud, order, config.orderSeed);
-        UploadOptions upload;
-        upload.progress = config.progress;
-        try {
-          scene = std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
-        } catch (const UnsupportedError& e) {
-          failure = e.what(); // out of device memory after all: every combination says so
-        }
-      } // the reordered host copy is freed here, before the GPU work
-      note(d.label + " / " + orderName(order) + ": ordered and uploaded in " +
-           printf1("%.1f s", secondsSince()));
-      for (View view : config.views) {
-        const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
-        for (Method method : config.methods) {
-          Result r;
-          r.dataset = d.name;
-          r.order = order;
-          r.view = view;
-          r.method = method;
-          r.points = cloud.size();
-          r.bytesPerPoint = methodInfo(method).bytesPerPoint;
-          r.camera = describeCamera(camera);
-          std::string why;
-          if (!failure.empty()) {
-            r.status = "unsupported";
-            r.reason = failure;
-          } else if (!Renderer::supports(context, method, &why)) {
-            r.status = "unsupported";
-            r.reason = why;
-          } else {
-            RenderSettings settings;
-            settings.method = method;
-            settings.frames = config.frames;
-            settings.warmup = run.warmup;
-            try {
-              r.stats = renderer.render(*scene, camera, settings);
-            } catch (const UnsupportedError& e) {
+  try {
+    for (DatasetOutcome& outcome : run.datasets) {
+      if (outcome.skipped) continue;
+      const Dataset& d = outcome.dataset;
+      auto since = std::chrono::steady_clock::now();
+      auto secondsSince = [&since] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+      };
+      // Host-side preparation can take minutes at the paper's sizes; a line each keeps a log readable.
+      PointCloud cloud = loadDataset(d, config.progress);
+      outcome.points = cloud.size();
+      outcome.description = cloud.source;
+      note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince()));
+      for (Order order : config.orders) {
+        since = std::chrono::steady_clock::now();
+        std::unique_ptr<GpuScene> scene;
+        std::string failure;
+        {
+          PointCloud ordered;
+          if (order != Order::Original) ordered = reorderedCopy(cloud, order, config.orderSeed);
+          UploadOptions upload;
+          upload.progress = config.progress;
+          try {
+            scene = std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
+          } catch (const UnsupportedError& e) {
+            failure = e.what(); // out of device memory after all: every combination says so
+          }
+        } // the reordered host copy is freed here, before the GPU work
+        note(d.label + " / " + orderName(order) + ": ordered and uploaded in " +
+             printf1("%.1f s", secondsSince()));
+        for (View view : config.views) {
+          const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
+          for (Method method : config.methods) {
+            Result r;
+            r.dataset = d.name;
+            r.order = order;
+            r.view = view;
+            r.method = method;
+            r.points = cloud.size();
+            r.bytesPerPoint = methodInfo(method).bytesPerPoint;
+            r.camera = describeCamera(camera);
+            std::string why;
+            if (!failure.empty()) {
               r.status = "unsupported";
-              r.reason = e.what();
+              r.reason = failure;
+            } else if (!Renderer::supports(context, method, &why)) {
+              r.status = "unsupported";
+              r.reason = why;
+            } else {
+              RenderSettings settings;
+              settings.method = method;
+              settings.frames = config.frames;
+              settings.warmup = run.warmup;
+              try {
+                r.stats = renderer.render(*scene, camera, settings);
+              } catch (const UnsupportedError& e) {
+                r.status = "unsupported";
+                r.reason = e.what();
+              } catch (const DeviceFault& e) {
+                r.status = "device-fault";
+                r.reason = e.what();
+                run.results.push_back(r);
+                ++done;
+                if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
+                throw;
+              }
             }
+            if (r.ok() && r.stats.medianMs > 0) {
+              const double seconds = r.stats.medianMs * 1e-3;
+              r.pointsPerSecond = double(r.stats.points) / seconds;
+              r.effectiveBytesPerSecond = double(r.stats.points) * r.bytesPerPoint / seconds;
+              r.copyFraction =
+                  run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
+            }
+            run.results.push_back(r);
+            ++done;
+            if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
           }
-          if (r.ok() && r.stats.medianMs > 0) {
-            const double seconds = r.stats.medianMs * 1e-3;
-            r.pointsPerSecond = double(r.stats.points) / seconds;
-            r.effectiveBytesPerSecond = double(r.stats.points) * r.bytesPerPoint / seconds;
-            r.copyFraction =
-                run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
-          }
-          run.results.push_back(r);
-          ++done;
-          if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
         }
       }
     }
+  } catch (const DeviceFault& e) {
+    run.deviceFault = std::string(e.what()) + "; the run stopped there, later combinations were not run";
+    note("stopped: " + run.deviceFault);
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;

@@ -100,6 +100,9 @@ struct BenchRun {
   std::vector<DatasetOutcome> datasets;
   std::vector<Result> results;
   double seconds = 0; // wall time of the whole run (not a GPU figure)
+  // Set when the GPU stopped making progress: the run ends there (every later submission would wait on
+  // the stuck one) and the reports hold what was measured before.
+  std::string deviceFault;
 };
 
 struct BenchCallbacks {

@@ -19,4 +19,11 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+// The GPU stopped making progress (a submission did not finish in time, or the device was lost). Unlike
+// UnsupportedError it says nothing about the method: every later submission on the device is suspect.
+class DeviceFault : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
 } // namespace pointrast

@@ -67,7 +67,9 @@ CopyBandwidth measureCopy(Context& context, uint64_t bytes, int repeats) {
   std::vector<double> ms = timestamps.milliseconds();
   double transferMs = median(std::vector<double>(ms.begin(), ms.begin() + repeats));
   double shaderMs = median(std::vector<double>(ms.begin() + repeats, ms.end()));
-  auto rate = [&](double milliseconds) { return milliseconds > 0 ? 2.0 * double(result.bytes) / (milliseconds * 1e-3) : 0.0; };
+  auto rate = [&](double milliseconds) {
+    return milliseconds > 0 ? 2.0 * double(result.bytes) / (milliseconds * 1e-3) : 0.0;
+  };
   result.transferBytesPerSecond = rate(transferMs);
   result.shaderBytesPerSecond = rate(shaderMs);
   result.medianMs = std::min(transferMs, shaderMs);

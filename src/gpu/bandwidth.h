@@ -13,10 +13,10 @@ namespace pointrast::gpu {
 class Context;
 
 struct CopyBandwidth {
-  uint64_t bytes = 0;        // size of one copy (after clamping)
-  int repeats = 0;           // timed copies
-  double medianMs = 0;       // GPU time of one copy by the faster way, median over the repeats
-  double bytesPerSecond = 0; // 2 * bytes / median: read + written (see below), the faster way
+  uint64_t bytes = 0;                // size of one copy (after clamping)
+  int repeats = 0;                   // timed copies
+  double medianMs = 0;               // GPU time of one copy by the faster way, median over the repeats
+  double bytesPerSecond = 0;         // 2 * bytes / median: read + written (see below), the faster way
   double transferBytesPerSecond = 0; // vkCmdCopyBuffer alone
   double shaderBytesPerSecond = 0;   // the compute-shader copy alone
 };

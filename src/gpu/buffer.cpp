@@ -92,6 +92,7 @@ Buffer::~Buffer() {
 }
 
 void Buffer::release() {
+  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
   if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
   if (memory_) vkFreeMemory(device_, memory_, nullptr);
   buffer_ = VK_NULL_HANDLE;

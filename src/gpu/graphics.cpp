@@ -122,6 +122,7 @@ GraphicsProgram::~GraphicsProgram() {
 }
 
 void GraphicsProgram::release() {
+  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
   if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
   if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
   pipeline_ = VK_NULL_HANDLE;

@@ -73,6 +73,7 @@ Image::~Image() {
 }
 
 void Image::release() {
+  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
   if (view_) vkDestroyImageView(device_, view_, nullptr);
   if (image_) vkDestroyImage(device_, image_, nullptr);
   if (memory_) vkFreeMemory(device_, memory_, nullptr);

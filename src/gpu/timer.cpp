@@ -15,6 +15,7 @@ TimestampPool::TimestampPool(Context& context, uint32_t spans) : context_(contex
 }
 
 TimestampPool::~TimestampPool() {
+  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
   vkDestroyQueryPool(context_.device(), pool_, nullptr);
 }
 

@@ -1,5 +1,7 @@
 #include "gpu/vulkan_api.h"
 
+#include <atomic>
+
 #include <dlfcn.h>
 
 #include "base/error.h"
@@ -52,13 +54,25 @@ void loadDeviceFunctions(VkDevice device) {
 #undef PR_VK_LOAD
 }
 
+namespace {
+std::atomic<bool> gDeviceFaulted{false};
+}
+
+bool deviceFaulted() {
+  return gDeviceFaulted.load();
+}
+void markDeviceFaulted() {
+  gDeviceFaulted = true;
+}
+
 const char* resultName(VkResult result) {
   switch (result) {
 #define PR_CASE(r)                                                                                           \
   case r:                                                                                                    \
     return #r;
     PR_CASE(VK_SUCCESS)
-    PR_CASE(VK_NOT_READY) PR_CASE(VK_TIMEOUT) PR_CASE(VK_INCOMPLETE) PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
+    PR_CASE(VK_NOT_READY)
+    PR_CASE(VK_TIMEOUT) PR_CASE(VK_INCOMPLETE) PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
         PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY) PR_CASE(VK_ERROR_INITIALIZATION_FAILED)
             PR_CASE(VK_ERROR_DEVICE_LOST) PR_CASE(VK_ERROR_MEMORY_MAP_FAILED)
                 PR_CASE(VK_ERROR_LAYER_NOT_PRESENT) PR_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)

@@ -69,6 +69,12 @@ private:
 
 const char* resultName(VkResult result);
 
+// Set once a submission did not finish in time (DeviceFault). From then on destructors leave Vulkan
+// objects alone: the GPU may still be using them and waiting for it could take forever; the process
+// exits soon and the driver reclaims everything.
+bool deviceFaulted();
+void markDeviceFaulted();
+
 } // namespace pointrast::gpu
 
 // Checks a VkResult in every build (benchmarks run in Release). Anything but VK_SUCCESS throws.

@@ -155,3 +155,22 @@ TEST(BenchCli, HelpAndUsageErrors) {
 }
 
 } // namespace
+
+TEST(BenchCli, AGpuThatStopsMakingProgressIsOneClearErrorNotAHang) {
+  // POINTRAST_GPU_TIMEOUT_S makes every submission "time out": the run must end with exit 1, one line
+  // naming the fault, no crash, no validation error, and no half-written report.
+  fs::path out = tempDir() / "fault";
+  fs::remove_all(out);
+  setenv("POINTRAST_GPU_TIMEOUT_S", "0.000001", 1);
+  Result r =
+      run("bench terrain --points 20k --methods atomicmin --orders original --views overview --frames 2 "
+          "--width 160 --height 100 --copy-size 16M -q --out " +
+          out.string());
+  unsetenv("POINTRAST_GPU_TIMEOUT_S");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("did not finish a submission"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("validation error"), std::string::npos) << r.err;
+  if (fs::exists(out))
+    for (const auto& entry : fs::directory_iterator(out))
+      ADD_FAILURE() << "nothing should be written, found " << entry.path();
+}
