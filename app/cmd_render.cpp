@@ -24,7 +24,7 @@ namespace {
 
 struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
-  std::string method = "atomicmin", points = "1M";
+  std::string method = "atomicmin", points = "1M", depth = "float";
   uint32_t width = 1920, height = 1080, frames = 10, parts = 1;
   double fov = 60, nearW = 0;
   uint64_t seed = 1;
@@ -42,6 +42,7 @@ int runRender(const RenderArgs& a) {
   spec.progress = !a.quiet;
   RenderSettings settings;
   settings.method = parseMethod(a.method);
+  settings.depth = parseDepthMode(a.depth);
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -103,6 +104,7 @@ int runRender(const RenderArgs& a) {
     j["device"] = context.info().name;
     j["device_type"] = context.info().typeName;
     j["method"] = methodName(settings.method);
+    j["depth"] = depthModeName(settings.depth);
     j["input"] = cloud.source;
     j["points"] = stats.points;
     j["order"] = orderName(spec.order);
@@ -163,6 +165,11 @@ Command addRender(CLI::App& app) {
          "--method", a->method,
          "Rasterization method, e.g. atomicmin (compute) or hw-points (the hardware GL_POINTS baseline); "
          "an unknown name lists them all")
+      ->capture_default_str();
+  cmd->add_option(
+         "--depth", a->depth,
+         "Depth encoding of the atomic methods: float (32-bit linear depth) or int40 (40-bit integer "
+         "computed in double precision)")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
