@@ -147,8 +147,6 @@ Renderer::Renderer(gpu::Context& context, uint32_t width, uint32_t height)
   t.framebuffer =
       gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
   t.image = gpu::Buffer(context, t.pixels() * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "image");
-  t.words =
-      gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
 }
 
 Renderer::~Renderer() = default;
@@ -187,6 +185,10 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   validateCamera(camera);
   PointMethod& m = method(settings);
   Targets& t = *targets_;
+  // Canonical words are for equivalence tests only: allocated on first request (8 B a pixel).
+  if (settings.captureWords && !t.words)
+    t.words =
+        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
   // Double-precision copies of each scene's matrix, for the int40 path.
   uint64_t matrixBytes = std::max<size_t>(1, scenes.size()) * sizeof(glm::dmat4);
   if (!t.matrices || t.matrices.size() < matrixBytes)
