@@ -41,6 +41,7 @@ for what in "$@"; do
     echo "== GPU tests (validation ${POINTRAST_VALIDATION:-on})"
     .gpu/bin/gpu_tests --gtest_brief=1 || status=1
     .gpu/bin/cli_tests --gtest_brief=1 || status=1
+    .gpu/bin/bench_tests --gtest_brief=1 || status=1
     ;;
   autzen)
     echo "== autzen_trim.las"
