@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_harness.h"
 #include "test_data.h"
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,37 +19,14 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Result {
-  int exitCode = -1;
-  std::string out, err;
-};
+using Result = pointrast::test::CliResult;
+using pointrast::test::slurp;
 
 fs::path tempDir() {
-  static fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("pointrast_bench_cli_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
+  return pointrast::test::cliTempDir();
 }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 Result run(const std::string& args) {
-  fs::path out = tempDir() / "stdout.txt", err = tempDir() / "stderr.txt";
-  std::string command = "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
-                        pointrast::test::pointrastBinary() + " " + args + " >" + out.string() + " 2>" +
-                        err.string();
-  int status = std::system(command.c_str());
-  Result r;
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return pointrast::test::runPointrast(args);
 }
 
 const char* kTiny = "bench terrain --points 20k --methods atomicmin,earlyz --orders original,morton "

@@ -7,6 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "cloud/cloud.h"
 #include "gpu/context.h"
 
 namespace pointrast::test {
@@ -27,5 +33,21 @@ protected:
   }
   std::unique_ptr<gpu::Context> context;
 };
+
+// A cloud from world points and RGBA8 colors, quantized at `scale` around `offset`; bounds computed.
+inline PointCloud cloudFromPoints(const std::vector<glm::dvec3>& points, const std::vector<uint32_t>& colors,
+                                  double scale = 1e-4, glm::dvec3 offset = glm::dvec3(0)) {
+  PointCloud cloud;
+  cloud.scale = glm::dvec3(scale);
+  cloud.offset = offset;
+  for (const glm::dvec3& p : points) {
+    glm::dvec3 q = (p - offset) / scale;
+    cloud.positions.insert(cloud.positions.end(), {int32_t(std::llround(q.x)), int32_t(std::llround(q.y)),
+                                                   int32_t(std::llround(q.z))});
+  }
+  cloud.colors = colors;
+  computeBounds(cloud);
+  return cloud;
+}
 
 } // namespace pointrast::test

@@ -23,21 +23,6 @@ namespace pointrast::test {
 
 namespace {
 
-PointCloud pointsCloud(const std::vector<glm::dvec3>& points, const std::vector<uint32_t>& colors,
-                       double scale = 1e-4) {
-  PointCloud cloud;
-  cloud.scale = glm::dvec3(scale);
-  cloud.offset = glm::dvec3(0);
-  for (const glm::dvec3& p : points) {
-    glm::dvec3 q = p / scale;
-    cloud.positions.insert(cloud.positions.end(), {int32_t(std::llround(q.x)), int32_t(std::llround(q.y)),
-                                                   int32_t(std::llround(q.z))});
-  }
-  cloud.colors = colors;
-  computeBounds(cloud);
-  return cloud;
-}
-
 std::vector<uint32_t> renderImage(gpu::Context& context, const GpuScene& scene, const Camera& camera,
                                   uint32_t w, uint32_t h, Method method, uint32_t background = 0) {
   Renderer renderer(context, w, h);
@@ -136,7 +121,7 @@ TEST_F(GpuTest, HwPointsHandBuiltContract) {
                                  {0.00375, 0.00125, -0.005},
                                  {3, 0, -1}});
     colors.insert(colors.end(), {kBlue, kMagenta, kYellow, kGreen, kGreen, kGreen});
-    PointCloud cloud = pointsCloud(points, colors);
+    PointCloud cloud = cloudFromPoints(points, colors);
     UploadOptions upload;
     upload.progress = false;
     GpuScene scene(*context, cloud, upload);
@@ -164,7 +149,7 @@ TEST_F(GpuTest, HwPointsAgreesWithAtomicMinOnRandomCloud) {
     points[i] = {u(rng) * 20, u(rng) * 10, u(rng) * 5};
     colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
   }
-  compareWithAtomicMin(*context, "random", pointsCloud(points, colors), 160, 100);
+  compareWithAtomicMin(*context, "random", cloudFromPoints(points, colors), 160, 100);
 }
 
 TEST_F(GpuTest, HwPointsAgreesWithAtomicMinOnTerrain) {
@@ -220,7 +205,7 @@ TEST_F(GpuTest, HwPointsDrawsPartsAndScenesInOrder) {
 }
 
 TEST_F(GpuTest, HwPointsHasNoInt40Depth) {
-  PointCloud cloud = pointsCloud({{0, 0, -1}}, {kRed});
+  PointCloud cloud = cloudFromPoints({{0, 0, -1}}, {kRed});
   UploadOptions upload;
   upload.progress = false;
   GpuScene scene(*context, cloud, upload);

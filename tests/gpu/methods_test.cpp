@@ -18,21 +18,6 @@ namespace pointrast::test {
 
 namespace {
 
-PointCloud fromPoints(const std::vector<glm::dvec3>& points, const std::vector<uint32_t>& colors,
-                      double scale = 1e-4, glm::dvec3 offset = glm::dvec3(0)) {
-  PointCloud cloud;
-  cloud.scale = glm::dvec3(scale);
-  cloud.offset = offset;
-  for (const glm::dvec3& p : points) {
-    glm::dvec3 q = (p - offset) / scale;
-    cloud.positions.insert(cloud.positions.end(), {int32_t(std::llround(q.x)), int32_t(std::llround(q.y)),
-                                                   int32_t(std::llround(q.z))});
-  }
-  cloud.colors = colors;
-  computeBounds(cloud);
-  return cloud;
-}
-
 struct Result {
   std::vector<uint64_t> words;
   std::vector<uint32_t> image;
@@ -64,7 +49,7 @@ std::map<std::string, PointCloud> testClouds() {
     points.push_back({u(rng) * 20, u(rng) * 10, u(rng) * 5});
     colors.push_back(0xFF000000u | uint32_t(rng() & 0xFFFFFF));
   }
-  clouds["box"] = fromPoints(points, colors);
+  clouds["box"] = cloudFromPoints(points, colors);
   points.clear();
   colors.clear();
   for (int i = 0; i < 60'000; ++i) {
@@ -73,7 +58,7 @@ std::map<std::string, PointCloud> testClouds() {
   }
   points.push_back({5, 5, 5}); // stretch the bounds so the blob is a few pixels in the overview
   colors.push_back(0xFFFFFFFFu);
-  clouds["blob"] = fromPoints(points, colors);
+  clouds["blob"] = cloudFromPoints(points, colors);
   GenerateOptions options;
   options.points = 80'000;
   options.progress = false;
@@ -195,7 +180,7 @@ double backSurfaceFraction(gpu::Context& context, double gap, double distance, D
       points.push_back(p - glm::dvec3(0, 0, gap));
       colors.push_back(kBack);
     }
-  PointCloud cloud = fromPoints(points, colors, 1e-6);
+  PointCloud cloud = cloudFromPoints(points, colors, 1e-6);
   Camera camera;
   camera.target = {0.512, 0.512, 0.0};
   camera.eye = camera.target + distance * glm::normalize(glm::dvec3(3.0, 4.0, 9999.0)); // not axis-aligned
@@ -294,7 +279,7 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
   for (int k = 0; k < 1500; ++k)
     add(10, 20, 1.5 * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
 
-  PointCloud cloud = fromPoints(points, colors, 1e-7);
+  PointCloud cloud = cloudFromPoints(points, colors, 1e-7);
   // The quantized positions move points by < 1e-7: recompute the CPU view depths from them.
   for (size_t i = 0; i < view.size(); ++i)
     view[i].z = -cloud.world(i).z;
@@ -324,7 +309,7 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
 }
 
 TEST_F(GpuTest, UnsupportedCombinationsAreClearErrors) {
-  PointCloud cloud = fromPoints({{0, 0, -1}}, {0xFFFFFFFFu});
+  PointCloud cloud = cloudFromPoints({{0, 0, -1}}, {0xFFFFFFFFu});
   UploadOptions upload;
   upload.progress = false;
   GpuScene scene(*context, cloud, upload);

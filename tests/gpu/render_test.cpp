@@ -19,22 +19,6 @@ namespace pointrast::test {
 
 namespace {
 
-// A cloud from world points and colors (1 mm quantization around the first point's neighbourhood).
-PointCloud makeCloud(const std::vector<glm::dvec3>& points, const std::vector<uint32_t>& colors,
-                     glm::dvec3 scale = glm::dvec3(1e-4)) {
-  PointCloud cloud;
-  cloud.scale = scale;
-  cloud.offset = glm::dvec3(0);
-  for (const glm::dvec3& p : points) {
-    glm::dvec3 q = p / scale;
-    cloud.positions.insert(cloud.positions.end(), {int32_t(std::llround(q.x)), int32_t(std::llround(q.y)),
-                                                   int32_t(std::llround(q.z))});
-  }
-  cloud.colors = colors;
-  computeBounds(cloud);
-  return cloud;
-}
-
 std::vector<uint64_t> renderWords(gpu::Context& context, const PointCloud& cloud, const Camera& camera,
                                   uint32_t w, uint32_t h, const UploadOptions& upload = {}) {
   GpuScene scene(context, cloud, upload);
@@ -82,9 +66,9 @@ Camera axisCamera() {
 TEST_F(GpuTest, ContractPixelPlacementAndDepthOrder) {
   // 4x4 image, aspect 1. Points: red at pixel (2,1) depth 1; green behind red on the same pixel; blue at
   // pixel (0,3); one behind the eye; one outside the image; one between eye and near plane.
-  PointCloud cloud =
-      makeCloud({{0.25, 0.25, -1}, {0.5, 0.5, -2}, {-0.9, -0.9, -1}, {0, 0, 1}, {3, 0, -1}, {0, 0, -0.005}},
-                {kRed, kGreen, kBlue, kGreen, kGreen, kGreen});
+  PointCloud cloud = cloudFromPoints(
+      {{0.25, 0.25, -1}, {0.5, 0.5, -2}, {-0.9, -0.9, -1}, {0, 0, 1}, {3, 0, -1}, {0, 0, -0.005}},
+      {kRed, kGreen, kBlue, kGreen, kGreen, kGreen});
   std::vector<uint64_t> words = renderWords(*context, cloud, axisCamera(), 4, 4);
   for (uint32_t i = 0; i < 16; ++i) {
     uint32_t x = i % 4, y = i / 4;
@@ -111,7 +95,7 @@ TEST_F(GpuTest, ClosestPointWinsWhateverTheOrder) {
     points.push_back({0.01, 0.01, -(1.0 + d * 0.01)});
     colors.push_back(0xFF000000u | uint32_t(d + 1));
   }
-  std::vector<uint64_t> words = renderWords(*context, makeCloud(points, colors), axisCamera(), 8, 8);
+  std::vector<uint64_t> words = renderWords(*context, cloudFromPoints(points, colors), axisCamera(), 8, 8);
   uint32_t pixel = 3 * 8 + 4; // px = floor((0.01 + 1)/2*8) = 4, py = floor((1 - 0.01)/2*8) = 3
   EXPECT_EQ(uint32_t(words[pixel]), 0xFF000001u);
 }
@@ -125,7 +109,7 @@ TEST_F(GpuTest, RandomCloudMatchesCpuReference) {
     points[i] = {u(rng) * 50, u(rng) * 30, u(rng) * 10};
     colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
   }
-  PointCloud cloud = makeCloud(points, colors);
+  PointCloud cloud = cloudFromPoints(points, colors);
   uint32_t w = 320, h = 200;
   std::vector<Camera> cameras = {overviewCamera(cloud.bounds, double(w) / h)};
   Camera inside;
@@ -177,7 +161,7 @@ TEST_F(GpuTest, PartsAndSeparateScenesGiveIdenticalFramebuffers) {
     points[i] = {u(rng) * 5, u(rng) * 5, u(rng) * 5};
     colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
   }
-  PointCloud cloud = makeCloud(points, colors);
+  PointCloud cloud = cloudFromPoints(points, colors);
   Camera camera = overviewCamera(cloud.bounds, 2.0);
   std::vector<uint64_t> whole = renderWords(*context, cloud, camera, 256, 128);
 
@@ -226,7 +210,7 @@ TEST_F(GpuTest, TwoDimensionalGridReachesEveryPoint) {
 }
 
 TEST_F(GpuTest, TimingsArePositiveAndOrdered) {
-  PointCloud cloud = makeCloud({{0, 0, -1}}, {kRed});
+  PointCloud cloud = cloudFromPoints({{0, 0, -1}}, {kRed});
   GpuScene scene(*context, cloud);
   Renderer renderer(*context, 64, 64);
   RenderSettings settings;
