@@ -89,24 +89,11 @@ double decode(const uint8_t* p, PlyType t, bool bigEndian) {
   return 0;
 }
 
-// A list count as stored in binary; negative counts (signed count types) are refused by the caller.
+// A list count as stored in binary: an integer type only (-1 for a float type, refused by the caller, as
+// are negative counts of signed types). decode() is exact for every integer type of 32 bits or less.
 int64_t decodeCount(const uint8_t* p, PlyType t, bool bigEndian) {
-  switch (t) {
-  case PlyType::Int8:
-    return static_cast<int8_t>(p[0]);
-  case PlyType::UInt8:
-    return p[0];
-  case PlyType::Int16:
-    return loadAs<int16_t>(p, bigEndian);
-  case PlyType::UInt16:
-    return loadAs<uint16_t>(p, bigEndian);
-  case PlyType::Int32:
-    return loadAs<int32_t>(p, bigEndian);
-  case PlyType::UInt32:
-    return loadAs<uint32_t>(p, bigEndian);
-  default:
-    return -1;
-  }
+  if (t == PlyType::Float32 || t == PlyType::Float64) return -1;
+  return static_cast<int64_t>(decode(p, t, bigEndian));
 }
 
 struct PlyProperty {

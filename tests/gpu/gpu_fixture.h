@@ -14,6 +14,7 @@
 
 #include "cloud/cloud.h"
 #include "gpu/context.h"
+#include "render/camera.h"
 
 namespace pointrast::test {
 
@@ -48,6 +49,18 @@ inline PointCloud cloudFromPoints(const std::vector<glm::dvec3>& points, const s
   cloud.colors = colors;
   computeBounds(cloud);
   return cloud;
+}
+
+// Camera at the origin looking down -z with a 90 degree field of view: a point (x, y, -d) lands at
+// px = floor((x/d + 1) / 2 * W), py = floor((1 - y/d) / 2 * H).
+inline Camera axisCamera() {
+  Camera c;
+  c.eye = {0, 0, 0};
+  c.target = {0, 0, -1};
+  c.up = {0, 1, 0};
+  c.fovY = 90;
+  c.nearW = 0.01;
+  return c;
 }
 
 } // namespace pointrast::test

@@ -49,18 +49,6 @@ Agreement agreement(const std::vector<uint32_t>& a, const std::vector<uint32_t>&
   return {double(same) / double(a.size()), lit ? double(litSame) / double(lit) : 1.0};
 }
 
-// Camera at the origin looking down -z, 90 degrees: a point (x, y, -d) lands at
-// px = floor((x/d + 1) / 2 * W), py = floor((1 - y/d) / 2 * H).
-Camera axisCamera() {
-  Camera c;
-  c.eye = {0, 0, 0};
-  c.target = {0, 0, -1};
-  c.up = {0, 1, 0};
-  c.fovY = 90;
-  c.nearW = 0.01;
-  return c;
-}
-
 std::vector<std::pair<std::string, Camera>> views(const Bounds& bounds, double aspect) {
   Camera inside;
   inside.eye = bounds.center() + 0.1 * (bounds.max - bounds.center());

@@ -49,18 +49,6 @@ double equalLitFraction(const std::vector<uint32_t>& a, const std::vector<uint32
 
 constexpr uint32_t kRed = 0xFF0000FFu, kGreen = 0xFF00FF00u, kBlue = 0xFFFF0000u;
 
-// Camera at the origin looking down -z with a 90 degree field of view: a point (x, y, -d) lands at
-// px = floor((x/d + 1) / 2 * W), py = floor((1 - y/d) / 2 * H).
-Camera axisCamera() {
-  Camera c;
-  c.eye = {0, 0, 0};
-  c.target = {0, 0, -1};
-  c.up = {0, 1, 0};
-  c.fovY = 90;
-  c.nearW = 0.01;
-  return c;
-}
-
 } // namespace
 
 TEST_F(GpuTest, ContractPixelPlacementAndDepthOrder) {
