@@ -1,0 +1,37 @@
+// The host model of a particle set (spheres): float32 positions relative to a double-precision origin,
+// a radius per particle or one global radius, and an RGBA8 color per particle or one global color.
+// This is what MMPLD carries (positions float or double, radius global or per particle, color global or
+// per particle) and what the sphere renderers draw.
+//
+// Memory per particle: 12 B positions + 4 B radius (if per particle) + 4 B color (if per particle).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cloud/cloud.h"
+
+namespace pointrast {
+
+struct ParticleSet {
+  glm::dvec3 origin{0.0};        // world = origin + double(xyz)
+  std::vector<float> xyz;         // 3 per particle, relative to origin
+  std::vector<float> radius;      // one per particle; empty: globalRadius for every particle
+  float globalRadius = 1.0f;
+  std::vector<uint32_t> colors;   // packRgba per particle; empty: globalColor for every particle
+  uint32_t globalColor = packRgba(192, 192, 192);
+  Bounds bounds;                  // of world positions, centers only (sphereBounds() adds the radii)
+  std::string source;             // file name or scene description, for messages
+
+  uint64_t size() const { return xyz.size() / 3; }
+  bool perParticleRadius() const { return !radius.empty(); }
+  bool perParticleColor() const { return !colors.empty(); }
+  float radiusOf(uint64_t i) const { return radius.empty() ? globalRadius : radius[i]; }
+  uint32_t colorOf(uint64_t i) const { return colors.empty() ? globalColor : colors[i]; }
+  glm::dvec3 world(uint64_t i) const {
+    return origin + glm::dvec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  }
+};
+
+} // namespace pointrast
