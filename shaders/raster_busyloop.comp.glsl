@@ -8,17 +8,20 @@
 // the lock finishes its critical section and releases in the same loop iteration, so no lane ever waits
 // on a lock held by a lane of its own subgroup that cannot advance.
 //
-// RELEASE_BARRIER orders the color store before the release on GPUs. On lavapipe (Mesa 22.3) the barrier
-// appears to park the invocation until the other subgroups of its workgroup reach one; a lane spinning on
-// its lock never does, lavapipe's loop limiter ends the spin and the point is lost (pixels were left
-// locked). CPU devices need no barrier there: x86 keeps the store before the sequentially consistent
-// atomic that releases. So it is 0 on CPU devices and 1 elsewhere.
+// RELEASE orders the color store before the release on GPUs: 1 = memoryBarrierBuffer() before the
+// exchange, 2 = the lock taken with acquire and released with release semantics (memory scope
+// semantics), 0 = nothing. On lavapipe (Mesa 22.3) the barrier appears to park the invocation until the
+// other subgroups of its workgroup reach one; a lane spinning on its lock never does, lavapipe's loop
+// limiter ends the spin and the point is lost (pixels were left locked). CPU devices need no ordering
+// there: x86 keeps the store before the sequentially consistent atomic that releases. So it is 0 on CPU
+// devices.
+#extension GL_KHR_memory_scope_semantics : require
 #include "common.inc.glsl"
 #include "grid.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
 layout(push_constant) uniform Push { RasterPush pc; };
-layout(constant_id = 0) const uint RELEASE_BARRIER = 1;
+layout(constant_id = 0) const uint RELEASE = 1;
 #define DEPTH_INT40 0
 #include "point.inc.glsl"
 
@@ -42,12 +45,20 @@ void main() {
     if (depthBits > oldDepth) {
       done = true; // early-z: farther than what is (or is being) stored
     } else if ((old & kPixelLockBit) == 0u) {
-      if (atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit) == old) {
+      uint seen = RELEASE == 2 ? atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit, gl_ScopeDevice,
+                                                gl_StorageSemanticsBuffer, gl_SemanticsAcquire,
+                                                gl_StorageSemanticsBuffer, gl_SemanticsRelaxed)
+                               : atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit);
+      if (seen == old) {
         // Locked. Ties in depth go to the smaller color, as with the 64-bit atomicMin methods.
         bool closer = depthBits < oldDepth || color < colors.v[pixel];
         if (closer) colors.v[pixel] = color;
-        if (RELEASE_BARRIER != 0) memoryBarrierBuffer();
-        atomicExchange(depth.v[pixel], closer ? depthBits : oldDepth); // release
+        uint released = closer ? depthBits : oldDepth;
+        if (RELEASE == 1) memoryBarrierBuffer();
+        if (RELEASE == 2)
+          atomicExchange(depth.v[pixel], released, gl_ScopeDevice, gl_StorageSemanticsBuffer, gl_SemanticsRelease);
+        else
+          atomicExchange(depth.v[pixel], released);
         done = true;
       }
     }

@@ -15,7 +15,6 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
-#extension GL_EXT_shader_subgroup_extended_types_int64 : require
 #if DEDUP_NV
 #extension GL_NV_shader_subgroup_partitioned : require
 #endif
@@ -35,6 +34,28 @@ layout(constant_id = 4) const uint POINTS_PER_THREAD = 1;
 
 const uint kNoPixel = 0xFFFFFFFFu;
 
+// Subgroup operations on 64-bit words built from 32-bit ones. The H200 (NVIDIA 580) hung, at random,
+// in kernels that used 64-bit subgroup arithmetic (bench/NOTES.md); 32-bit operations are what every
+// device implements natively, and they need no shaderSubgroupExtendedTypes.
+uint64_t joinWord(uint hi, uint lo) {
+  return (uint64_t(hi) << 32) | uint64_t(lo);
+}
+uint64_t subgroupMinWord(uint64_t w) {
+  uint hi = uint(w >> 32);
+  uint leastHi = subgroupMin(hi);
+  return joinWord(leastHi, subgroupMin(hi == leastHi ? uint(w) : 0xFFFFFFFFu));
+}
+uint64_t subgroupShuffleXorWord(uint64_t w, uint mask) {
+  return joinWord(subgroupShuffleXor(uint(w >> 32), mask), subgroupShuffleXor(uint(w), mask));
+}
+#if DEDUP_NV
+uint64_t partitionedMinWord(uint64_t w, uvec4 same) {
+  uint hi = uint(w >> 32);
+  uint leastHi = subgroupPartitionedMinNV(hi, same);
+  return joinWord(leastHi, subgroupPartitionedMinNV(hi == leastHi ? uint(w) : 0xFFFFFFFFu, same));
+}
+#endif
+
 void writeClosest(uint pixel, uint64_t word) {
   Uint64Array fb = Uint64Array(pc.framebuffer);
   if (EARLY_Z != 0 && word >= fb.v[pixel]) return;
@@ -51,7 +72,7 @@ void settle(uint pixel, uint64_t word) {
   uint64_t value = word; // and with which word
 #if DEDUP_NV
   uvec4 same = subgroupPartitionNV(pixel);
-  value = subgroupPartitionedMinNV(word, same);
+  value = partitionedMinWord(word, same);
   writes = valid && gl_SubgroupInvocationID == subgroupBallotFindLSB(same);
 #else
   if (JUST_SET == 0 && REDUCE == 1) {
@@ -61,12 +82,12 @@ void settle(uint pixel, uint64_t word) {
       uint leaderPixel = subgroupShuffle(pixel, leader);
       if (subgroupAll(!valid || pixel == leaderPixel)) {
         // The whole subgroup hits one pixel: one atomic of the subgroup minimum.
-        value = subgroupMin(word);
+        value = subgroupMinWord(word);
         writes = gl_SubgroupInvocationID == leader;
       } else {
         // Otherwise neighbouring pairs that share a pixel combine; the even lane writes.
         uint otherPixel = subgroupShuffleXor(pixel, 1);
-        uint64_t otherWord = subgroupShuffleXor(word, 1);
+        uint64_t otherWord = subgroupShuffleXorWord(word, 1);
         if (valid && otherPixel == pixel) {
           value = min(word, otherWord);
           writes = (gl_SubgroupInvocationID & 1u) == 0u;
@@ -76,14 +97,18 @@ void settle(uint pixel, uint64_t word) {
   } else if (JUST_SET == 0 && REDUCE == 2) {
     bool pending = valid;
     writes = false;
-    // One round per distinct pixel: the lowest pending lane's pixel is settled by one atomic.
-    while (subgroupAny(pending)) {
+    // One round per distinct pixel: the lowest pending lane takes the minimum of the lanes sharing its
+    // pixel and writes it after the loop. The loop body has no memory access and no branch (selects only),
+    // and it runs at most once per lane.
+    for (uint round = 0; round < gl_SubgroupSize && subgroupAny(pending); ++round) {
       uint leader = subgroupBallotFindLSB(subgroupBallot(pending));
       uint leaderPixel = subgroupShuffle(pixel, leader);
       bool mine = pending && pixel == leaderPixel;
-      uint64_t least = subgroupMin(mine ? word : kEmptyPixel);
-      if (gl_SubgroupInvocationID == leader) writeClosest(leaderPixel, least);
-      if (mine) pending = false;
+      uint64_t least = subgroupMinWord(mine ? word : kEmptyPixel);
+      bool lead = gl_SubgroupInvocationID == leader;
+      writes = writes || lead;
+      value = lead ? least : value;
+      pending = pending && !mine;
     }
   }
 #endif

@@ -13,7 +13,6 @@
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
-#extension GL_EXT_shader_subgroup_extended_types_int64 : require
 #if PARTITIONED_NV
 #extension GL_NV_shader_subgroup_partitioned : require
 #endif
@@ -27,6 +26,10 @@ layout(constant_id = 0) const uint ONE_ROUND = 0;
 #include "point.inc.glsl"
 
 const uint kNoPixel = 0xFFFFFFFFu;
+
+uint64_t joinPair(uint hi, uint lo) {
+  return (uint64_t(hi) << 32) | uint64_t(lo);
+}
 
 void accumulate(uint pixel, uint64_t packed, uint64_t rg, uint64_t bn, uint count) {
   Uint64Array acc = Uint64Array(pc.aux);
@@ -57,25 +60,30 @@ void main() {
     if (depth > closest * float(PR_HQS_DEPTH_FACTOR)) pixel = kNoPixel; // hidden: not blended
   }
   bool blended = pixel != kNoPixel;
-  uint64_t r = word & 0xFFul, g = (word >> 8) & 0xFFul, b = (word >> 16) & 0xFFul, one = blended ? 1ul : 0ul;
-  uint64_t packed = blended ? r | (g << 16) | (b << 32) | (1ul << 48) : 0ul;
-  uint64_t rg = blended ? (r << 32) | g : 0ul;
-  uint64_t bn = blended ? (b << 32) | one : 0ul;
+  // Sums within the subgroup in 32 bits (see raster_closest.inc.glsl on 64-bit subgroup arithmetic):
+  // at most 128 lanes x 255 per channel.
+  uint r = blended ? uint(word) & 0xFFu : 0u, g = blended ? (uint(word) >> 8) & 0xFFu : 0u;
+  uint b = blended ? (uint(word) >> 16) & 0xFFu : 0u, one = blended ? 1u : 0u;
 #if PARTITIONED_NV
   uvec4 same = subgroupPartitionNV(pixel);
-  uint64_t groupPacked = subgroupPartitionedAddNV(packed, same);
-  uint64_t groupRG = subgroupPartitionedAddNV(rg, same);
-  uint64_t groupBN = subgroupPartitionedAddNV(bn, same);
-  uint count = uint(subgroupPartitionedAddNV(one, same));
-  if (blended && gl_SubgroupInvocationID == subgroupBallotFindLSB(same))
-    accumulate(pixel, groupPacked, groupRG, groupBN, count);
+  r = subgroupPartitionedAddNV(r, same);
+  g = subgroupPartitionedAddNV(g, same);
+  b = subgroupPartitionedAddNV(b, same);
+  uint count = subgroupPartitionedAddNV(one, same);
+  bool writes = blended && gl_SubgroupInvocationID == subgroupBallotFindLSB(same);
 #else
+  uint count = one;
+  bool writes = blended;
   if (subgroupAllEqual(pixel)) {
-    uint64_t groupPacked = subgroupAdd(packed), groupRG = subgroupAdd(rg), groupBN = subgroupAdd(bn);
-    uint count = uint(subgroupAdd(one));
-    if (blended && subgroupElect()) accumulate(pixel, groupPacked, groupRG, groupBN, count);
-  } else if (blended) {
-    accumulate(pixel, packed, rg, bn, 1u);
+    r = subgroupAdd(r);
+    g = subgroupAdd(g);
+    b = subgroupAdd(b);
+    count = subgroupAdd(one);
+    writes = blended && subgroupElect();
   }
 #endif
+  if (writes) {
+    uint64_t packed = uint64_t(r) | (uint64_t(g) << 16) | (uint64_t(b) << 32) | (uint64_t(count) << 48);
+    accumulate(pixel, packed, joinPair(r, g), joinPair(b, count), count);
+  }
 }

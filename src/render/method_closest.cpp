@@ -1,5 +1,7 @@
 // The closest-point methods: atomicmin, earlyz, reduce, reduce-earlyz, dedup (NV and ballot), justset
 // (raster_closest*.comp with specialization constants) and busyloop (its own shader and layout).
+#include <cstdlib>
+
 #include "base/error.h"
 #include "gpu/context.h"
 #include "render/method.h"
@@ -23,9 +25,10 @@ public:
                                                                                  : 0;
     uint32_t justSet = method == Method::JustSet;
     if (method == Method::BusyLoop) {
-      // No release barrier on CPU devices: see the shader for why lavapipe needs that.
-      raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp",
-                                    {{/* RELEASE_BARRIER= */ 0, context.info().software() ? 0u : 1u}});
+      // No release ordering on CPU devices: see the shader for why lavapipe needs that.
+      uint32_t release = context.info().software() ? 0u : 2u;
+      if (const char* forced = std::getenv("POINTRAST_BUSYLOOP_RELEASE")) release = uint32_t(std::atoi(forced));
+      raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp", {{/* RELEASE= */ 0, release}});
       pointsPerGroup_ = raster_.groupSize();
     } else if (method == Method::Dedup) {
       // The NV variant partitions instead of reducing: it has no REDUCE constant.

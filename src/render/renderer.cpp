@@ -114,7 +114,7 @@ double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera)
 bool Renderer::supports(gpu::Context& context, Method method, std::string* why) {
   const gpu::DeviceFeatures& f = context.features();
   std::string reason;
-  bool subgroups = f.subgroupCompute && f.subgroupExtendedTypes;
+  bool subgroups = f.subgroupCompute;
   switch (method) {
   case Method::Reduce:
   case Method::ReduceEarlyZ:
@@ -122,7 +122,7 @@ bool Renderer::supports(gpu::Context& context, Method method, std::string* why) 
   case Method::Hqs:
   case Method::Hqs1r:
     if (!subgroups)
-      reason = "needs subgroup vote/ballot/shuffle/arithmetic on 64-bit integers in compute shaders";
+      reason = "needs subgroup vote/ballot/shuffle/arithmetic in compute shaders";
     break;
   case Method::Dedup:
     if (!subgroups || !f.subgroupPartitionedNV)
