@@ -1,4 +1,4 @@
-// pointrast generate SCENE --points N -o OUT.las
+// pointrast generate SCENE --points N -o OUT.las | OUT.mmpld
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -11,7 +11,9 @@
 #include "cli_util.h"
 #include "cloud/generate.h"
 #include "cloud/order.h"
+#include "cloud/particles_generate.h"
 #include "commands.h"
+#include "io/particles_io.h"
 #include "io/writer.h"
 
 namespace pointrast::app {
@@ -19,42 +21,104 @@ namespace pointrast::app {
 namespace {
 
 struct GenerateArgs {
-  std::string scene, output, points = "1M", order = "original";
+  std::string scene, output, points = "1M", order = "original", mmpld = "1.3";
   uint64_t seed = 1;
-  bool quiet = false;
+  float radius = 0.5f;
+  bool perParticleRadius = false, quiet = false;
+  // Options that apply to one kind of scene only, to refuse them for the other.
+  CLI::Option *orderOption = nullptr, *radiusOption = nullptr, *perParticleOption = nullptr,
+              *mmpldOption = nullptr;
 };
+
+int generatePoints(const GenerateArgs& a) {
+  for (const CLI::Option* o : {a.radiusOption, a.perParticleOption, a.mmpldOption})
+    if (o->count())
+      throw InputError(o->get_name() + " applies to particle scenes (" + kParticleSceneNames + "), not to " +
+                       a.scene);
+  Scene scene = parseScene(a.scene);
+  Order order = parseOrder(a.order);
+  lasFlavorFor(a.output, 0); // refuse a non-LAS name before spending minutes generating
+  GenerateOptions options;
+  options.points = parseCount(a.points, "--points");
+  options.seed = a.seed;
+  options.progress = !a.quiet;
+  PointCloud cloud = generateScene(scene, options);
+  reorder(cloud, order, a.seed);
+  io::writeLas(a.output, cloud, lasFlavorFor(a.output, cloud.size()));
+  if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(cloud.size())).c_str());
+  return 0;
+}
+
+int generateParticleScene(const GenerateArgs& a) {
+  if (a.orderOption->count())
+    throw InputError("--order applies to point scenes (terrain, tls), not to " + a.scene);
+  if (a.mmpld != "1.0" && a.mmpld != "1.3")
+    throw InputError("--mmpld expects 1.0 or 1.3, got '" + a.mmpld + "'");
+  if (std::filesystem::path(a.output).extension() != ".mmpld")
+    throw InputError(a.output + ": particle scenes are written as MMPLD (a .mmpld name)");
+  ParticleGenerateOptions options;
+  options.particles = parseCount(a.points, "--points");
+  options.seed = a.seed;
+  options.radius = a.radius;
+  options.perParticleRadius = a.perParticleRadius;
+  options.progress = !a.quiet;
+  ParticleSet set = generateParticles(parseParticleScene(a.scene), options);
+  io::writeMmpld(a.output, set, a.mmpld == "1.0" ? io::MmpldVersion::V1_0 : io::MmpldVersion::V1_3);
+  if (!a.quiet) std::printf("%s: %s particles\n", a.output.c_str(), humanCount(double(set.size())).c_str());
+  return 0;
+}
 
 } // namespace
 
 Command addGenerate(CLI::App& app) {
   auto a = std::make_shared<GenerateArgs>();
-  CLI::App* cmd = app.add_subcommand("generate", "Generate a synthetic scene and write it as LAS");
+  CLI::App* cmd =
+      app.add_subcommand("generate", "Generate a synthetic point cloud (LAS) or particle scene (MMPLD)");
   cmd->footer(
-      "\nScenes: terrain (aerial LiDAR: ground, buildings, trees, flight-strip order), tls (terrestrial\n"
-      "scans from a few scanner positions, in scan-line order). Deterministic for a given seed,\n"
-      "whatever the number of cores. Positions are quantized to 1 mm.\n\n"
-      "Example:\n  pointrast generate terrain --points 100M -o terrain100m.las");
-  cmd->add_option("SCENE", a->scene, "terrain or tls")->required();
-  cmd->add_option("-o,--output", a->output, "LAS file to write")->required();
-  cmd->add_option("--points", a->points, "Number of points (e.g. 5M, 1.2G)")->capture_default_str();
+      "\nPoint scenes, written as LAS (positions quantized to 1 mm):\n"
+      "  terrain            aerial LiDAR: ground, buildings, trees, in flight-strip order\n"
+      "  tls                terrestrial scans from a few scanner positions, in scan-line order\n"
+      "\n"
+      "Particle scenes, written as MMPLD (MegaMol's particle format) for the sphere renderers, shaped\n"
+      "after the data sets of \"Efficient Sphere Rendering Revisited\" (2023):\n"
+      "  particles-block    a dense jittered lattice block between two vapor regions (like Riemann)\n"
+      "  particles-drops    liquid droplets joined by filaments, in a vapor (like Drop and Fluid)\n"
+      "  particles-laser    a crystal slab with a molten crater and ejected clusters (like Laser ablation)\n"
+      "  particles-uniform  uniform random in a cube, for scaling measurements\n"
+      "Lengths are in units of the dense phase's atom spacing, so the default --radius 0.5 makes\n"
+      "neighbors touch; a scene grows with --points. Colors follow phase and speed (Turbo ramp).\n"
+      "--per-particle-radius varies the radius by kind around --radius (gas atoms smaller) and stores\n"
+      "it per particle (FLOAT_XYZR: 20 B instead of 16 B per particle, in memory and on disk).\n"
+      "\n"
+      "Every scene is deterministic for a given seed, whatever the number of cores.\n"
+      "\n"
+      "Examples:\n"
+      "  pointrast generate terrain --points 100M -o terrain100m.las\n"
+      "  pointrast generate particles-laser --points 30M -o laser30m.mmpld\n"
+      "  pointrast generate particles-drops --points 4M --per-particle-radius --seed 7 -o drops.mmpld\n"
+      "  pointrast info laser30m.mmpld");
+  cmd->add_option("SCENE", a->scene, "terrain, tls, or a particle scene (particles-block, ...)")->required();
+  cmd->add_option("-o,--output", a->output, "LAS file (point scenes) or MMPLD file (particle scenes)")
+      ->required();
+  cmd->add_option("--points", a->points, "Number of points or particles (e.g. 5M, 1.2G)")
+      ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Random seed")->capture_default_str();
-  cmd->add_option("--order", a->order, "Vertex order of the written file")->capture_default_str();
+  a->orderOption = cmd->add_option("--order", a->order, "Point scenes: vertex order of the written file")
+                       ->capture_default_str();
+  a->radiusOption =
+      cmd->add_option("--radius", a->radius, "Particle scenes: sphere radius")->capture_default_str();
+  a->perParticleOption = cmd->add_flag("--per-particle-radius", a->perParticleRadius,
+                                       "Particle scenes: a radius per particle, varying around --radius");
+  a->mmpldOption = cmd->add_option("--mmpld", a->mmpld, "Particle scenes: MMPLD version, 1.0 or 1.3")
+                       ->capture_default_str();
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
   return [a] {
     Progress::setEnabled(!a->quiet);
-    Scene scene = parseScene(a->scene);
-    Order order = parseOrder(a->order);
-    lasFlavorFor(a->output, 0); // refuse a non-LAS name before spending minutes generating
-    GenerateOptions options;
-    options.points = parseCount(a->points, "--points");
-    options.seed = a->seed;
-    options.progress = !a->quiet;
-    PointCloud cloud = generateScene(scene, options);
-    reorder(cloud, order, a->seed);
-    io::writeLas(a->output, cloud, lasFlavorFor(a->output, cloud.size()));
-    if (!a->quiet)
-      std::printf("%s: %s points\n", a->output.c_str(), humanCount(double(cloud.size())).c_str());
-    return 0;
+    if (isParticleSceneName(a->scene)) return generateParticleScene(*a);
+    if (!isSceneName(a->scene))
+      throw InputError("unknown scene '" + a->scene +
+                       "' (point scenes: terrain, tls; particle scenes: " + kParticleSceneNames + ")");
+    return generatePoints(*a);
   };
 }
 

@@ -10,6 +10,7 @@
 #include "base/error.h"
 #include "commands.h"
 #include "gpu/context.h"
+#include "io/particles_io.h"
 #include "io/reader.h"
 
 namespace pointrast::app {
@@ -18,6 +19,7 @@ namespace {
 
 struct InfoArgs {
   std::string input;
+  uint32_t frame = 0;
   bool json = false, devices = false;
 };
 
@@ -40,10 +42,116 @@ int listDevicesCommand(bool json) {
   return 0;
 }
 
+nlohmann::json jsonVec(const glm::dvec3& v) {
+  return {v.x, v.y, v.z};
+}
+
+std::string rgba(uint32_t c) {
+  return std::to_string(c & 255) + "," + std::to_string((c >> 8) & 255) + "," +
+         std::to_string((c >> 16) & 255) + "," + std::to_string(c >> 24);
+}
+
+// MMPLD: the headers of the file and of one frame, then what only a pass over the particles can tell
+// (how many are usable, the bounds of their centers, the radius range).
+int mmpldInfo(const InfoArgs& a) {
+  const io::MmpldInfo info = io::probeMmpld(a.input, a.frame);
+  io::MmpldReadOptions options;
+  options.frame = a.frame;
+  const io::MmpldStats stats = io::scanMmpld(a.input, options);
+  const std::string version = std::to_string(info.version / 100) + "." + std::to_string(info.version % 100);
+  if (a.json) {
+    nlohmann::json j;
+    j["file"] = a.input;
+    j["format"] = io::formatName(io::Format::Mmpld);
+    j["version"] = version;
+    j["frames"] = info.frames;
+    j["frame"] = info.frame;
+    j["timestamp"] = info.hasTimestamp ? nlohmann::json(info.timestamp) : nlohmann::json();
+    j["bounds_min"] = jsonVec(info.bbox.min);
+    j["bounds_max"] = jsonVec(info.bbox.max);
+    j["clip_min"] = jsonVec(info.clipBox.min);
+    j["clip_max"] = jsonVec(info.clipBox.max);
+    j["lists"] = nlohmann::json::array();
+    for (const io::MmpldList& list : info.lists) {
+      nlohmann::json l = {{"vertex", io::mmpldVertexName(list.vertex)},
+                          {"color", io::mmpldColorName(list.color)},
+                          {"particles", list.count}};
+      if (list.vertex != io::MmpldVertex::FloatXyzr && list.hasPositions())
+        l["global_radius"] = list.globalRadius;
+      if (list.color == io::MmpldColor::None)
+        l["global_color"] = {list.globalColor & 255, (list.globalColor >> 8) & 255,
+                             (list.globalColor >> 16) & 255, list.globalColor >> 24};
+      if (list.color == io::MmpldColor::FloatI || list.color == io::MmpldColor::DoubleI)
+        l["intensity_range"] = {list.intensityMin, list.intensityMax};
+      if (list.hasBounds) {
+        l["bounds_min"] = jsonVec(list.bounds.min);
+        l["bounds_max"] = jsonVec(list.bounds.max);
+      }
+      j["lists"].push_back(l);
+    }
+    j["particles"] = stats.particles;
+    j["dropped"] = stats.dropped;
+    if (stats.particles > 0) {
+      j["centers_min"] = jsonVec(stats.centers.min);
+      j["centers_max"] = jsonVec(stats.centers.max);
+      j["radius_min"] = stats.radiusMin;
+      j["radius_max"] = stats.radiusMax;
+    }
+    std::printf("%s\n", j.dump().c_str());
+    return 0;
+  }
+  std::printf("file:    %s\n", a.input.c_str());
+  std::printf("format:  MMPLD %s (%u), %u frame%s\n", version.c_str(), info.version, info.frames,
+              info.frames == 1 ? "" : "s");
+  std::printf("frame:   %u, %zu list%s", info.frame, info.lists.size(), info.lists.size() == 1 ? "" : "s");
+  if (info.hasTimestamp) std::printf(", timestamp %g", double(info.timestamp));
+  if (info.timestampMissing) std::printf(", no timestamp (1.3 as older MegaMol wrote it)");
+  std::printf("\n");
+  const auto box = [](const Bounds& b) {
+    char line[200];
+    std::snprintf(line, sizeof line, "%.6f, %.6f, %.6f .. %.6f, %.6f, %.6f", b.min.x, b.min.y, b.min.z,
+                  b.max.x, b.max.y, b.max.z);
+    return std::string(line);
+  };
+  std::printf("bounds:  %s (header)\n", box(info.bbox).c_str());
+  std::printf("clip:    %s (header)\n", box(info.clipBox).c_str());
+  for (size_t l = 0; l < info.lists.size(); ++l) {
+    const io::MmpldList& list = info.lists[l];
+    std::string line = std::string(io::mmpldVertexName(list.vertex)) + " + " +
+                       io::mmpldColorName(list.color) + ", " + std::to_string(list.count) + " particles";
+    if (!list.hasPositions()) line += " (no positions: skipped)";
+    if (list.hasPositions() && list.vertex != io::MmpldVertex::FloatXyzr) {
+      char radius[48];
+      std::snprintf(radius, sizeof radius, ", radius %g", double(list.globalRadius));
+      line += radius;
+    }
+    if (list.color == io::MmpldColor::None) line += ", color " + rgba(list.globalColor);
+    if (list.color == io::MmpldColor::FloatI || list.color == io::MmpldColor::DoubleI) {
+      char range[80];
+      std::snprintf(range, sizeof range, ", intensity %g .. %g", double(list.intensityMin),
+                    double(list.intensityMax));
+      line += range;
+    }
+    if (list.hasBounds) line += ", bounds " + box(list.bounds);
+    std::printf("%-8s %s\n", ("list " + std::to_string(l) + ":").c_str(), line.c_str());
+  }
+  std::printf("particles: %llu", static_cast<unsigned long long>(stats.particles));
+  if (stats.dropped)
+    std::printf(" (%llu dropped: NaN, infinite or bad radius)",
+                static_cast<unsigned long long>(stats.dropped));
+  std::printf("\n");
+  if (stats.particles > 0) {
+    std::printf("centers: %s\n", box(stats.centers).c_str());
+    std::printf("radius:  %g .. %g\n", double(stats.radiusMin), double(stats.radiusMax));
+  }
+  return 0;
+}
+
 int runInfo(const InfoArgs& a) {
   if (a.devices) return listDevicesCommand(a.json);
   if (a.input.empty()) throw InputError("info needs a FILE (or --devices)");
   if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file");
+  if (io::detectFormat(a.input) == io::Format::Mmpld) return mmpldInfo(a);
   io::FileInfo info = io::probeFile(a.input);
   if (a.json) {
     nlohmann::json j;
@@ -92,11 +200,17 @@ int runInfo(const InfoArgs& a) {
 
 Command addInfo(CLI::App& app) {
   auto a = std::make_shared<InfoArgs>();
-  CLI::App* cmd = app.add_subcommand("info", "Show what a point cloud file holds, or list Vulkan devices");
-  cmd->footer("\nReads the header (and for LAS the color values, to tell 8-bit from 16-bit color).\n"
-              "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n  pointrast info "
-              "--devices");
-  cmd->add_option("FILE", a->input, "LAS/PLY/XYZ file");
+  CLI::App* cmd =
+      app.add_subcommand("info", "Show what a point cloud or particle file holds, or list Vulkan devices");
+  cmd->footer(
+      "\nReads the header (and for LAS the color values, to tell 8-bit from 16-bit color). For MMPLD\n"
+      "particle files: the version, frames, each list of one frame (vertex and color type, count,\n"
+      "global radius or color, intensity range), then from a pass over its particles how many are\n"
+      "usable, the bounds of their centers and the radius range.\n"
+      "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n"
+      "  pointrast info particles.mmpld --frame 3\n  pointrast info --devices");
+  cmd->add_option("FILE", a->input, "LAS/PLY/XYZ or MMPLD file");
+  cmd->add_option("--frame", a->frame, "MMPLD: the frame to describe")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");
   return [a] { return runInfo(*a); };

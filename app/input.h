@@ -1,4 +1,5 @@
-// What the commands take as input: a file, or the name of a generated scene.
+// What the commands take as input: a file, or the name of a generated scene; points for the point
+// renderers, particles (spheres) for the sphere renderers.
 #pragma once
 
 #include <cstdint>
@@ -6,6 +7,7 @@
 
 #include "cloud/cloud.h"
 #include "cloud/order.h"
+#include "cloud/particles.h"
 
 namespace pointrast::app {
 
@@ -24,5 +26,26 @@ constexpr uint64_t kDemoPoints = 1'000'000;
 // Reads the file or generates the scene, then applies the order. Throws InputError for a source that is
 // neither an existing file nor a scene name.
 PointCloud loadInput(const InputSpec& spec);
+
+struct ParticleInputSpec {
+  // An MMPLD file; a LAS/PLY/XYZ file or a point scene name (terrain, tls), drawn as spheres of `radius`;
+  // or a particle scene name (particles-block, ...). Empty = the particle demo scene.
+  std::string source;
+  uint32_t frame = 0; // MMPLD: the frame to read
+  // Points: the spheres' radius, required. Particle scenes: 0 = the scene default (0.5). MMPLD: 0 = the
+  // file's radii, anything else replaces them.
+  float radius = 0;
+  bool perParticleRadius = false; // particle scenes: radii vary per particle around `radius`
+  uint64_t particles = 1'000'000; // scenes
+  uint64_t seed = 1;              // scenes
+  bool progress = true;
+};
+
+// The built-in particle demo: particles-block, 1 M particles, seed 1.
+constexpr const char* kDemoParticleScene = "particles-block";
+
+// Reads or generates the particles (for the sphere renderers). Throws InputError for a source that is
+// neither an existing file nor a scene name, a point input without a radius, or a negative radius.
+ParticleSet loadParticles(const ParticleInputSpec& spec);
 
 } // namespace pointrast::app

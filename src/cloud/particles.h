@@ -34,4 +34,27 @@ struct ParticleSet {
   }
 };
 
+// Recomputes set.bounds (centers) from the particles, on all hardware threads. Positions must be finite
+// (every reader and generator guarantees it).
+void computeBounds(ParticleSet& set);
+
+// Bounds of the spheres: each center expanded by its radius, in double precision. Empty for an empty set.
+Bounds sphereBounds(const ParticleSet& set);
+
+// Smallest and largest radius over the particles: {globalRadius, globalRadius} without per-particle
+// radii, {0, 0} for an empty set with per-particle radii.
+struct RadiusRange {
+  float min = 0, max = 0;
+};
+RadiusRange radiusRange(const ParticleSet& set);
+
+// The color ramp for scalar particle attributes (MMPLD intensities, the generated scenes' phases and
+// speeds): Turbo, as used for point clouds without color. t is clamped to [0, 1]; NaN gives the low end.
+uint32_t particleRamp(double t);
+
+// A point cloud drawn as spheres of one radius (radius > 0, in the cloud's units): positions relative to
+// cloud.origin(), colors as displayColors() shows the points (RGB, else an intensity or elevation ramp).
+// Memory: 16 B per point beside the cloud.
+ParticleSet particlesFromCloud(const PointCloud& cloud, float radius);
+
 } // namespace pointrast

@@ -1,6 +1,7 @@
 // Per-format entry points that are private to src/io/ (reader.cpp dispatches to them).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 
 #include "io/reader.h"
@@ -10,5 +11,9 @@ namespace pointrast::io::detail {
 FileInfo probeLas(const std::filesystem::path& path);
 FileInfo probePly(const std::filesystem::path& path);
 FileInfo probeXyz(const std::filesystem::path& path);
+
+// Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to
+// cross chunk boundaries with small files; 0 restores the default.
+void setMmpldChunkBytes(uint64_t bytes);
 
 } // namespace pointrast::io::detail

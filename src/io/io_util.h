@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <future>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,33 @@ private:
   int fd_ = -1;
   uint64_t size_ = 0;
 };
+
+// Calls fn(records, first, n) for consecutive chunks of `count` fixed-size records of `stride` bytes that
+// start at file offset `offset` (records [first, first + n)). A chunk holds at most chunkBytes (at least
+// one record), so memory is two chunk buffers whatever the count; a helper thread reads chunk k + 1 while
+// fn works on chunk k. The caller has checked that the records lie inside the file.
+template <class Fn>
+void forEachRecordChunk(const InputFile& file, uint64_t offset, uint64_t count, uint64_t stride,
+                        uint64_t chunkBytes, Fn&& fn) {
+  if (count == 0) return;
+  const uint64_t perChunk = std::min<uint64_t>(count, std::max<uint64_t>(1, chunkBytes / stride));
+  std::vector<uint8_t> buffers[2];
+  buffers[0].resize(perChunk * stride);
+  if (count > perChunk) buffers[1].resize(perChunk * stride);
+  auto readChunk = [&](int b, uint64_t first) {
+    uint64_t n = std::min(perChunk, count - first);
+    file.readAt(offset + first * stride, buffers[b].data(), n * stride);
+  };
+  readChunk(0, 0);
+  int b = 0;
+  for (uint64_t first = 0; first < count; first += perChunk, b ^= 1) {
+    uint64_t n = std::min(perChunk, count - first);
+    std::future<void> next;
+    if (first + n < count) next = std::async(std::launch::async, readChunk, b ^ 1, first + n);
+    fn(static_cast<const uint8_t*>(buffers[b].data()), first, n);
+    if (next.valid()) next.get();
+  }
+}
 
 // Sequential reading with a bounded window, for formats whose records are not fixed-size (PLY lists,
 // text). ensure(n) makes n bytes available at data(); it fails with InputError at the end of the file.

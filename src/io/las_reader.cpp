@@ -4,7 +4,6 @@
 // validated header count: memory is the cloud itself plus two chunk buffers.
 #include <atomic>
 #include <climits>
-#include <future>
 #include <optional>
 
 #include "base/parallel.h"
@@ -36,29 +35,9 @@ struct Destination {
   uint8_t* returnNumber = nullptr;
 };
 
-// Calls fn(records, firstIndex, count) for consecutive chunks of point records. A helper thread reads
-// chunk k + 1 while fn works on chunk k.
+// Calls fn(records, firstIndex, count) for consecutive chunks of point records (see forEachRecordChunk).
 template <class Fn> void forEachChunk(const InputFile& file, const LasHeader& hd, Fn&& fn) {
-  const uint64_t n = hd.pointCount;
-  const uint64_t stride = hd.recordLength;
-  if (n == 0) return;
-  const uint64_t perChunk = std::min<uint64_t>(n, std::max<uint64_t>(1, lasChunkBytes() / stride));
-  std::vector<uint8_t> buffers[2];
-  buffers[0].resize(perChunk * stride);
-  if (n > perChunk) buffers[1].resize(perChunk * stride);
-  auto readChunk = [&](int b, uint64_t first) {
-    uint64_t count = std::min(perChunk, n - first);
-    file.readAt(hd.pointOffset + first * stride, buffers[b].data(), count * stride);
-  };
-  readChunk(0, 0);
-  int b = 0;
-  for (uint64_t first = 0; first < n; first += perChunk, b ^= 1) {
-    uint64_t count = std::min(perChunk, n - first);
-    std::future<void> next;
-    if (first + count < n) next = std::async(std::launch::async, readChunk, b ^ 1, first + count);
-    fn(buffers[b].data(), first, count);
-    if (next.valid()) next.get();
-  }
+  forEachRecordChunk(file, hd.pointOffset, hd.pointCount, hd.recordLength, lasChunkBytes(), fn);
 }
 
 // 8-bit value from a 16-bit LAS color channel: shift is 8 for files with 16-bit colors, else 0.

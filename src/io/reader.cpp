@@ -48,7 +48,9 @@ namespace {
 
 [[noreturn]] void failUnreadable(const std::filesystem::path& path, Format format) {
   if (format == Format::Laz) failCompressed(path);
-  if (format == Format::Mmpld) fail(path, "MMPLD particle files are not supported yet");
+  if (format == Format::Mmpld)
+    fail(path, "an MMPLD file holds particles (spheres), not a point cloud; `pointrast info` and the sphere "
+               "renderers read it");
   InputFile file(path); // a missing or unreadable file reports that instead
   if (file.size() == 0) fail(path, "the file is empty");
   fail(path, "not a LAS, LAZ, PLY, XYZ/CSV/PTS or MMPLD file (unrecognised content and extension)");

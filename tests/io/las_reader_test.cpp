@@ -372,18 +372,6 @@ TEST(LasReader, ContentDecidesNotTheExtension) {
   EXPECT_THROW(readCloud(dir / "flag.las", quiet()), InputError);
 }
 
-TEST(LasReader, MmpldIsRecognisedButNotYetRead) {
-  auto file = data("mmpld/test_xyz_float_rgb_float.mmpld");
-  EXPECT_EQ(detectFormat(file), Format::Mmpld);
-  try {
-    readCloud(file, quiet());
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("not supported yet"), std::string::npos) << e.what();
-  }
-  EXPECT_THROW(probeFile(file), InputError);
-}
-
 TEST(LasReader, LyingCountsAreRefusedBeforeAllocating) {
   iotest::TempDir dir;
   auto bytes = iotest::readBytes(data("las/1.2-with-color.las"));
