@@ -20,7 +20,7 @@ for spec in "$@"; do
   IFS=: read -r release methods extra <<< "$spec"
   start=$(date +%s%N)
   env $extra POINTRAST_BUSYLOOP_RELEASE=$release timeout -s KILL "${DIAG_KILL_S:-30}" $pr bench tls --points 4M \
-    --views all --methods "$methods" --orders all --frames 15 --out /tmp/diag --name "d$n" > "$OUT/diag-$n.log" 2>&1
+    --views "${DIAG_VIEWS:-all}" --methods "$methods" --orders "${DIAG_ORDERS:-all}" --frames 15 --out /tmp/diag --name "d$n" > "$OUT/diag-$n.log" 2>&1
   rc=$?
   stalled=$(grep -m1 'n/a' "$OUT/diag-$n.log" | sed 's/:.*//')
   printf '== %-2s release=%s %-50s rc=%s %6s ms, first n/a: %s\n' "$n" "$release" "$methods $extra" "$rc" \

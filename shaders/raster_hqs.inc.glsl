@@ -38,12 +38,18 @@ void accumulate(uint pixel, uint64_t packed, uint64_t rg, uint64_t bn, uint coun
     atomicAdd(acc.v[2 * pixel + 1], bn);
     return;
   }
-  uint64_t before = atomicAdd(acc.v[pixel], packed);
-  if (uint(before >> 48) + count <= kHqs1rMaxCount) return;
-  // The word would pass 255 points: take the add back (modular addition undoes exactly, whatever carries
-  // happened meanwhile) and add to the 32-bit fallback sums instead. Adds that stay always saw a total
-  // of at most 255 including themselves, so the packed fields never overflow in the final sums.
-  atomicAdd(acc.v[pixel], -packed);
+  // A pixel already full (as a plain read shows it) goes to the fallback sums at once: in dense views
+  // thousands of points share a pixel, and the add-then-take-back pair below would put two atomics per
+  // point on one hot address. The read may count adds that are about to be taken back; such a point then
+  // uses the fallback although it might have fitted, which changes nothing in the resolved sums.
+  if (uint(acc.v[pixel] >> 48) + count <= kHqs1rMaxCount) {
+    uint64_t before = atomicAdd(acc.v[pixel], packed);
+    if (uint(before >> 48) + count <= kHqs1rMaxCount) return;
+    // The word would pass 255 points: take the add back (modular addition undoes exactly, whatever
+    // carries happened meanwhile) and add to the 32-bit fallback sums instead. Adds that stay always saw
+    // a total of at most 255 including themselves, so the packed fields never overflow in the final sums.
+    atomicAdd(acc.v[pixel], -packed);
+  }
   uint pixels = pc.width * pc.height;
   atomicAdd(acc.v[pixels + 2 * pixel], rg);
   atomicAdd(acc.v[pixels + 2 * pixel + 1], bn);
