@@ -16,6 +16,8 @@ vec3 loadPosition(uint i) {
 
 // The depth part of point p's framebuffer word (payload 0) and its pixel; false if the point is dropped.
 bool depthWordOf(vec3 p, out uint pixel, out uint64_t word) {
+  pixel = 0xFFFFFFFFu; // written on every path (see projectPoint)
+  word = 0xFFFFFFFFFFFFFFFFul;
 #if DEPTH_INT40
   dvec4 c = DMat4Ref(pc.viewProjD).m * dvec4(dvec3(p), 1.0lf);
   if (!(c.w > double(pc.nearW))) return false;

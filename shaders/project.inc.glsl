@@ -4,6 +4,10 @@
 // Returns false for a dropped point; otherwise the pixel index and the depth bits for the high word.
 bool projectPoint(mat4 viewProj, vec3 p, uint width, uint height, float nearW, out uint pixel,
                   out uint depthBits) {
+  // Out parameters are written on every path: GLSL copies an out parameter back to the caller even when
+  // the function never assigned it, so an early return would hand the caller an undefined pixel.
+  pixel = 0xFFFFFFFFu;
+  depthBits = 0xFFFFFFFFu;
   vec4 c = viewProj * vec4(p, 1.0);
   if (!(c.w > nearW)) return false; // also drops NaN
   float fx = (c.x / c.w + 1.0) * 0.5 * float(width);

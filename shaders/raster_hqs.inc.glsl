@@ -64,6 +64,10 @@ void main() {
     float closest = uintBitsToFloat(uint(Uint64Array(pc.framebuffer).v[pixel] >> 32));
     float depth = uintBitsToFloat(uint(word >> 32));
     if (depth > closest * float(PR_HQS_DEPTH_FACTOR)) pixel = kNoPixel; // hidden: not blended
+  } else {
+    // Not drawn. (Before projectPoint wrote its out parameters on every path, a point it dropped came
+    // back with an undefined pixel here and was blended into it: atomics at arbitrary addresses.)
+    pixel = kNoPixel;
   }
   bool blended = pixel != kNoPixel;
   // Sums within the subgroup in 32 bits (see raster_closest.inc.glsl on 64-bit subgroup arithmetic):

@@ -199,16 +199,18 @@ namespace {
 
 // An independent HQS on the CPU for clouds whose points sit near pixel centers (no pixel-border ties):
 // closest float depth per pixel, then the rounded average of every point within 1 % of it.
+// Points whose pixel is kDropped are outside the view and take no part.
+constexpr uint32_t kDropped = UINT32_MAX;
+
 std::vector<uint32_t> cpuHqs(const std::vector<glm::dvec3>& viewPoints, const std::vector<uint32_t>& colors,
-                             const std::vector<uint32_t>& pixels) {
-  size_t n = pixels.size();
+                             const std::vector<uint32_t>& pixels, size_t n) {
   std::vector<float> closest(n, INFINITY);
   for (size_t i = 0; i < viewPoints.size(); ++i)
-    closest[pixels[i]] = std::min(closest[pixels[i]], float(viewPoints[i].z));
+    if (pixels[i] != kDropped) closest[pixels[i]] = std::min(closest[pixels[i]], float(viewPoints[i].z));
   std::vector<uint64_t> sum(n * 4, 0);
   for (size_t i = 0; i < viewPoints.size(); ++i) {
     uint32_t p = pixels[i];
-    if (float(viewPoints[i].z) > closest[p] * 1.01f) continue;
+    if (p == kDropped || float(viewPoints[i].z) > closest[p] * 1.01f) continue;
     for (int c = 0; c < 3; ++c)
       sum[4 * p + c] += (colors[i] >> (8 * c)) & 0xFF;
     sum[4 * p + 3] += 1;
@@ -251,6 +253,12 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
       for (int k = 0; k < count; ++k)
         add(px, py, front * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
       add(px, py, front * 1.03, 0xFF0000FFu); // hidden: beyond 1 %
+      // A point the projection drops, between drawn ones (so in their subgroups): behind the eye, or
+      // beside the frustum. It must not blend anywhere.
+      points.push_back(px % 2 ? glm::dvec3(0.1, 0.1, 1.0) : glm::dvec3(-50.0, 0.0, -1.0));
+      view.push_back({0, 0, 1});
+      colors.push_back(0xFFFFFFFFu);
+      pixels.push_back(kDropped);
     }
   // One pixel with 1,500 blended points: past hqs1r's 255-point packed word.
   for (int k = 0; k < 1500; ++k)
@@ -259,7 +267,7 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
   PointCloud cloud = cloudFromPoints(points, colors, 1e-7);
   // The quantized positions move points by < 1e-7: recompute the CPU view depths from them.
   for (size_t i = 0; i < view.size(); ++i)
-    view[i].z = -cloud.world(i).z;
+    if (pixels[i] != kDropped) view[i].z = -cloud.world(i).z;
   Camera camera;
   camera.eye = {0, 0, 0};
   camera.target = {0, 0, -1};
@@ -269,7 +277,7 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
   UploadOptions upload;
   upload.progress = false;
   GpuScene scene(*context, cloud, upload);
-  std::vector<uint32_t> cpu = cpuHqs(view, colors, pixels);
+  std::vector<uint32_t> cpu = cpuHqs(view, colors, pixels, W * H);
   std::vector<uint32_t> hqs = draw(*context, scene, camera, W, H, Method::Hqs).image;
   std::vector<uint32_t> hqs1r = draw(*context, scene, camera, W, H, Method::Hqs1r).image;
   auto maxChannelDiff = [](const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
