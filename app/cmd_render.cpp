@@ -1,4 +1,5 @@
 // pointrast render [FILE|SCENE] -o OUT.png ...
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -12,11 +13,14 @@
 #include "base/error.h"
 #include "base/progress.h"
 #include "cli_util.h"
+#include "cloud/particles_generate.h"
 #include "commands.h"
 #include "gpu/context.h"
+#include "gpu/shared_types.h"
 #include "input.h"
 #include "io/writer.h"
 #include "render/renderer.h"
+#include "render/spheres/sphere_renderer.h"
 
 namespace pointrast::app {
 
@@ -25,15 +29,109 @@ namespace {
 struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
+  std::string precision = "adaptive"; // batch methods
+  std::string layout = "auto";        // sphere methods
   uint32_t width = 1920, height = 1080, frames = 10, parts = 1;
+  uint32_t frame = 0; // sphere methods: MMPLD frame
+  float radius = 0;   // sphere methods: radius of points drawn as spheres, or replacing the file's
   double fov = 60, nearW = 0;
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
 };
 
+// The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
+// as spheres of --radius, through the SphereRenderer.
+int runRenderSpheres(const RenderArgs& a) {
+  SphereSettings settings;
+  settings.method = parseSphereMethod(a.method);
+  settings.background = parseRgb(a.background, "--background");
+  settings.frames = a.frames;
+  if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
+    throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
+                     a.method);
+  if (std::filesystem::path(a.output).extension() != ".png")
+    throw InputError("-o " + a.output + ": the output must be a .png file");
+  ParticleUploadOptions upload;
+  upload.progress = !a.quiet;
+  if (a.layout != "auto") upload.layout = parseParticleLayout(a.layout);
+  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+
+  ParticleInputSpec spec;
+  spec.source = a.input;
+  spec.frame = a.frame;
+  spec.radius = a.radius;
+  spec.particles = parseCount(a.points, "--points");
+  spec.seed = a.seed;
+  spec.progress = !a.quiet;
+  ParticleSet set = loadParticles(spec);
+  std::string why;
+  if (upload.layout && !layoutHolds(*upload.layout, set, &why)) throw InputError(why);
+  Bounds bounds = sphereSetBounds(set);
+  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
+  if (!a.eye.empty()) {
+    camera.eye = parseVec3(a.eye, "--eye");
+    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
+    camera.up = parseVec3(a.up, "--up");
+  }
+  camera.nearW = a.nearW;
+  validateCamera(camera);
+
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = a.device;
+  contextOptions.announce = !a.quiet;
+  gpu::Context context(contextOptions);
+  SphereRenderer renderer(context, a.width, a.height);
+  GpuParticles particles(context, set, upload);
+  SphereStats stats = renderer.render(particles, camera, settings);
+  std::vector<uint32_t> pixels = renderer.image();
+  if (context.validationErrors() > 0)
+    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                     " error(s)");
+  io::writePng(a.output, a.width, a.height, pixels.data());
+  double perSecond = stats.medianMs > 0 ? double(stats.particles) / (stats.medianMs * 1e-3) : 0.0;
+  if (a.json) {
+    nlohmann::json j;
+    j["device"] = context.info().name;
+    j["device_type"] = context.info().typeName;
+    j["method"] = sphereMethodName(settings.method);
+    j["layout"] = particleLayoutName(particles.layout());
+    j["input"] = set.source;
+    j["particles"] = stats.particles;
+    j["width"] = a.width;
+    j["height"] = a.height;
+    j["frames"] = stats.frames;
+    j["median_ms"] = stats.medianMs;
+    j["min_ms"] = stats.minMs;
+    j["max_ms"] = stats.maxMs;
+    j["particles_per_second"] = perSecond;
+    j["large_chunks"] = stats.largeChunks;
+    j["spilled_spheres"] = stats.spilledSpheres;
+    j["clamped_spheres"] = stats.clampedSpheres;
+    j["camera"] = describeCamera(camera);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
+    j["image_hash"] = hex;
+    j["output"] = a.output;
+    std::printf("%s\n", j.dump().c_str());
+  } else if (!a.quiet) {
+    std::printf("%s: %s particles (%s), %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
+                "particles/s\n",
+                a.output.c_str(), humanCount(double(stats.particles)).c_str(),
+                particleLayoutName(particles.layout()), a.width, a.height, sphereMethodName(settings.method),
+                stats.medianMs, stats.frames, stats.minMs, stats.maxMs, humanCount(perSecond).c_str());
+  }
+  return 0;
+}
+
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
+  if (isSphereMethodName(a.method)) return runRenderSpheres(a);
+  if (a.method.rfind("sphere-", 0) == 0) parseSphereMethod(a.method); // throws, naming the sphere methods
+  if (isParticleSceneName(a.input) || std::filesystem::path(a.input).extension() == ".mmpld")
+    throw InputError(a.input + " holds particles: draw them with a sphere method (--method sphere-compute)");
   InputSpec spec;
   spec.source = a.input;
   spec.points = parseCount(a.points, "--points");
@@ -43,6 +141,10 @@ int runRender(const RenderArgs& a) {
   RenderSettings settings;
   settings.method = parseMethod(a.method);
   settings.depth = parseDepthMode(a.depth);
+  settings.precision = parsePrecision(a.precision);
+  const SceneLayout layout = methodInfo(settings.method).layout;
+  if (settings.precision != 0 && layout != SceneLayout::Batched)
+    throw InputError("--precision applies to the batch methods (batch, batch-prefetch, batch-hqs)");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -81,10 +183,22 @@ int runRender(const RenderArgs& a) {
   // as one upload (the atomic min does not care which dispatch a point came from).
   std::vector<std::unique_ptr<GpuScene>> scenes;
   uint64_t perPart = (cloud.size() + a.parts - 1) / a.parts;
+  if (layout == SceneLayout::Batched && perPart > 0) {
+    // Said before uploading: the batch methods address 64 parts of a frame (4.29 billion points).
+    uint64_t capacity =
+        partCapacity(layout, 0, std::min(context.maxAllocationSize(), context.maxBufferSize()));
+    uint64_t parts = capacity ? uint64_t(a.parts) * ((perPart + capacity - 1) / capacity) : 0;
+    if (parts > shared::kMaxVisibilityParts)
+      throw InputError(cloud.source + " needs " + std::to_string(parts) +
+                       " parts on this device; the batch methods "
+                       "draw at most " +
+                       std::to_string(shared::kMaxVisibilityParts) + " (4.29 billion points) per frame");
+  }
   for (uint32_t p = 0; p < a.parts; ++p) {
     UploadOptions upload;
     upload.first = uint64_t(p) * perPart;
     upload.count = perPart;
+    upload.layout = layout;
     upload.progress = !a.quiet;
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
@@ -116,6 +230,17 @@ int runRender(const RenderArgs& a) {
     j["max_ms"] = stats.maxMs;
     j["points_per_second"] = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
     j["parts"] = a.parts;
+    if (stats.batch) {
+      const BatchStats& b = *stats.batch;
+      j["precision"] = a.precision;
+      j["batch_stats"] = {{"batches_processed", b.batchesProcessed},
+                          {"batches_rendered", b.batchesRendered},
+                          {"points_processed", b.pointsProcessed},
+                          {"points_rendered", b.pointsRendered},
+                          {"points_blended", b.pointsBlended},
+                          {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
+                          {"bytes_read", b.bytesRead}};
+    }
     j["camera"] = describeCamera(camera);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
@@ -128,8 +253,28 @@ int runRender(const RenderArgs& a) {
         a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
         methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
         humanCount(stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0).c_str());
+    if (stats.batch) {
+      const BatchStats& b = *stats.batch;
+      std::printf(
+          "  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), %s "
+          "rendered\n",
+          (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
+          humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
+          humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
+          humanCount(double(b.pointsRendered)).c_str());
+    }
   }
   return 0;
+}
+
+// "  name  description" per point method, from the method table.
+std::string methodList() {
+  std::string list;
+  for (const MethodInfo& m : methodTable()) {
+    std::string name = m.name;
+    list += "  " + name + std::string(name.size() < 16 ? 16 - name.size() : 1, ' ') + m.description + "\n";
+  }
+  return list;
 }
 
 } // namespace
@@ -144,11 +289,19 @@ Command addRender(CLI::App& app) {
       "35 degrees above the horizon, z up, as close as keeps the whole bounding box in the image.\n"
       "Coordinates of --eye/--target are in the file's own units (after LAS scale/offset).\n"
       "The GPU time is the median over --frames frames of clear + draw + resolve, from timestamp queries.\n\n"
-      "Examples:\n"
+      "Point methods (--method):\n" +
+      methodList() +
+      "\nExamples:\n"
       "  pointrast render -o demo.png\n"
       "  pointrast render autzen.las -o a.png --json\n"
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
-      "  pointrast render terrain --points 100M --order morton -o t.png --frames 50");
+      "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
+      "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
+      "Spheres (particles): --method sphere-compute with an MMPLD file, a particle scene (" +
+      std::string(kParticleSceneNames) +
+      ") or points and --radius:\n"
+      "  pointrast render particles-drops --points 10M --method sphere-compute -o d.png\n"
+      "  pointrast render md.mmpld --method sphere-compute --layout soa8 -o md.png --json");
   cmd->add_option("FILE", a->input, "LAS/PLY/XYZ file, or a scene name (terrain, tls)");
   cmd->add_option("-o,--output", a->output, "PNG to write")->required();
   cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
@@ -171,12 +324,22 @@ Command addRender(CLI::App& app) {
          "Depth encoding of the atomic methods: float (32-bit linear depth) or int40 (40-bit integer "
          "computed in double precision)")
       ->capture_default_str();
+  cmd->add_option("--precision", a->precision,
+                  "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
+                  "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
+      ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
       ->capture_default_str();
   cmd->add_option("--frames", a->frames, "Timed frames; the median GPU time is reported")
       ->capture_default_str();
   cmd->add_option("--parts", a->parts, "Upload the cloud as N separate scenes drawn into one framebuffer")
+      ->capture_default_str();
+  cmd->add_option("--radius", a->radius,
+                  "Sphere methods: radius of points drawn as spheres, or replacing an MMPLD file's radii");
+  cmd->add_option("--frame", a->frame, "Sphere methods: the MMPLD frame to draw")->capture_default_str();
+  cmd->add_option("--layout", a->layout,
+                  "Sphere methods: GPU particle layout soa8, vec4x2, aos, xyz, or auto")
       ->capture_default_str();
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");

@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "base/error.h"
+#include "bench/suites.h"
 
 namespace pointrast::bench {
 
@@ -174,6 +175,16 @@ nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   j["copy_gb_per_s"] = run.copy.bytesPerSecond * 1e-9;
   if (!run.deviceFault.empty()) j["device_fault"] = run.deviceFault;
   j["copy_fraction"] = r.copyFraction;
+  if (r.stats.batch) {
+    const BatchStats& b = *r.stats.batch;
+    j["batch_stats"] = {{"batches_processed", b.batchesProcessed},
+                        {"batches_rendered", b.batchesRendered},
+                        {"points_processed", b.pointsProcessed},
+                        {"points_rendered", b.pointsRendered},
+                        {"points_blended", b.pointsBlended},
+                        {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
+                        {"bytes_read", b.bytesRead}};
+  }
   j["camera"] = r.camera;
   return j;
 }
@@ -269,6 +280,11 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
     md << "\n";
     for (const DatasetOutcome* d : datasets) {
       for (Order o : c.orders) {
+        // A data set measured in fewer orders or views than the run (a suite's choice) has no row here.
+        bool any = false;
+        for (Method m : c.methods)
+          any = any || index.find(d->dataset.name, o, view, m);
+        if (!any) continue;
         md << "| " << mdCell(d->dataset.label) << " | " << orderName(o) << " |";
         for (Method m : c.methods) {
           const Result* r = index.find(d->dataset.name, o, view, m);
@@ -290,10 +306,54 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
     md << "## " << viewName(bandwidthView) << ": effective bandwidth, % of copy bandwidth\n\n";
     md << "Effective bandwidth = points x bytes of point data the method must read per point / median time. "
           "Bytes per point:";
-    for (size_t k = 0; k < c.methods.size(); ++k)
-      md << (k ? ", " : " ") << methodName(c.methods[k]) << " " << methodInfo(c.methods[k]).bytesPerPoint;
-    md << ".\n\n";
+    bool batched = false;
+    for (size_t k = 0; k < c.methods.size(); ++k) {
+      const MethodInfo& m = methodInfo(c.methods[k]);
+      md << (k ? ", " : " ") << m.name << " "
+         << (m.layout == SceneLayout::Batched ? "*" : std::to_string(m.bytesPerPoint));
+      batched = batched || m.layout == SceneLayout::Batched;
+    }
+    md << ".";
+    if (batched)
+      md << " *: the bytes the frame read, from the batch statistics: 4 per coordinate word of each point "
+            "processed, 32 per batch's bounds; batch-hqs reads both twice (depth and blending pass) and the "
+            "color of each blended point.";
+    md << "\n\n";
     table(bandwidthView, [](const Result& r) { return printf1("%.0f%%", r.copyFraction * 100); });
+  }
+
+  // The 2022 paper's Table 2: what the batch methods processed and rendered, per frame.
+  bool batchStats = false;
+  for (const Result& r : run.results)
+    batchStats = batchStats || (r.ok() && r.stats.batch);
+  if (batchStats) {
+    md << "## Batch statistics per frame (the 2022 paper's Table 2)\n\n";
+    md << "Batches of 10,240 points: processed (all), rendered (not culled); points processed (in rendered "
+          "batches) and how many coordinate words they needed; points rendered (passed early-z and did the "
+          "atomic); batch-hqs: points blended.\n\n";
+    md << "| data set | order | view | method | batches | rendered | points processed | 1 / 2 / 3 words | "
+          "points rendered | blended | ms |\n";
+    md << "| --- | --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    auto count = [](uint64_t n) { return shortCount(n); };
+    for (const DatasetOutcome* d : datasets)
+      for (Order o : c.orders)
+        for (View v : c.views)
+          for (Method m : c.methods) {
+            const Result* r = index.find(d->dataset.name, o, v, m);
+            if (!r || !r->ok() || !r->stats.batch) continue;
+            const BatchStats& b = *r->stats.batch;
+            auto share = [&](uint64_t n) {
+              return b.pointsProcessed ? printf1("%.0f%%", 100.0 * double(n) / double(b.pointsProcessed))
+                                       : std::string("-");
+            };
+            md << "| " << mdCell(d->dataset.label) << " | " << orderName(o) << " | " << viewName(v) << " | "
+               << methodName(m) << " | " << b.batchesProcessed << " | " << b.batchesRendered << " | "
+               << count(b.pointsProcessed) << " | " << share(b.pointsByWords[0]) << " / "
+               << share(b.pointsByWords[1]) << " / " << share(b.pointsByWords[2]) << " | "
+               << count(b.pointsRendered) << " | " << (m == Method::BatchHqs ? count(b.pointsBlended) : "-")
+               << " | " << formatMs(r->stats.medianMs) << " |\n";
+          }
+    md << "\n";
   }
 
   md << "## Data sets\n\n";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <unistd.h>
 
@@ -33,6 +34,13 @@ uint64_t expectedPoints(const Dataset& d) {
   return d.file ? io::probeFile(d.source).pointCount : d.points;
 }
 
+const std::vector<Order>& ordersOf(const Dataset& d, const BenchConfig& c) {
+  return d.orders.empty() ? c.orders : d.orders;
+}
+const std::vector<View>& viewsOf(const Dataset& d, const BenchConfig& c) {
+  return d.views.empty() ? c.views : d.views;
+}
+
 // Parallel gather in fixed blocks (as everywhere in src/cloud), so it costs a fraction of the sort.
 constexpr uint64_t kGatherBlock = uint64_t(1) << 16;
 
@@ -58,9 +66,25 @@ std::string MemoryEstimate::describe() const {
          bytesText(hostBytes) + " of host memory (machine has " + bytesText(hostHave) + ")";
 }
 
-MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height) {
+std::vector<SceneLayout> layoutsOf(const std::vector<Method>& methods) {
+  std::vector<SceneLayout> layouts;
+  for (SceneLayout layout : {SceneLayout::Float, SceneLayout::Batched})
+    for (Method m : methods)
+      if (methodInfo(m).layout == layout) {
+        layouts.push_back(layout);
+        break;
+      }
+  return layouts;
+}
+
+MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height,
+                              const std::vector<Method>& methods) {
   MemoryEstimate m;
-  m.gpuBytes = points * 16 + uint64_t(width) * height * kTargetBytesPerPixel;
+  m.gpuBytes = uint64_t(width) * height * kTargetBytesPerPixel;
+  std::vector<SceneLayout> layouts = layoutsOf(methods);
+  if (layouts.empty()) layouts.push_back(SceneLayout::Float);
+  for (SceneLayout layout : layouts)
+    m.gpuBytes += sceneBytes(layout, points);
   m.hostBytes = points * kHostBytesPerPoint;
   if (context.info().software()) m.hostBytes += m.gpuBytes;
   m.gpuHave = context.deviceLocalBytes();
@@ -131,7 +155,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
     DatasetOutcome outcome;
     outcome.dataset = d;
     outcome.points = expectedPoints(d);
-    outcome.memory = estimateMemory(context, outcome.points, config.width, config.height);
+    outcome.memory = estimateMemory(context, outcome.points, config.width, config.height, config.methods);
     if (outcome.points == 0) {
       outcome.skipped = true;
       outcome.reason = "it has no points";
@@ -140,7 +164,8 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       outcome.reason = "it does not fit: " + outcome.memory.describe();
     }
     note(d.label + ": " + (outcome.skipped ? "skipped, " + outcome.reason : outcome.memory.describe()));
-    if (!outcome.skipped) total += config.orders.size() * config.views.size() * config.methods.size();
+    if (!outcome.skipped)
+      total += ordersOf(d, config).size() * viewsOf(d, config).size() * config.methods.size();
     run.datasets.push_back(std::move(outcome));
   }
 
@@ -169,24 +194,29 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       outcome.points = cloud.size();
       outcome.description = cloud.source;
       note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince()));
-      for (Order order : config.orders) {
+      for (Order order : ordersOf(d, config)) {
         since = std::chrono::steady_clock::now();
-        std::unique_ptr<GpuScene> scene;
-        std::string failure;
+        // One scene per layout the methods read (a suite mixing 2021 and batch methods holds both).
+        std::map<SceneLayout, std::unique_ptr<GpuScene>> scenes;
+        std::map<SceneLayout, std::string> failures;
         {
           PointCloud ordered;
           if (order != Order::Original) ordered = reorderedCopy(cloud, order, config.orderSeed);
-          UploadOptions upload;
-          upload.progress = config.progress;
-          try {
-            scene = std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
-          } catch (const UnsupportedError& e) {
-            failure = e.what(); // out of device memory after all: every combination says so
+          for (SceneLayout layout : layoutsOf(config.methods)) {
+            UploadOptions upload;
+            upload.layout = layout;
+            upload.progress = config.progress;
+            try {
+              scenes[layout] =
+                  std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
+            } catch (const UnsupportedError& e) {
+              failures[layout] = e.what(); // out of device memory after all: every combination says so
+            }
           }
         } // the reordered host copy is freed here, before the GPU work
         note(d.label + " / " + orderName(order) + ": ordered and uploaded in " +
              printf1("%.1f s", secondsSince()));
-        for (View view : config.views) {
+        for (View view : viewsOf(d, config)) {
           const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
           for (Method method : config.methods) {
             Result r;
@@ -198,9 +228,10 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
             r.bytesPerPoint = methodInfo(method).bytesPerPoint;
             r.camera = describeCamera(camera);
             std::string why;
-            if (!failure.empty()) {
+            const SceneLayout layout = methodInfo(method).layout;
+            if (!scenes[layout]) {
               r.status = "unsupported";
-              r.reason = failure;
+              r.reason = failures[layout];
             } else if (!Renderer::supports(context, method, &why)) {
               r.status = "unsupported";
               r.reason = why;
@@ -210,8 +241,11 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
               settings.frames = config.frames;
               settings.warmup = run.warmup;
               try {
-                r.stats = renderer.render(*scene, camera, settings);
+                r.stats = renderer.render(*scenes[layout], camera, settings);
               } catch (const UnsupportedError& e) {
+                r.status = "unsupported";
+                r.reason = e.what();
+              } catch (const InputError& e) { // a scene beyond what the method addresses (4.29 G points)
                 r.status = "unsupported";
                 r.reason = e.what();
               } catch (const DeviceFault& e) {
@@ -226,7 +260,9 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
             if (r.ok() && r.stats.medianMs > 0) {
               const double seconds = r.stats.medianMs * 1e-3;
               r.pointsPerSecond = double(r.stats.points) / seconds;
-              r.effectiveBytesPerSecond = double(r.stats.points) * r.bytesPerPoint / seconds;
+              r.effectiveBytesPerSecond = (r.stats.batch ? double(r.stats.batch->bytesRead)
+                                                         : double(r.stats.points) * r.bytesPerPoint) /
+                                          seconds;
               r.copyFraction =
                   run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
             }

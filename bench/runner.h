@@ -4,7 +4,9 @@
 //
 // Memory: the host holds the data set in its original order (16 B/point: positions and display colors;
 // a file's other attributes are dropped once its colors are decided) plus one reordered copy and its
-// permutation (8 B/point) while that order is uploaded; the GPU holds one order of one data set at a time.
+// permutation (8 B/point) while that order is uploaded; the GPU holds one order of one data set at a time,
+// in each scene layout a method of the run reads (float for the 2019/2021 methods, batched for the 2022
+// batch methods: 16 B/point each).
 #pragma once
 
 #include <cstdint>
@@ -27,6 +29,10 @@ struct Dataset {
   uint64_t points = 0; // points to generate (scenes); ignored for files
   uint64_t seed = 1;   // scene seed
   bool file = false;   // source is a file
+  // The orders and views measured for this data set; empty: those of the BenchConfig (a suite measures
+  // some of its data sets in more orders or views than others).
+  std::vector<Order> orders;
+  std::vector<View> views;
 };
 
 struct BenchConfig {
@@ -50,8 +56,8 @@ std::string bytesText(uint64_t bytes);
 uint32_t warmupFrames(uint32_t frames);
 
 // Bytes per pixel of the render targets of every method a Renderer may hold at once: framebuffer (8),
-// image (4), canonical words (8), HQS accumulators (16) and HQS1R's (24), rounded up.
-constexpr uint64_t kTargetBytesPerPixel = 64;
+// image (4), canonical words (8), HQS accumulators (16), HQS1R's (24) and batch-hqs's (24), rounded up.
+constexpr uint64_t kTargetBytesPerPixel = 88;
 // Host bytes per point: the original (16 B) + a reordered copy (16 B) + its permutation (8 B).
 constexpr uint64_t kHostBytesPerPoint = 40;
 
@@ -61,9 +67,12 @@ struct MemoryEstimate {
   bool fits() const { return gpuBytes <= gpuHave && hostBytes <= hostHave; }
   std::string describe() const; // "needs 12.7 GB of GPU memory (has 80.0 GB) and ..."
 };
-// GPU: points x 16 B + targets; host: points x 40 B, plus the GPU bytes on a software device (its
-// "device memory" is host memory).
-MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height);
+// GPU: points x 16 B in every layout the methods read (float when `methods` is empty) + targets; host:
+// points x 40 B, plus the GPU bytes on a software device (its "device memory" is host memory).
+MemoryEstimate estimateMemory(const gpu::Context& context, uint64_t points, uint32_t width, uint32_t height,
+                              const std::vector<Method>& methods = {});
+// The scene layouts `methods` read, each once, float first.
+std::vector<SceneLayout> layoutsOf(const std::vector<Method>& methods);
 
 struct Result {
   std::string dataset; // Dataset::name
@@ -76,7 +85,8 @@ struct Result {
   FrameStats stats;
   uint32_t bytesPerPoint = 0;
   double pointsPerSecond = 0;
-  double effectiveBytesPerSecond = 0; // points x bytesPerPoint / median time
+  double effectiveBytesPerSecond = 0; // points x bytesPerPoint / median time; batch methods: the bytes
+                                      // the frame read (FrameStats::batch) / median time
   double copyFraction = 0;            // effectiveBytesPerSecond / copy bandwidth (read + write)
   std::string camera;                 // describeCamera(), to reproduce the view with `pointrast render`
   bool ok() const { return status == "ok"; }

@@ -21,7 +21,34 @@ constexpr SuiteEntry kPaper2021[] = {
     {"endeavor", Scene::Tls, 796'000'000, "Space Shuttle Endeavour, terrestrial laser scans"},
 };
 
+// The 2022 paper's data sets by size (its Table 1 and 2: 69 M, 279 M, 529 M seen from outside and from
+// inside, 1,000 M; rendered at 2560 x 1140), in Morton order as the paper stores them; and a generated
+// laser scan in its scan order and in Morton order (the paper's section on vertex order: batches of
+// consecutive points in scan order are long strips, so fewer of them are culled or get by on few words).
+// Generators as for paper2021: laser scans of objects and buildings -> tls, aerial surveys -> terrain.
+constexpr SuiteEntry kPaper2022[] = {
+    {"scan69m", Scene::Tls, 69'000'000, "a 69 M point terrestrial laser scan"},
+    {"aerial279m", Scene::Terrain, 279'000'000, "a 279 M point aerial survey"},
+    {"scan529m", Scene::Tls, 529'000'000, "a 529 M point laser scan, seen from outside and inside", true},
+    {"aerial1g", Scene::Terrain, 1'000'000'000, "a 1,000 M point aerial survey"},
+    {"tls-order", Scene::Tls, 100'000'000, "a generated laser scan in scan order and in Morton order", true,
+     true},
+};
+
 constexpr uint64_t kMinScaledPoints = 1000;
+
+std::span<const SuiteEntry> entriesOf(std::string_view suite) {
+  if (suite == "paper2021") return kPaper2021;
+  if (suite == "paper2022") return kPaper2022;
+  throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021 or paper2022");
+}
+
+std::string entryNames(std::span<const SuiteEntry> entries) {
+  std::string names;
+  for (const SuiteEntry& e : entries)
+    names += (names.empty() ? "" : ", ") + std::string(e.name);
+  return names;
+}
 
 } // namespace
 
@@ -29,8 +56,27 @@ std::span<const SuiteEntry> paper2021Suite() {
   return kPaper2021;
 }
 
+std::span<const SuiteEntry> paper2022Suite() {
+  return kPaper2022;
+}
+
 std::vector<std::string> suiteNames() {
-  return {"paper2021"};
+  return {"paper2021", "paper2022"};
+}
+
+SuiteDefaults suiteDefaults(std::string_view suite) {
+  entriesOf(suite); // throws for an unknown name
+  SuiteDefaults d;
+  if (suite == "paper2022") {
+    // The paper's comparison: the hardware baseline, its three methods, and the best 2021 methods.
+    d.methods = {Method::HwPoints, Method::Batch, Method::BatchPrefetch,
+                 Method::BatchHqs, Method::Dedup, Method::Hqs};
+    d.orders = {Order::Morton, Order::Original};
+    d.views = {View::Overview, View::Closeup};
+    d.width = 2560;
+    d.height = 1140;
+  }
+  return d;
 }
 
 std::string shortCount(uint64_t points) {
@@ -55,39 +101,49 @@ std::string shortCount(uint64_t points) {
 
 std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_t seed,
                                    const std::vector<std::string>& replacements) {
-  if (suite != "paper2021") throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021");
+  const std::span<const SuiteEntry> entries = entriesOf(suite);
+  const bool paper2022 = suite == "paper2022";
   if (!(scale > 0) || !std::isfinite(scale)) throw InputError("--scale must be a positive number");
   std::vector<Dataset> datasets;
-  for (const SuiteEntry& e : kPaper2021) {
+  for (const SuiteEntry& e : entries) {
     Dataset d;
     d.source = sceneName(e.scene);
     d.seed = seed;
     d.points = std::max<uint64_t>(kMinScaledPoints, uint64_t(std::llround(double(e.points) * scale)));
-    d.name = std::string(e.name) + "-like";
+    d.name = std::string(e.name) + (e.scanOrder ? "" : "-like");
     d.label = d.name + " (" + sceneName(e.scene) + ", " + shortCount(d.points) + ")";
+    if (paper2022) {
+      d.orders = e.scanOrder ? std::vector<Order>{Order::Original, Order::Morton}
+                             : std::vector<Order>{Order::Morton};
+      d.views =
+          e.inside ? std::vector<View>{View::Overview, View::Closeup} : std::vector<View>{View::Overview};
+    }
     datasets.push_back(d);
   }
   for (const std::string& item : replacements) {
     size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      throw InputError("'" + item +
-                       "': with --suite, a file replaces a stand-in as NAME=PATH (names: "
-                       "banyunibo, eclepens, retz, endeavor)");
+      throw InputError("'" + item + "': with --suite, a file replaces a stand-in as NAME=PATH (names: " +
+                       entryNames(entries) + ")");
     std::string name = item.substr(0, eq), path = item.substr(eq + 1);
     bool found = false;
     for (size_t k = 0; k < datasets.size(); ++k) {
-      if (name != kPaper2021[k].name && name != datasets[k].name) continue;
+      if (name != entries[k].name && name != datasets[k].name) continue;
       Dataset& d = datasets[k];
+      const std::vector<Order> orders = d.orders;
+      const std::vector<View> views = d.views;
       d = Dataset{};
       d.source = path;
       d.file = true;
-      d.name = kPaper2021[k].name;
+      d.orders = orders;
+      d.views = views;
+      d.name = entries[k].name;
       d.label = d.name + " (" + std::filesystem::path(path).filename().string() + ")";
       found = true;
     }
     if (!found)
-      throw InputError("'" + name +
-                       "' is no data set of suite paper2021 (banyunibo, eclepens, retz, endeavor)");
+      throw InputError("'" + name + "' is no data set of suite " + std::string(suite) + " (" +
+                       entryNames(entries) + ")");
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such file");
   }

@@ -1,6 +1,8 @@
 // Named benchmark suites. `paper2021` stands in for the data sets of "Rendering Point Clouds with
 // Compute Shaders and Vertex Order Optimization" (Schuetz, Kerbl, Wimmer, EGSR 2021) with generated
-// scenes of the same sizes; see suites.cpp for which generator stands in for which data set and why.
+// scenes of the same sizes; `paper2022` for those of "Software Rasterization of 2 Billion Points in Real
+// Time" (Schuetz, Kerbl, Wimmer, HPG 2022), plus its scan order vs Morton order study; see suites.cpp for
+// which generator stands in for which data set and why.
 #pragma once
 
 #include <cstdint>
@@ -19,15 +21,31 @@ struct SuiteEntry {
   Scene scene;          // the generator that stands in for it
   uint64_t points;      // the paper's size
   const char* acquired; // how the original was acquired, the reason for the generator
+  // paper2022: measured from inside (the closeup view) as well as the overview, and in the original (scan)
+  // order as well as Morton order. paper2021 measures every data set in every order and view.
+  bool inside = false;
+  bool scanOrder = false;
 };
 
 std::span<const SuiteEntry> paper2021Suite();
+std::span<const SuiteEntry> paper2022Suite();
 std::vector<std::string> suiteNames();
 
+// What a suite measures besides its data sets; the CLI takes these where no option says otherwise.
+// Empty lists: every method, order or view.
+struct SuiteDefaults {
+  std::vector<Method> methods; // the columns of its tables
+  std::vector<Order> orders;   // every order some data set is measured in
+  std::vector<View> views;
+  uint32_t width = 1920, height = 1080;
+};
+// Throws InputError for an unknown suite.
+SuiteDefaults suiteDefaults(std::string_view suite);
+
 // The data sets of a suite with every size multiplied by `scale` (a quick smoke run: 0.001 gives
-// 4 k .. 796 k points; at least 1000 points each). `replacements` are "NAME=PATH" items: the file at
-// PATH replaces the stand-in NAME at its own size. Throws InputError for an unknown suite, a bad scale
-// or a replacement naming no data set of the suite.
+// 4 k .. 796 k points for paper2021; at least 1000 points each); paper2022's carry their orders and views.
+// `replacements` are "NAME=PATH" items: the file at PATH replaces the stand-in NAME at its own size. Throws
+// InputError for an unknown suite, a bad scale or a replacement naming no data set of the suite.
 std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_t seed,
                                    const std::vector<std::string>& replacements = {});
 

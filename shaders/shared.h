@@ -94,6 +94,158 @@ PR_CONST kEmptyDepthBits = 0x7FFFFFFFu; // above every finite positive float
 // below 2^16, so a pixel stays exact up to 255 points; later points go to 32-bit fallback sums.
 PR_CONST kHqs1rMaxCount = 255;
 
+// ------------------------------------------------------------------------------------------------------
+// The 2022 batched rasterizer: Schuetz, Kerbl, Wimmer, "Software Rasterization of 2 Billion Points in Real
+// Time" (2022). One workgroup per batch of consecutive points; per-batch frustum culling and coordinate
+// precision; a visibility buffer (depth << 32 | point index) resolved to colors afterwards.
+// ------------------------------------------------------------------------------------------------------
+
+// 128 threads x 80 points = 10240 points per batch (src/cloud/batch.h: kBatchSize).
+PR_CONST kBatchPointsPerThread = 80;
+PR_CONST kBatchPoints = kPointGroupSize * kBatchPointsPerThread;
+// batch-prefetch: a thread loads the words of 4 consecutive points with one 128-bit load; 80 / 4 steps.
+PR_CONST kBatchPrefetchSteps = kBatchPointsPerThread / 4;
+// Quantized coordinates: 30 bits per axis relative to the batch bounds, 10 bits of each axis per word
+// (src/cloud/batch_words.h); 2^30 - 1 is the largest.
+PR_CONST kBatchWordBits = 10;
+PR_CONST kBatchCoordinateMax = 0x3FFFFFFFu;
+
+// Visibility index of a point: part << 26 | index of the point in its part, parts numbered over all
+// scenes of a frame. A part holds at most 6553 batches x 10240 = 67,102,720 points < 2^26, and a frame at
+// most 64 parts: 64 x 2^26 = 2^32 indices, 4.29 billion points per frame.
+PR_CONST kVisibilityPartShift = 26;
+PR_CONST kVisibilityLocalMask = 0x3FFFFFFu; // 2^26 - 1
+PR_CONST kMaxPartBatches = 6553;
+PR_CONST kMaxVisibilityParts = 64;
+
+// Frame statistics: kBatchStatSlots rows of kBatchStatCount uint64 counters. A workgroup reduces its
+// counts and adds them to row (workgroup id % 64), so 64 addresses share the atomics instead of one; the
+// host sums the rows after the frame.
+PR_CONST kBatchStatSlots = 64;
+PR_CONST kBatchStatCount = 8;
+PR_CONST kStatBatchesProcessed = 0; // workgroups that ran (every batch of every part)
+PR_CONST kStatBatchesRendered = 1;  // batches not culled
+PR_CONST kStatPointsRendered = 2;   // points that passed early-z and did the atomicMin
+PR_CONST kStatPointsBlended = 3;    // batch-hqs: points blended into their pixel (within 1 % of closest)
+PR_CONST kStatPointsOneWord = 4;    // points of rendered batches decoded from 1, 2, 3 words; their sum
+PR_CONST kStatPointsTwoWords = 5;   // is the number of points processed
+PR_CONST kStatPointsThreeWords = 6;
+
+// Bounds of one batch relative to the scene origin, rounded once to float from the exact (double) bounds
+// its points were quantized in. w is unused.
+struct BatchBounds {
+  vec4 min;
+  vec4 max;
+};
+
+// What every batch pass reads about the frame. Copied into a device buffer at the start of each frame
+// (it outgrows push constants), read through BatchPush::frame.
+struct BatchFrame {
+  uint64_t framebuffer;  // uint64_t per pixel: floatBits(depth) << 32 | visibility index; ones = empty
+  uint64_t stats;        // uint64_t[kBatchStatSlots][kBatchStatCount]
+  uint64_t accumulators; // batch-hqs: 1 packed + 2 fallback uint64_t per pixel, as hqs1r
+  uint width;
+  uint height;
+  uint forcedWords; // 0: adaptive precision; 1..3: every batch decodes from this many words
+  uint culling;     // 1: frustum culling; 0 (a debug setting): every batch is drawn
+  uint64_t partColors[kMaxVisibilityParts]; // RGBA8 colors of visibility part p (the resolve's table)
+};
+
+// Push constants of the batch passes: one dispatch draws one part, one workgroup per batch.
+struct BatchPush {
+  mat4 viewProj;   // world-relative-to-origin -> clip; only rows x, y, w are used
+  uint64_t high;   // uint per point: bits 29..20 of x | y << 10 | z << 20; padded to a multiple of 4
+  uint64_t medium; // bits 19..10, same layout and padding
+  uint64_t low;    // bits 9..0
+  uint64_t bounds; // BatchBounds per batch
+  uint64_t colors; // uint per point, RGBA8 (read by batch-hqs for blended points only)
+  uint64_t frame;  // BatchFrame
+  uint pointCount; // points of the part
+  float nearW;     // points with c.w <= nearW are dropped
+  uint part;       // visibility part number of this part
+  uint reserved;
+};
+
+// ------------------------------------------------------------------------------------------------------
+// Spheres (particle sets): Gralka et al., "Efficient Sphere Rendering Revisited" (2023), ray-cast sphere
+// impostors; sphere-compute rasterizes them in compute into the visibility-buffer word of the 2022 paper.
+// ------------------------------------------------------------------------------------------------------
+
+// GPU layouts of a particle part (one buffer each, named as in the 2023 study). `n` is the part's count.
+//   soa8    8 float streams of n: x, y, z, r, R, G, B, A (color in [0, 1]), stream k at byte k * 4n
+//   vec4x2  vec4 (x, y, z, r)[n], then vec4 (R, G, B, A)[n] at byte 16n
+//   aos     { vec3 xyz; uint rgba8; }[n], 16 B; one global radius
+//   xyz     float[3n]; one global radius and one global color
+PR_CONST kSphereLayoutSoa8 = 0;
+PR_CONST kSphereLayoutVec4x2 = 1;
+PR_CONST kSphereLayoutAos = 2;
+PR_CONST kSphereLayoutXyz = 3;
+
+// Threads per workgroup of the per-sphere pass: one sphere per thread, as wide as the point kernels.
+PR_CONST kSphereGroupSize = 128;
+// A sphere whose clamped pixel box has at most 64 pixels (8 x 8) is ray-tested by its own thread; a larger
+// one is cut into chunks for the large-sphere pass, so that a close-up does not serialize on one thread.
+PR_CONST kSphereSmallPixels = 64;
+// Large-sphere chunks: 256 consecutive pixels of the sphere's box in row-major order, one pixel per thread
+// of a 256-thread workgroup. Linear chunks waste at most one partial chunk per sphere (square tiles would
+// waste most of a tile on every sphere just above the small limit), and read framebuffer rows in order.
+PR_CONST kSphereChunkPixels = 256;
+
+// Particle index of a pixel (or impostor) without a sphere.
+PR_CONST kNoParticle = 0xFFFFFFFFu;
+
+// Primitive of the rasterization sphere pipelines' quad vertex shader (sphere_quads.vert.glsl).
+PR_CONST kSphereQuadTriangles = 0; // 6 vertices per sphere, triangle list
+PR_CONST kSphereQuadStrip = 1;     // one instance per sphere, a 4-vertex triangle strip
+
+// Shading of every sphere pipeline (sphere_shade.inc.glsl, and the CPU ray caster): a headlight (light
+// at the eye), color * (ambient + diffuse * max(dot(normal, toEye), 0)); 0.25 + 0.75 = 1 where the
+// surface faces the eye.
+#define PR_SPHERE_AMBIENT 0.25
+#define PR_SPHERE_DIFFUSE 0.75
+
+// What every sphere pass reads about the frame: camera, targets and particle set constants. Lives in a
+// small host-visible buffer (referenced by address from SpherePush), since it outgrows 128 B of push
+// constants. Camera: view space is right-handed, looking down -z; the linear view depth is -z.
+struct SphereFrame {
+  mat4 view;            // world relative to the particles' origin -> view space
+  vec4 pixelToRay;      // (sx, ox, sy, oy): the view ray through pixel position (x, y) (pixel centers at
+                        // +0.5, row 0 at the top) is (x * sx + ox, y * sy + oy, -1); its t is view depth
+  uint64_t framebuffer; // uint64_t per pixel: floatBits(view depth) << 32 | particle index; ones = empty
+  uint64_t chunks;      // SphereChunks list of the large-sphere pass
+  uint64_t parts;       // SpherePartRef[] of the particle set: particle i is in part i / partCapacity
+  uint64_t image;       // uint[width * height] RGBA8, row 0 = top
+  uint width;
+  uint height;
+  float nearW;          // spheres not entirely beyond this view depth (center depth - radius <= nearW) are
+                        // culled, like points with c.w <= nearW
+  float globalRadius;   // aos and xyz layouts
+  uint globalColor;     // xyz layout (RGBA8)
+  uint partCapacity;    // particles per part; every part but the last holds exactly this many
+  uint chunkCapacity;   // entries the chunk list holds
+  uint background;      // RGBA8 written where no sphere covers the pixel center
+  uint64_t counters;    // uint[4] statistics of the frame: [0] spheres whose point size was clamped
+  float maxPointSize;   // sphere-points: the device's largest point size
+  uint reserved;
+};
+
+// One part of a particle set on the GPU, as the resolve and large-sphere passes find it by index.
+struct SpherePartRef {
+  uint64_t address; // the part's buffer (layout above)
+  uint count;
+  uint reserved;
+};
+
+// Push constants of every sphere compute pass.
+struct SpherePush {
+  uint64_t frame;     // SphereFrame
+  uint64_t particles; // the part drawn by this dispatch (per-sphere pass)
+  uint first;         // global index of the part's first particle
+  uint count;         // particles in the part
+  uint groupsX;       // workgroups per row of a 2D dispatch; the large-sphere pass: workgroups in all
+  uint reserved;
+};
+
 PR_NAMESPACE_END
 
 #endif

@@ -13,10 +13,13 @@ namespace pointrast {
 constexpr uint64_t kBatchSize = 10240;
 
 struct Batch {
-  uint64_t first = 0;  // index of the first point
-  uint32_t count = 0;  // points in the batch, <= batchSize
-  Bounds bounds;       // world bounds of exactly these points
+  uint64_t first = 0; // index of the first point
+  uint32_t count = 0; // points in the batch, <= batchSize
+  Bounds bounds;      // world bounds of exactly these points
 };
+
+// The batch of points [first, first + count) with its bounds. Precondition: the range is in the cloud.
+Batch makeBatch(const PointCloud& cloud, uint64_t first, uint32_t count);
 
 // Cuts [0, cloud.size()) into batches of batchSize consecutive points (the last may be shorter).
 std::vector<Batch> makeBatches(const PointCloud& cloud, uint64_t batchSize = kBatchSize);

@@ -316,6 +316,7 @@ void Context::createDevice() {
   want.features.vertexPipelineStoresAndAtomics = has.features.vertexPipelineStoresAndAtomics;
   want.features.fragmentStoresAndAtomics = has.features.fragmentStoresAndAtomics;
   want.features.largePoints = has.features.largePoints;
+  want.features.geometryShader = has.features.geometryShader;
 
   uint32_t extensionCount = 0;
   VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, nullptr));
@@ -329,6 +330,9 @@ void Context::createDevice() {
   std::vector<const char*> enabled;
   features_.float64 = has.features.shaderFloat64;
   features_.subgroupExtendedTypes = has12.shaderSubgroupExtendedTypes;
+  features_.geometryShader = has.features.geometryShader;
+  features_.largePoints = has.features.largePoints;
+  features_.vertexStores = has.features.vertexPipelineStoresAndAtomics;
   if (partitioned && hasExtension(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME)) {
     enabled.push_back(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME);
     features_.subgroupPartitionedNV = true;

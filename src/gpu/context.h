@@ -38,6 +38,9 @@ struct DeviceFeatures {
   bool subgroupCompute = false;       // vote, ballot, shuffle and arithmetic in compute shaders
   bool subgroupExtendedTypes = false; // 64-bit integers in subgroup operations
   bool subgroupPartitionedNV = false; // VK_NV_shader_subgroup_partitioned
+  bool geometryShader = false;        // geometry shaders (sphere-geom)
+  bool largePoints = false;           // points larger than one pixel (sphere-points)
+  bool vertexStores = false;          // vertexPipelineStoresAndAtomics (sphere-points counts clamped sizes)
 };
 
 class Context {

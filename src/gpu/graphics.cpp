@@ -25,38 +25,61 @@ VkShaderModule createModule(VkDevice device, std::span<const uint32_t> words) {
 GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShader,
                                  const std::string& fragmentShader, const GraphicsOptions& options)
     : device_(context.device()), options_(options) {
-  std::span<const uint32_t> vertexWords = findShader(vertexShader);
-  std::span<const uint32_t> fragmentWords = findShader(fragmentShader);
-  SpirvReflection vertex = reflectSpirv(vertexWords);
-  SpirvReflection fragment = reflectSpirv(fragmentWords);
-  // Both stages see the same block from offset 0 (one struct from shared.h), or a stage declares none.
-  assert((vertex.pushConstantSize == 0 || fragment.pushConstantSize == 0 ||
-          vertex.pushConstantSize == fragment.pushConstantSize) &&
-         "vertex and fragment shaders declare different push-constant blocks");
+  bool geometry = !options.geometryShader.empty();
+  // Stages in pipeline order: vertex, [geometry,] fragment.
+  std::vector<std::pair<VkShaderStageFlagBits, std::span<const uint32_t>>> sources = {
+      {VK_SHADER_STAGE_VERTEX_BIT, findShader(vertexShader)}};
+  if (geometry) sources.push_back({VK_SHADER_STAGE_GEOMETRY_BIT, findShader(options.geometryShader)});
+  sources.push_back({VK_SHADER_STAGE_FRAGMENT_BIT, findShader(fragmentShader)});
+  std::vector<SpirvReflection> reflections;
+  for (const auto& [stage, words] : sources) {
+    reflections.push_back(reflectSpirv(words));
+    uint32_t size = reflections.back().pushConstantSize;
+    // Every stage sees the same block from offset 0 (one struct from shared.h), or declares none.
+    assert((size == 0 || pushConstantSize_ == 0 || size == pushConstantSize_) &&
+           "the stages declare different push-constant blocks");
+    pushConstantSize_ = std::max(pushConstantSize_, size);
+    pushStages_ |= stage;
+  }
   // Without maintenance5 a point list rasterizes with an undefined size unless the last vertex stage
-  // writes gl_PointSize.
-  assert((options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST || vertex.usesPointSize) &&
+  // writes gl_PointSize (a geometry shader turns points into its own output primitives).
+  assert((options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST || geometry || reflections[0].usesPointSize) &&
          "a point-list pipeline needs a vertex shader that writes gl_PointSize");
-  pushConstantSize_ = std::max(vertex.pushConstantSize, fragment.pushConstantSize);
+  for (const SpecConstant& s : options.spec) {
+    assert(std::any_of(reflections.begin(), reflections.end(),
+                       [&](const SpirvReflection& r) {
+                         return std::find(r.specIds.begin(), r.specIds.end(), s.id) != r.specIds.end();
+                       }) &&
+           "specialization constant id not declared by any stage");
+    (void)s;
+  }
+  std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> values;
+  for (const SpecConstant& s : options.spec) {
+    entries.push_back({s.id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+    values.push_back(s.value);
+  }
+  VkSpecializationInfo specInfo{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
+                                values.data()};
 
-  VkShaderModule modules[2] = {createModule(device_, vertexWords), VK_NULL_HANDLE};
+  std::vector<VkShaderModule> modules;
   try {
-    modules[1] = createModule(device_, fragmentWords);
-    VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                              pushConstantSize_};
+    for (const auto& source : sources)
+      modules.push_back(createModule(device_, source.second));
+    VkPushConstantRange range{pushStages_, 0, pushConstantSize_};
     VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     layoutInfo.pushConstantRangeCount = range.size ? 1 : 0;
     layoutInfo.pPushConstantRanges = &range;
     VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
 
-    VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-                                                 {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
-    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-    stages[0].module = modules[0];
-    stages[0].pName = "main";
-    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-    stages[1].module = modules[1];
-    stages[1].pName = "main";
+    std::vector<VkPipelineShaderStageCreateInfo> stages(
+        sources.size(), {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO});
+    for (size_t i = 0; i < sources.size(); ++i) {
+      stages[i].stage = sources[i].first;
+      stages[i].module = modules[i];
+      stages[i].pName = "main";
+      stages[i].pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+    }
 
     VkPipelineVertexInputStateCreateInfo vertexInput{
         VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
@@ -78,24 +101,27 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
     depth.depthTestEnable = VK_TRUE;
     depth.depthWriteEnable = VK_TRUE;
     depth.depthCompareOp = options.depthCompare;
-    VkPipelineColorBlendAttachmentState blendAttachment{};
-    blendAttachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
-                                     VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    VkFormat colorFormats[2] = {options.colorFormat, options.secondColorFormat};
+    uint32_t colorCount = options.secondColorFormat == VK_FORMAT_UNDEFINED ? 1 : 2;
+    VkPipelineColorBlendAttachmentState blendAttachments[2] = {};
+    for (VkPipelineColorBlendAttachmentState& b : blendAttachments)
+      b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                         VK_COLOR_COMPONENT_A_BIT;
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = 1;
-    blend.pAttachments = &blendAttachment;
+    blend.attachmentCount = colorCount;
+    blend.pAttachments = blendAttachments;
     VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dynamic.dynamicStateCount = 2;
     dynamic.pDynamicStates = dynamicStates;
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    rendering.colorAttachmentCount = 1;
-    rendering.pColorAttachmentFormats = &options.colorFormat;
+    rendering.colorAttachmentCount = colorCount;
+    rendering.pColorAttachmentFormats = colorFormats;
     rendering.depthAttachmentFormat = options.depthFormat;
 
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &rendering};
-    info.stageCount = 2;
-    info.pStages = stages;
+    info.stageCount = uint32_t(stages.size());
+    info.pStages = stages.data();
     info.pVertexInputState = &vertexInput;
     info.pInputAssemblyState = &assembly;
     info.pViewportState = &viewport;
@@ -106,7 +132,8 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
     info.pDynamicState = &dynamic;
     info.layout = layout_;
     VK_CHECK(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
-    context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_), vertexShader + " + " + fragmentShader);
+    context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_),
+                    vertexShader + " + " + (geometry ? options.geometryShader + " + " : "") + fragmentShader);
   } catch (...) {
     for (VkShaderModule m : modules)
       if (m) vkDestroyShaderModule(device_, m, nullptr);
@@ -140,19 +167,18 @@ GraphicsProgram& GraphicsProgram::operator=(GraphicsProgram&& other) noexcept {
     layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
     pushConstantSize_ = other.pushConstantSize_;
+    pushStages_ = other.pushStages_;
     options_ = other.options_;
   }
   return *this;
 }
 
-void GraphicsProgram::drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, const void* push,
-                              uint32_t size) const {
-  if (vertexCount == 0) return;
+void GraphicsProgram::drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_t instanceCount,
+                              const void* push, uint32_t size) const {
+  if (vertexCount == 0 || instanceCount == 0) return;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-  if (size)
-    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, size,
-                       push);
-  vkCmdDraw(cmd, vertexCount, 1, 0, 0);
+  if (size) vkCmdPushConstants(cmd, layout_, pushStages_, 0, size, push);
+  vkCmdDraw(cmd, vertexCount, instanceCount, 0, 0);
 }
 
 void setViewport(VkCommandBuffer cmd, uint32_t width, uint32_t height) {

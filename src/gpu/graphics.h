@@ -1,7 +1,8 @@
-// Graphics programs (vertex + fragment) built from embedded SPIR-V, the rasterization-pipeline sibling of
-// ComputeProgram. Like it, the layout comes from the modules: one push-constant range of the reflected
-// size shared by both stages, no descriptor sets and no vertex input bindings (the vertex shader pulls its
-// data by buffer device address with gl_VertexIndex). Pipelines draw with dynamic rendering (Vulkan 1.3),
+// Graphics programs (vertex [+ geometry] + fragment) built from embedded SPIR-V, the rasterization-pipeline
+// sibling of ComputeProgram. Like it, the layout comes from the modules: one push-constant range of the
+// reflected size shared by all stages, no descriptor sets and no vertex input bindings (the vertex shader
+// pulls its data by buffer device address with gl_VertexIndex / gl_InstanceIndex), and variants are
+// specialization constants named at the call site. Pipelines draw with dynamic rendering (Vulkan 1.3),
 // so no render pass objects; viewport and scissor are dynamic state, set with setViewport.
 //
 //   GraphicsProgram points(ctx, "points_hw.vert", "points_hw.frag", {.depthCompare = VK_COMPARE_OP_GREATER});
@@ -11,7 +12,9 @@
 #include <cassert>
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "gpu/program.h"
 #include "gpu/spirv_reflect.h"
 #include "gpu/vulkan_api.h"
 
@@ -24,6 +27,13 @@ struct GraphicsOptions {
   VkFormat colorFormat = VK_FORMAT_R8G8B8A8_UNORM;
   VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
   VkCompareOp depthCompare = VK_COMPARE_OP_LESS; // with depth writes; GREATER for reverse-Z
+  // A geometry shader between vertex and fragment shader; empty for none (needs the geometryShader
+  // feature, DeviceFeatures::geometryShader).
+  std::string geometryShader;
+  // Specialization constants, given to every stage (a stage that does not declare an id ignores it).
+  std::vector<SpecConstant> spec;
+  // A second color attachment (fragment output location 1) when not UNDEFINED, e.g. R32_UINT ids.
+  VkFormat secondColorFormat = VK_FORMAT_UNDEFINED;
 };
 
 class GraphicsProgram {
@@ -40,20 +50,24 @@ public:
   uint32_t pushConstantSize() const { return pushConstantSize_; }
   const GraphicsOptions& options() const { return options_; }
 
-  // Binds the pipeline, pushes the constants and draws vertexCount vertices (one instance). Must be
-  // recorded between vkCmdBeginRendering and vkCmdEndRendering with attachments of options() formats.
-  template <class Push> void draw(VkCommandBuffer cmd, uint32_t vertexCount, const Push& push) const {
+  // Binds the pipeline, pushes the constants and draws vertexCount vertices of each of instanceCount
+  // instances. Must be recorded between vkCmdBeginRendering and vkCmdEndRendering with attachments of
+  // options() formats.
+  template <class Push>
+  void draw(VkCommandBuffer cmd, uint32_t vertexCount, const Push& push, uint32_t instanceCount = 1) const {
     assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
-    drawRaw(cmd, vertexCount, &push, sizeof(Push));
+    drawRaw(cmd, vertexCount, instanceCount, &push, sizeof(Push));
   }
 
 private:
-  void drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, const void* push, uint32_t size) const;
+  void drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_t instanceCount, const void* push,
+               uint32_t size) const;
   void release();
   VkDevice device_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   uint32_t pushConstantSize_ = 0;
+  VkShaderStageFlags pushStages_ = 0;
   GraphicsOptions options_;
 };
 

@@ -18,4 +18,32 @@ static_assert(sizeof(ResolvePush) == 48);
 static_assert(offsetof(ResolvePush, width) == 32);
 static_assert(sizeof(CopyPush) == 24);
 
+// The 2022 batch passes: BatchPush is 128 bytes like RasterPush; BatchFrame and BatchBounds live in
+// buffers read with std430 rules (uint64_t members at multiples of 8, vec4 at multiples of 16).
+static_assert(sizeof(BatchPush) == 128);
+static_assert(offsetof(BatchPush, high) == 64);
+static_assert(offsetof(BatchPush, frame) == 104);
+static_assert(offsetof(BatchPush, pointCount) == 112);
+static_assert(offsetof(BatchPush, part) == 120);
+static_assert(sizeof(BatchBounds) == 32);
+static_assert(offsetof(BatchFrame, width) == 24);
+static_assert(offsetof(BatchFrame, culling) == 36);
+static_assert(offsetof(BatchFrame, partColors) == 40);
+static_assert(sizeof(BatchFrame) == 40 + 8 * kMaxVisibilityParts);
+static_assert(kBatchPoints == 10240 && kBatchPrefetchSteps * 4 == kBatchPointsPerThread);
+static_assert(uint64_t(kMaxPartBatches) * kBatchPoints <= kVisibilityLocalMask + 1ull);
+static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 32);
+
+// Spheres: SphereFrame lives in a buffer read with std430 rules (struct alignment 16 for its mat4/vec4).
+static_assert(sizeof(SphereFrame) == 160);
+static_assert(offsetof(SphereFrame, pixelToRay) == 64);
+static_assert(offsetof(SphereFrame, framebuffer) == 80);
+static_assert(offsetof(SphereFrame, image) == 104);
+static_assert(offsetof(SphereFrame, width) == 112);
+static_assert(offsetof(SphereFrame, background) == 140);
+static_assert(offsetof(SphereFrame, counters) == 144);
+static_assert(sizeof(SpherePartRef) == 16);
+static_assert(sizeof(SpherePush) == 32);
+static_assert(offsetof(SpherePush, first) == 16);
+
 } // namespace pointrast::shared

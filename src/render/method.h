@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 
 #include <glm/glm.hpp>
@@ -42,6 +43,9 @@ public:
   // Whether the method fills targets.words with depth << 32 | color words (every compute method but
   // HQS, which blends; justset's words are valid words of some point, not the closest).
   virtual bool hasCanonicalWords() const { return true; }
+  // Counts of the last frame, for methods that keep them (the batch methods); read after the frame's
+  // submission finished.
+  virtual std::optional<BatchStats> readStats() { return std::nullopt; }
 };
 
 // Calls draw(push, grid) for every part of every scene, with `base` completed for that part: the matrix
@@ -80,5 +84,7 @@ std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, Method m
 std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width,
                                              uint32_t height);
 std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, uint32_t width, uint32_t height);
+std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, Method method, uint32_t width,
+                                               uint32_t height);
 
 } // namespace pointrast

@@ -39,6 +39,18 @@ constexpr MethodInfo kMethods[] = {
      "Vulkan point-list pipeline, 1-pixel points, hardware depth test: the GL_POINTS "
      "baseline",
      false, false, 16},
+    // Batch methods read 4 to 12 B of coordinates a point (adaptive precision) plus the colors of visible
+    // points only; 4 is the least, FrameStats::batch says what a frame read.
+    {Method::Batch, "batch",
+     "2022: a workgroup per batch of 10240 points, frustum culling, adaptive coordinate precision, "
+     "visibility buffer",
+     true, false, 4, SceneLayout::Batched},
+    {Method::BatchPrefetch, "batch-prefetch",
+     "batch with 128-bit loads, four points in flight per thread (2022)", true, false, 4,
+     SceneLayout::Batched},
+    {Method::BatchHqs, "batch-hqs",
+     "HQS on batches: prefetch depth pass, one packed atomicAdd per point with overflow fallback (2022)",
+     false, false, 8, SceneLayout::Batched},
 };
 
 // 16384 x 16384 pixels: 2 GiB of framebuffer words, the most a single allocation is guaranteed to hold
@@ -78,6 +90,13 @@ DepthMode parseDepthMode(std::string_view name) {
   if (name == "float") return DepthMode::Float;
   if (name == "int40") return DepthMode::Int40;
   throw InputError("unknown depth encoding '" + std::string(name) + "'; choose float or int40");
+}
+
+uint32_t parsePrecision(std::string_view text) {
+  if (text == "adaptive") return 0;
+  if (text == "1" || text == "2" || text == "3") return uint32_t(text[0] - '0');
+  throw InputError("unknown precision '" + std::string(text) +
+                   "'; choose adaptive, 1, 2 or 3 (coordinate words per point; 3 = full 30 bits)");
 }
 
 const char* depthModeName(DepthMode mode) {
@@ -121,8 +140,8 @@ bool Renderer::supports(gpu::Context& context, Method method, std::string* why) 
   case Method::DedupBallot:
   case Method::Hqs:
   case Method::Hqs1r:
-    if (!subgroups)
-      reason = "needs subgroup vote/ballot/shuffle/arithmetic in compute shaders";
+  case Method::BatchHqs:
+    if (!subgroups) reason = "needs subgroup vote/ballot/shuffle/arithmetic in compute shaders";
     break;
   case Method::Dedup:
     if (!subgroups || !f.subgroupPartitionedNV)
@@ -175,6 +194,8 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
     created = createHqsMethod(context_, settings.method, targets_->width, targets_->height);
   else if (settings.method == Method::HwPoints)
     created = createHwPointsMethod(context_, targets_->width, targets_->height);
+  else if (info.layout == SceneLayout::Batched)
+    created = createBatchMethod(context_, settings.method, targets_->width, targets_->height);
   else
     created = createClosestMethod(context_, settings.method, settings.depth);
   return *methods_.emplace(key, std::move(created)).first->second;
@@ -183,6 +204,21 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
 FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camera& camera,
                             const RenderSettings& settings) {
   validateCamera(camera);
+  const MethodInfo& info = methodInfo(settings.method);
+  size_t parts = 0;
+  for (const GpuScene* scene : scenes) {
+    if (scene->layout() != info.layout)
+      throw InputError(std::string(info.name) + " reads scenes in the " + sceneLayoutName(info.layout) +
+                       " layout, but a scene was uploaded in the " + sceneLayoutName(scene->layout()) +
+                       " layout (UploadOptions::layout)");
+    parts += scene->parts().size();
+  }
+  if (info.layout == SceneLayout::Batched && parts > shared::kMaxVisibilityParts)
+    throw InputError("the scenes have " + std::to_string(parts) + " parts; the batch methods draw at most " +
+                     std::to_string(shared::kMaxVisibilityParts) +
+                     " per frame (parts of up to 67,102,720 points: 4.29 billion points, the reach of a "
+                     "32-bit visibility index)");
+  if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
   PointMethod& m = method(settings);
   Targets& t = *targets_;
   // Canonical words are for equivalence tests only: allocated on first request (8 B a pixel).
@@ -224,6 +260,7 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   stats.maxMs = *std::max_element(ms.begin(), ms.end());
   for (const GpuScene* scene : scenes)
     stats.points += scene->pointCount();
+  stats.batch = m.readStats();
   return stats;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -21,17 +22,20 @@ class Context;
 }
 
 enum class Method {
-  AtomicMin,    // 2019: one 64-bit atomicMin of (depth << 32 | color) per point
-  EarlyZ,       // 2021: read first, atomicMin only if closer
-  Reduce,       // 2021: subgroup reduction before the atomic
-  ReduceEarlyZ, // 2021: both
-  Dedup,        // 2021: one atomic per distinct pixel of the subgroup (VK_NV_shader_subgroup_partitioned)
-  DedupBallot,  // dedup built from portable subgroup ballots
-  BusyLoop,     // 2013 per-pixel lock, with early-z
-  JustSet,      // plain stores without depth test: a speed reference only
-  Hqs,          // 2019 high-quality splatting: depth pass + two-atomic accumulation + resolve
-  Hqs1r,        // 2022 single-atomic HQS (16-bit packed) with overflow fallback
-  HwPoints,     // the hardware point list (GL_POINTS): graphics pipeline, 1-pixel points, depth test
+  AtomicMin,     // 2019: one 64-bit atomicMin of (depth << 32 | color) per point
+  EarlyZ,        // 2021: read first, atomicMin only if closer
+  Reduce,        // 2021: subgroup reduction before the atomic
+  ReduceEarlyZ,  // 2021: both
+  Dedup,         // 2021: one atomic per distinct pixel of the subgroup (VK_NV_shader_subgroup_partitioned)
+  DedupBallot,   // dedup built from portable subgroup ballots
+  BusyLoop,      // 2013 per-pixel lock, with early-z
+  JustSet,       // plain stores without depth test: a speed reference only
+  Hqs,           // 2019 high-quality splatting: depth pass + two-atomic accumulation + resolve
+  Hqs1r,         // 2022 single-atomic HQS (16-bit packed) with overflow fallback
+  HwPoints,      // the hardware point list (GL_POINTS): graphics pipeline, 1-pixel points, depth test
+  Batch,         // 2022: one workgroup per batch, culling, adaptive precision, visibility buffer
+  BatchPrefetch, // batch with 128-bit loads, four points in flight per thread
+  BatchHqs,      // HQS on batches: depth pass + single-atomic accumulation with overflow fallback
 };
 
 enum class DepthMode {
@@ -43,9 +47,13 @@ struct MethodInfo {
   Method method;
   const char* name;
   const char* description;
-  bool closest;           // writes the canonical closest-point framebuffer (bit-identical across methods)
+  bool closest;           // writes the canonical closest-point framebuffer (bit-identical across methods;
+                          // the batch methods' quantized coordinates pick the same point on >= 99.9 % of
+                          // pixels at full precision)
   bool int40;             // supports --depth int40
   uint32_t bytesPerPoint; // point data the method must read per point per frame (for effective bandwidth)
+                          // batch methods: the least (one word); FrameStats::batch has what was read
+  SceneLayout layout = SceneLayout::Float; // the scene layout the method reads
 };
 std::span<const MethodInfo> methodTable();
 const MethodInfo& methodInfo(Method method);
@@ -65,12 +73,32 @@ struct RenderSettings {
   uint32_t frames = 1;               // timed frames; the median is reported
   uint32_t warmup = 1;               // untimed frames first (pipeline caches, clocks)
   bool captureWords = false;         // keep canonical words of the last frame for framebufferWords()
+  // Batch methods: coordinate words per point, 0 = adaptive (the fewest that keep the decoding error of
+  // the batch under half a pixel), 1..3 = forced (3 = full 30-bit precision).
+  uint32_t precision = 0;
+  bool batchCulling = true; // batch methods: frustum culling of batches (off only to test that it is exact)
+};
+// "adaptive", "1", "2", "3" -> 0..3; throws InputError naming the choices.
+uint32_t parsePrecision(std::string_view text);
+
+// Per-frame counts of the batch methods (the 2022 paper's Table 2), of the last timed frame.
+struct BatchStats {
+  uint64_t batchesProcessed = 0;         // batches of all parts (one workgroup each)
+  uint64_t batchesRendered = 0;          // batches not culled
+  uint64_t pointsProcessed = 0;          // points of rendered batches
+  uint64_t pointsRendered = 0;           // points that passed early-z (did the atomicMin)
+  uint64_t pointsBlended = 0;            // batch-hqs: points blended into their pixel's average
+  uint64_t pointsByWords[3] = {0, 0, 0}; // points processed with 1, 2, 3 coordinate words
+  // Bytes of point data read: 4 per coordinate word, 32 per rendered batch's bounds; batch-hqs reads the
+  // words twice (depth and accumulation pass) and the color of every blended point.
+  uint64_t bytesRead = 0;
 };
 
 struct FrameStats {
   double medianMs = 0, minMs = 0, maxMs = 0; // GPU time of clear + draw + resolve, timestamp queries
   uint32_t frames = 0;
-  uint64_t points = 0; // points submitted per frame
+  uint64_t points = 0;             // points submitted per frame
+  std::optional<BatchStats> batch; // batch methods only
 };
 
 struct Targets;
@@ -83,7 +111,8 @@ public:
   ~Renderer();
 
   // Throws UnsupportedError if the device cannot run the method (missing extension or feature) and
-  // InputError for a combination that does not exist (hqs with int40 depth).
+  // InputError for a combination that does not exist (hqs with int40 depth), for a scene uploaded in
+  // another layout than the method reads (MethodInfo::layout), and for more than 64 batched parts.
   FrameStats render(std::span<const GpuScene* const> scenes, const Camera& camera,
                     const RenderSettings& settings);
   FrameStats render(const GpuScene& scene, const Camera& camera, const RenderSettings& settings) {

@@ -5,8 +5,11 @@
 #include <string>
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "base/progress.h"
+#include "cloud/batch_words.h"
 #include "gpu/context.h"
+#include "gpu/shared_types.h"
 
 namespace pointrast {
 
@@ -17,20 +20,55 @@ constexpr uint64_t kStagingPoints = kStagingBytes / 16;
 constexpr uint64_t kPartAlign = 10240;           // parts hold whole 2022-style batches
 constexpr uint64_t kMaxPartPoints = 64ull << 20; // 64 M points: 768 MiB of positions
 
+// Batched upload: whole batches per staging copy, 16 B a point plus their bounds: 409 batches, 4.2 M points.
+constexpr uint64_t kBatchBytes = kBatchSize * 16 + sizeof(shared::BatchBounds);
+constexpr uint64_t kStagingBatches = kStagingBytes / kBatchBytes;
+constexpr uint64_t kStagingBatchPoints = kStagingBatches * kBatchSize;
+static_assert(kBatchSize == shared::kBatchPoints);
+
+uint64_t roundUp4(uint64_t n) {
+  return (n + 3) & ~uint64_t(3);
+}
+
 } // namespace
 
+const char* sceneLayoutName(SceneLayout layout) {
+  return layout == SceneLayout::Batched ? "batched" : "float";
+}
+
+uint64_t ScenePart::batchCount() const {
+  return (count + kBatchSize - 1) / kBatchSize;
+}
+
+uint64_t partCapacity(SceneLayout layout, uint64_t requested, uint64_t bufferLimit) {
+  if (layout == SceneLayout::Float) {
+    if (requested) return requested;
+    return std::min(kMaxPartPoints, (bufferLimit / 12) / kPartAlign * kPartAlign);
+  }
+  // The largest buffer of a batched part is one word (or one color) per point. (A requested size that is
+  // no multiple of 10240 works too: each part's last batch is short.)
+  uint64_t fit = std::min<uint64_t>(shared::kMaxPartBatches, (bufferLimit / 4) / kBatchSize) * kBatchSize;
+  return requested ? std::min(requested, fit) : fit;
+}
+
+uint64_t sceneBytes(SceneLayout layout, uint64_t points) {
+  uint64_t bytes = points * 16;
+  if (layout == SceneLayout::Batched)
+    bytes += (points + kBatchSize - 1) / kBatchSize * sizeof(shared::BatchBounds);
+  return bytes;
+}
+
 GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadOptions& options)
-    : origin_(cloud.origin()), bounds_(cloud.bounds) {
+    : layout_(options.layout), origin_(cloud.origin()), bounds_(cloud.bounds) {
   uint64_t first = std::min(options.first, cloud.size());
   uint64_t count = std::min(options.count, cloud.size() - first);
   pointCount_ = count;
   uint64_t limit = std::min(context.maxAllocationSize(), context.maxBufferSize());
-  uint64_t partPoints = options.maxPartPoints;
-  if (partPoints == 0) partPoints = std::min(kMaxPartPoints, (limit / 12) / kPartAlign * kPartAlign);
+  uint64_t partPoints = partCapacity(layout_, options.maxPartPoints, limit);
   if (partPoints == 0)
     throw UnsupportedError("device buffers are too small to hold even one batch of points");
 
-  uint64_t needed = count * 16;
+  uint64_t needed = sceneBytes(layout_, count);
   if (needed > context.deviceLocalBytes())
     throw UnsupportedError("the cloud needs " + std::to_string(needed >> 20) +
                            " MiB of GPU memory but device '" + context.info().name + "' has " +
@@ -41,20 +79,34 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
     part.first = first + at;
     part.count = std::min(partPoints, count - at);
     std::string index = std::to_string(parts_.size());
-    part.positions = gpu::Buffer(context, part.count * 12, gpu::kBufferUsage, gpu::MemoryKind::Device,
-                                 "positions " + index);
-    part.colors =
-        gpu::Buffer(context, part.count * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "colors " + index);
+    auto buffer = [&](uint64_t bytes, const std::string& name) {
+      return gpu::Buffer(context, bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, name + " " + index);
+    };
+    if (layout_ == SceneLayout::Float) {
+      part.positions = buffer(part.count * 12, "positions");
+    } else {
+      part.high = buffer(roundUp4(part.count) * 4, "high words");
+      part.medium = buffer(roundUp4(part.count) * 4, "medium words");
+      part.low = buffer(roundUp4(part.count) * 4, "low words");
+      part.batches = buffer(part.batchCount() * sizeof(shared::BatchBounds), "batch bounds");
+    }
+    part.colors = buffer(part.count * 4, "colors");
     parts_.push_back(std::move(part));
   }
   if (count == 0) return;
+  if (layout_ == SceneLayout::Float)
+    uploadFloat(context, cloud, options.progress);
+  else
+    uploadBatched(context, cloud, options.progress);
+}
 
+void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, bool progressShown) {
   gpu::Buffer staging(context, kStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload,
                       "upload staging");
   auto* stagingFloats = static_cast<float*>(staging.mapped());
   auto* stagingColors =
       reinterpret_cast<uint32_t*>(static_cast<char*>(staging.mapped()) + kStagingPoints * 12);
-  Progress progress("uploading to GPU", count, " points", options.progress);
+  Progress progress("uploading to GPU", pointCount_, " points", progressShown);
   for (const ScenePart& part : parts_) {
     for (uint64_t at = 0; at < part.count; at += kStagingPoints) {
       uint64_t n = std::min(kStagingPoints, part.count - at);
@@ -65,6 +117,54 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
         VkBufferCopy col{kStagingPoints * 12, at * 4, n * 4};
         gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.positions.handle(), 1, &pos);
         gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.colors.handle(), 1, &col);
+      });
+      progress.advance(n);
+    }
+  }
+}
+
+// Encodes whole batches into the staging buffer on all cores (bounds, three words, colors per batch, as
+// cloud/batch_words.h defines them), then copies them into the part's buffers.
+void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud, bool progressShown) {
+  gpu::Buffer staging(context, kStagingBatches * kBatchBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                      gpu::MemoryKind::Upload, "upload staging");
+  // Staging sections: high, medium, low words, colors (kStagingBatchPoints each), then the bounds.
+  auto* words = static_cast<uint32_t*>(staging.mapped());
+  uint32_t* section[4] = {words, words + kStagingBatchPoints, words + 2 * kStagingBatchPoints,
+                          words + 3 * kStagingBatchPoints};
+  auto* bounds = reinterpret_cast<shared::BatchBounds*>(words + 4 * kStagingBatchPoints);
+  const DisplayColorMode colorMode = displayColorMode(cloud); // once, not per chunk
+  Progress progress("uploading to GPU (batched)", pointCount_, " points", progressShown);
+  for (const ScenePart& part : parts_) {
+    for (uint64_t at = 0; at < part.count; at += kStagingBatchPoints) {
+      const uint64_t n = std::min(kStagingBatchPoints, part.count - at);
+      const uint64_t batches = (n + kBatchSize - 1) / kBatchSize;
+      parallelBlocks(batches, 4, [&](uint64_t, uint64_t begin, uint64_t end) {
+        for (uint64_t b = begin; b < end; ++b) {
+          const uint64_t local = b * kBatchSize; // in this chunk
+          const Batch batch =
+              makeBatch(cloud, part.first + at + local, uint32_t(std::min(kBatchSize, n - local)));
+          encodeBatchWords(section[0] + local, section[1] + local, section[2] + local, cloud, batch);
+          displayColors(section[3] + local, cloud, batch.first, batch.count, colorMode);
+          const glm::dvec3 lo = batch.bounds.min - origin_, hi = batch.bounds.max - origin_;
+          bounds[b] = {glm::vec4(glm::vec3(lo), 0.0f), glm::vec4(glm::vec3(hi), 0.0f)};
+        }
+      });
+      // Zero the padding words of a part's last, partial group of four (batch-prefetch loads them).
+      for (uint64_t k = n; k < roundUp4(n); ++k)
+        section[0][k] = section[1][k] = section[2][k] = 0;
+      const uint64_t wordBytes = roundUp4(n) * 4;
+      context.submitAndWait([&](VkCommandBuffer cmd) {
+        const gpu::Buffer* targets[3] = {&part.high, &part.medium, &part.low};
+        for (int w = 0; w < 3; ++w) {
+          VkBufferCopy copy{w * kStagingBatchPoints * 4, at * 4, wordBytes};
+          gpu::vkCmdCopyBuffer(cmd, staging.handle(), targets[w]->handle(), 1, &copy);
+        }
+        VkBufferCopy col{3 * kStagingBatchPoints * 4, at * 4, n * 4};
+        gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.colors.handle(), 1, &col);
+        VkBufferCopy box{4 * kStagingBatchPoints * 4, at / kBatchSize * sizeof(shared::BatchBounds),
+                         batches * sizeof(shared::BatchBounds)};
+        gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.batches.handle(), 1, &box);
       });
       progress.advance(n);
     }

@@ -1,6 +1,11 @@
 // A point cloud on the GPU: float32 positions relative to an origin (rounded once from double) and RGBA8
 // display colors, split into parts that each fit one buffer. A part is the unit of a dispatch, so scenes
 // of billions of points (tens of GB) work on any device whatever its largest buffer or allocation.
+//
+// The 2022 batch methods read another layout of the same points (SceneLayout::Batched): batches of 10240
+// consecutive points, each point's coordinates quantized to 30 bits per axis relative to its batch's
+// bounds and split into three words (cloud/batch_words.h), the bounds in a per-batch buffer. Both layouts
+// take 16 B a point (the batched one 32 B a batch more) and are built while uploading.
 #pragma once
 
 #include <cstdint>
@@ -15,35 +20,66 @@ namespace gpu {
 class Context;
 }
 
+// How a scene's points lie in GPU memory; every method reads one of them (MethodInfo::layout).
+enum class SceneLayout {
+  Float,   // float xyz relative to the origin + RGBA8: the 2019/2021 methods and hw-points
+  Batched, // the 2022 batch methods: three words of batch-relative coordinates + RGBA8, bounds per batch
+};
+const char* sceneLayoutName(SceneLayout layout);
+
 struct ScenePart {
-  gpu::Buffer positions; // float[3 * count]
+  gpu::Buffer positions; // Float: float[3 * count]
   gpu::Buffer colors;    // uint[count]
-  uint64_t first = 0;    // index of the part's first point in the source cloud
+  // Batched: uint per point (cloud/batch_words.h), padded with zeros to a multiple of 4 points so that
+  // batch-prefetch loads whole uvec4s; and shared::BatchBounds per batch.
+  gpu::Buffer high, medium, low;
+  gpu::Buffer batches;
+  uint64_t first = 0; // index of the part's first point in the source cloud
   uint64_t count = 0;
+  // Batches of the part (Batched layout): every batch but the part's last holds 10240 points.
+  uint64_t batchCount() const;
 };
 
 struct UploadOptions {
   uint64_t first = 0;          // upload points [first, first + count) of the cloud
   uint64_t count = UINT64_MAX; // clamped to the cloud's size
-  uint64_t maxPartPoints = 0;  // 0: largest multiple of 10240 whose positions fit one buffer, <= 64 M
+  // Points per part. 0: as many as fit (Float: largest multiple of 10240 whose positions fit one buffer,
+  // <= 64 M; Batched: kMaxPartBatches batches, 67,102,720 points, fewer if the device's buffers are
+  // smaller). Batched: at most kMaxPartBatches batches; a batch never straddles two parts, so a multiple of
+  // 10240 keeps every batch but the last full. Tests use small parts to exercise the part number of
+  // visibility indices.
+  uint64_t maxPartPoints = 0;
+  SceneLayout layout = SceneLayout::Float;
   bool progress = true;
 };
+
+// Points per part of a layout: `requested` (0: as many as fit) bounded by the layout's maximum and by a
+// device whose largest buffer holds `bufferLimit` bytes; 0 if not even one batch fits.
+uint64_t partCapacity(SceneLayout layout, uint64_t requested, uint64_t bufferLimit);
+// GPU bytes of `points` points in a layout (both 16 B a point; Batched adds 32 B a batch of bounds).
+uint64_t sceneBytes(SceneLayout layout, uint64_t points);
 
 class GpuScene {
 public:
   // Uploads through a staging buffer; positions are relative to cloud.origin() whatever the subrange,
-  // so scenes uploaded from parts of one cloud draw exactly the points the whole upload would.
+  // so scenes uploaded from parts of one cloud draw exactly the points the whole upload would. Batched:
+  // batches are cut from the first uploaded point on. Throws UnsupportedError when the device lacks the
+  // memory.
   GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadOptions& options = {});
 
   uint64_t pointCount() const { return pointCount_; }
   const glm::dvec3& origin() const { return origin_; }
   const Bounds& bounds() const { return bounds_; }
   const std::vector<ScenePart>& parts() const { return parts_; }
-  // Bytes of point data in GPU memory (12 B position + 4 B color per point).
-  uint64_t bytes() const { return pointCount_ * 16; }
+  SceneLayout layout() const { return layout_; }
+  // Bytes of point data in GPU memory (sceneBytes()).
+  uint64_t bytes() const { return sceneBytes(layout_, pointCount_); }
 
 private:
+  void uploadFloat(gpu::Context& context, const PointCloud& cloud, bool progress);
+  void uploadBatched(gpu::Context& context, const PointCloud& cloud, bool progress);
   std::vector<ScenePart> parts_;
+  SceneLayout layout_ = SceneLayout::Float;
   uint64_t pointCount_ = 0;
   glm::dvec3 origin_{0};
   Bounds bounds_;

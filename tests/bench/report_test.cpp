@@ -146,7 +146,7 @@ TEST(Suites, Paper2021SizesAndScale) {
   std::vector<Dataset> smoke = suiteDatasets("paper2021", 0.001, 1);
   EXPECT_EQ(smoke[0].points, 4'000u);
   EXPECT_EQ(smoke[3].points, 796'000u);
-  EXPECT_THROW(suiteDatasets("paper2022", 1.0, 1), InputError);
+  EXPECT_THROW(suiteDatasets("paper1999", 1.0, 1), InputError);
   EXPECT_THROW(suiteDatasets("paper2021", 0.0, 1), InputError);
   EXPECT_THROW(suiteDatasets("paper2021", 1.0, 1, {"nowhere=/x.las"}), InputError);
   EXPECT_THROW(suiteDatasets("paper2021", 1.0, 1, {"retz=/does/not/exist.las"}), InputError);

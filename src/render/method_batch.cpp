@@ -1,0 +1,155 @@
+// The 2022 batch methods (Schuetz, Kerbl, Wimmer, "Software Rasterization of 2 Billion Points in Real
+// Time"): batch and batch-prefetch (raster_batch.comp, then resolve_batch.comp fetching the colors of
+// visible points) and batch-hqs (a prefetch depth pass, raster_batch_hqs.comp accumulating, resolve_hqs.comp
+// with hqs1r's layout). They read scenes in the batched layout (render/scene.h).
+#include <cstring>
+
+#include "base/error.h"
+#include "gpu/context.h"
+#include "render/method.h"
+
+namespace pointrast {
+
+namespace {
+
+// Calls draw(push, batches) for every part of every scene, numbering parts in draw order: the number is
+// the part's visibility part (shared.h), and the index of its colors in BatchFrame::partColors.
+template <class Draw>
+void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frameAddress, Draw&& draw) {
+  const double aspect = double(targets.width) / double(targets.height);
+  shared::BatchPush push{};
+  push.frame = frameAddress;
+  uint32_t number = 0;
+  for (const GpuScene* scene : frame.scenes) {
+    // The matrix and near plane of forEachPart(): the same projection as the 2021 methods.
+    push.viewProj = glm::mat4(viewProjection(frame.camera, scene->origin(), aspect));
+    push.nearW = float(frame.camera.nearW > 0 ? frame.camera.nearW : defaultNear(scene->bounds()));
+    for (const ScenePart& part : scene->parts()) {
+      push.high = part.high.address();
+      push.medium = part.medium.address();
+      push.low = part.low.address();
+      push.bounds = part.batches.address();
+      push.colors = part.colors.address();
+      push.pointCount = uint32_t(part.count);
+      push.part = number++;
+      draw(push, uint32_t(part.batchCount())); // <= kMaxPartBatches: one row of workgroups
+    }
+  }
+}
+
+class BatchMethod : public PointMethod {
+public:
+  BatchMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
+      : context_(context), hqs_(method == Method::BatchHqs) {
+    uint32_t prefetch = method != Method::Batch; // batch-hqs draws its depth pass with prefetch
+    raster_ = gpu::ComputeProgram(context, "raster_batch.comp",
+                                  {{/* PREFETCH= */ 0, prefetch}, {/* DEPTH_ONLY= */ 1, uint32_t(hqs_)}});
+    if (hqs_) {
+      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp");
+      resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
+      // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
+      accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
+                                  gpu::MemoryKind::Device, "batch-hqs accumulators");
+    } else {
+      resolve_ = gpu::ComputeProgram(context, "resolve_batch.comp");
+    }
+    frame_ = gpu::Buffer(context, sizeof(shared::BatchFrame), gpu::kBufferUsage, gpu::MemoryKind::Device,
+                         "batch frame");
+    frameUpload_ = gpu::Buffer(context, sizeof(shared::BatchFrame), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                               gpu::MemoryKind::Upload, "batch frame upload");
+    stats_ =
+        gpu::Buffer(context, kStatsBytes, gpu::kBufferUsage, gpu::MemoryKind::Device, "batch statistics");
+  }
+
+  void recordFrame(const Frame& frame, Targets& targets) override {
+    VkCommandBuffer cmd = frame.cmd;
+    const uint64_t pixels = targets.pixels();
+    // The frame's constants, written here (before the submission) and copied into device memory at the
+    // start of the frame: 600 bytes, and every workgroup reads them from the GPU's caches.
+    shared::BatchFrame f{};
+    f.framebuffer = targets.framebuffer.address();
+    f.stats = stats_.address();
+    f.accumulators = hqs_ ? accumulators_.address() : 0;
+    f.width = targets.width;
+    f.height = targets.height;
+    f.forcedWords = frame.settings.precision;
+    f.culling = frame.settings.batchCulling ? 1 : 0;
+    uint32_t part = 0;
+    for (const GpuScene* scene : frame.scenes)
+      for (const ScenePart& p : scene->parts())
+        f.partColors[part++] = p.colors.address(); // Renderer::render checked part <= 64
+    std::memcpy(frameUpload_.mapped(), &f, sizeof f);
+    VkBufferCopy copy{0, 0, sizeof f};
+    gpu::vkCmdCopyBuffer(cmd, frameUpload_.handle(), frame_.handle(), 1, &copy);
+    gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 8, 0xFFFFFFFFu); // kEmptyPixel
+    gpu::vkCmdFillBuffer(cmd, stats_.handle(), 0, VK_WHOLE_SIZE, 0);
+    if (hqs_) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
+    gpu::fullBarrier(cmd);
+    forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
+      raster_.dispatch(cmd, batches, 1, push);
+    });
+    gpu::fullBarrier(cmd);
+    shared::ResolvePush resolve =
+        resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
+    if (hqs_) {
+      forEachBatchPart(frame, targets, frame_.address(),
+                       [&](const shared::BatchPush& push, uint32_t batches) {
+                         accumulate_.dispatch(cmd, batches, 1, push);
+                       });
+      gpu::fullBarrier(cmd);
+      resolve.aux = accumulators_.address();
+      resolve.words = 0;
+    } else {
+      resolve.aux = frame_.address(); // the table of color buffers
+    }
+    resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
+    gpu::fullBarrier(cmd);
+  }
+
+  bool hasCanonicalWords() const override { return !hqs_; }
+
+  std::optional<BatchStats> readStats() override {
+    uint64_t rows[shared::kBatchStatSlots][shared::kBatchStatCount];
+    gpu::readBuffer(context_, stats_, 0, rows, sizeof rows);
+    uint64_t sum[shared::kBatchStatCount] = {};
+    for (const auto& row : rows)
+      for (uint32_t k = 0; k < shared::kBatchStatCount; ++k)
+        sum[k] += row[k];
+    BatchStats s;
+    s.batchesProcessed = sum[shared::kStatBatchesProcessed];
+    s.batchesRendered = sum[shared::kStatBatchesRendered];
+    s.pointsRendered = sum[shared::kStatPointsRendered];
+    s.pointsBlended = sum[shared::kStatPointsBlended];
+    for (int w = 0; w < 3; ++w) {
+      s.pointsByWords[w] = sum[shared::kStatPointsOneWord + w];
+      s.pointsProcessed += s.pointsByWords[w];
+    }
+    // Every batch reads its bounds, every point of a drawn batch its words; batch-hqs does both twice and
+    // reads the color of each blended point.
+    uint64_t once = s.batchesProcessed * sizeof(shared::BatchBounds) +
+                    4 * (s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2]);
+    s.bytesRead = hqs_ ? 2 * once + 4 * s.pointsBlended : once;
+    return s;
+  }
+
+private:
+  static constexpr uint64_t kStatsBytes = uint64_t(shared::kBatchStatSlots) * shared::kBatchStatCount * 8;
+  gpu::Context& context_;
+  bool hqs_;
+  gpu::ComputeProgram raster_;     // batch / batch-prefetch, or batch-hqs's depth pass
+  gpu::ComputeProgram accumulate_; // batch-hqs
+  gpu::ComputeProgram resolve_;
+  gpu::Buffer accumulators_; // batch-hqs
+  gpu::Buffer frame_;        // shared::BatchFrame, device-local
+  gpu::Buffer frameUpload_;  // its host-written source
+  gpu::Buffer stats_;        // uint64_t[kBatchStatSlots][kBatchStatCount]
+};
+
+} // namespace
+
+std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, Method method, uint32_t width,
+                                               uint32_t height) {
+  return std::make_unique<BatchMethod>(context, method, width, height);
+}
+
+} // namespace pointrast

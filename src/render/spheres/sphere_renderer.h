@@ -1,0 +1,100 @@
+// Draws a particle set as ray-cast spheres with one of the sphere methods and returns an RGBA8 image,
+// plus the per-pixel view depth and particle index for tests. Every method shades with
+// shaders/sphere_shade.inc.glsl and is checked against the CPU ray caster (cpu_spheres.h).
+//
+// Methods, after Gralka et al., "Efficient Sphere Rendering Revisited" (2023): the study draws ray-cast
+// sphere impostors through every rasterization pipeline (points, triangles, strips, geometry and mesh
+// shaders) and ray tracing; pointrast adds sphere-compute, the software rasterizer of the point methods
+// applied to spheres. A new method is one enum value, one row of the table and one implementation.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "render/camera.h"
+#include "render/spheres/gpu_particles.h"
+
+namespace pointrast {
+
+namespace gpu {
+class Context;
+}
+
+enum class SphereMethod {
+  Compute,   // compute rasterization into a 64-bit visibility buffer, large spheres in chunks, then a resolve
+  Points,    // hardware point list, gl_PointSize from the projected bounds
+  Triangles, // hardware triangle list, 6 vertices per sphere
+  Strip,     // hardware triangle strips, one instance of 4 vertices per sphere
+  Geometry,  // hardware points expanded into strips by a geometry shader
+};
+
+struct SphereMethodInfo {
+  SphereMethod method;
+  const char* name;
+  const char* description;
+  // Whether the device can run the method; why: one sentence when it cannot.
+  bool (*supported)(gpu::Context& context, std::string* why);
+};
+std::span<const SphereMethodInfo> sphereMethodTable();
+const SphereMethodInfo& sphereMethodInfo(SphereMethod method);
+// Throws InputError listing the known names.
+SphereMethod parseSphereMethod(std::string_view name);
+bool isSphereMethodName(std::string_view name);
+const char* sphereMethodName(SphereMethod method);
+
+struct SphereSettings {
+  SphereMethod method = SphereMethod::Compute;
+  uint32_t background = 0xFF000000u; // RGBA8
+  uint32_t frames = 1;               // timed frames; the median is reported
+  uint32_t warmup = 1;               // untimed frames first
+  // sphere-compute: entries of the large-sphere chunk list; 0 = the default (4 M chunks, 64 MiB). Tests
+  // set a small one to exercise the overflow path (spheres drawn by their own thread).
+  uint32_t chunkCapacity = 0;
+};
+
+struct SphereStats {
+  double medianMs = 0, minMs = 0, maxMs = 0; // GPU time of clear + draw + resolve, timestamp queries
+  uint32_t frames = 0;
+  uint64_t particles = 0;      // particles submitted per frame
+  uint64_t largeChunks = 0;    // sphere-compute: 256-pixel chunks of large spheres listed in the last frame
+  uint64_t spilledSpheres = 0; // sphere-compute: large spheres that drew chunks themselves (list full)
+  uint64_t clampedSpheres = 0; // sphere-points: spheres larger than the largest point, drawn incomplete
+};
+
+class SphereMethodImpl;
+struct SphereTargets;
+
+class SphereRenderer {
+public:
+  // Throws InputError for a zero or oversized image.
+  SphereRenderer(gpu::Context& context, uint32_t width, uint32_t height);
+  ~SphereRenderer();
+
+  // Throws UnsupportedError if the device cannot run the method, InputError for a bad camera.
+  SphereStats render(const GpuParticles& particles, const Camera& camera, const SphereSettings& settings);
+
+  // RGBA8 pixels of the last frame, row 0 at the top.
+  std::vector<uint32_t> image();
+  // Linear view depth of the visible sphere per pixel of the last frame, +infinity where none.
+  std::vector<float> depth();
+  // Particle index of the visible sphere per pixel of the last frame, kNoParticle where none.
+  std::vector<uint32_t> indices();
+
+  uint32_t width() const;
+  uint32_t height() const;
+
+  static bool supports(gpu::Context& context, SphereMethod method, std::string* why = nullptr);
+
+private:
+  SphereMethodImpl& method(SphereMethod method);
+  gpu::Context& context_;
+  std::unique_ptr<SphereTargets> targets_;
+  std::vector<std::pair<SphereMethod, std::unique_ptr<SphereMethodImpl>>> methods_;
+  SphereMethodImpl* last_ = nullptr; // the method of the last frame (depth and indices come from it)
+};
+
+} // namespace pointrast

@@ -1,0 +1,604 @@
+// The 2022 batch methods (batch, batch-prefetch, batch-hqs) and their scene layout:
+// - the upload writes exactly what cloud/batch_words.h encodes, bounds and colors included;
+// - at full precision (3 words) batch and batch-prefetch match atomicmin on >= 99.9 % of lit pixels (clouds x
+//   orders x views, one of them inside the cloud where the near plane cuts batches and most are culled);
+// - adaptive precision keeps >= 99.5 % of the lit pixels and moves no point by more than one pixel, checked
+//   per point through colors that encode the point's index;
+// - frustum culling changes no framebuffer word (against culling switched off);
+// - statistics are exact on a hand-built scene of known batches and known occlusion;
+// - several parts and several scenes give the framebuffer of one part (the part number of visibility
+//   indices), and more than 64 parts or a scene of the wrong layout is a clear error;
+// - batch-hqs equals hqs within 1 per channel.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <random>
+
+#include "base/error.h"
+#include "cloud/batch_words.h"
+#include "cloud/generate.h"
+#include "cloud/order.h"
+#include "gpu/buffer.h"
+#include "gpu/shader_registry.h"
+#include "gpu/shared_types.h"
+#include "gpu/spirv_reflect.h"
+#include "gpu_fixture.h"
+#include "io/reader.h"
+#include "render/renderer.h"
+#include "test_data.h"
+
+namespace pointrast::test {
+
+namespace {
+
+struct Drawn {
+  std::vector<uint64_t> words; // canonical words (closest-point methods)
+  std::vector<uint32_t> image;
+  FrameStats stats;
+};
+
+struct Draw {
+  Method method = Method::Batch;
+  uint32_t precision = 0;
+  bool culling = true;
+};
+
+Drawn draw(gpu::Context& context, std::span<const GpuScene* const> scenes, const Camera& camera, uint32_t w,
+           uint32_t h, const Draw& d) {
+  Renderer renderer(context, w, h);
+  RenderSettings settings;
+  settings.method = d.method;
+  settings.precision = d.precision;
+  settings.batchCulling = d.culling;
+  settings.captureWords = true;
+  settings.background = 0;
+  Drawn out;
+  out.stats = renderer.render(scenes, camera, settings);
+  if (methodInfo(d.method).closest) out.words = renderer.framebufferWords();
+  out.image = renderer.image();
+  return out;
+}
+Drawn draw(gpu::Context& context, const GpuScene& scene, const Camera& camera, uint32_t w, uint32_t h,
+           const Draw& d) {
+  const GpuScene* one[] = {&scene};
+  return draw(context, one, camera, w, h, d);
+}
+
+UploadOptions batched(uint64_t maxPartPoints = 0) {
+  UploadOptions o;
+  o.layout = SceneLayout::Batched;
+  o.maxPartPoints = maxPartPoints;
+  o.progress = false;
+  return o;
+}
+UploadOptions floats() {
+  UploadOptions o;
+  o.progress = false;
+  return o;
+}
+
+size_t litCount(const std::vector<uint32_t>& image) {
+  return size_t(std::count_if(image.begin(), image.end(), [](uint32_t c) { return c != 0; }));
+}
+
+// Fraction of equal pixels among those lit in either image.
+double equalLitFraction(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+  size_t same = 0, lit = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == 0 && b[i] == 0) continue;
+    ++lit;
+    same += a[i] == b[i];
+  }
+  return lit ? double(same) / double(lit) : 1.0;
+}
+
+PointCloud autzen() {
+  std::filesystem::path file = dataDir() / "las/autzen_trim.las";
+  io::ReadOptions read;
+  read.progress = false;
+  return io::readCloud(file, read);
+}
+
+// A random box (few points per pixel), generated terrain and the real autzen_trim.las (110,000 points).
+std::map<std::string, PointCloud> testClouds() {
+  std::map<std::string, PointCloud> clouds;
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<glm::dvec3> points;
+  std::vector<uint32_t> colors;
+  for (int i = 0; i < 100'000; ++i) {
+    points.push_back({u(rng) * 20, u(rng) * 10, u(rng) * 5});
+    colors.push_back(0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+  }
+  clouds["random"] = cloudFromPoints(points, colors);
+  GenerateOptions options;
+  options.points = 80'000;
+  options.progress = false;
+  clouds["terrain"] = generateScene(Scene::Terrain, options);
+  clouds["autzen"] = autzen();
+  return clouds;
+}
+
+// overview: the whole cloud; inside: from inside the bounds towards a corner; close: the eye at the center
+// looking along +x, so that batches around the eye cross the near plane and most batches are culled.
+std::vector<std::pair<std::string, Camera>> views(const Bounds& bounds, double aspect) {
+  Camera inside;
+  inside.eye = bounds.center() + 0.1 * (bounds.max - bounds.center());
+  inside.target = bounds.max;
+  Camera close;
+  close.eye = bounds.center();
+  close.target = bounds.center() + glm::dvec3(1, 0, 0);
+  return {{"overview", overviewCamera(bounds, aspect)}, {"inside", inside}, {"close", close}};
+}
+
+// Colors 1..n in the low 24 bits: a pixel's color names its point.
+void colorsAreIndices(PointCloud& cloud) {
+  cloud.colors.resize(cloud.size());
+  for (uint64_t i = 0; i < cloud.size(); ++i)
+    cloud.colors[i] = 0xFF000000u | uint32_t(i + 1);
+}
+
+} // namespace
+
+TEST(BatchLayout, ShadersMatchTheSharedStructs) {
+  for (const char* name : {"raster_batch.comp", "raster_batch_hqs.comp"}) {
+    gpu::SpirvReflection r = gpu::reflectSpirv(gpu::findShader(name));
+    EXPECT_EQ(r.pushConstantSize, sizeof(shared::BatchPush)) << name;
+    EXPECT_EQ(r.localSize[0] * r.localSize[1] * r.localSize[2], shared::kPointGroupSize) << name;
+  }
+  EXPECT_EQ(gpu::reflectSpirv(gpu::findShader("resolve_batch.comp")).pushConstantSize,
+            sizeof(shared::ResolvePush));
+}
+
+TEST(BatchLayout, PartCapacityAndBytes) {
+  constexpr uint64_t kBatch = shared::kBatchPoints;
+  EXPECT_EQ(partCapacity(SceneLayout::Batched, 0, uint64_t(1) << 40), 6553 * kBatch);
+  EXPECT_EQ(6553 * kBatch, 67'102'720u);
+  EXPECT_LT(6553 * kBatch, uint64_t(1) << shared::kVisibilityPartShift);
+  // A device whose largest buffer holds 1 MiB: 256 k words, 25 whole batches.
+  EXPECT_EQ(partCapacity(SceneLayout::Batched, 0, 1 << 20), 25 * kBatch);
+  EXPECT_EQ(partCapacity(SceneLayout::Batched, 2 * kBatch, uint64_t(1) << 40), 2 * kBatch);
+  EXPECT_EQ(partCapacity(SceneLayout::Batched, 10000 * kBatch, uint64_t(1) << 40), 6553 * kBatch);
+  EXPECT_EQ(partCapacity(SceneLayout::Batched, 0, kBatch * 4 - 1), 0u);
+  EXPECT_EQ(partCapacity(SceneLayout::Float, 0, uint64_t(1) << 40), uint64_t(64) << 20);
+  EXPECT_EQ(partCapacity(SceneLayout::Float, 12345, uint64_t(1) << 40), 12345u);
+  EXPECT_EQ(sceneBytes(SceneLayout::Float, 1000), 16000u);
+  EXPECT_EQ(sceneBytes(SceneLayout::Batched, 10241), 10241u * 16 + 2 * 32);
+  // 4 billion points: 60 parts, under the 64 a frame addresses, and 4 words a point stay 16 B a point.
+  uint64_t billions = uint64_t(4'000'000'000);
+  EXPECT_LE((billions + 6553 * kBatch - 1) / (6553 * kBatch), uint64_t(shared::kMaxVisibilityParts));
+  EXPECT_EQ(parsePrecision("adaptive"), 0u);
+  EXPECT_EQ(parsePrecision("3"), 3u);
+  EXPECT_THROW(parsePrecision("4"), InputError);
+  EXPECT_THROW(parsePrecision("30"), InputError);
+}
+
+TEST_F(GpuTest, BatchedUploadWritesTheBatchWordsOfEveryBatch) {
+  // 25,003 points in parts of 2 batches: parts of 20480 and 4523 points, the last batch 4523 points long
+  // (not a multiple of 4: padding), uploaded from point 7 on so batches do not start at cloud multiples.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<glm::dvec3> points;
+  std::vector<uint32_t> colors;
+  for (int i = 0; i < 25'010; ++i) {
+    points.push_back({1000 + u(rng) * 50, -200 + u(rng) * 3, u(rng) * 0.5});
+    colors.push_back(0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+  }
+  PointCloud cloud = cloudFromPoints(points, colors, 1e-3, {1000, 0, 0});
+  UploadOptions upload = batched(2 * shared::kBatchPoints);
+  upload.first = 7;
+  upload.count = 25'003;
+  GpuScene scene(*context, cloud, upload);
+  EXPECT_EQ(scene.layout(), SceneLayout::Batched);
+  EXPECT_EQ(scene.pointCount(), 25'003u);
+  EXPECT_EQ(scene.bytes(), 25'003u * 16 + 3 * 32);
+  ASSERT_EQ(scene.parts().size(), 2u);
+  EXPECT_EQ(scene.parts()[0].count, 20480u);
+  EXPECT_EQ(scene.parts()[1].count, 4523u);
+  EXPECT_EQ(scene.parts()[1].first, 7u + 20480u);
+  EXPECT_FALSE(scene.parts()[0].positions) << "the batched layout has no float positions";
+  uint64_t checked = 0;
+  for (const ScenePart& part : scene.parts()) {
+    uint64_t padded = (part.count + 3) / 4 * 4;
+    std::vector<uint32_t> words[3];
+    const gpu::Buffer* buffers[3] = {&part.high, &part.medium, &part.low};
+    for (int w = 0; w < 3; ++w) {
+      ASSERT_EQ(buffers[w]->size(), padded * 4);
+      words[w].resize(padded);
+      gpu::readBuffer(*context, *buffers[w], 0, words[w].data(), padded * 4);
+    }
+    std::vector<uint32_t> gpuColors(part.count);
+    gpu::readBuffer(*context, part.colors, 0, gpuColors.data(), part.count * 4);
+    std::vector<shared::BatchBounds> bounds(part.batchCount());
+    gpu::readBuffer(*context, part.batches, 0, bounds.data(), bounds.size() * sizeof(shared::BatchBounds));
+    for (uint64_t b = 0; b < part.batchCount(); ++b) {
+      uint64_t local = b * shared::kBatchPoints;
+      Batch batch = makeBatch(cloud, part.first + local,
+                              uint32_t(std::min<uint64_t>(shared::kBatchPoints, part.count - local)));
+      std::vector<uint32_t> expect[3];
+      for (auto& e : expect)
+        e.resize(batch.count);
+      encodeBatchWords(expect[0].data(), expect[1].data(), expect[2].data(), cloud, batch);
+      for (int w = 0; w < 3; ++w)
+        ASSERT_TRUE(std::equal(expect[w].begin(), expect[w].end(), words[w].begin() + local)) << "word " << w;
+      glm::vec3 lo(batch.bounds.min - cloud.origin()), hi(batch.bounds.max - cloud.origin());
+      EXPECT_EQ(glm::vec3(bounds[b].min), lo);
+      EXPECT_EQ(glm::vec3(bounds[b].max), hi);
+      for (uint32_t k = 0; k < batch.count; ++k)
+        ASSERT_EQ(gpuColors[local + k], colors[batch.first + k]);
+      checked += batch.count;
+    }
+    for (uint64_t k = part.count; k < padded; ++k)
+      for (int w = 0; w < 3; ++w)
+        EXPECT_EQ(words[w][k], 0u) << "padding word";
+  }
+  EXPECT_EQ(checked, 25'003u);
+}
+
+TEST_F(GpuTest, BatchAtFullPrecisionMatchesAtomicMin) {
+  // Colors are point indices, so that both methods break depth ties alike (atomicmin by the smaller color,
+  // batch by the smaller visibility index) and an equal pixel means the same point won: in dense views
+  // many pixels hold two points of equal float depth.
+  uint32_t w = 200, h = 120;
+  for (auto& [cloudName, original] : testClouds()) {
+    for (Order order : {Order::Original, Order::Morton, Order::Shuffled}) {
+      PointCloud cloud = original;
+      reorder(cloud, order, 3);
+      colorsAreIndices(cloud);
+      GpuScene floatScene(*context, cloud, floats());
+      GpuScene batchScene(*context, cloud, batched());
+      for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
+        std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
+        Drawn reference = draw(*context, floatScene, camera, w, h, {Method::AtomicMin});
+        EXPECT_GT(litCount(reference.image), 100u) << where;
+        Drawn batch = draw(*context, batchScene, camera, w, h, {Method::Batch, 3});
+        Drawn prefetch = draw(*context, batchScene, camera, w, h, {Method::BatchPrefetch, 3});
+        double same = equalLitFraction(batch.image, reference.image);
+        EXPECT_GE(same, 0.999) << where;
+        if (same < 1.0) std::printf("%s: %.4f %% of lit pixels equal\n", where.c_str(), 100 * same);
+        // Both decode every point the same way: the same words, bit for bit.
+        EXPECT_EQ(prefetch.words, batch.words) << where;
+        ASSERT_TRUE(batch.stats.batch && prefetch.stats.batch);
+        const BatchStats& s = *batch.stats.batch;
+        EXPECT_EQ(s.batchesProcessed, (cloud.size() + 10239) / 10240) << where;
+        EXPECT_EQ(s.pointsByWords[0] + s.pointsByWords[1], 0u) << where << ": precision forced to 3 words";
+        EXPECT_EQ(s.pointsProcessed, s.pointsByWords[2]);
+        EXPECT_LE(s.pointsRendered, s.pointsProcessed);
+        EXPECT_GE(s.pointsRendered, litCount(batch.image)) << where;
+        EXPECT_EQ(prefetch.stats.batch->batchesRendered, s.batchesRendered) << where;
+        EXPECT_EQ(prefetch.stats.batch->pointsProcessed, s.pointsProcessed) << where;
+        if (viewName == "close" && order == Order::Morton) {
+          EXPECT_LT(s.batchesRendered, s.batchesProcessed) << where << ": expected culled batches";
+        }
+      }
+    }
+  }
+}
+
+TEST_F(GpuTest, AdaptivePrecisionMovesNoPointByMoreThanOnePixel) {
+  // Colors name points, so the pixel of every point visible in both images can be compared between
+  // adaptive precision and the full 30 bits. A sparse random cloud (almost every point visible) and dense
+  // ones (terrain, autzen: the points that win their pixel in both).
+  std::map<std::string, PointCloud> clouds = testClouds();
+  {
+    std::mt19937_64 rng(8);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<glm::dvec3> points;
+    for (int i = 0; i < 400'000; ++i)
+      points.push_back({u(rng) * 100, u(rng) * 100, u(rng) * 1});
+    clouds["sparse"] = cloudFromPoints(points, std::vector<uint32_t>(points.size(), 0xFFFFFFFFu));
+  }
+  for (auto& [cloudName, original] : clouds) {
+    PointCloud cloud = original;
+    reorder(cloud, Order::Morton, 1);
+    colorsAreIndices(cloud);
+    GpuScene scene(*context, cloud, batched());
+    // 800 x 500 and a larger one: the bigger the image, the more batches need more words.
+    for (auto [w, h] : {std::pair<uint32_t, uint32_t>{800, 500}, {2400, 1500}}) {
+      for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
+        std::string where =
+            cloudName + " / " + viewName + " / " + std::to_string(w) + "x" + std::to_string(h);
+        for (Method method : {Method::Batch, Method::BatchPrefetch}) {
+          Drawn full = draw(*context, scene, camera, w, h, {method, 3});
+          Drawn adaptive = draw(*context, scene, camera, w, h, {method, 0});
+          size_t litFull = litCount(full.image), litAdaptive = litCount(adaptive.image);
+          EXPECT_GE(double(litAdaptive), 0.995 * double(litFull)) << where;
+          // Pixel of each visible point in the full-precision image.
+          std::vector<int64_t> fullPixel(cloud.size() + 1, -1);
+          for (size_t p = 0; p < full.image.size(); ++p)
+            if (full.image[p]) fullPixel[full.image[p] & 0xFFFFFF] = int64_t(p);
+          size_t compared = 0, moved = 0, tooFar = 0;
+          for (size_t p = 0; p < adaptive.image.size(); ++p) {
+            if (!adaptive.image[p]) continue;
+            int64_t q = fullPixel[adaptive.image[p] & 0xFFFFFF];
+            if (q < 0) continue;
+            ++compared;
+            int64_t dx = std::abs(int64_t(p % w) - q % w), dy = std::abs(int64_t(p / w) - q / w);
+            moved += dx + dy > 0;
+            tooFar += dx > 1 || dy > 1;
+          }
+          EXPECT_EQ(tooFar, 0u) << where << ": points moved by more than one pixel";
+          EXPECT_GE(compared, litAdaptive / 2) << where << ": too few points to compare";
+          if (cloudName == "sparse" && viewName == "overview" && w == 2400) {
+            EXPECT_GE(compared, cloud.size() * 6 / 10) << where << ": most points should be visible";
+            EXPECT_GE(compared, litAdaptive * 9 / 10) << where;
+          }
+          const BatchStats& s = *adaptive.stats.batch;
+          if (viewName == "overview") {
+            EXPECT_GT(s.pointsByWords[0], 0u) << where << ": adaptive precision never used one word";
+          }
+          if (method == Method::Batch && w == 2400)
+            std::printf("%-28s words 1/2/3: %8llu %8llu %8llu  compared %6zu, moved %5zu, lit %zu / %zu\n",
+                        where.c_str(), (unsigned long long)s.pointsByWords[0],
+                        (unsigned long long)s.pointsByWords[1], (unsigned long long)s.pointsByWords[2],
+                        compared, moved, litAdaptive, litFull);
+        }
+      }
+    }
+  }
+}
+
+TEST_F(GpuTest, BatchCullingNeverDropsAVisiblePoint) {
+  uint32_t w = 240, h = 160;
+  for (auto& [cloudName, original] : testClouds()) {
+    for (Order order : {Order::Original, Order::Morton}) {
+      PointCloud cloud = original;
+      reorder(cloud, order, 2);
+      GpuScene scene(*context, cloud, batched());
+      std::vector<std::pair<std::string, Camera>> cameras = views(cloud.bounds, double(w) / h);
+      // And looking straight down from just above the middle with a narrow lens: most batches beside the
+      // frustum, some across its sides.
+      Camera down;
+      down.eye = cloud.bounds.center() + glm::dvec3(0, 0, cloud.bounds.size().z);
+      down.target = cloud.bounds.center();
+      down.up = {0, 1, 0};
+      down.fovY = 20;
+      cameras.push_back({"down", down});
+      size_t culledSomewhere = 0;
+      for (auto& [viewName, camera] : cameras) {
+        std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
+        for (uint32_t precision : {0u, 3u}) {
+          Drawn culled = draw(*context, scene, camera, w, h, {Method::BatchPrefetch, precision, true});
+          Drawn all = draw(*context, scene, camera, w, h, {Method::BatchPrefetch, precision, false});
+          EXPECT_EQ(culled.words, all.words) << where << ", precision " << precision;
+          EXPECT_EQ(all.stats.batch->batchesRendered, all.stats.batch->batchesProcessed) << where;
+          culledSomewhere += culled.stats.batch->batchesRendered < culled.stats.batch->batchesProcessed;
+          EXPECT_EQ(culled.stats.batch->pointsRendered > 0, all.stats.batch->pointsRendered > 0) << where;
+        }
+      }
+      if (order == Order::Morton) { // (a random cloud in its own order has no batch smaller than the cloud)
+        EXPECT_GT(culledSomewhere, 0u) << cloudName << ": no view culled anything";
+      }
+    }
+  }
+}
+
+namespace {
+
+// Five batches with known fates, seen by axisCamera() in a 32 x 48 image:
+//   0: 10240 points on the 512 pixels of rows 0..15, 20 per pixel, point i on pixel i % 512 at step
+//      s = i / 512. Both batch (thread t draws points t + 128 j) and batch-prefetch (points 4 (t + 128 j)
+//      + k) give all points of a pixel to one thread in the order of s, so early-z is deterministic:
+//      pixels 0..255 get their points front to back (1 atomic each), pixels 256..511 back to front (20).
+//   1: 10240 points behind the eye: culled.
+//   2: 10240 points left of the frustum: culled.
+//   3: 10240 points at x = -50 and x = +50: the box crosses the frustum, no point is in the image.
+//   4: 1000 points, one on each of 1000 pixels of rows 16..47.
+constexpr uint32_t kHandW = 32, kHandH = 48;
+
+PointCloud handBuiltBatches() {
+  std::vector<glm::dvec3> points;
+  std::vector<uint32_t> colors;
+  auto atPixel = [&](uint32_t px, uint32_t py, double depth, uint32_t color) {
+    // Normalized device coordinates of the pixel center; x / w = ndc x needs x = ndc x * depth * aspect.
+    double sx = (px + 0.5) / (kHandW / 2.0) - 1.0, sy = 1.0 - (py + 0.5) / (kHandH / 2.0);
+    points.push_back({sx * depth * kHandW / kHandH, sy * depth, -depth});
+    colors.push_back(color);
+  };
+  for (uint32_t i = 0; i < 10240; ++i) {
+    uint32_t r = i % 512, s = i / 512;
+    double depth = r < 256 ? 2.0 + 0.05 * s : 3.0 - 0.05 * s;
+    atPixel(r % 32, r / 32, depth, 0xFF000000u | (r * 97 + s * 13));
+  }
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (uint32_t i = 0; i < 10240; ++i)
+    points.push_back({u(rng) * 4 - 2, u(rng) * 4 - 2, 1 + u(rng)}), colors.push_back(0xFF0000FFu);
+  for (uint32_t i = 0; i < 10240; ++i)
+    points.push_back({-10 + 4 * u(rng), u(rng) - 0.5, -2 - u(rng)}), colors.push_back(0xFF00FF00u);
+  for (uint32_t i = 0; i < 10240; ++i)
+    points.push_back({i % 2 ? 50.0 : -50.0, 0.0, -2.0}), colors.push_back(0xFFFF0000u);
+  for (uint32_t i = 0; i < 1000; ++i)
+    atPixel(i % 32, 16 + i / 32, 2.5, 0xFF000000u | (i * 7919));
+  return cloudFromPoints(points, colors);
+}
+
+} // namespace
+
+TEST_F(GpuTest, BatchStatisticsAreExactOnAHandBuiltScene) {
+  PointCloud cloud = handBuiltBatches();
+  ASSERT_EQ(cloud.size(), 4 * 10240u + 1000);
+  Camera camera = axisCamera();
+  for (uint64_t partPoints : {uint64_t(0), uint64_t(10240), uint64_t(20480)}) {
+    GpuScene scene(*context, cloud, batched(partPoints));
+    for (Method method : {Method::Batch, Method::BatchPrefetch, Method::BatchHqs}) {
+      for (uint32_t precision : {0u, 1u, 2u, 3u}) {
+        std::string where = std::string(methodName(method)) + ", parts of " + std::to_string(partPoints) +
+                            ", precision " + std::to_string(precision);
+        Drawn d = draw(*context, scene, camera, kHandW, kHandH, {method, precision});
+        ASSERT_TRUE(d.stats.batch) << where;
+        const BatchStats& s = *d.stats.batch;
+        EXPECT_EQ(s.batchesProcessed, 5u) << where;
+        EXPECT_EQ(s.batchesRendered, 3u) << where;
+        EXPECT_EQ(s.pointsProcessed, 10240u + 10240u + 1000u) << where;
+        EXPECT_EQ(s.pointsRendered, 256u * 1 + 256u * 20 + 1000u) << where;
+        EXPECT_EQ(s.pointsBlended, method == Method::BatchHqs ? 512u + 1000u : 0u) << where;
+        if (precision != 0) {
+          EXPECT_EQ(s.pointsByWords[precision - 1], s.pointsProcessed) << where;
+        } else {
+          EXPECT_EQ(s.pointsByWords[0], 11240u) << where << ": batches 0 and 4 span few pixels";
+        }
+        uint64_t words = s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2];
+        uint64_t once = 5 * 32 + 4 * words;
+        EXPECT_EQ(s.bytesRead, method == Method::BatchHqs ? 2 * once + 4 * s.pointsBlended : once) << where;
+        EXPECT_EQ(litCount(d.image), 1512u) << where;
+      }
+    }
+  }
+}
+
+TEST_F(GpuTest, BatchPartsAndScenesGiveTheFramebufferOfOnePart) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<glm::dvec3> points(100'000);
+  std::vector<uint32_t> colors(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    points[i] = {u(rng) * 5, u(rng) * 5, u(rng) * 5};
+    colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
+  }
+  PointCloud cloud = cloudFromPoints(points, colors);
+  Camera camera = overviewCamera(cloud.bounds, 2.0);
+  GpuScene whole(*context, cloud, batched());
+  ASSERT_EQ(whole.parts().size(), 1u);
+  GpuScene small(*context, cloud, batched(10240)); // 10 parts, the last one short
+  ASSERT_EQ(small.parts().size(), 10u);
+  // Three scenes cut at batch boundaries (so their batches are those of the whole upload), in parts of
+  // two, three and one batch: 2 + 2 + 6 parts.
+  std::vector<std::unique_ptr<GpuScene>> scenes;
+  uint64_t cuts[] = {0, 40'960, 81'920, cloud.size()};
+  uint64_t partSizes[] = {20'480, 30'720, 10'240};
+  for (int s = 0; s < 3; ++s) {
+    UploadOptions o = batched(partSizes[s]);
+    o.first = cuts[s];
+    o.count = cuts[s + 1] - cuts[s];
+    scenes.push_back(std::make_unique<GpuScene>(*context, cloud, o));
+  }
+  const GpuScene* three[] = {scenes[0].get(), scenes[1].get(), scenes[2].get()};
+  for (Method method : {Method::Batch, Method::BatchPrefetch}) {
+    for (uint32_t precision : {0u, 3u}) {
+      Drawn reference = draw(*context, whole, camera, 256, 128, {method, precision});
+      EXPECT_GT(litCount(reference.image), 1000u);
+      EXPECT_EQ(draw(*context, small, camera, 256, 128, {method, precision}).words, reference.words)
+          << methodName(method) << ": ten parts";
+      Drawn split = draw(*context, three, camera, 256, 128, {method, precision});
+      EXPECT_EQ(split.words, reference.words) << methodName(method) << ": three scenes, ten parts";
+      EXPECT_EQ(split.stats.batch->pointsProcessed, reference.stats.batch->pointsProcessed);
+      EXPECT_EQ(split.stats.points, cloud.size());
+    }
+  }
+}
+
+TEST_F(GpuTest, BatchLayoutAndPartLimitsAreClearErrors) {
+  PointCloud cloud = cloudFromPoints({{0, 0, -1}, {0.1, 0, -1}}, {0xFFFFFFFFu, 0xFF0000FFu});
+  GpuScene floatScene(*context, cloud, floats());
+  GpuScene batchScene(*context, cloud, batched());
+  Renderer renderer(*context, 8, 8);
+  RenderSettings settings;
+  settings.method = Method::Batch;
+  EXPECT_THROW(renderer.render(floatScene, axisCamera(), settings), InputError);
+  settings.method = Method::AtomicMin;
+  EXPECT_THROW(renderer.render(batchScene, axisCamera(), settings), InputError);
+  settings.method = Method::HwPoints;
+  EXPECT_THROW(renderer.render(batchScene, axisCamera(), settings), InputError);
+  settings.method = Method::BatchPrefetch;
+  settings.precision = 4;
+  EXPECT_THROW(renderer.render(batchScene, axisCamera(), settings), InputError);
+  settings.precision = 0;
+  // 65 parts (of one batch each, over 5 scenes) is one more than visibility indices address.
+  std::vector<glm::dvec3> many(13 * 10240, glm::dvec3(0, 0, -1));
+  PointCloud big = cloudFromPoints(many, std::vector<uint32_t>(many.size(), 0xFFFFFFFFu));
+  std::vector<std::unique_ptr<GpuScene>> scenes;
+  std::vector<const GpuScene*> drawn;
+  for (int s = 0; s < 5; ++s) {
+    scenes.push_back(std::make_unique<GpuScene>(*context, big, batched(10240)));
+    drawn.push_back(scenes.back().get());
+  }
+  try {
+    renderer.render(drawn, axisCamera(), settings);
+    ADD_FAILURE() << "65 parts were drawn";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("65 parts"), std::string::npos) << e.what();
+  }
+  drawn.pop_back();
+  drawn.push_back(&batchScene); // 53 parts: fine
+  FrameStats stats = renderer.render(drawn, axisCamera(), settings);
+  EXPECT_EQ(stats.batch->batchesProcessed, 53u);
+}
+
+namespace {
+
+int maxChannelDiff(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b,
+                   double* withinOne = nullptr) {
+  int worst = 0;
+  size_t ok = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    int d = 0;
+    for (int c = 0; c < 4; ++c)
+      d = std::max(d, std::abs(int((a[i] >> (8 * c)) & 0xFF) - int((b[i] >> (8 * c)) & 0xFF)));
+    worst = std::max(worst, d);
+    ok += d <= 1;
+  }
+  if (withinOne) *withinOne = double(ok) / double(a.size());
+  return worst;
+}
+
+} // namespace
+
+TEST_F(GpuTest, BatchHqsMatchesHqs) {
+  // As methods_test's HQS case: points near pixel centers at depths well within 1 % of the pixel's front
+  // surface or 3 % behind it, one pixel with 1,500 blended points (past the packed word's 255).
+  constexpr uint32_t W = 64, H = 64;
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3), layer(0.0, 0.004);
+  std::vector<glm::dvec3> points;
+  std::vector<uint32_t> colors;
+  auto add = [&](uint32_t px, uint32_t py, double depth, uint32_t color) {
+    double sx = (px + 0.5 + jitter(rng)) / (W / 2.0) - 1.0, sy = 1.0 - (py + 0.5 + jitter(rng)) / (H / 2.0);
+    points.push_back({sx * depth, sy * depth, -depth});
+    colors.push_back(color);
+  };
+  for (uint32_t py = 0; py < H; ++py)
+    for (uint32_t px = 0; px < W; ++px) {
+      if ((px * 7 + py * 3) % 11 == 0) continue;
+      double front = 2.0 + 0.5 * std::sin(px * 0.2) + 0.3 * std::cos(py * 0.3);
+      int count = 1 + int(rng() % 6);
+      for (int k = 0; k < count; ++k)
+        add(px, py, front * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+      add(px, py, front * 1.03, 0xFF0000FFu);
+    }
+  for (int k = 0; k < 1500; ++k)
+    add(10, 20, 1.5 * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+  PointCloud cloud = cloudFromPoints(points, colors, 1e-7);
+  for (Order order : {Order::Original, Order::Shuffled}) {
+    PointCloud ordered = cloud;
+    reorder(ordered, order, 1);
+    GpuScene floatScene(*context, ordered, floats());
+    GpuScene batchScene(*context, ordered, batched(10240));
+    std::vector<uint32_t> hqs = draw(*context, floatScene, axisCamera(), W, H, {Method::Hqs}).image;
+    for (uint32_t precision : {3u, 0u}) {
+      Drawn b = draw(*context, batchScene, axisCamera(), W, H, {Method::BatchHqs, precision});
+      EXPECT_TRUE(b.words.empty());
+      EXPECT_LE(maxChannelDiff(b.image, hqs), 1) << orderName(order) << ", precision " << precision;
+      EXPECT_NE(b.image[20 * W + 10], 0u);
+    }
+  }
+  // Generated terrain: almost every pixel within 1 (points on pixel borders may switch pixels).
+  GenerateOptions options;
+  options.points = 80'000;
+  options.progress = false;
+  PointCloud terrain = generateScene(Scene::Terrain, options);
+  reorder(terrain, Order::Morton, 1);
+  Camera camera = overviewCamera(terrain.bounds, 1.6);
+  GpuScene floatScene(*context, terrain, floats());
+  GpuScene batchScene(*context, terrain, batched());
+  std::vector<uint32_t> hqs = draw(*context, floatScene, camera, 320, 200, {Method::Hqs}).image;
+  Drawn b = draw(*context, batchScene, camera, 320, 200, {Method::BatchHqs, 3});
+  double withinOne = 0;
+  maxChannelDiff(b.image, hqs, &withinOne);
+  EXPECT_GE(withinOne, 0.998);
+  EXPECT_GT(b.stats.batch->pointsBlended, litCount(b.image));
+}
+
+} // namespace pointrast::test
