@@ -31,6 +31,12 @@ pr=$POINTRAST_BIN
 
 echo "== machine"
 nvidia-smi -L 2>/dev/null || true
+# A machine that ran a hung kernel stays busy with no process and hangs graphics work from then on
+# (bench/NOTES.md): say so at once instead of producing stalls.
+busy=$(nvidia-smi --query-gpu=utilization.gpu --format=csv,noheader,nounits 2>/dev/null | head -1)
+if [ -n "$busy" ] && [ "$busy" -gt 50 ] && [ -z "$(nvidia-smi --query-compute-apps=pid --format=csv,noheader 2>/dev/null)" ]; then
+  echo "WARNING: GPU ${busy}% busy with no process: probably wedged by an earlier hang; use a fresh machine"
+fi
 nproc; free -g | head -2
 $pr info --devices
 
@@ -69,8 +75,19 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 timeout "${SUITE_LIMIT:-560}" $pr bench --suite paper2021 --frames "${SUITE_FRAMES:-15}" \
       --methods "${SUITE_METHODS:-all}" --out "$OUT" --name paper2021 --json > "$OUT/paper2021.jsonl" || status=1
     ;;
+  paper2022)
+    # The 2022 evaluation: 69 M .. 1,000 M stand-ins at 2560x1140, batch methods vs hw-points, dedup, hqs.
+    POINTRAST_VALIDATION=0 timeout "${SUITE_LIMIT:-560}" $pr bench --suite paper2022 --frames "${SUITE_FRAMES:-15}" \
+      --methods "${SUITE_METHODS:-all}" --out "$OUT" --name paper2022 --json > "$OUT/paper2022.jsonl" || status=1
+    ;;
+  big4g)
+    # 4 billion generated points (the 2022 target: >= 60 fps on an H200), batched layout, Morton order.
+    echo "== 4 G points, batch-prefetch"
+    POINTRAST_VALIDATION=0 $pr render terrain --points 4G --order morton --method batch-prefetch --width 2560 \
+      --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, sweep, paper2021)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, big4g, sweep, paper2021, paper2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
