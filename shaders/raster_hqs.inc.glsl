@@ -18,6 +18,7 @@
 #endif
 #include "common.inc.glsl"
 #include "grid.inc.glsl"
+#include "hqs_accumulate.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
 layout(push_constant) uniform Push { RasterPush pc; };
@@ -27,32 +28,15 @@ layout(constant_id = 0) const uint ONE_ROUND = 0;
 
 const uint kNoPixel = 0xFFFFFFFFu;
 
-uint64_t joinPair(uint hi, uint lo) {
-  return (uint64_t(hi) << 32) | uint64_t(lo);
-}
-
-void accumulate(uint pixel, uint64_t packed, uint64_t rg, uint64_t bn, uint count) {
+// hqs: two 64-bit sums per pixel. hqs1r: the single-atomic layout of hqs_accumulate.inc.glsl.
+void accumulate(uint pixel, uint r, uint g, uint b, uint count) {
   Uint64Array acc = Uint64Array(pc.aux);
-  if (ONE_ROUND == 0) {
-    atomicAdd(acc.v[2 * pixel], rg);
-    atomicAdd(acc.v[2 * pixel + 1], bn);
+  if (ONE_ROUND != 0) {
+    hqsAccumulate(acc, pc.width * pc.height, pixel, r, g, b, count);
     return;
   }
-  // A pixel already full (as a plain read shows it) goes to the fallback sums at once: in dense views
-  // thousands of points share a pixel, and the add-then-take-back pair below would put two atomics per
-  // point on one hot address. The read may count adds that are about to be taken back; such a point then
-  // uses the fallback although it might have fitted, which changes nothing in the resolved sums.
-  if (uint(acc.v[pixel] >> 48) + count <= kHqs1rMaxCount) {
-    uint64_t before = atomicAdd(acc.v[pixel], packed);
-    if (uint(before >> 48) + count <= kHqs1rMaxCount) return;
-    // The word would pass 255 points: take the add back (modular addition undoes exactly, whatever
-    // carries happened meanwhile) and add to the 32-bit fallback sums instead. Adds that stay always saw
-    // a total of at most 255 including themselves, so the packed fields never overflow in the final sums.
-    atomicAdd(acc.v[pixel], -packed);
-  }
-  uint pixels = pc.width * pc.height;
-  atomicAdd(acc.v[pixels + 2 * pixel], rg);
-  atomicAdd(acc.v[pixels + 2 * pixel + 1], bn);
+  atomicAdd(acc.v[2 * pixel], (uint64_t(r) << 32) | uint64_t(g));
+  atomicAdd(acc.v[2 * pixel + 1], (uint64_t(b) << 32) | uint64_t(count));
 }
 
 void main() {
@@ -69,31 +53,20 @@ void main() {
     // back with an undefined pixel here and was blended into it: atomics at arbitrary addresses.)
     pixel = kNoPixel;
   }
-  bool blended = pixel != kNoPixel;
-  // Sums within the subgroup in 32 bits (see raster_closest.inc.glsl on 64-bit subgroup arithmetic):
-  // at most 128 lanes x 255 per channel.
-  uint r = blended ? uint(word) & 0xFFu : 0u, g = blended ? (uint(word) >> 8) & 0xFFu : 0u;
-  uint b = blended ? (uint(word) >> 16) & 0xFFu : 0u, one = blended ? 1u : 0u;
+  // Sums within the subgroup in 32 bits (see raster_closest.inc.glsl on 64-bit subgroup arithmetic).
+  uint r, g, b, count;
+  bool writes;
 #if PARTITIONED_NV
+  bool blended = pixel != kNoPixel;
+  uint color = uint(word);
   uvec4 same = subgroupPartitionNV(pixel);
-  r = subgroupPartitionedAddNV(r, same);
-  g = subgroupPartitionedAddNV(g, same);
-  b = subgroupPartitionedAddNV(b, same);
-  uint count = subgroupPartitionedAddNV(one, same);
-  bool writes = blended && gl_SubgroupInvocationID == subgroupBallotFindLSB(same);
+  r = subgroupPartitionedAddNV(blended ? color & 0xFFu : 0u, same);
+  g = subgroupPartitionedAddNV(blended ? (color >> 8) & 0xFFu : 0u, same);
+  b = subgroupPartitionedAddNV(blended ? (color >> 16) & 0xFFu : 0u, same);
+  count = subgroupPartitionedAddNV(blended ? 1u : 0u, same);
+  writes = blended && gl_SubgroupInvocationID == subgroupBallotFindLSB(same);
 #else
-  uint count = one;
-  bool writes = blended;
-  if (subgroupAllEqual(pixel)) {
-    r = subgroupAdd(r);
-    g = subgroupAdd(g);
-    b = subgroupAdd(b);
-    count = subgroupAdd(one);
-    writes = blended && subgroupElect();
-  }
+  hqsSubgroupSums(pixel, uint(word), r, g, b, count, writes);
 #endif
-  if (writes) {
-    uint64_t packed = uint64_t(r) | (uint64_t(g) << 16) | (uint64_t(b) << 32) | (uint64_t(count) << 48);
-    accumulate(pixel, packed, joinPair(r, g), joinPair(b, count), count);
-  }
+  if (writes) accumulate(pixel, r, g, b, count);
 }
