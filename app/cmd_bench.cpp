@@ -1,4 +1,5 @@
-// pointrast bench FILE|SCENE... | --suite paper2021: the method x order x view matrix, timed on the GPU.
+// pointrast bench FILE|SCENE... | --suite paper2021: the method x order x view matrix, timed on the GPU;
+// --suite spheres2023: the sphere method x layout x billboard x conservative x orbit matrix.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -16,12 +17,14 @@
 #include "base/progress.h"
 #include "bench/report.h"
 #include "bench/runner.h"
+#include "bench/sphere_runner.h"
 #include "bench/suites.h"
 #include "cli_util.h"
 #include "cloud/generate.h"
 #include "commands.h"
 #include "gpu/context.h"
 #include "input.h"
+#include "render/spheres/sphere_renderer.h"
 
 namespace pointrast::app {
 
@@ -34,6 +37,9 @@ struct BenchArgs {
   std::vector<std::string> inputs;
   std::string suite, methods = "all", orders = "all", views = "all", points = "1M", copySize = "1G";
   std::string out, name;
+  // Sphere suites: the layouts, billboards, conservative settings and orbits measured, cameras per orbit.
+  std::string layouts = "all", billboards = "all", conservative = "all", orbits = "all";
+  uint32_t cameras = 10;
   double scale = 1.0, fov = 60;
   uint32_t width = 1920, height = 1080, frames = 50;
   uint64_t seed = 1;
@@ -42,7 +48,12 @@ struct BenchArgs {
   bool scaleGiven = false, pointsGiven = false;
   // Options given on the command line (a suite brings its own methods, orders, views and image size).
   bool methodsGiven = false, ordersGiven = false, viewsGiven = false, widthGiven = false, heightGiven = false;
+  bool framesGiven = false, sphereOptionsGiven = false;
 };
+
+// Timed frames per camera of the sphere suites unless --frames says otherwise: 5 x 10 cameras = 50 frames
+// per combination, as many as the point suites time.
+constexpr uint32_t kSphereSuiteFrames = 5;
 
 // "a,b" -> {"a", "b"}, or every choice for "all"; each name parsed (InputError names the choices),
 // duplicates dropped, first occurrence kept.
@@ -120,6 +131,154 @@ std::vector<bench::Dataset> inputDatasets(const BenchArgs& a) {
   return out;
 }
 
+// Notes and one line per result on stderr; on a terminal each result line replaces the last, so the screen
+// shows where the run is. A skipped data set or layout is said even when quiet.
+class ProgressLines {
+public:
+  explicit ProgressLines(bool quiet) : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
+  void note(const std::string& line) {
+    if (quiet_ && line.find("skipped") == std::string::npos) return;
+    end();
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+  void result(size_t done, size_t total, const std::string& what) {
+    if (quiet_) return;
+    std::fprintf(stderr, "%s[%zu/%zu] %s%s", tty_ ? "\r\033[K" : "", done, total, what.c_str(),
+                 tty_ ? "" : "\n");
+    open_ = tty_;
+    std::fflush(stderr);
+  }
+  void end() {
+    if (open_) std::fprintf(stderr, "\n");
+    open_ = false;
+  }
+
+private:
+  bool quiet_, tty_, open_ = false;
+};
+
+void printJsonLine(nlohmann::json j, const gpu::Context& context) {
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  std::printf("%s\n", j.dump().c_str());
+  std::fflush(stdout);
+}
+
+std::filesystem::path reportDir(const BenchArgs& a, const gpu::Context& context) {
+  return a.out.empty() ? std::filesystem::path("bench/results") / bench::sanitizeName(context.info().name)
+                       : std::filesystem::path(a.out);
+}
+
+// What every run checks at its end: validation errors, and that something was measured at all.
+void checkRun(const gpu::Context& context, const std::vector<bench::DatasetOutcome>& datasets) {
+  if (context.validationErrors() > 0)
+    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                     " error(s)");
+  bool measured = false;
+  std::string skipped;
+  for (const bench::DatasetOutcome& d : datasets) {
+    measured = measured || !d.skipped;
+    if (d.skipped) skipped += (skipped.empty() ? "" : "; ") + d.dataset.label + " " + d.reason;
+  }
+  if (!measured) throw InputError("nothing was measured: " + skipped);
+}
+
+void printWritten(const BenchArgs& a, size_t results, double seconds, const bench::WrittenFiles& files) {
+  if (a.quiet && a.json) return;
+  std::FILE* to = a.json ? stderr : stdout;
+  std::fprintf(to, "%zu results in %.1f s; wrote %s, %s, %s\n", results, seconds, files.json.string().c_str(),
+               files.markdown.string().c_str(), files.svg.string().c_str());
+}
+
+gpu::ContextOptions contextOptions(const BenchArgs& a) {
+  gpu::ContextOptions options;
+  options.deviceIndex = a.device;
+  options.announce = !a.quiet;
+  return options;
+}
+
+bench::ReportInfo suiteReportInfo(const BenchArgs& a) {
+  bench::ReportInfo info;
+  info.name = a.suite;
+  info.title = a.suite;
+  if (a.scale != 1.0) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", a.scale);
+    info.name += std::string("-scale") + text;
+    info.title += std::string(" (scale ") + text + ")";
+  }
+  if (!a.name.empty()) info.name = a.name;
+  info.commandLine = commandLine();
+  info.date = bench::utcNow();
+  return info;
+}
+
+bool parseOnOff(const std::string& item) {
+  if (item == "off") return false;
+  if (item == "on") return true;
+  throw InputError("--conservative '" + item + "': choose off, on, or all");
+}
+
+// --suite spheres2023: particle stand-ins, sphere methods of the method table.
+int runSphereSuite(const BenchArgs& a) {
+  if (!a.inputs.empty())
+    throw InputError("--suite " + a.suite + " generates its data sets; it takes no INPUT (" +
+                     a.inputs.front() + ")");
+  if (a.ordersGiven || a.viewsGiven)
+    throw InputError("--orders and --views apply to the point benchmarks; --suite " + a.suite +
+                     " takes --orbits short,long");
+  if (a.cameras == 0) throw InputError("--cameras must be at least 1");
+  bench::SphereBenchConfig config;
+  config.datasets = bench::sphereSuiteDatasets(a.suite, a.scale, a.seed);
+  std::vector<SphereMethod> allMethods;
+  for (const SphereMethodInfo& m : sphereMethodTable())
+    allMethods.push_back(m.method);
+  config.methods = parseList(a.methods, "--methods", allMethods, parseSphereMethod);
+  std::vector<ParticleLayout> allLayouts;
+  for (const ParticleLayoutInfo& l : particleLayoutTable())
+    allLayouts.push_back(l.layout);
+  config.layouts = parseList(a.layouts, "--layouts", allLayouts, parseParticleLayout);
+  config.billboards = parseList(
+      a.billboards, "--billboards",
+      std::vector<SphereBillboard>{SphereBillboard::Screen, SphereBillboard::Camera}, parseSphereBillboard);
+  config.conservative =
+      parseList(a.conservative, "--conservative", std::vector<bool>{false, true}, parseOnOff);
+  config.orbits = parseList(a.orbits, "--orbits",
+                            std::vector<bench::Orbit>(bench::allOrbits().begin(), bench::allOrbits().end()),
+                            bench::parseOrbit);
+  config.cameras = a.cameras;
+  config.width = a.width;
+  config.height = a.height;
+  config.frames = a.framesGiven ? a.frames : kSphereSuiteFrames;
+  config.fovY = a.fov;
+  config.copyBytes = parseCount(a.copySize, "--copy-size");
+  if (config.copyBytes == 0) throw InputError("--copy-size must be at least 1");
+  config.progress = !a.quiet;
+  const bench::ReportInfo info = suiteReportInfo(a);
+
+  gpu::Context context(contextOptions(a));
+  ProgressLines lines(a.quiet);
+  bench::SphereBenchCallbacks callbacks;
+  callbacks.onNote = [&](const std::string& line) { lines.note(line); };
+  callbacks.onResult = [&](const bench::SphereBenchRun& run, const bench::SphereResult& r, size_t done,
+                           size_t total) {
+    if (a.json) printJsonLine(bench::sphereResultJson(run, r), context);
+    std::string what = r.dataset + " / " + particleLayoutName(r.layout) + " / " + bench::orbitName(r.orbit) +
+                       " / " + sphereMethodName(r.method);
+    if (r.billboards())
+      what +=
+          std::string(" / ") + sphereBillboardName(r.billboard) + (r.conservative ? ", conservative" : "");
+    lines.result(done, total,
+                 what + ": " + (r.ok() ? bench::formatMs(r.medianMs) + " ms" : std::string("n/a")));
+  };
+  bench::SphereBenchRun run = bench::runSphereBench(context, config, callbacks);
+  lines.end();
+  checkRun(context, run.datasets);
+  bench::WrittenFiles files = bench::writeSphereReports(run, info, reportDir(a, context));
+  printWritten(a, run.results.size(), run.seconds, files);
+  return 0;
+}
+
 int runBench(const BenchArgs& a) {
   Progress::setEnabled(!a.quiet);
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -130,6 +289,10 @@ int runBench(const BenchArgs& a) {
   if (a.pointsGiven && !a.suite.empty()) throw InputError("--points does not apply to --suite; use --scale");
   if (!a.name.empty() && (a.name.find('/') != std::string::npos || a.name == "." || a.name == ".."))
     throw InputError("--name '" + a.name + "': give a plain file name without '/'");
+  if (bench::isSphereSuite(a.suite)) return runSphereSuite(a);
+  if (a.sphereOptionsGiven)
+    throw InputError("--layouts, --billboards, --conservative, --orbits and --cameras apply to --suite "
+                     "spheres2023");
 
   bench::BenchConfig config;
   std::vector<Method> allMethods;
@@ -162,14 +325,7 @@ int runBench(const BenchArgs& a) {
       if (a.ordersGiven) d.orders.clear();
       if (a.viewsGiven) d.views.clear();
     }
-    info.name = a.suite;
-    info.title = a.suite;
-    if (a.scale != 1.0) {
-      char text[64];
-      std::snprintf(text, sizeof text, "%g", a.scale);
-      info.name += std::string("-scale") + text;
-      info.title += std::string(" (scale ") + text + ")";
-    }
+    info = suiteReportInfo(a);
   } else {
     config.datasets = inputDatasets(a);
     for (const bench::Dataset& d : config.datasets)
@@ -180,64 +336,22 @@ int runBench(const BenchArgs& a) {
   info.commandLine = commandLine();
   info.date = bench::utcNow();
 
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
-
-  // One line per result; on a terminal each replaces the last, so the screen shows where the run is.
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  bool lineOpen = false;
-  auto endLine = [&] {
-    if (lineOpen) std::fprintf(stderr, "\n");
-    lineOpen = false;
-  };
+  gpu::Context context(contextOptions(a));
+  ProgressLines lines(a.quiet);
   bench::BenchCallbacks callbacks;
-  callbacks.onNote = [&](const std::string& line) {
-    if (a.quiet && line.find("skipped") == std::string::npos) return; // a skip is said even when quiet
-    endLine();
-    std::fprintf(stderr, "%s\n", line.c_str());
-  };
-  const std::string device = context.info().name, deviceType = context.info().typeName;
+  callbacks.onNote = [&](const std::string& line) { lines.note(line); };
   callbacks.onResult = [&](const bench::BenchRun& run, const bench::Result& r, size_t done, size_t total) {
-    if (a.json) {
-      nlohmann::json j = bench::resultJson(run, r);
-      j["device"] = device;
-      j["device_type"] = deviceType;
-      std::printf("%s\n", j.dump().c_str());
-      std::fflush(stdout);
-    }
-    if (a.quiet) return;
-    std::string what = r.ok() ? bench::formatMs(r.stats.medianMs) + " ms" : "n/a";
-    std::fprintf(stderr, "%s[%zu/%zu] %s / %s / %s / %s: %s%s", tty ? "\r\033[K" : "", done, total,
-                 r.dataset.c_str(), orderName(r.order), bench::viewName(r.view), methodName(r.method),
-                 what.c_str(), tty ? "" : "\n");
-    lineOpen = tty;
-    std::fflush(stderr);
+    if (a.json) printJsonLine(bench::resultJson(run, r), context);
+    lines.result(done, total,
+                 r.dataset + " / " + orderName(r.order) + " / " + bench::viewName(r.view) + " / " +
+                     methodName(r.method) + ": " +
+                     (r.ok() ? bench::formatMs(r.stats.medianMs) + " ms" : std::string("n/a")));
   };
   bench::BenchRun run = bench::runBench(context, config, callbacks);
-  endLine();
-
-  if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
-  bool measured = false;
-  std::string skipped;
-  for (const bench::DatasetOutcome& d : run.datasets) {
-    measured = measured || !d.skipped;
-    if (d.skipped) skipped += (skipped.empty() ? "" : "; ") + d.dataset.label + " " + d.reason;
-  }
-  if (!measured) throw InputError("nothing was measured: " + skipped);
-
-  std::filesystem::path dir = a.out.empty()
-                                  ? std::filesystem::path("bench/results") / bench::sanitizeName(device)
-                                  : std::filesystem::path(a.out);
-  bench::WrittenFiles files = bench::writeReports(run, info, dir);
-  if (!a.quiet || !a.json) {
-    std::FILE* to = a.json ? stderr : stdout;
-    std::fprintf(to, "%zu results in %.1f s; wrote %s, %s, %s\n", run.results.size(), run.seconds,
-                 files.json.string().c_str(), files.markdown.string().c_str(), files.svg.string().c_str());
-  }
+  lines.end();
+  checkRun(context, run.datasets);
+  bench::WrittenFiles files = bench::writeReports(run, info, reportDir(a, context));
+  printWritten(a, run.results.size(), run.seconds, files);
   return 0;
 }
 
@@ -275,6 +389,21 @@ Command addBench(CLI::App& app) {
       "points per coordinate precision). Each data set is uploaded once per scene layout its methods read\n"
       "(float and batched, 16 B/point each); the memory estimate counts both. --methods, --orders, --views,\n"
       "--width and --height override the suite's.\n\n"
+      "--suite spheres2023 stands in for the particle data sets of \"Efficient Sphere Rendering Revisited\"\n"
+      "(2023) with generated particle scenes at the sizes issue 5 gives them: laser (particles-laser, 306 "
+      "M:\n"
+      "laser ablation, a crystal slab with a crater and ejected clusters), riemann (particles-block, 4 M: a\n"
+      "shock tube, dense block between vapor regions), drop (particles-drops, 30 M) and fluid\n"
+      "(particles-drops, 200 M: droplets and filaments in vapor). It times every sphere method of the "
+      "method\n"
+      "table (`pointrast render --help`) x layout (soa8, vec4x2, aos, xyz where the set allows: the\n"
+      "generated sets have per-particle colors, so xyz is skipped) x billboard (screen, camera) x\n"
+      "conservative rasterization (off, on where the device has it) for the methods that rasterize\n"
+      "billboards, from two orbits of --cameras cameras (10) around the center of the bounds: short (inside\n"
+      "the bounds) and long (outside, everything in frame). Per camera a warm-up and --frames timed frames\n"
+      "(default 5 here); a result is the median over the orbit's cameras of each camera's median. Its\n"
+      "report adds sphere-compute against the fastest other method. --methods, --layouts, --billboards,\n"
+      "--conservative off,on and --orbits short,long pick parts of the matrix.\n\n"
       "Examples:\n"
       "  pointrast bench terrain --points 10M --methods atomicmin,earlyz --orders original,morton\n"
       "  pointrast bench autzen.las --views overview --frames 100 --json\n"
@@ -282,10 +411,13 @@ Command addBench(CLI::App& app) {
       "  pointrast bench --suite paper2021 --scale 0.001 --frames 5 --out /tmp/smoke\n"
       "  pointrast bench --suite paper2021 retz=/data/retz.las\n"
       "  pointrast bench --suite paper2022\n"
-      "  pointrast bench --suite paper2022 --scale 0.001 --frames 5 --out /tmp/smoke");
+      "  pointrast bench --suite paper2022 --scale 0.001 --frames 5 --out /tmp/smoke\n"
+      "  pointrast bench --suite spheres2023\n"
+      "  pointrast bench --suite spheres2023 --scale 0.0001 --cameras 2 --frames 1 --out /tmp/smoke\n"
+      "  pointrast bench --suite spheres2023 --methods sphere-compute,sphere-points --orbits long");
   cmd->add_option("INPUT", a->inputs,
                   "LAS/PLY/XYZ files or scene names (terrain, tls); with --suite, NAME=PATH");
-  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021 or paper2022");
+  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022 or spheres2023");
   cmd->add_option("--scale", a->scale, "Multiply every size of the suite (e.g. 0.001 for a smoke run)")
       ->each([a](const std::string&) { a->scaleGiven = true; });
   cmd->add_option("--methods", a->methods, "Methods, comma-separated, or all (see `pointrast render --help`)")
@@ -303,8 +435,27 @@ Command addBench(CLI::App& app) {
   cmd->add_option("--height", a->height, "Image height in pixels (paper2022: 1140)")
       ->capture_default_str()
       ->each([a](const std::string&) { a->heightGiven = true; });
-  cmd->add_option("--frames", a->frames, "Timed frames per combination; the median is reported")
-      ->capture_default_str();
+  cmd->add_option("--frames", a->frames,
+                  "Timed frames per combination (spheres2023: per camera, default 5); the median is reported")
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->framesGiven = true; });
+  auto sphereOption = [a](const std::string&) { a->sphereOptionsGiven = true; };
+  cmd->add_option("--layouts", a->layouts, "spheres2023: particle layouts soa8, vec4x2, aos, xyz, or all")
+      ->capture_default_str()
+      ->each(sphereOption);
+  cmd->add_option("--billboards", a->billboards, "spheres2023: billboards screen, camera, or all")
+      ->capture_default_str()
+      ->each(sphereOption);
+  cmd->add_option("--conservative", a->conservative,
+                  "spheres2023: conservative rasterization off, on (where supported), or all")
+      ->capture_default_str()
+      ->each(sphereOption);
+  cmd->add_option("--orbits", a->orbits, "spheres2023: camera orbits short (inside), long (outside), or all")
+      ->capture_default_str()
+      ->each(sphereOption);
+  cmd->add_option("--cameras", a->cameras, "spheres2023: cameras per orbit")
+      ->capture_default_str()
+      ->each(sphereOption);
   cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of generated scenes (e.g. 20k, 10M)")
       ->capture_default_str()

@@ -31,6 +31,10 @@ struct RenderArgs {
   std::string method = "atomicmin", points = "1M", depth = "float";
   std::string precision = "adaptive"; // batch methods
   std::string layout = "auto";        // sphere methods
+  std::string billboard;              // sphere methods that rasterize billboards; empty: screen
+  bool conservative = false;          // the same: VK_EXT_conservative_rasterization
+  std::optional<uint32_t> meshlet;    // sphere-mesh-*: spheres per mesh workgroup (31 or 15)
+  bool taskCull = false;              // sphere-mesh-*: cull in a task shader first
   uint32_t width = 1920, height = 1080, frames = 10, parts = 1;
   uint32_t frame = 0; // sphere methods: MMPLD frame
   float radius = 0;   // sphere methods: radius of points drawn as spheres, or replacing the file's
@@ -51,6 +55,22 @@ int runRenderSpheres(const RenderArgs& a) {
   if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
     throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
                      a.method);
+  if (!a.billboard.empty()) settings.billboard = parseSphereBillboard(a.billboard);
+  settings.conservative = a.conservative;
+  if ((!a.billboard.empty() || a.conservative) && !sphereMethodTakesBillboards(settings.method))
+    throw InputError(
+        "--billboard and --conservative apply to the sphere methods that rasterize billboards (" +
+        billboardMethodNames() + "), not to " + a.method);
+  bool mesh = settings.method == SphereMethod::MeshPoints || settings.method == SphereMethod::MeshTriangles;
+  if ((a.meshlet || a.taskCull) && !mesh)
+    throw InputError("--meshlet and --task-cull apply to sphere-mesh-points and sphere-mesh-tris, not to " +
+                     a.method);
+  settings.meshlet = a.meshlet.value_or(shared::kSphereMeshletLarge);
+  settings.taskCull = a.taskCull;
+  if (settings.meshlet != shared::kSphereMeshletLarge && settings.meshlet != shared::kSphereMeshletSmall)
+    throw InputError("--meshlet takes " + std::to_string(shared::kSphereMeshletLarge) + " or " +
+                     std::to_string(shared::kSphereMeshletSmall) + " (spheres per mesh workgroup), not " +
+                     std::to_string(settings.meshlet));
   if (std::filesystem::path(a.output).extension() != ".png")
     throw InputError("-o " + a.output + ": the output must be a .png file");
   ParticleUploadOptions upload;
@@ -82,6 +102,7 @@ int runRenderSpheres(const RenderArgs& a) {
   contextOptions.deviceIndex = a.device;
   contextOptions.announce = !a.quiet;
   gpu::Context context(contextOptions);
+  if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the upload
   SphereRenderer renderer(context, a.width, a.height);
   GpuParticles particles(context, set, upload);
   SphereStats stats = renderer.render(particles, camera, settings);
@@ -97,6 +118,15 @@ int runRenderSpheres(const RenderArgs& a) {
     j["device_type"] = context.info().typeName;
     j["method"] = sphereMethodName(settings.method);
     j["layout"] = particleLayoutName(particles.layout());
+    if (sphereMethodTakesBillboards(settings.method)) {
+      j["billboard"] = sphereBillboardName(settings.billboard);
+      j["conservative"] = settings.conservative;
+    }
+    if (mesh) {
+      j["meshlet"] = settings.meshlet;
+      j["task_cull"] = settings.taskCull;
+    }
+    if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
     j["input"] = set.source;
     j["particles"] = stats.particles;
     j["width"] = a.width;
@@ -122,6 +152,9 @@ int runRenderSpheres(const RenderArgs& a) {
                 a.output.c_str(), humanCount(double(stats.particles)).c_str(),
                 particleLayoutName(particles.layout()), a.width, a.height, sphereMethodName(settings.method),
                 stats.medianMs, stats.frames, stats.minMs, stats.maxMs, humanCount(perSecond).c_str());
+    if (settings.method == SphereMethod::RayTracing)
+      std::printf("  acceleration structures built in %.3f ms of GPU time (not in the frame times)\n",
+                  stats.buildMs);
   }
   return 0;
 }
@@ -129,6 +162,11 @@ int runRenderSpheres(const RenderArgs& a) {
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
+  if (!a.billboard.empty() || a.conservative)
+    throw InputError("--billboard and --conservative apply to the sphere methods (" + billboardMethodNames() +
+                     ")");
+  if (a.meshlet || a.taskCull)
+    throw InputError("--meshlet and --task-cull apply to sphere-mesh-points and sphere-mesh-tris");
   if (a.method.rfind("sphere-", 0) == 0) parseSphereMethod(a.method); // throws, naming the sphere methods
   if (isParticleSceneName(a.input) || std::filesystem::path(a.input).extension() == ".mmpld")
     throw InputError(a.input + " holds particles: draw them with a sphere method (--method sphere-compute)");
@@ -277,6 +315,16 @@ std::string methodList() {
   return list;
 }
 
+// The same for the sphere methods.
+std::string sphereMethodList() {
+  std::string list;
+  for (const SphereMethodInfo& m : sphereMethodTable()) {
+    std::string name = m.name;
+    list += "  " + name + std::string(name.size() < 20 ? 20 - name.size() : 1, ' ') + m.description + "\n";
+  }
+  return list;
+}
+
 } // namespace
 
 Command addRender(CLI::App& app) {
@@ -297,11 +345,15 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
       "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
       "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
-      "Spheres (particles): --method sphere-compute with an MMPLD file, a particle scene (" +
-      std::string(kParticleSceneNames) +
-      ") or points and --radius:\n"
+      "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
+      std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
+      sphereMethodList() + "The pipelines that rasterize billboards (" + billboardMethodNames() +
+      ") take --billboard screen|camera\n"
+      "and --conservative (overestimating conservative rasterization, where the device has it); the image "
+      "is the same,\nonly the fragments spent on it differ.\n"
       "  pointrast render particles-drops --points 10M --method sphere-compute -o d.png\n"
-      "  pointrast render md.mmpld --method sphere-compute --layout soa8 -o md.png --json");
+      "  pointrast render md.mmpld --method sphere-compute --layout soa8 -o md.png --json\n"
+      "  pointrast render particles-laser --points 10M --method sphere-strip --billboard camera -o l.png");
   cmd->add_option("FILE", a->input, "LAS/PLY/XYZ file, or a scene name (terrain, tls)");
   cmd->add_option("-o,--output", a->output, "PNG to write")->required();
   cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
@@ -341,6 +393,18 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--layout", a->layout,
                   "Sphere methods: GPU particle layout soa8, vec4x2, aos, xyz, or auto")
       ->capture_default_str();
+  cmd->add_option("--billboard", a->billboard,
+                  "Sphere pipelines that rasterize billboards: screen (the tight screen-space box of the "
+                  "projected sphere, the default) or camera (a camera-aligned square, side 2r enlarged to "
+                  "cover the sphere under perspective)");
+  cmd->add_flag("--conservative", a->conservative,
+                "Sphere pipelines that rasterize billboards: overestimating conservative rasterization "
+                "(VK_EXT_conservative_rasterization; refused where the device lacks it)");
+  cmd->add_option("--meshlet", a->meshlet,
+                  "sphere-mesh-points, sphere-mesh-tris: spheres per mesh workgroup, 31 (default) or 15");
+  cmd->add_flag("--task-cull", a->taskCull,
+                "sphere-mesh-points, sphere-mesh-tris: a task shader culls spheres outside the view first "
+                "and launches mesh workgroups only for the rest");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/runner.h"
+#include "bench/sphere_runner.h"
 
 namespace pointrast::bench {
 
@@ -35,6 +36,18 @@ struct WrittenFiles {
 // Creates `dir` and writes the three files, each through a ".partial" file renamed into place, so an
 // interrupted run leaves no half-written report. Throws InputError when a file cannot be written.
 WrittenFiles writeReports(const BenchRun& run, const ReportInfo& info, const std::filesystem::path& dir);
+
+// The sphere suite's reports (spheres2023), from the same machinery: one result as a flat object (also the
+// line `pointrast bench --json` prints per result), the whole run, a Markdown report with one table per
+// orbit (rows: data set x layout x method, columns: billboard x conservative), sphere-compute against the
+// fastest rasterization pipeline and the per-frame counters, and an SVG chart of each method's fastest
+// setting per data set and orbit.
+nlohmann::json sphereResultJson(const SphereBenchRun& run, const SphereResult& result);
+nlohmann::json sphereRunJson(const SphereBenchRun& run, const ReportInfo& info);
+std::string sphereMarkdownReport(const SphereBenchRun& run, const ReportInfo& info);
+std::string sphereSvgChart(const SphereBenchRun& run, const ReportInfo& info);
+WrittenFiles writeSphereReports(const SphereBenchRun& run, const ReportInfo& info,
+                                const std::filesystem::path& dir);
 
 // "NVIDIA H200" -> "nvidia-h200": lower case, runs of anything but letters and digits become one '-'.
 std::string sanitizeName(std::string_view text);

@@ -23,11 +23,6 @@ std::string printf1(const char* format, double value) {
   return text;
 }
 
-uint64_t physicalMemory() {
-  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && pageSize > 0 ? uint64_t(pages) * uint64_t(pageSize) : 0;
-}
-
 // Points a data set will have, known before it is loaded: generated scenes have exactly the count
 // asked for; files state theirs in the header (counted for XYZ).
 uint64_t expectedPoints(const Dataset& d) {
@@ -55,6 +50,15 @@ std::string bytesText(uint64_t bytes) {
   else
     std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / 1024.0);
   return text;
+}
+
+uint64_t physicalMemory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && pageSize > 0 ? uint64_t(pages) * uint64_t(pageSize) : 0;
+}
+
+std::string deviceFaultText(const DeviceFault& fault) {
+  return std::string(fault.what()) + "; the run stopped there, later combinations were not run";
 }
 
 uint32_t warmupFrames(uint32_t frames) {
@@ -240,22 +244,13 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
               settings.method = method;
               settings.frames = config.frames;
               settings.warmup = run.warmup;
-              try {
-                r.stats = renderer.render(*scenes[layout], camera, settings);
-              } catch (const UnsupportedError& e) {
-                r.status = "unsupported";
-                r.reason = e.what();
-              } catch (const InputError& e) { // a scene beyond what the method addresses (4.29 G points)
-                r.status = "unsupported";
-                r.reason = e.what();
-              } catch (const DeviceFault& e) {
-                r.status = "device-fault";
-                r.reason = e.what();
-                run.results.push_back(r);
-                ++done;
-                if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
-                throw;
-              }
+              measureGuarded(
+                  r, [&] { r.stats = renderer.render(*scenes[layout], camera, settings); },
+                  [&](const Result& faulted) {
+                    run.results.push_back(faulted);
+                    ++done;
+                    if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
+                  });
             }
             if (r.ok() && r.stats.medianMs > 0) {
               const double seconds = r.stats.medianMs * 1e-3;
@@ -274,7 +269,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       }
     }
   } catch (const DeviceFault& e) {
-    run.deviceFault = std::string(e.what()) + "; the run stopped there, later combinations were not run";
+    run.deviceFault = deviceFaultText(e);
     note("stopped: " + run.deviceFault);
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "base/error.h"
 #include "bench/views.h"
 #include "cloud/order.h"
 #include "gpu/bandwidth.h"
@@ -60,6 +61,9 @@ uint32_t warmupFrames(uint32_t frames);
 constexpr uint64_t kTargetBytesPerPixel = 88;
 // Host bytes per point: the original (16 B) + a reordered copy (16 B) + its permutation (8 B).
 constexpr uint64_t kHostBytesPerPoint = 40;
+
+// Physical memory of this machine in bytes (0 if unknown).
+uint64_t physicalMemory();
 
 struct MemoryEstimate {
   uint64_t gpuBytes = 0, hostBytes = 0; // needed
@@ -122,6 +126,31 @@ struct BenchCallbacks {
   // Memory statements, skipped data sets, the copy bandwidth: one line each.
   std::function<void(const std::string&)> onNote;
 };
+
+// Runs `measure` for one combination of a run (Result, SphereResult): an UnsupportedError (a device feature,
+// out of device memory) or an InputError (a data set beyond what a method addresses) becomes status
+// "unsupported" with the message. A DeviceFault sets status "device-fault", hands the result to `record`
+// and is rethrown: the run ends there, since every later submission would wait on the stuck one.
+template <class R, class Measure, class Record>
+void measureGuarded(R& result, Measure&& measure, Record&& record) {
+  try {
+    measure();
+  } catch (const UnsupportedError& e) {
+    result.status = "unsupported";
+    result.reason = e.what();
+  } catch (const InputError& e) {
+    result.status = "unsupported";
+    result.reason = e.what();
+  } catch (const DeviceFault& e) {
+    result.status = "device-fault";
+    result.reason = e.what();
+    record(result);
+    throw;
+  }
+}
+
+// The line a run that met a device fault ends with (BenchRun::deviceFault).
+std::string deviceFaultText(const DeviceFault& fault);
 
 // Runs the whole matrix. Data sets that do not fit are skipped and say why (DatasetOutcome). Throws
 // InputError for an unreadable file, UnsupportedError if the copy buffers cannot be had.

@@ -35,12 +35,31 @@ constexpr SuiteEntry kPaper2022[] = {
      true},
 };
 
+// The four particle data sets of the 2023 sphere study, at the sizes the issue gives for them (306 M, 4 M,
+// 30 M, 200 M particles, in this order), each drawn by the particle scene closest to what it shows:
+// laser ablation of a metal (a crystal slab with a molten crater and ejected clusters), a Riemann shock tube
+// (a dense block between two vapor regions), a drop and a fluid simulation (liquid droplets and filaments in
+// a vapor; particles-drops for both, at their two sizes).
+constexpr SphereSuiteEntry kSpheres2023[] = {
+    {"laser", ParticleScene::Laser, 306'000'000, "laser ablation of a metal crystal (molecular dynamics)"},
+    {"riemann", ParticleScene::Block, 4'000'000, "a Riemann shock tube: dense liquid between vapor regions"},
+    {"drop", ParticleScene::Drops, 30'000'000, "a liquid drop breaking up in its vapor"},
+    {"fluid", ParticleScene::Drops, 200'000'000, "a two-phase fluid: droplets and filaments in vapor"},
+};
+
 constexpr uint64_t kMinScaledPoints = 1000;
 
 std::span<const SuiteEntry> entriesOf(std::string_view suite) {
   if (suite == "paper2021") return kPaper2021;
   if (suite == "paper2022") return kPaper2022;
-  throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021 or paper2022");
+  if (suite == "spheres2023")
+    throw InputError("spheres2023 is a particle suite: it has no point data sets or methods");
+  throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021, paper2022 or spheres2023");
+}
+
+uint64_t scaled(uint64_t size, double scale) {
+  if (!(scale > 0) || !std::isfinite(scale)) throw InputError("--scale must be a positive number");
+  return std::max<uint64_t>(kMinScaledPoints, uint64_t(std::llround(double(size) * scale)));
 }
 
 std::string entryNames(std::span<const SuiteEntry> entries) {
@@ -61,12 +80,36 @@ std::span<const SuiteEntry> paper2022Suite() {
 }
 
 std::vector<std::string> suiteNames() {
-  return {"paper2021", "paper2022"};
+  return {"paper2021", "paper2022", "spheres2023"};
+}
+
+std::span<const SphereSuiteEntry> spheres2023Suite() {
+  return kSpheres2023;
+}
+
+bool isSphereSuite(std::string_view suite) {
+  return suite == "spheres2023";
+}
+
+std::vector<Dataset> sphereSuiteDatasets(std::string_view suite, double scale, uint64_t seed) {
+  if (!isSphereSuite(suite)) entriesOf(suite); // throws, naming the suites
+  std::vector<Dataset> datasets;
+  for (const SphereSuiteEntry& e : kSpheres2023) {
+    Dataset d;
+    d.source = particleSceneName(e.scene);
+    d.seed = seed;
+    d.points = scaled(e.particles, scale);
+    d.name = std::string(e.name) + "-like";
+    d.label = d.name + " (" + particleSceneName(e.scene) + ", " + shortCount(d.points) + ")";
+    datasets.push_back(d);
+  }
+  return datasets;
 }
 
 SuiteDefaults suiteDefaults(std::string_view suite) {
-  entriesOf(suite); // throws for an unknown name
   SuiteDefaults d;
+  if (isSphereSuite(suite)) return d;
+  entriesOf(suite); // throws for an unknown name
   if (suite == "paper2022") {
     // The paper's comparison: the hardware baseline, its three methods, and the best 2021 methods.
     d.methods = {Method::HwPoints, Method::Batch, Method::BatchPrefetch,
@@ -103,13 +146,12 @@ std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_
                                    const std::vector<std::string>& replacements) {
   const std::span<const SuiteEntry> entries = entriesOf(suite);
   const bool paper2022 = suite == "paper2022";
-  if (!(scale > 0) || !std::isfinite(scale)) throw InputError("--scale must be a positive number");
   std::vector<Dataset> datasets;
   for (const SuiteEntry& e : entries) {
     Dataset d;
     d.source = sceneName(e.scene);
     d.seed = seed;
-    d.points = std::max<uint64_t>(kMinScaledPoints, uint64_t(std::llround(double(e.points) * scale)));
+    d.points = scaled(e.points, scale);
     d.name = std::string(e.name) + (e.scanOrder ? "" : "-like");
     d.label = d.name + " (" + sceneName(e.scene) + ", " + shortCount(d.points) + ")";
     if (paper2022) {

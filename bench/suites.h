@@ -2,7 +2,9 @@
 // Compute Shaders and Vertex Order Optimization" (Schuetz, Kerbl, Wimmer, EGSR 2021) with generated
 // scenes of the same sizes; `paper2022` for those of "Software Rasterization of 2 Billion Points in Real
 // Time" (Schuetz, Kerbl, Wimmer, HPG 2022), plus its scan order vs Morton order study; see suites.cpp for
-// which generator stands in for which data set and why.
+// which generator stands in for which data set and why. `spheres2023` stands in for the particle data sets
+// of "Efficient Sphere Rendering Revisited" (Gralka, Reina, Ertl, EGPGV 2023) with generated particle
+// scenes, measured by bench/sphere_runner.h.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +15,7 @@
 
 #include "bench/runner.h"
 #include "cloud/generate.h"
+#include "cloud/particles_generate.h"
 
 namespace pointrast::bench {
 
@@ -31,6 +34,21 @@ std::span<const SuiteEntry> paper2021Suite();
 std::span<const SuiteEntry> paper2022Suite();
 std::vector<std::string> suiteNames();
 
+// A particle data set of a sphere suite and the particle scene that stands in for it.
+struct SphereSuiteEntry {
+  const char* name;      // "laser": the study's data set
+  ParticleScene scene;   // the generator that resembles it
+  uint64_t particles;    // the size measured
+  const char* resembles; // what the original holds, the reason for the generator
+};
+std::span<const SphereSuiteEntry> spheres2023Suite();
+// Whether `suite` is a sphere suite (its data sets are particle sets, its runner the sphere runner).
+bool isSphereSuite(std::string_view suite);
+// The particle data sets of a sphere suite with every size multiplied by `scale` (at least 1000 particles
+// each); Dataset::source is the particle scene's name. Throws InputError for an unknown suite or a bad
+// scale.
+std::vector<Dataset> sphereSuiteDatasets(std::string_view suite, double scale, uint64_t seed);
+
 // What a suite measures besides its data sets; the CLI takes these where no option says otherwise.
 // Empty lists: every method, order or view.
 struct SuiteDefaults {
@@ -39,7 +57,7 @@ struct SuiteDefaults {
   std::vector<View> views;
   uint32_t width = 1920, height = 1080;
 };
-// Throws InputError for an unknown suite.
+// Throws InputError for an unknown suite. A sphere suite has no point methods, orders or views.
 SuiteDefaults suiteDefaults(std::string_view suite);
 
 // The data sets of a suite with every size multiplied by `scale` (a quick smoke run: 0.001 gives

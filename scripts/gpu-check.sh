@@ -80,6 +80,13 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 timeout "${SUITE_LIMIT:-560}" $pr bench --suite paper2022 --frames "${SUITE_FRAMES:-15}" \
       --methods "${SUITE_METHODS:-all}" --out "$OUT" --name paper2022 --json > "$OUT/paper2022.jsonl" || status=1
     ;;
+  spheres2023)
+    # The 2023 sphere study: every sphere pipeline x layout x billboard x conservative on four particle
+    # stand-ins (306 M, 4 M, 30 M, 200 M), 10 cameras per orbit. SUITE_ARGS narrows the matrix
+    # (e.g. "--layouts vec4x2 --conservative off"), SUITE_SCALE shrinks the data sets.
+    POINTRAST_VALIDATION=0 timeout "${SUITE_LIMIT:-560}" $pr bench --suite spheres2023 --scale "${SUITE_SCALE:-1}" \
+      ${SUITE_ARGS:-} --out "$OUT" --name spheres2023 --json > "$OUT/spheres2023.jsonl" || status=1
+    ;;
   big4g)
     # 4 billion generated points (the 2022 target: >= 60 fps on an H200), batched layout, Morton order.
     echo "== 4 G points, batch-prefetch"
@@ -87,7 +94,7 @@ for what in "$@"; do
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, sweep, paper2021, paper2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, big4g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

@@ -198,6 +198,11 @@ PR_CONST kNoParticle = 0xFFFFFFFFu;
 PR_CONST kSphereQuadTriangles = 0; // 6 vertices per sphere, triangle list
 PR_CONST kSphereQuadStrip = 1;     // one instance per sphere, a 4-vertex triangle strip
 
+// Impostor of the rasterization sphere pipelines (specialization constant BILLBOARD of
+// sphere_impostor.inc.glsl; SphereBillboard on the C++ side).
+PR_CONST kSphereBillboardScreen = 0; // the tight screen-space box of the projected sphere
+PR_CONST kSphereBillboardCamera = 1; // a camera-aligned square through the center, enlarged to cover it
+
 // Shading of every sphere pipeline (sphere_shade.inc.glsl, and the CPU ray caster): a headlight (light
 // at the eye), color * (ambient + diffuse * max(dot(normal, toEye), 0)); 0.25 + 0.75 = 1 where the
 // surface faces the eye.
@@ -243,7 +248,32 @@ struct SpherePush {
   uint first;         // global index of the part's first particle
   uint count;         // particles in the part
   uint groupsX;       // workgroups per row of a 2D dispatch; the large-sphere pass: workgroups in all
-  uint reserved;
+  uint firstGroup;    // mesh pipelines: index of the draw's first workgroup (a part may need several draws)
+};
+
+// Mesh-shader sphere pipelines (VK_EXT_mesh_shader, shaders/sphere_mesh.inc.glsl): one invocation per
+// sphere, meshlets of 31 or 15 spheres as in the 2023 study (the output arithmetic is in
+// sphere_mesh.inc.glsl). With --task-cull a task workgroup of 32 invocations culls 4 x 32 = 128 spheres
+// and launches mesh workgroups only for the survivors, passed as offsets in the task payload.
+PR_CONST kSphereMeshletLarge = 31;
+PR_CONST kSphereMeshletSmall = 15;
+PR_CONST kSphereTaskGroupSize = 32;
+PR_CONST kSphereTaskSpheres = 128;
+
+// Push constants of sphere-rt's AABB pass (sphere_rt_aabbs.comp.glsl): one VkAabbPositionsKHR (6 floats,
+// 24 bytes) per particle of a part, the input of the part's bottom-level acceleration structure.
+struct SphereAabbPush {
+  uint64_t frame;     // SphereFrame (the global radius of the aos and xyz layouts)
+  uint64_t particles; // the part
+  uint64_t aabbs;     // float[6 * count]: min xyz, max xyz, relative to the particles' origin
+  uint count;         // particles in the part
+  uint groupsX;       // workgroups per row of the 2D dispatch
+};
+
+// Push constants of the sphere-rt ray tracing pipeline (shaders/sphere_rt.*.glsl).
+struct SphereRtPush {
+  uint64_t frame; // SphereFrame
+  uint64_t tlas;  // device address of the top-level acceleration structure
 };
 
 PR_NAMESPACE_END

@@ -1,6 +1,7 @@
 #version 460
-// sphere-points: one point per sphere (a Vulkan point list), gl_PointSize the larger side of the sphere's
-// projected bounds, centered on them, at the depth of the sphere's front. A sphere larger than the
+// sphere-points: one point per sphere (a Vulkan point list), gl_PointSize the larger side of the impostor
+// (the sphere's projected bounds, or the camera-aligned square), centered on it, at the depth of the
+// sphere's front. A sphere larger than the
 // device's largest point is drawn clipped to it (its edge is missing) and counted in frame.counters[0],
 // the study's known limit of this pipeline.
 #include "sphere_impostor.inc.glsl"

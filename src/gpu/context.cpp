@@ -333,6 +333,84 @@ void Context::createDevice() {
   features_.geometryShader = has.features.geometryShader;
   features_.largePoints = has.features.largePoints;
   features_.vertexStores = has.features.vertexPipelineStoresAndAtomics;
+  if (hasExtension(VK_EXT_CONSERVATIVE_RASTERIZATION_EXTENSION_NAME)) {
+    VkPhysicalDeviceConservativeRasterizationPropertiesEXT conservative{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONSERVATIVE_RASTERIZATION_PROPERTIES_EXT};
+    VkPhysicalDeviceProperties2 conservativeProps{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
+                                                  &conservative};
+    vkGetPhysicalDeviceProperties2(physical_, &conservativeProps);
+    enabled.push_back(VK_EXT_CONSERVATIVE_RASTERIZATION_EXTENSION_NAME);
+    features_.conservativeRasterization = true;
+    features_.conservativePoints = conservative.conservativePointAndLineRasterization;
+  }
+  // Mesh shaders and ray tracing: features and limits are queried only where the device lists the
+  // extensions (a structure of an unsupported extension in a query or in vkCreateDevice is invalid), and
+  // enabled only where the features are present. VK_KHR_spirv_1_4, which both require, is core in 1.2.
+  VkPhysicalDeviceMeshShaderFeaturesEXT hasMesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR hasAccel{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR hasRayTracing{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  bool meshExtension = hasExtension(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+  bool rayTracingExtensions = hasExtension(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) &&
+                              hasExtension(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
+                              hasExtension(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+  if (meshExtension || rayTracingExtensions) {
+    VkPhysicalDeviceFeatures2 extensionFeatures{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    VkPhysicalDeviceProperties2 extensionProperties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    meshProperties_ = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_PROPERTIES_EXT};
+    rayTracingProperties_ = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR};
+    accelerationProperties_ = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+    if (meshExtension) {
+      hasMesh.pNext = extensionFeatures.pNext;
+      extensionFeatures.pNext = &hasMesh;
+      meshProperties_.pNext = extensionProperties.pNext;
+      extensionProperties.pNext = &meshProperties_;
+    }
+    if (rayTracingExtensions) {
+      hasAccel.pNext = extensionFeatures.pNext;
+      hasRayTracing.pNext = &hasAccel;
+      extensionFeatures.pNext = &hasRayTracing;
+      accelerationProperties_.pNext = extensionProperties.pNext;
+      rayTracingProperties_.pNext = &accelerationProperties_;
+      extensionProperties.pNext = &rayTracingProperties_;
+    }
+    vkGetPhysicalDeviceFeatures2(physical_, &extensionFeatures);
+    vkGetPhysicalDeviceProperties2(physical_, &extensionProperties);
+    meshProperties_.pNext = nullptr;
+    rayTracingProperties_.pNext = nullptr;
+    accelerationProperties_.pNext = nullptr;
+  }
+  VkPhysicalDeviceMeshShaderFeaturesEXT wantMesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR wantAccel{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR wantRayTracing{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  if (meshExtension && hasMesh.meshShader) {
+    enabled.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+    wantMesh.meshShader = VK_TRUE;
+    wantMesh.taskShader = hasMesh.taskShader;
+    wantMesh.pNext = want13.pNext;
+    want13.pNext = &wantMesh;
+    features_.meshShader = true;
+    features_.taskShader = hasMesh.taskShader;
+  } else {
+    meshProperties_ = {};
+  }
+  if (rayTracingExtensions && hasRayTracing.rayTracingPipeline && hasAccel.accelerationStructure) {
+    enabled.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+    enabled.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+    enabled.push_back(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
+    wantAccel.accelerationStructure = VK_TRUE;
+    wantRayTracing.rayTracingPipeline = VK_TRUE;
+    wantRayTracing.pNext = &wantAccel;
+    wantAccel.pNext = want13.pNext;
+    want13.pNext = &wantRayTracing;
+    features_.rayTracing = true;
+  } else {
+    rayTracingProperties_ = {};
+    accelerationProperties_ = {};
+  }
   if (partitioned && hasExtension(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME)) {
     enabled.push_back(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME);
     features_.subgroupPartitionedNV = true;
@@ -345,6 +423,7 @@ void Context::createDevice() {
   create.pQueueCreateInfos = &queueInfo;
   VK_CHECK(vkCreateDevice(physical_, &create, nullptr, &device_));
   loadDeviceFunctions(device_);
+  loadExtensionDeviceFunctions(device_, features_.meshShader, features_.rayTracing);
   vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
   VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};

@@ -41,6 +41,16 @@ struct DeviceFeatures {
   bool geometryShader = false;        // geometry shaders (sphere-geom)
   bool largePoints = false;           // points larger than one pixel (sphere-points)
   bool vertexStores = false;          // vertexPipelineStoresAndAtomics (sphere-points counts clamped sizes)
+  // VK_EXT_conservative_rasterization (overestimation; sphere pipelines' --conservative), and whether it
+  // applies to point primitives too (conservativePointAndLineRasterization; sphere-points).
+  bool conservativeRasterization = false;
+  bool conservativePoints = false;
+  // VK_EXT_mesh_shader with meshShader (sphere-mesh-points, sphere-mesh-tris), and taskShader (--task-cull).
+  bool meshShader = false;
+  bool taskShader = false;
+  // VK_KHR_ray_tracing_pipeline + VK_KHR_acceleration_structure + VK_KHR_deferred_host_operations with
+  // rayTracingPipeline and accelerationStructure (bufferDeviceAddress every device here has): sphere-rt.
+  bool rayTracing = false;
 };
 
 class Context {
@@ -60,6 +70,14 @@ public:
   const VkPhysicalDeviceMemoryProperties& memoryProperties() const { return memory_; }
   uint32_t subgroupSize() const { return subgroupSize_; }
   const DeviceFeatures& features() const { return features_; }
+  // Limits of the optional extensions, queried where the device has them (zero otherwise; pNext null).
+  const VkPhysicalDeviceMeshShaderPropertiesEXT& meshShaderProperties() const { return meshProperties_; }
+  const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rayTracingProperties() const {
+    return rayTracingProperties_;
+  }
+  const VkPhysicalDeviceAccelerationStructurePropertiesKHR& accelerationStructureProperties() const {
+    return accelerationProperties_;
+  }
   // Largest single VkDeviceMemory allocation (VkPhysicalDeviceMaintenance3Properties), and the largest
   // buffer (maintenance4); scenes are split into parts below both.
   uint64_t maxAllocationSize() const { return maxAllocation_; }
@@ -99,6 +117,9 @@ private:
   DeviceInfo info_;
   uint32_t subgroupSize_ = 0;
   DeviceFeatures features_;
+  VkPhysicalDeviceMeshShaderPropertiesEXT meshProperties_{};
+  VkPhysicalDeviceRayTracingPipelinePropertiesKHR rayTracingProperties_{};
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR accelerationProperties_{};
   uint64_t maxAllocation_ = 0;
   uint64_t maxBuffer_ = 0;
   uint64_t deviceLocalBytes_ = 0;

@@ -26,9 +26,16 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
                                  const std::string& fragmentShader, const GraphicsOptions& options)
     : device_(context.device()), options_(options) {
   bool geometry = !options.geometryShader.empty();
-  // Stages in pipeline order: vertex, [geometry,] fragment.
-  std::vector<std::pair<VkShaderStageFlagBits, std::span<const uint32_t>>> sources = {
-      {VK_SHADER_STAGE_VERTEX_BIT, findShader(vertexShader)}};
+  bool mesh = options.meshShader;
+  assert((!mesh || (!geometry && context.features().meshShader)) && "a mesh pipeline the device cannot make");
+  assert((options.taskShader.empty() || (mesh && context.features().taskShader)) &&
+         "a task shader belongs to a mesh pipeline of a device with task shaders");
+  // Stages in pipeline order: vertex, [geometry,] fragment; or [task,] mesh, fragment.
+  std::vector<std::pair<VkShaderStageFlagBits, std::span<const uint32_t>>> sources;
+  if (!options.taskShader.empty())
+    sources.push_back({VK_SHADER_STAGE_TASK_BIT_EXT, findShader(options.taskShader)});
+  sources.push_back(
+      {mesh ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT, findShader(vertexShader)});
   if (geometry) sources.push_back({VK_SHADER_STAGE_GEOMETRY_BIT, findShader(options.geometryShader)});
   sources.push_back({VK_SHADER_STAGE_FRAGMENT_BIT, findShader(fragmentShader)});
   std::vector<SpirvReflection> reflections;
@@ -43,8 +50,15 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
   }
   // Without maintenance5 a point list rasterizes with an undefined size unless the last vertex stage
   // writes gl_PointSize (a geometry shader turns points into its own output primitives).
-  assert((options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST || geometry || reflections[0].usesPointSize) &&
-         "a point-list pipeline needs a vertex shader that writes gl_PointSize");
+  const SpirvReflection& firstVertexStage = reflections[options.taskShader.empty() ? 0 : 1];
+  assert(
+      (options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST || geometry || firstVertexStage.usesPointSize) &&
+      "a point-list pipeline needs a vertex shader that writes gl_PointSize");
+  assert((!mesh || firstVertexStage.executionModel == kSpirvMesh) && "meshShader names no mesh shader");
+  assert((!mesh || (firstVertexStage.outputTopology == kSpirvOutputPoints) ==
+                       (options.topology == VK_PRIMITIVE_TOPOLOGY_POINT_LIST)) &&
+         "topology does not name the mesh shader's output primitive");
+  (void)firstVertexStage;
   for (const SpecConstant& s : options.spec) {
     assert(std::any_of(reflections.begin(), reflections.end(),
                        [&](const SpirvReflection& r) {
@@ -94,6 +108,17 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
     raster.cullMode = VK_CULL_MODE_NONE;
     raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
     raster.lineWidth = 1.0f;
+    VkPipelineRasterizationConservativeStateCreateInfoEXT conservative{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_CONSERVATIVE_STATE_CREATE_INFO_EXT};
+    conservative.conservativeRasterizationMode = VK_CONSERVATIVE_RASTERIZATION_MODE_OVERESTIMATE_EXT;
+    conservative.extraPrimitiveOverestimationSize = 0.0f; // the device's own overestimation suffices
+    if (options.conservative) {
+      assert(context.features().conservativeRasterization &&
+             (context.features().conservativePoints || geometry ||
+              options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST) &&
+             "conservative rasterization the device does not support");
+      raster.pNext = &conservative;
+    }
     VkPipelineMultisampleStateCreateInfo multisample{
         VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
     multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
@@ -122,8 +147,8 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &rendering};
     info.stageCount = uint32_t(stages.size());
     info.pStages = stages.data();
-    info.pVertexInputState = &vertexInput;
-    info.pInputAssemblyState = &assembly;
+    info.pVertexInputState = mesh ? nullptr : &vertexInput; // ignored with a mesh shader: none given
+    info.pInputAssemblyState = mesh ? nullptr : &assembly;
     info.pViewportState = &viewport;
     info.pRasterizationState = &raster;
     info.pMultisampleState = &multisample;
@@ -133,7 +158,8 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
     info.layout = layout_;
     VK_CHECK(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
     context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_),
-                    vertexShader + " + " + (geometry ? options.geometryShader + " + " : "") + fragmentShader);
+                    (options.taskShader.empty() ? "" : options.taskShader + " + ") + vertexShader + " + " +
+                        (geometry ? options.geometryShader + " + " : "") + fragmentShader);
   } catch (...) {
     for (VkShaderModule m : modules)
       if (m) vkDestroyShaderModule(device_, m, nullptr);
@@ -179,6 +205,15 @@ void GraphicsProgram::drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
   if (size) vkCmdPushConstants(cmd, layout_, pushStages_, 0, size, push);
   vkCmdDraw(cmd, vertexCount, instanceCount, 0, 0);
+}
+
+void GraphicsProgram::drawMeshTasksRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY,
+                                       const void* push, uint32_t size) const {
+  assert(options_.meshShader && vkCmdDrawMeshTasksEXT && "drawMeshTasks needs a mesh pipeline");
+  if (groupsX == 0 || groupsY == 0) return;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+  if (size) vkCmdPushConstants(cmd, layout_, pushStages_, 0, size, push);
+  vkCmdDrawMeshTasksEXT(cmd, groupsX, groupsY, 1);
 }
 
 void setViewport(VkCommandBuffer cmd, uint32_t width, uint32_t height) {

@@ -34,6 +34,16 @@ struct GraphicsOptions {
   std::vector<SpecConstant> spec;
   // A second color attachment (fragment output location 1) when not UNDEFINED, e.g. R32_UINT ids.
   VkFormat secondColorFormat = VK_FORMAT_UNDEFINED;
+  // Overestimating conservative rasterization (VK_EXT_conservative_rasterization): every pixel the
+  // primitive touches gets a fragment, not only those whose center it covers. Needs
+  // DeviceFeatures::conservativeRasterization, and conservativePoints for a point list drawn as points.
+  bool conservative = false;
+  // A mesh pipeline (VK_EXT_mesh_shader, DeviceFeatures::meshShader): the first shader named is a mesh
+  // shader instead of a vertex shader, preceded by taskShader unless empty (DeviceFeatures::taskShader).
+  // No vertex input or input assembly; draw with drawMeshTasks. `topology` then names the list of the
+  // mesh shader's output primitives (points or triangles), for the checks that depend on it.
+  bool meshShader = false;
+  std::string taskShader;
 };
 
 class GraphicsProgram {
@@ -59,7 +69,17 @@ public:
     drawRaw(cmd, vertexCount, instanceCount, &push, sizeof(Push));
   }
 
+  // Mesh pipelines: binds, pushes the constants and launches groupsX x groupsY task workgroups (or mesh
+  // workgroups without a task shader), between vkCmdBeginRendering and vkCmdEndRendering.
+  template <class Push>
+  void drawMeshTasks(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const Push& push) const {
+    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
+    drawMeshTasksRaw(cmd, groupsX, groupsY, &push, sizeof(Push));
+  }
+
 private:
+  void drawMeshTasksRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const void* push,
+                        uint32_t size) const;
   void drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_t instanceCount, const void* push,
                uint32_t size) const;
   void release();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstring>
 #include <unordered_map>
 
 namespace pointrast::gpu {
@@ -10,6 +11,7 @@ namespace {
 
 // Opcodes and enumerants from the SPIR-V 1.6 specification, section 3.
 enum : uint32_t {
+  OpEntryPoint = 15,
   OpExecutionMode = 16,
   OpExecutionModeId = 331,
   OpTypeInt = 21,
@@ -25,6 +27,11 @@ enum : uint32_t {
   OpMemberDecorate = 72,
   ExecutionModeLocalSize = 17,
   ExecutionModeLocalSizeId = 38,
+  ExecutionModeOutputVertices = 26,
+  ExecutionModeOutputPoints = 27,
+  ExecutionModeOutputLinesEXT = 5269,
+  ExecutionModeOutputPrimitivesEXT = 5270,
+  ExecutionModeOutputTrianglesEXT = 5298,
   DecorationSpecId = 1,
   DecorationArrayStride = 6,
   DecorationMatrixStride = 7,
@@ -58,8 +65,22 @@ SpirvReflection reflectSpirv(std::span<const uint32_t> words) {
     assert(count > 0 && at + count <= words.size());
     const uint32_t* op = &words[at];
     switch (opcode) {
+    case OpEntryPoint:
+      if (result.executionModel == ~0u) {
+        result.executionModel = op[1];
+        // The name: a nul-terminated string packed into the words after the function id, first character
+        // in the lowest byte, which is the first byte in memory on the little-endian hosts pointrast runs on.
+        const char* name = reinterpret_cast<const char*>(op + 3);
+        result.entryPoint.assign(name, strnlen(name, size_t(count - 3) * 4));
+      }
+      break;
     case OpExecutionMode:
       if (op[2] == ExecutionModeLocalSize) std::copy(op + 3, op + 6, result.localSize);
+      if (op[2] == ExecutionModeOutputVertices) result.outputVertices = op[3];
+      if (op[2] == ExecutionModeOutputPrimitivesEXT) result.outputPrimitives = op[3];
+      if (op[2] == ExecutionModeOutputPoints || op[2] == ExecutionModeOutputLinesEXT ||
+          op[2] == ExecutionModeOutputTrianglesEXT)
+        result.outputTopology = op[2];
       break;
     case OpExecutionModeId: // local_size_x = aConstant: sizes are ids of constants defined later
       if (op[2] == ExecutionModeLocalSizeId) std::copy(op + 3, op + 6, localSizeIds);

@@ -13,6 +13,8 @@ PR_VK_GLOBAL_FUNCTIONS(PR_VK_DEFINE)
 PR_VK_INSTANCE_FUNCTIONS(PR_VK_DEFINE)
 PR_VK_DEBUG_FUNCTIONS(PR_VK_DEFINE)
 PR_VK_DEVICE_FUNCTIONS(PR_VK_DEFINE)
+PR_VK_MESH_FUNCTIONS(PR_VK_DEFINE)
+PR_VK_RAY_TRACING_FUNCTIONS(PR_VK_DEFINE)
 #undef PR_VK_DEFINE
 
 namespace {
@@ -54,6 +56,25 @@ void loadDeviceFunctions(VkDevice device) {
 #undef PR_VK_LOAD
 }
 
+void loadExtensionDeviceFunctions(VkDevice device, bool meshShader, bool rayTracing) {
+#define PR_VK_LOAD(name)                                                                                     \
+  name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device, #name));                                   \
+  if (!name) throw UnsupportedError("the Vulkan driver lacks " #name ", although it lists its extension");
+#define PR_VK_CLEAR(name) name = nullptr;
+  if (meshShader) {
+    PR_VK_MESH_FUNCTIONS(PR_VK_LOAD)
+  } else {
+    PR_VK_MESH_FUNCTIONS(PR_VK_CLEAR)
+  }
+  if (rayTracing) {
+    PR_VK_RAY_TRACING_FUNCTIONS(PR_VK_LOAD)
+  } else {
+    PR_VK_RAY_TRACING_FUNCTIONS(PR_VK_CLEAR)
+  }
+#undef PR_VK_CLEAR
+#undef PR_VK_LOAD
+}
+
 namespace {
 std::atomic<bool> gDeviceFaulted{false};
 }
@@ -72,13 +93,14 @@ const char* resultName(VkResult result) {
     return #r;
     PR_CASE(VK_SUCCESS)
     PR_CASE(VK_NOT_READY)
-    PR_CASE(VK_TIMEOUT) PR_CASE(VK_INCOMPLETE) PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY)
-        PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY) PR_CASE(VK_ERROR_INITIALIZATION_FAILED)
-            PR_CASE(VK_ERROR_DEVICE_LOST) PR_CASE(VK_ERROR_MEMORY_MAP_FAILED)
-                PR_CASE(VK_ERROR_LAYER_NOT_PRESENT) PR_CASE(VK_ERROR_EXTENSION_NOT_PRESENT)
-                    PR_CASE(VK_ERROR_FEATURE_NOT_PRESENT) PR_CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
-                        PR_CASE(VK_ERROR_TOO_MANY_OBJECTS) PR_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
-                            PR_CASE(VK_ERROR_UNKNOWN) PR_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
+    PR_CASE(VK_TIMEOUT)
+    PR_CASE(VK_INCOMPLETE) PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+        PR_CASE(VK_ERROR_INITIALIZATION_FAILED) PR_CASE(VK_ERROR_DEVICE_LOST)
+            PR_CASE(VK_ERROR_MEMORY_MAP_FAILED) PR_CASE(VK_ERROR_LAYER_NOT_PRESENT)
+                PR_CASE(VK_ERROR_EXTENSION_NOT_PRESENT) PR_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
+                    PR_CASE(VK_ERROR_INCOMPATIBLE_DRIVER) PR_CASE(VK_ERROR_TOO_MANY_OBJECTS)
+                        PR_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED) PR_CASE(VK_ERROR_UNKNOWN)
+                            PR_CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
 #undef PR_CASE
                                 default : return "VkResult(?)";
   }

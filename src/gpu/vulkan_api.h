@@ -40,6 +40,16 @@
   X(vkCreateImage) X(vkDestroyImage) X(vkGetImageMemoryRequirements) X(vkBindImageMemory) \
   X(vkCreateImageView) X(vkDestroyImageView) X(vkCreateGraphicsPipelines) X(vkCmdBeginRendering) \
   X(vkCmdEndRendering) X(vkCmdDraw) X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdCopyImageToBuffer)
+
+// Of device extensions pointrast enables only where the device has them (Context and DeviceFeatures):
+// VK_EXT_mesh_shader, and VK_KHR_acceleration_structure + VK_KHR_ray_tracing_pipeline. Null on a device
+// without them; callers check DeviceFeatures::meshShader / rayTracing first.
+#define PR_VK_MESH_FUNCTIONS(X) X(vkCmdDrawMeshTasksEXT)
+#define PR_VK_RAY_TRACING_FUNCTIONS(X) \
+  X(vkCreateAccelerationStructureKHR) X(vkDestroyAccelerationStructureKHR) \
+  X(vkGetAccelerationStructureBuildSizesKHR) X(vkGetAccelerationStructureDeviceAddressKHR) \
+  X(vkCmdBuildAccelerationStructuresKHR) X(vkCreateRayTracingPipelinesKHR) \
+  X(vkGetRayTracingShaderGroupHandlesKHR) X(vkCmdTraceRaysKHR)
 // clang-format on
 
 namespace pointrast::gpu {
@@ -49,6 +59,8 @@ PR_VK_GLOBAL_FUNCTIONS(PR_VK_DECLARE)
 PR_VK_INSTANCE_FUNCTIONS(PR_VK_DECLARE)
 PR_VK_DEBUG_FUNCTIONS(PR_VK_DECLARE)
 PR_VK_DEVICE_FUNCTIONS(PR_VK_DECLARE)
+PR_VK_MESH_FUNCTIONS(PR_VK_DECLARE)
+PR_VK_RAY_TRACING_FUNCTIONS(PR_VK_DECLARE)
 #undef PR_VK_DECLARE
 
 // Opens libvulkan.so.1 and loads the global functions. Throws UnsupportedError naming the package to
@@ -56,6 +68,9 @@ PR_VK_DEVICE_FUNCTIONS(PR_VK_DECLARE)
 void loadVulkanLoader();
 void loadInstanceFunctions(VkInstance instance);
 void loadDeviceFunctions(VkDevice device);
+// The functions of the optional extensions that were enabled on `device`; the others become null (asking
+// for a function of an extension that is not enabled is not allowed).
+void loadExtensionDeviceFunctions(VkDevice device, bool meshShader, bool rayTracing);
 
 // A Vulkan call failed: which call, where, and the VkResult's name.
 class VulkanError : public std::runtime_error {

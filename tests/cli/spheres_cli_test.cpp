@@ -1,5 +1,6 @@
 // `pointrast render --method sphere-compute` as a user runs it: particle scenes and points drawn as
 // spheres write a PNG and one JSON line; wrong combinations exit 1 with one line and leave no file.
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -65,6 +66,53 @@ TEST(SpheresCli, WrongCombinationsFailCleanly) {
                            png, "--order");
   expectCleanSphereFailure("render no-such.mmpld --method sphere-compute -o " + png.string(), png,
                            "no-such.mmpld");
+}
+
+TEST(SpheresCli, BillboardOptionsOfTheRasterizationPipelines) {
+  // Camera billboards draw the same image as screen ones (same hash); conservative rasterization is drawn
+  // where the device has it and refused with one line elsewhere; sphere-compute and the point methods
+  // refuse both options.
+  fs::path png = cliTempDir() / "billboards.png";
+  const std::string base = "render particles-drops --points 5k --method sphere-strip --width 160 --height 90 "
+                           "--frames 1 --json -q -o " +
+                           png.string();
+  auto hashOf = [](const std::string& out) {
+    size_t at = out.find("\"image_hash\":\"");
+    return at == std::string::npos ? std::string() : out.substr(at + 14, 16);
+  };
+  CliResult screen = runPointrast(base);
+  ASSERT_EQ(screen.exitCode, 0) << screen.err;
+  EXPECT_NE(screen.out.find("\"billboard\":\"screen\""), std::string::npos) << screen.out;
+  CliResult camera = runPointrast(base + " --billboard camera");
+  ASSERT_EQ(camera.exitCode, 0) << camera.err;
+  EXPECT_NE(camera.out.find("\"billboard\":\"camera\""), std::string::npos) << camera.out;
+  EXPECT_FALSE(hashOf(screen.out).empty());
+  EXPECT_EQ(hashOf(camera.out), hashOf(screen.out));
+  fs::remove(png);
+  CliResult conservative = runPointrast(base + " --conservative");
+  if (conservative.exitCode == 0) {
+    EXPECT_EQ(hashOf(conservative.out), hashOf(screen.out));
+  } else {
+    std::printf("skipped: %s", conservative.err.c_str());
+    EXPECT_EQ(conservative.exitCode, 1);
+    EXPECT_NE(conservative.err.find("conservative rasterization"), std::string::npos) << conservative.err;
+    EXPECT_FALSE(fs::exists(png));
+  }
+  expectCleanSphereFailure(
+      "render particles-drops --points 1k --method sphere-compute --billboard camera -o " + png.string(), png,
+      "sphere-compute");
+  expectCleanSphereFailure("render particles-drops --points 1k --method sphere-compute --conservative -o " +
+                               png.string(),
+                           png, "--conservative apply to");
+  expectCleanSphereFailure("render particles-drops --points 1k --method sphere-strip --billboard round -o " +
+                               png.string(),
+                           png, "unknown billboard 'round'");
+  expectCleanSphereFailure("render terrain --points 1k --billboard camera -o " + png.string(), png,
+                           "--billboard and --conservative apply to the sphere methods");
+  CliResult help = runPointrast("render --help");
+  EXPECT_NE(help.out.find("--billboard"), std::string::npos);
+  EXPECT_NE(help.out.find("--conservative"), std::string::npos);
+  EXPECT_NE(help.out.find("sphere-strip"), std::string::npos) << "the sphere methods are listed";
 }
 
 } // namespace pointrast::test

@@ -2,7 +2,9 @@
 // the CPU ray caster, with the contract sphere-compute meets (spheres_compute_test.cpp): >= 99 % of pixels
 // agree, depth within 1e-5 relative away from silhouettes; plus overlapping spheres, spheres across the
 // image border and the frustum edges, every particle layout, and sphere-points' clamping to the device's
-// largest point. A method the device cannot run is skipped with the reason printed.
+// largest point. Camera-aligned billboards meet the same contract and draw the same image as screen ones;
+// so does conservative rasterization where the device has it. A method or option the device cannot run
+// is skipped with the reason printed.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -156,6 +158,93 @@ TEST_P(SphereHardwareTest, PointsClampToTheLargestPoint) {
   } else {
     EXPECT_EQ(gpu.stats.clampedSpheres, 0u);
     expectAgreement(name("larger than the largest point"), gpu, cpu);
+  }
+}
+
+TEST_P(SphereHardwareTest, CameraBillboardsAgreeWithCpuInEveryLayout) {
+  std::vector<SphereSpec> spheres = randomSpheres(3000, 23, 10, 0.05, 0.6);
+  Camera camera = lookAt({-14, -20, 9}, {0, 0, 0});
+  ParticleSet perParticle = makeSet(spheres);
+  ParticleSet globalBoth = makeSet(spheres, true, true);
+  SphereRaycast cpuPerParticle = renderCpu(perParticle, camera, 192, 128);
+  SphereRaycast cpuGlobal = renderCpu(globalBoth, camera, 192, 128);
+  SphereSettings s = settings();
+  s.billboard = SphereBillboard::Camera;
+  for (ParticleLayout layout :
+       {ParticleLayout::Soa8, ParticleLayout::Vec4x2, ParticleLayout::Aos, ParticleLayout::Xyz}) {
+    bool global = !layoutHolds(layout, perParticle);
+    ParticleUploadOptions upload;
+    upload.layout = layout;
+    GpuFrame gpu = renderGpu(*context, global ? globalBoth : perParticle, camera, 192, 128, upload, s);
+    expectAgreement(name(std::string("camera billboards ") + particleLayoutName(layout)), gpu,
+                    global ? cpuGlobal : cpuPerParticle);
+  }
+}
+
+namespace {
+
+// Large spheres close to the eye of a 90-degree view, out to the image edges, where perspective widens a
+// sphere's projection most beyond its radius: a camera-aligned square of side 2r would miss up to half of
+// the disc at the corners (the square needs a half side of 1.9 r there). Centers stay in the image, so
+// sphere-points draws every sphere too.
+std::vector<SphereSpec> wideViewSpheres() {
+  std::vector<SphereSpec> spheres;
+  const double aspect = 160.0 / 120.0;
+  uint32_t color = 0xFF204080u;
+  for (double d : {4.0, 9.0})
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 4; ++j) {
+        double x = (-0.85 + 1.7 * i / 4) * aspect * d, y = (-0.85 + 1.7 * j / 3) * d;
+        spheres.push_back({{x + (d > 5 ? 1.1 : 0), y, -d}, d > 5 ? 1.6 : 1.0, color});
+        color = color * 2654435761u | 0xFF000000u;
+      }
+  return spheres;
+}
+
+} // namespace
+
+TEST_P(SphereHardwareTest, CameraBillboardsDrawWhatScreenBillboardsDraw) {
+  // The same fragment shader decides every pixel, so as long as both impostors contain every pixel center
+  // the sphere covers, the images are identical; a camera square too small under perspective loses pixels
+  // at the silhouettes farthest from the image center.
+  ParticleSet set = makeSet(wideViewSpheres());
+  Camera camera = axisCamera();
+  SphereSettings s = settings();
+  GpuFrame screen = renderGpu(*context, set, camera, 160, 120, {}, s);
+  s.billboard = SphereBillboard::Camera;
+  GpuFrame cam = renderGpu(*context, set, camera, 160, 120, {}, s);
+  size_t differ = 0;
+  for (size_t i = 0; i < screen.index.size(); ++i)
+    differ += screen.index[i] != cam.index[i] || screen.image[i] != cam.image[i];
+  std::printf("%s: camera vs screen billboards differ on %zu pixels\n", sphereMethodName(GetParam()), differ);
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(cam.stats.clampedSpheres, 0u);
+  expectAgreement(name("camera billboards, wide view"), cam, renderCpu(set, camera, 160, 120));
+}
+
+TEST_P(SphereHardwareTest, ConservativeRasterizationDrawsTheSameImage) {
+  SphereSettings s = settings();
+  s.conservative = true;
+  std::string why;
+  if (!SphereRenderer::supports(*context, s, &why)) {
+    std::printf("skipped: %s\n", why.c_str());
+    GTEST_SKIP() << why;
+  }
+  ParticleSet set = makeSet(wideViewSpheres());
+  Camera camera = axisCamera();
+  SphereRaycast cpu = renderCpu(set, camera, 160, 120);
+  for (SphereBillboard billboard : {SphereBillboard::Screen, SphereBillboard::Camera}) {
+    s.billboard = billboard;
+    s.conservative = false;
+    GpuFrame plain = renderGpu(*context, set, camera, 160, 120, {}, s);
+    s.conservative = true;
+    GpuFrame conservative = renderGpu(*context, set, camera, 160, 120, {}, s);
+    size_t differ = 0;
+    for (size_t i = 0; i < plain.index.size(); ++i)
+      differ += plain.index[i] != conservative.index[i] || plain.image[i] != conservative.image[i];
+    EXPECT_EQ(differ, 0u) << sphereBillboardName(billboard);
+    expectAgreement(name(std::string("conservative, ") + sphereBillboardName(billboard) + " billboards"),
+                    conservative, cpu);
   }
 }
 

@@ -7,12 +7,16 @@
 //   sphere-triangles  a triangle list, 6 vertices per sphere
 //   sphere-strip      one instance per sphere of a 4-vertex triangle strip
 //   sphere-geom       one point per sphere, expanded into a strip by a geometry shader
+// Every pipeline takes both billboards of the study (SphereSettings::billboard: the tight screen-space box
+// of the projection, or the camera-aligned square of sphere_impostor.inc.glsl) and optionally overestimating
+// conservative rasterization; the images are the same, only the fragments spent on them differ.
 // Attachments: RGBA8 color (copied into the shared image at the end of a frame, like hw-points), R32_UINT
 // particle index and D32 depth (read back for tests only). The timed frame is clear + draw + copy.
 #include <algorithm>
 #include <cstring>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "base/error.h"
 #include "gpu/context.h"
@@ -60,7 +64,8 @@ public:
 
   void recordFrame(const SphereDraw& draw, SphereTargets& targets) override {
     VkCommandBuffer cmd = draw.cmd;
-    const gpu::GraphicsProgram& program = this->program(particleLayoutInfo(draw.particles.layout()).shaderId);
+    const gpu::GraphicsProgram& program =
+        this->program(particleLayoutInfo(draw.particles.layout()).shaderId, draw.settings);
     gpu::vkCmdFillBuffer(cmd, counters_.handle(), 0, 16, 0);
     gpu::fullBarrier(cmd);
     // Every attachment is cleared on load: old contents are discarded (UNDEFINED). The color image waits
@@ -171,16 +176,21 @@ private:
     return pixels;
   }
 
-  // Pipelines per particle layout (specialization constant 0 of every sphere shader).
-  const gpu::GraphicsProgram& program(uint32_t layout) {
-    auto found = programs_.find(layout);
+  // Pipelines per particle layout (specialization constant 0 of every sphere shader), billboard
+  // (constant 2 of the vertex stage) and conservative rasterization.
+  const gpu::GraphicsProgram& program(uint32_t layout, const SphereSettings& settings) {
+    const uint32_t billboard = settings.billboard == SphereBillboard::Camera ? shared::kSphereBillboardCamera
+                                                                             : shared::kSphereBillboardScreen;
+    const std::tuple<uint32_t, uint32_t, bool> key{layout, billboard, settings.conservative};
+    auto found = programs_.find(key);
     if (found != programs_.end()) return found->second;
     gpu::GraphicsOptions options;
     options.colorFormat = kColorFormat;
     options.depthFormat = kDepthFormat;
     options.depthCompare = VK_COMPARE_OP_GREATER;
     options.secondColorFormat = kIndexFormat;
-    options.spec = {{/* LAYOUT= */ 0, layout}};
+    options.conservative = settings.conservative;
+    options.spec = {{/* LAYOUT= */ 0, layout}, {/* BILLBOARD= */ 2, billboard}};
     std::string vertex;
     switch (method_) {
     case SphereMethod::Points:
@@ -201,7 +211,7 @@ private:
       options.geometryShader = "sphere_geom.geom";
       break;
     }
-    return programs_.emplace(layout, gpu::GraphicsProgram(context_, vertex, "sphere_impostor.frag", options))
+    return programs_.emplace(key, gpu::GraphicsProgram(context_, vertex, "sphere_impostor.frag", options))
         .first->second;
   }
 
@@ -210,7 +220,7 @@ private:
   gpu::Image color_, index_, depth_;
   gpu::Buffer counters_;
   float nearW_ = 0;
-  std::map<uint32_t, gpu::GraphicsProgram> programs_;
+  std::map<std::tuple<uint32_t, uint32_t, bool>, gpu::GraphicsProgram> programs_;
 };
 
 } // namespace

@@ -38,6 +38,34 @@ bool geometrySupported(gpu::Context& context, std::string* why) {
   return false;
 }
 
+bool meshPointsSupported(gpu::Context& context, std::string* why) {
+  return sphereMeshSupported(context, /* points= */ true, why);
+}
+
+bool meshTrianglesSupported(gpu::Context& context, std::string* why) {
+  return sphereMeshSupported(context, /* points= */ false, why);
+}
+
+bool rayTracingSupported(gpu::Context& context, std::string* why) {
+  return sphereRtSupported(context, why);
+}
+
+// Billboard options of the rasterization pipelines: both billboards everywhere; conservative rasterization
+// where the device has VK_EXT_conservative_rasterization, and for points only where it covers points.
+bool billboardOptions(gpu::Context& context, const SphereSettings& settings, std::string* why) {
+  if (!settings.conservative) return true;
+  if (context.features().conservativeRasterization) return true;
+  *why = "the device has no conservative rasterization (VK_EXT_conservative_rasterization)";
+  return false;
+}
+
+bool pointBillboardOptions(gpu::Context& context, const SphereSettings& settings, std::string* why) {
+  if (!billboardOptions(context, settings, why)) return false;
+  if (!settings.conservative || context.features().conservativePoints) return true;
+  *why = "the device rasterizes no points conservatively (conservativePointAndLineRasterization)";
+  return false;
+}
+
 constexpr SphereMethodInfo kSphereMethods[] = {
     {SphereMethod::Compute, "sphere-compute",
      "compute rasterization of ray-cast spheres into a 64-bit depth|index visibility buffer; large spheres "
@@ -46,17 +74,31 @@ constexpr SphereMethodInfo kSphereMethods[] = {
     {SphereMethod::Points, "sphere-points",
      "hardware point list, gl_PointSize from the projected bounds (clamped to the largest point), ray-cast "
      "in the fragment shader (2023 study)",
-     pointsSupported},
+     pointsSupported, pointBillboardOptions},
     {SphereMethod::Triangles, "sphere-triangles",
      "hardware triangle list, 6 vertices per sphere over its projected bounds, ray-cast in the fragment "
      "shader",
-     alwaysSupported},
+     alwaysSupported, billboardOptions},
     {SphereMethod::Strip, "sphere-strip",
      "hardware 4-vertex triangle strips, one instance per sphere, ray-cast in the fragment shader",
-     alwaysSupported},
+     alwaysSupported, billboardOptions},
     {SphereMethod::Geometry, "sphere-geom",
      "hardware points expanded into strips by a geometry shader, ray-cast in the fragment shader",
-     geometrySupported},
+     geometrySupported, billboardOptions},
+    {SphereMethod::MeshPoints, "sphere-mesh-points",
+     "VK_EXT_mesh_shader: a meshlet of 31 or 15 spheres per workgroup (--meshlet; --task-cull culls first), "
+     "one point each, gl_PointSize from the projected bounds (clamped to the largest point), ray-cast in the "
+     "fragment shader (2023 study)",
+     meshPointsSupported, pointBillboardOptions},
+    {SphereMethod::MeshTriangles, "sphere-mesh-tris",
+     "VK_EXT_mesh_shader: a meshlet of 31 or 15 spheres per workgroup (--meshlet; --task-cull culls first), "
+     "a quad of 2 triangles over each one's projected bounds, ray-cast in the fragment shader (2023 study)",
+     meshTrianglesSupported, billboardOptions},
+    {SphereMethod::RayTracing, "sphere-rt",
+     "VK_KHR_ray_tracing_pipeline: an acceleration structure of one AABB per sphere (built before the "
+     "frames, timed apart), a ray per pixel, the shared intersection in an intersection shader, then the "
+     "shading resolve of sphere-compute",
+     rayTracingSupported},
 };
 
 // As the point renderer: 16384 x 16384 pixels, 2 GiB of visibility words.
@@ -114,6 +156,42 @@ const char* sphereMethodName(SphereMethod method) {
   return sphereMethodInfo(method).name;
 }
 
+bool sphereMethodTakesBillboards(SphereMethod method) {
+  return sphereMethodInfo(method).rasterOptions != nullptr;
+}
+
+std::string billboardMethodNames() {
+  std::string names;
+  for (const SphereMethodInfo& m : kSphereMethods)
+    if (m.rasterOptions) names += (names.empty() ? "" : ", ") + std::string(m.name);
+  return names;
+}
+
+SphereBillboard parseSphereBillboard(std::string_view name) {
+  if (name == "screen") return SphereBillboard::Screen;
+  if (name == "camera") return SphereBillboard::Camera;
+  throw InputError("unknown billboard '" + std::string(name) + "'; choose screen or camera");
+}
+
+const char* sphereBillboardName(SphereBillboard billboard) {
+  return billboard == SphereBillboard::Camera ? "camera" : "screen";
+}
+
+bool SphereRenderer::supports(gpu::Context& context, const SphereSettings& settings, std::string* why) {
+  const SphereMethodInfo& info = sphereMethodInfo(settings.method);
+  if (!info.rasterOptions && (settings.billboard != SphereBillboard::Screen || settings.conservative))
+    throw InputError(std::string("--billboard and --conservative apply to the sphere methods that rasterize "
+                                 "billboards (") +
+                     billboardMethodNames() + "); " + info.name + " draws none");
+  if (!supports(context, settings.method, why)) return false;
+  std::string reason;
+  if (!info.rasterOptions || info.rasterOptions(context, settings, &reason)) return true;
+  if (why)
+    *why = std::string(info.name) + (settings.conservative ? " with conservative rasterization" : "") +
+           " is not available on '" + context.info().name + "': " + reason;
+  return false;
+}
+
 bool SphereRenderer::supports(gpu::Context& context, SphereMethod method, std::string* why) {
   std::string reason;
   if (sphereMethodInfo(method).supported(context, &reason)) return true;
@@ -163,6 +241,13 @@ SphereMethodImpl& SphereRenderer::method(SphereMethod method) {
   case SphereMethod::Geometry:
     created = createSphereHardwareMethod(context_, targets_->width, targets_->height, method);
     break;
+  case SphereMethod::MeshPoints:
+  case SphereMethod::MeshTriangles:
+    created = createSphereMeshMethod(context_, targets_->width, targets_->height, method);
+    break;
+  case SphereMethod::RayTracing:
+    created = createSphereRtMethod(context_, targets_->width, targets_->height);
+    break;
   }
   methods_.emplace_back(method, std::move(created));
   return *methods_.back().second;
@@ -171,6 +256,18 @@ SphereMethodImpl& SphereRenderer::method(SphereMethod method) {
 SphereStats SphereRenderer::render(const GpuParticles& particles, const Camera& camera,
                                    const SphereSettings& settings) {
   validateCamera(camera);
+  bool mesh = settings.method == SphereMethod::MeshPoints || settings.method == SphereMethod::MeshTriangles;
+  if (settings.meshlet != shared::kSphereMeshletLarge && settings.meshlet != shared::kSphereMeshletSmall)
+    throw InputError("a meshlet holds " + std::to_string(shared::kSphereMeshletLarge) + " or " +
+                     std::to_string(shared::kSphereMeshletSmall) + " spheres, not " +
+                     std::to_string(settings.meshlet));
+  if (!mesh && (settings.taskCull || settings.meshlet != shared::kSphereMeshletLarge))
+    throw InputError(
+        std::string("--meshlet and --task-cull apply to sphere-mesh-points and sphere-mesh-tris, "
+                    "not to ") +
+        sphereMethodName(settings.method));
+  std::string why;
+  if (!supports(context_, settings, &why)) throw UnsupportedError(why);
   SphereMethodImpl& m = method(settings.method);
   SphereTargets& t = *targets_;
   shared::SphereFrame frame = frameConstants(particles, camera, t.width, t.height);
@@ -178,6 +275,7 @@ SphereStats SphereRenderer::render(const GpuParticles& particles, const Camera& 
   frame.background = settings.background;
   m.prepare(settings, frame);
   std::memcpy(t.frameStaging.mapped(), &frame, sizeof frame);
+  double buildMs = m.build(particles, t); // sphere-rt's acceleration structures; timed apart from frames
 
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
@@ -203,6 +301,7 @@ SphereStats SphereRenderer::render(const GpuParticles& particles, const Camera& 
   stats.minMs = *std::min_element(ms.begin(), ms.end());
   stats.maxMs = *std::max_element(ms.begin(), ms.end());
   stats.particles = particles.count();
+  stats.buildMs = buildMs;
   m.addCounters(stats);
   return stats;
 }

@@ -30,7 +30,12 @@ enum class SphereMethod {
   Triangles, // hardware triangle list, 6 vertices per sphere
   Strip,     // hardware triangle strips, one instance of 4 vertices per sphere
   Geometry,  // hardware points expanded into strips by a geometry shader
+  MeshPoints,    // VK_EXT_mesh_shader: a meshlet of spheres per workgroup, one point each
+  MeshTriangles, // VK_EXT_mesh_shader: a meshlet of spheres per workgroup, one quad (2 triangles) each
+  RayTracing,    // VK_KHR_ray_tracing_pipeline: one AABB per sphere, an intersection shader, a ray per pixel
 };
+
+struct SphereSettings;
 
 struct SphereMethodInfo {
   SphereMethod method;
@@ -38,6 +43,10 @@ struct SphereMethodInfo {
   const char* description;
   // Whether the device can run the method; why: one sentence when it cannot.
   bool (*supported)(gpu::Context& context, std::string* why);
+  // Methods that rasterize billboards: whether the device can draw them with the settings' billboard and
+  // conservative rasterization (why: one sentence when it cannot). nullptr: the method draws no
+  // billboards, and takes only the default settings (screen, not conservative).
+  bool (*rasterOptions)(gpu::Context& context, const SphereSettings& settings, std::string* why) = nullptr;
 };
 std::span<const SphereMethodInfo> sphereMethodTable();
 const SphereMethodInfo& sphereMethodInfo(SphereMethod method);
@@ -45,6 +54,20 @@ const SphereMethodInfo& sphereMethodInfo(SphereMethod method);
 SphereMethod parseSphereMethod(std::string_view name);
 bool isSphereMethodName(std::string_view name);
 const char* sphereMethodName(SphereMethod method);
+// Whether the method rasterizes billboards, so that --billboard and --conservative apply to it.
+bool sphereMethodTakesBillboards(SphereMethod method);
+// "sphere-points, sphere-triangles, ...": the methods that do, for messages and help.
+std::string billboardMethodNames();
+
+// The impostor each sphere is rasterized as (shaders/sphere_impostor.inc.glsl):
+enum class SphereBillboard {
+  Screen, // the tight screen-space box of the sphere's projection (an ellipse), plus a quarter pixel
+  Camera, // a square parallel to the image plane through the center, side 2r enlarged to cover the
+          // sphere's perspective projection; looser than the box, cheaper to set up
+};
+// Throws InputError naming the choices.
+SphereBillboard parseSphereBillboard(std::string_view name);
+const char* sphereBillboardName(SphereBillboard billboard);
 
 struct SphereSettings {
   SphereMethod method = SphereMethod::Compute;
@@ -54,6 +77,14 @@ struct SphereSettings {
   // sphere-compute: entries of the large-sphere chunk list; 0 = the default (4 M chunks, 64 MiB). Tests
   // set a small one to exercise the overflow path (spheres drawn by their own thread).
   uint32_t chunkCapacity = 0;
+  // Methods that rasterize billboards (sphereMethodTakesBillboards): the impostor, and overestimating
+  // conservative rasterization (VK_EXT_conservative_rasterization). Others refuse anything but the default.
+  SphereBillboard billboard = SphereBillboard::Screen;
+  bool conservative = false;
+  // sphere-mesh-*: spheres per mesh workgroup, kSphereMeshletLarge (31) or kSphereMeshletSmall (15)
+  // (render() throws InputError for others), and a task shader that culls spheres before the mesh stage.
+  uint32_t meshlet = 31;
+  bool taskCull = false;
 };
 
 struct SphereStats {
@@ -62,7 +93,11 @@ struct SphereStats {
   uint64_t particles = 0;      // particles submitted per frame
   uint64_t largeChunks = 0;    // sphere-compute: 256-pixel chunks of large spheres listed in the last frame
   uint64_t spilledSpheres = 0; // sphere-compute: large spheres that drew chunks themselves (list full)
-  uint64_t clampedSpheres = 0; // sphere-points: spheres larger than the largest point, drawn incomplete
+  uint64_t clampedSpheres = 0; // sphere-points, sphere-mesh-points: spheres larger than the largest point,
+                               // drawn incomplete
+  // sphere-rt: GPU time of building the acceleration structures (AABBs, bottom and top levels) before the
+  // frames, timestamp queries; not part of the frame times above.
+  double buildMs = 0;
 };
 
 class SphereMethodImpl;
@@ -88,6 +123,10 @@ public:
   uint32_t height() const;
 
   static bool supports(gpu::Context& context, SphereMethod method, std::string* why = nullptr);
+  // The method with the settings' billboard and conservative rasterization. Throws InputError when the
+  // method takes no such settings (sphere-compute draws no billboards); false with why when the device
+  // cannot (conservative rasterization missing).
+  static bool supports(gpu::Context& context, const SphereSettings& settings, std::string* why = nullptr);
 
 private:
   SphereMethodImpl& method(SphereMethod method);

@@ -1,0 +1,251 @@
+#include "bench/sphere_runner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+#include "base/error.h"
+#include "cloud/particles_generate.h"
+#include "gpu/timer.h"
+#include "render/spheres/spheres.h"
+
+namespace pointrast::bench {
+
+namespace {
+
+std::string printf1(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+std::vector<SphereMethod> methodsOf(const SphereBenchConfig& config) {
+  if (!config.methods.empty()) return config.methods;
+  std::vector<SphereMethod> all;
+  for (const SphereMethodInfo& m : sphereMethodTable())
+    all.push_back(m.method);
+  return all;
+}
+
+ParticleSet generate(const Dataset& d, uint64_t particles, bool progress) {
+  ParticleGenerateOptions options;
+  options.particles = particles;
+  options.seed = d.seed;
+  options.progress = progress;
+  return generateParticles(parseParticleScene(d.source), options);
+}
+
+// The layouts of the configuration that hold the data set exactly, decided on a small sample of the same
+// scene (a generator gives every size of a scene the same attributes: per-particle colors, one radius), so
+// that what will be skipped is known before the set is generated. The others are said in `skipped`.
+std::vector<ParticleLayout> layoutsHolding(const SphereBenchConfig& config, const Dataset& d,
+                                           std::vector<std::string>& skipped) {
+  const ParticleSet sample = generate(d, 1000, false);
+  std::vector<ParticleLayout> held;
+  for (ParticleLayout layout : config.layouts) {
+    std::string why;
+    if (layoutHolds(layout, sample, &why))
+      held.push_back(layout);
+    else
+      skipped.push_back(d.label + ": layout " + particleLayoutName(layout) + " skipped: " + why);
+  }
+  return held;
+}
+
+} // namespace
+
+MemoryEstimate estimateSphereMemory(const gpu::Context& context, uint64_t particles, uint32_t width,
+                                    uint32_t height, const std::vector<ParticleLayout>& layouts,
+                                    size_t methods) {
+  uint64_t perParticle = 0;
+  for (ParticleLayout layout : layouts)
+    perParticle = std::max<uint64_t>(perParticle, particleLayoutInfo(layout).bytesPerParticle);
+  MemoryEstimate m;
+  const uint64_t pixels = uint64_t(width) * height;
+  m.gpuBytes = particles * perParticle +
+               pixels * (kSphereSharedBytesPerPixel + kSphereMethodBytesPerPixel * methods) +
+               kSphereFixedBytes;
+  m.hostBytes = particles * kSphereHostBytesPerParticle;
+  if (context.info().software()) m.hostBytes += m.gpuBytes;
+  m.gpuHave = context.deviceLocalBytes();
+  m.hostHave = physicalMemory();
+  return m;
+}
+
+std::vector<SphereResult> sphereCombinations(const SphereBenchConfig& config) {
+  std::vector<SphereResult> combinations;
+  for (SphereMethod method : methodsOf(config)) {
+    SphereResult r;
+    r.method = method;
+    if (!sphereMethodTakesBillboards(method)) {
+      combinations.push_back(r);
+      continue;
+    }
+    for (SphereBillboard billboard : config.billboards)
+      for (bool conservative : config.conservative) {
+        r.billboard = billboard;
+        r.conservative = conservative;
+        combinations.push_back(r);
+      }
+  }
+  return combinations;
+}
+
+SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& config,
+                              const SphereBenchCallbacks& callbacks) {
+  const auto start = std::chrono::steady_clock::now();
+  auto note = [&](const std::string& line) {
+    if (callbacks.onNote) callbacks.onNote(line);
+  };
+  SphereBenchRun run;
+  run.device = context.info();
+  run.deviceLocalBytes = context.deviceLocalBytes();
+  run.config = config;
+  run.config.methods = methodsOf(config);
+  run.warmup = warmupFrames(config.frames);
+  const std::vector<SphereResult> combinations = sphereCombinations(run.config);
+
+  // Every data set is sized before anything runs, so what will be skipped is said up front.
+  size_t total = 0;
+  std::vector<std::vector<ParticleLayout>> layouts;
+  for (const Dataset& d : config.datasets) {
+    DatasetOutcome outcome;
+    outcome.dataset = d;
+    outcome.points = d.points;
+    std::vector<std::string> skipped;
+    layouts.push_back(layoutsHolding(config, d, skipped));
+    for (const std::string& line : skipped)
+      note(line);
+    run.skippedLayouts.insert(run.skippedLayouts.end(), skipped.begin(), skipped.end());
+    outcome.memory = estimateSphereMemory(context, d.points, config.width, config.height, layouts.back(),
+                                          run.config.methods.size());
+    if (d.points == 0) {
+      outcome.skipped = true;
+      outcome.reason = "it has no particles";
+    } else if (layouts.back().empty()) {
+      outcome.skipped = true;
+      outcome.reason = "none of the layouts asked for holds it";
+    } else if (!outcome.memory.fits()) {
+      outcome.skipped = true;
+      outcome.reason = "it does not fit: " + outcome.memory.describe();
+    }
+    note(d.label + ": " + (outcome.skipped ? "skipped, " + outcome.reason : outcome.memory.describe()));
+    if (!outcome.skipped) total += layouts.back().size() * config.orbits.size() * combinations.size();
+    run.datasets.push_back(std::move(outcome));
+  }
+
+  // Before any particles are resident, so the copy buffers may take their full size.
+  run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
+  {
+    char line[160];
+    std::snprintf(line, sizeof line, "copy bandwidth: %.1f GB/s (read + write, %s copied, median of %d)",
+                  run.copy.bytesPerSecond * 1e-9, bytesText(run.copy.bytes).c_str(), run.copy.repeats);
+    note(line);
+  }
+
+  SphereRenderer renderer(context, config.width, config.height);
+  const double aspect = double(config.width) / double(config.height);
+  size_t done = 0;
+  auto record = [&](const SphereResult& r) {
+    run.results.push_back(r);
+    ++done;
+    if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
+  };
+  try {
+    for (size_t k = 0; k < run.datasets.size(); ++k) {
+      DatasetOutcome& outcome = run.datasets[k];
+      if (outcome.skipped) continue;
+      const Dataset& d = outcome.dataset;
+      auto since = std::chrono::steady_clock::now();
+      auto secondsSince = [&since] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+      };
+      const ParticleSet set = generate(d, d.points, config.progress);
+      outcome.points = set.size();
+      outcome.description = set.source;
+      note(d.label + ": " + set.source + " ready in " + printf1("%.1f s", secondsSince()));
+      const Bounds bounds = sphereSetBounds(set);
+      std::vector<std::vector<Camera>> cameras;
+      for (Orbit orbit : config.orbits) {
+        cameras.push_back(orbitCameras(orbit, bounds, aspect, config.fovY, config.cameras));
+        SphereOrbitCameras described{d.name, orbit, {}};
+        for (const Camera& c : cameras.back())
+          described.cameras.push_back(describeCamera(c));
+        run.cameras.push_back(described);
+      }
+      for (ParticleLayout layout : layouts[k]) {
+        since = std::chrono::steady_clock::now();
+        std::unique_ptr<GpuParticles> particles;
+        std::string failure;
+        try {
+          ParticleUploadOptions upload;
+          upload.layout = layout;
+          upload.progress = config.progress;
+          particles = std::make_unique<GpuParticles>(context, set, upload);
+        } catch (const UnsupportedError& e) {
+          failure = e.what(); // out of device memory after all: every combination says so
+        }
+        note(d.label + " / " + particleLayoutName(layout) + ": uploaded in " +
+             printf1("%.1f s", secondsSince()));
+        for (size_t o = 0; o < config.orbits.size(); ++o) {
+          for (SphereResult r : combinations) {
+            r.dataset = d.name;
+            r.layout = layout;
+            r.orbit = config.orbits[o];
+            r.particles = set.size();
+            r.frames = config.frames;
+            r.bytesPerParticle = particleLayoutInfo(layout).bytesPerParticle;
+            SphereSettings settings;
+            settings.method = r.method;
+            settings.billboard = r.billboard;
+            settings.conservative = r.conservative;
+            settings.frames = config.frames;
+            settings.warmup = run.warmup;
+            std::string why;
+            if (!particles) {
+              r.status = "unsupported";
+              r.reason = failure;
+            } else if (!SphereRenderer::supports(context, settings, &why)) {
+              r.status = "unsupported";
+              r.reason = why;
+            } else {
+              measureGuarded(
+                  r,
+                  [&] {
+                    for (const Camera& camera : cameras[o]) {
+                      const SphereStats stats = renderer.render(*particles, camera, settings);
+                      r.cameraMs.push_back(stats.medianMs);
+                      r.clampedSpheres = std::max(r.clampedSpheres, stats.clampedSpheres);
+                      r.largeChunks = std::max(r.largeChunks, stats.largeChunks);
+                      r.spilledSpheres = std::max(r.spilledSpheres, stats.spilledSpheres);
+                    }
+                  },
+                  record);
+            }
+            if (r.ok() && !r.cameraMs.empty()) {
+              r.medianMs = gpu::median(r.cameraMs);
+              r.minMs = *std::min_element(r.cameraMs.begin(), r.cameraMs.end());
+              r.maxMs = *std::max_element(r.cameraMs.begin(), r.cameraMs.end());
+            }
+            if (r.ok() && r.medianMs > 0) {
+              const double seconds = r.medianMs * 1e-3;
+              r.particlesPerSecond = double(r.particles) / seconds;
+              r.effectiveBytesPerSecond = double(r.particles) * r.bytesPerParticle / seconds;
+              r.copyFraction =
+                  run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
+            }
+            record(r);
+          }
+        }
+      }
+    }
+  } catch (const DeviceFault& e) {
+    run.deviceFault = deviceFaultText(e);
+    note("stopped: " + run.deviceFault);
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+} // namespace pointrast::bench

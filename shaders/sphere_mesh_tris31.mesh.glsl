@@ -1,0 +1,6 @@
+#version 460
+// sphere-mesh-tris, 31 spheres per meshlet, consecutive spheres of a part (sphere_mesh.inc.glsl).
+#define MESHLET 31
+#define MESH_TRIS 1
+#define MESH_TASK 0
+#include "sphere_mesh.inc.glsl"
