@@ -12,6 +12,7 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "bench/report.h"
 #include "cli_util.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
@@ -269,15 +270,8 @@ int runRender(const RenderArgs& a) {
     j["points_per_second"] = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
     j["parts"] = a.parts;
     if (stats.batch) {
-      const BatchStats& b = *stats.batch;
       j["precision"] = a.precision;
-      j["batch_stats"] = {{"batches_processed", b.batchesProcessed},
-                          {"batches_rendered", b.batchesRendered},
-                          {"points_processed", b.pointsProcessed},
-                          {"points_rendered", b.pointsRendered},
-                          {"points_blended", b.pointsBlended},
-                          {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
-                          {"bytes_read", b.bytesRead}};
+      j["batch_stats"] = bench::batchStatsJson(*stats.batch);
     }
     j["camera"] = describeCamera(camera);
     char hex[17];

@@ -18,12 +18,6 @@ namespace pointrast::bench {
 
 namespace {
 
-std::string printf1(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 std::string apiVersion(uint32_t v) {
   return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
          std::to_string(VK_API_VERSION_PATCH(v));
@@ -370,6 +364,16 @@ std::string utcNow() {
   return text;
 }
 
+nlohmann::json batchStatsJson(const BatchStats& b) {
+  return {{"batches_processed", b.batchesProcessed},
+          {"batches_rendered", b.batchesRendered},
+          {"points_processed", b.pointsProcessed},
+          {"points_rendered", b.pointsRendered},
+          {"points_blended", b.pointsBlended},
+          {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
+          {"bytes_read", b.bytesRead}};
+}
+
 nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   nlohmann::json j;
   j["dataset"] = r.dataset;
@@ -392,16 +396,7 @@ nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   j["copy_gb_per_s"] = run.copy.bytesPerSecond * 1e-9;
   if (!run.deviceFault.empty()) j["device_fault"] = run.deviceFault;
   j["copy_fraction"] = r.copyFraction;
-  if (r.stats.batch) {
-    const BatchStats& b = *r.stats.batch;
-    j["batch_stats"] = {{"batches_processed", b.batchesProcessed},
-                        {"batches_rendered", b.batchesRendered},
-                        {"points_processed", b.pointsProcessed},
-                        {"points_rendered", b.pointsRendered},
-                        {"points_blended", b.pointsBlended},
-                        {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
-                        {"bytes_read", b.bytesRead}};
-  }
+  if (r.stats.batch) j["batch_stats"] = batchStatsJson(*r.stats.batch);
   j["camera"] = r.camera;
   return j;
 }

@@ -22,6 +22,8 @@ struct ReportInfo {
   std::string date;        // ISO 8601, UTC
 };
 
+// The counters of a batched method's frame as every JSON output writes them (reports, `render --json`).
+nlohmann::json batchStatsJson(const BatchStats& stats);
 // One result as a flat object (also the line `pointrast bench --json` prints per result).
 nlohmann::json resultJson(const BenchRun& run, const Result& result);
 nlohmann::json runJson(const BenchRun& run, const ReportInfo& info);

@@ -17,12 +17,6 @@ namespace pointrast::bench {
 
 namespace {
 
-std::string printf1(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 // Points a data set will have, known before it is loaded: generated scenes have exactly the count
 // asked for; files state theirs in the header (counted for XYZ).
 uint64_t expectedPoints(const Dataset& d) {
@@ -50,6 +44,19 @@ std::string bytesText(uint64_t bytes) {
   else
     std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / 1024.0);
   return text;
+}
+
+std::string printf1(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+std::string copyBandwidthText(const gpu::CopyBandwidth& copy) {
+  char line[160];
+  std::snprintf(line, sizeof line, "copy bandwidth: %.1f GB/s (read + write, %s copied, median of %d)",
+                copy.bytesPerSecond * 1e-9, bytesText(copy.bytes).c_str(), copy.repeats);
+  return line;
 }
 
 uint64_t physicalMemory() {
@@ -175,12 +182,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
 
   // Before any scene is resident, so the copy buffers may take their full size.
   run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
-  {
-    char line[160];
-    std::snprintf(line, sizeof line, "copy bandwidth: %.1f GB/s (read + write, %s copied, median of %d)",
-                  run.copy.bytesPerSecond * 1e-9, bytesText(run.copy.bytes).c_str(), run.copy.repeats);
-    note(line);
-  }
+  note(copyBandwidthText(run.copy));
 
   Renderer renderer(context, config.width, config.height);
   const double aspect = double(config.width) / double(config.height);

@@ -52,6 +52,11 @@ struct BenchConfig {
 
 // "512 KiB", "3.1 MiB", "12.7 GiB": memory sizes in messages and reports.
 std::string bytesText(uint64_t bytes);
+// One number through a printf format: printf1("%.1f s", 2.34) = "2.3 s" (at most 63 characters).
+std::string printf1(const char* format, double value);
+// The line both runners log once the copy bandwidth is measured: "copy bandwidth: 4305.4 GB/s (read +
+// write, 953.7 MiB copied, median of 10)".
+std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);

@@ -14,12 +14,6 @@ namespace pointrast::bench {
 
 namespace {
 
-std::string printf1(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 std::vector<SphereMethod> methodsOf(const SphereBenchConfig& config) {
   if (!config.methods.empty()) return config.methods;
   std::vector<SphereMethod> all;
@@ -137,12 +131,7 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
 
   // Before any particles are resident, so the copy buffers may take their full size.
   run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
-  {
-    char line[160];
-    std::snprintf(line, sizeof line, "copy bandwidth: %.1f GB/s (read + write, %s copied, median of %d)",
-                  run.copy.bytesPerSecond * 1e-9, bytesText(run.copy.bytes).c_str(), run.copy.repeats);
-    note(line);
-  }
+  note(copyBandwidthText(run.copy));
 
   SphereRenderer renderer(context, config.width, config.height);
   const double aspect = double(config.width) / double(config.height);

@@ -5,22 +5,10 @@
 #include <utility>
 
 #include "gpu/context.h"
+#include "gpu/pipeline_parts.h"
 #include "gpu/shader_registry.h"
 
 namespace pointrast::gpu {
-
-namespace {
-
-VkShaderModule createModule(VkDevice device, std::span<const uint32_t> words) {
-  VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  info.codeSize = words.size_bytes();
-  info.pCode = words.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateShaderModule(device, &info, nullptr, &module));
-  return module;
-}
-
-} // namespace
 
 GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShader,
                                  const std::string& fragmentShader, const GraphicsOptions& options)
@@ -59,32 +47,14 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
                        (options.topology == VK_PRIMITIVE_TOPOLOGY_POINT_LIST)) &&
          "topology does not name the mesh shader's output primitive");
   (void)firstVertexStage;
-  for (const SpecConstant& s : options.spec) {
-    assert(std::any_of(reflections.begin(), reflections.end(),
-                       [&](const SpirvReflection& r) {
-                         return std::find(r.specIds.begin(), r.specIds.end(), s.id) != r.specIds.end();
-                       }) &&
-           "specialization constant id not declared by any stage");
-    (void)s;
-  }
-  std::vector<VkSpecializationMapEntry> entries;
-  std::vector<uint32_t> values;
-  for (const SpecConstant& s : options.spec) {
-    entries.push_back({s.id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
-    values.push_back(s.value);
-  }
-  VkSpecializationInfo specInfo{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
-                                values.data()};
+  assertSpecDeclared(reflections, options.spec);
+  Specialization specialization(options.spec);
 
-  std::vector<VkShaderModule> modules;
+  ShaderModules modules(device_);
   try {
     for (const auto& source : sources)
-      modules.push_back(createModule(device_, source.second));
-    VkPushConstantRange range{pushStages_, 0, pushConstantSize_};
-    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.pushConstantRangeCount = range.size ? 1 : 0;
-    layoutInfo.pPushConstantRanges = &range;
-    VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
+      modules.add(source.second);
+    layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
 
     std::vector<VkPipelineShaderStageCreateInfo> stages(
         sources.size(), {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO});
@@ -92,7 +62,7 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
       stages[i].stage = sources[i].first;
       stages[i].module = modules[i];
       stages[i].pName = "main";
-      stages[i].pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+      stages[i].pSpecializationInfo = specialization.info();
     }
 
     VkPipelineVertexInputStateCreateInfo vertexInput{
@@ -161,13 +131,9 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
                     (options.taskShader.empty() ? "" : options.taskShader + " + ") + vertexShader + " + " +
                         (geometry ? options.geometryShader + " + " : "") + fragmentShader);
   } catch (...) {
-    for (VkShaderModule m : modules)
-      if (m) vkDestroyShaderModule(device_, m, nullptr);
     release();
     throw;
   }
-  for (VkShaderModule m : modules)
-    vkDestroyShaderModule(device_, m, nullptr);
 }
 
 GraphicsProgram::~GraphicsProgram() {
@@ -175,11 +141,7 @@ GraphicsProgram::~GraphicsProgram() {
 }
 
 void GraphicsProgram::release() {
-  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
-  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
-  if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
-  pipeline_ = VK_NULL_HANDLE;
-  layout_ = VK_NULL_HANDLE;
+  destroyPipeline(device_, pipeline_, layout_);
 }
 
 GraphicsProgram::GraphicsProgram(GraphicsProgram&& other) noexcept {

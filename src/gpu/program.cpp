@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "gpu/context.h"
+#include "gpu/pipeline_parts.h"
 #include "gpu/shader_registry.h"
 
 namespace pointrast::gpu {
@@ -12,47 +13,25 @@ ComputeProgram::ComputeProgram(Context& context, const std::string& shaderName,
     : device_(context.device()), name_(shaderName) {
   std::span<const uint32_t> words = findShader(shaderName);
   reflection_ = reflectSpirv(words);
-  for (const SpecConstant& s : spec) {
-    assert(std::find(reflection_.specIds.begin(), reflection_.specIds.end(), s.id) !=
-               reflection_.specIds.end() &&
-           "specialization constant id not declared by the shader");
-    (void)s;
-  }
-  VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  moduleInfo.codeSize = words.size_bytes();
-  moduleInfo.pCode = words.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateShaderModule(device_, &moduleInfo, nullptr, &module));
+  assertSpecDeclared({&reflection_, 1}, spec);
+  ShaderModules modules(device_);
+  VkShaderModule module = modules.add(words);
   try {
-    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantSize};
-    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.pushConstantRangeCount = range.size ? 1 : 0;
-    layoutInfo.pPushConstantRanges = &range;
-    VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
-
-    std::vector<VkSpecializationMapEntry> entries;
-    std::vector<uint32_t> values;
-    for (const SpecConstant& s : spec) {
-      entries.push_back({s.id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
-      values.push_back(s.value);
-    }
-    VkSpecializationInfo specInfo{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
-                                  values.data()};
+    layout_ = createPipelineLayout(device_, VK_SHADER_STAGE_COMPUTE_BIT, reflection_.pushConstantSize);
+    Specialization specialization(spec);
     VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     info.stage.module = module;
     info.stage.pName = "main";
-    info.stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+    info.stage.pSpecializationInfo = specialization.info();
     info.layout = layout_;
     VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
     context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_), shaderName);
   } catch (...) {
-    vkDestroyShaderModule(device_, module, nullptr);
     release();
     throw;
   }
-  vkDestroyShaderModule(device_, module, nullptr);
 }
 
 ComputeProgram::~ComputeProgram() {
@@ -60,11 +39,7 @@ ComputeProgram::~ComputeProgram() {
 }
 
 void ComputeProgram::release() {
-  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
-  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
-  if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
-  pipeline_ = VK_NULL_HANDLE;
-  layout_ = VK_NULL_HANDLE;
+  destroyPipeline(device_, pipeline_, layout_);
 }
 
 ComputeProgram::ComputeProgram(ComputeProgram&& other) noexcept {

@@ -7,6 +7,7 @@
 
 #include "base/error.h"
 #include "gpu/context.h"
+#include "gpu/pipeline_parts.h"
 #include "gpu/shader_registry.h"
 #include "gpu/spirv_reflect.h"
 
@@ -103,22 +104,8 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& 
     pushConstantSize_ = std::max(pushConstantSize_, size);
     if (size) pushStages_ |= stage;
   }
-  for (const SpecConstant& s : spec) {
-    assert(std::any_of(reflections.begin(), reflections.end(),
-                       [&](const SpirvReflection& r) {
-                         return std::find(r.specIds.begin(), r.specIds.end(), s.id) != r.specIds.end();
-                       }) &&
-           "specialization constant id not declared by any stage");
-    (void)s;
-  }
-  std::vector<VkSpecializationMapEntry> entries;
-  std::vector<uint32_t> values;
-  for (const SpecConstant& s : spec) {
-    entries.push_back({s.id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
-    values.push_back(s.value);
-  }
-  VkSpecializationInfo specInfo{uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
-                                values.data()};
+  assertSpecDeclared(reflections, spec);
+  Specialization specialization(spec);
 
   const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& limits = context.rayTracingProperties();
   ShaderBindingTableLayout table = shaderBindingTableLayout(
@@ -127,22 +114,11 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& 
     throw UnsupportedError("the device's largest shader group stride (" +
                            std::to_string(limits.maxShaderGroupStride) + ") is below its handle size");
 
-  std::vector<VkShaderModule> modules;
+  ShaderModules modules(device_);
   try {
-    for (const auto& source : sources) {
-      std::span<const uint32_t> words = findShader(*source.second);
-      VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-      moduleInfo.codeSize = words.size_bytes();
-      moduleInfo.pCode = words.data();
-      VkShaderModule module = VK_NULL_HANDLE;
-      VK_CHECK(vkCreateShaderModule(device_, &moduleInfo, nullptr, &module));
-      modules.push_back(module);
-    }
-    VkPushConstantRange range{pushStages_, 0, pushConstantSize_};
-    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.pushConstantRangeCount = range.size ? 1 : 0;
-    layoutInfo.pPushConstantRanges = &range;
-    VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
+    for (const auto& source : sources)
+      modules.add(findShader(*source.second));
+    layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
 
     VkPipelineShaderStageCreateInfo stages[kStages];
     for (uint32_t i = 0; i < kStages; ++i) {
@@ -150,7 +126,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& 
       stages[i].stage = sources[i].first;
       stages[i].module = modules[i];
       stages[i].pName = "main";
-      stages[i].pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+      stages[i].pSpecializationInfo = specialization.info();
     }
     // Groups (the order of their handles in the table): ray generation, miss, one procedural hit group.
     VkRayTracingShaderGroupCreateInfoKHR groups[3];
@@ -208,13 +184,9 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& 
     hit_ = {start + table.hitOffset, table.stride, table.hitSize};
     callable_ = {0, 0, 0};
   } catch (...) {
-    for (VkShaderModule m : modules)
-      if (m) vkDestroyShaderModule(device_, m, nullptr);
     release();
     throw;
   }
-  for (VkShaderModule m : modules)
-    vkDestroyShaderModule(device_, m, nullptr);
 }
 
 RayTracingProgram::~RayTracingProgram() {
@@ -222,11 +194,7 @@ RayTracingProgram::~RayTracingProgram() {
 }
 
 void RayTracingProgram::release() {
-  if (deviceFaulted()) return; // the GPU may still use it: leave it to process exit
-  if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
-  if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
-  pipeline_ = VK_NULL_HANDLE;
-  layout_ = VK_NULL_HANDLE;
+  destroyPipeline(device_, pipeline_, layout_);
 }
 
 RayTracingProgram::RayTracingProgram(RayTracingProgram&& other) noexcept {

@@ -206,32 +206,8 @@ TEST_F(GpuTest, SphereComputeFrustumCullingNeverDropsAVisibleSphere) {
   // few pixels into the image, spheres just outside it, behind the eye, and crossing the near plane;
   // against the brute-force CPU ray caster, which tests every sphere at every pixel.
   Camera camera = axisCamera(); // 90 degrees, near 0.01
-  std::vector<SphereSpec> spheres;
-  std::mt19937_64 rng(17);
-  // Radii of 0.6 to 6 pixels whatever the depth (at depth d a pixel is d / 60 wide).
-  std::uniform_real_distribution<double> u(-1, 1), depth(2, 20), r(0.01, 0.1);
-  double aspect = 160.0 / 120.0;
-  for (int i = 0; i < 400; ++i) {
-    double d = depth(rng), radius = r(rng) * d;
-    // Center just beyond an edge of the frustum at this depth: the sphere reaches in by up to a radius.
-    double beyond = u(rng) * radius;
-    glm::dvec3 c;
-    switch (i % 4) {
-    case 0:
-      c = {-d * aspect - beyond, u(rng) * d, -d};
-      break;
-    case 1:
-      c = {d * aspect + beyond, u(rng) * d, -d};
-      break;
-    case 2:
-      c = {u(rng) * d * aspect, d + beyond, -d};
-      break;
-    default:
-      c = {u(rng) * d * aspect, -d - beyond, -d};
-      break;
-    }
-    spheres.push_back({c, radius, 0xFF000000u | uint32_t(rng() & 0xFFFFFF)});
-  }
+  // Radii of 0.6 to 6 pixels whatever the depth.
+  std::vector<SphereSpec> spheres = frustumEdgeSpheres(0.1);
   spheres.push_back({{0, 0, 3}, 1, 0xFFFFFFFFu});          // behind the eye
   spheres.push_back({{0.3, 0.2, -0.5}, 0.6, 0xFFFFFFFFu}); // crossing the near plane
   ParticleSet set = makeSet(spheres);

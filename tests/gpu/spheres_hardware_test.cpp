@@ -40,38 +40,11 @@ protected:
 } // namespace
 
 TEST_P(SphereHardwareTest, AgreesWithCpuInEveryLayout) {
-  std::vector<SphereSpec> spheres = randomSpheres(3000, 7, 10, 0.05, 0.6);
-  Camera camera = lookAt({-14, -20, 9}, {0, 0, 0});
-  ParticleSet perParticle = makeSet(spheres);
-  ParticleSet globalBoth = makeSet(spheres, true, true);
-  SphereRaycast cpuPerParticle = renderCpu(perParticle, camera, 192, 128);
-  SphereRaycast cpuGlobal = renderCpu(globalBoth, camera, 192, 128);
-  for (ParticleLayout layout :
-       {ParticleLayout::Soa8, ParticleLayout::Vec4x2, ParticleLayout::Aos, ParticleLayout::Xyz}) {
-    bool global = !layoutHolds(layout, perParticle);
-    ParticleUploadOptions upload;
-    upload.layout = layout;
-    GpuFrame gpu =
-        renderGpu(*context, global ? globalBoth : perParticle, camera, 192, 128, upload, settings());
-    expectAgreement(name(particleLayoutName(layout)), gpu, global ? cpuGlobal : cpuPerParticle);
-  }
+  expectAgreementInEveryLayout(*context, name(""), settings(), 7);
 }
 
 TEST_P(SphereHardwareTest, AgreesWithSphereCompute) {
-  // Same spheres, same shading include: the same particle wins nearly everywhere (ties of equal depth go
-  // to the lower index in compute, to the first drawn in hardware).
-  std::vector<SphereSpec> spheres = randomSpheres(4000, 19, 8, 0.1, 0.4);
-  ParticleSet set = makeSet(spheres);
-  Camera camera = lookAt({-10, -14, 7}, {0, 0, 0});
-  GpuFrame hw = renderGpu(*context, set, camera, 200, 150, {}, settings());
-  GpuFrame compute = renderGpu(*context, set, camera, 200, 150);
-  size_t same = 0;
-  for (size_t i = 0; i < hw.index.size(); ++i)
-    same += hw.index[i] == compute.index[i] && colorsClose(hw.image[i], compute.image[i], 1);
-  double fraction = double(same) / double(hw.index.size());
-  std::printf("%s vs sphere-compute: %.3f %% of pixels equal\n", sphereMethodName(GetParam()),
-              100 * fraction);
-  EXPECT_GE(fraction, 0.999);
+  expectAgreesWithSphereCompute(*context, sphereMethodName(GetParam()), settings());
 }
 
 TEST_P(SphereHardwareTest, OverlappingAndLargeSpheres) {
@@ -96,89 +69,20 @@ TEST_P(SphereHardwareTest, SpheresAcrossTheBorderAndFrustumEdges) {
   // ray caster. Vulkan may discard a point whose vertex is outside the clip volume (lavapipe draws it
   // through its guard band), so sphere-points may lose the parts of spheres whose bounds are centered
   // off-screen, the known limit of that pipeline: it must only never draw what the CPU does not.
-  Camera camera = axisCamera(); // 90 degrees, near 0.01
-  std::vector<SphereSpec> spheres;
-  std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> u(-1, 1), depth(2, 20), r(0.01, 0.08);
-  double aspect = 160.0 / 120.0;
-  for (int i = 0; i < 400; ++i) {
-    double d = depth(rng), radius = r(rng) * d, beyond = u(rng) * radius;
-    glm::dvec3 c;
-    switch (i % 4) {
-    case 0:
-      c = {-d * aspect - beyond, u(rng) * d, -d};
-      break;
-    case 1:
-      c = {d * aspect + beyond, u(rng) * d, -d};
-      break;
-    case 2:
-      c = {u(rng) * d * aspect, d + beyond, -d};
-      break;
-    default:
-      c = {u(rng) * d * aspect, -d - beyond, -d};
-      break;
-    }
-    spheres.push_back({c, radius, 0xFF000000u | uint32_t(rng() & 0xFFFFFF)});
-  }
-  spheres.push_back({{0.3, 0.2, -0.5}, 0.6, 0xFFFFFFFFu}); // crossing the near plane: culled
-  ParticleSet set = makeSet(spheres);
-  GpuFrame gpu = renderGpu(*context, set, camera, 160, 120, {}, settings());
-  SphereRaycast cpu = renderCpu(set, camera, 160, 120, true);
-  Comparison c = compare(gpu, cpu);
-  std::printf("%s frustum edges: %.3f %% of pixels agree, %llu cpu-only, %llu gpu-only of %llu lit\n",
-              sphereMethodName(GetParam()), 100 * c.agreement(), (unsigned long long)c.cpuOnly,
-              (unsigned long long)c.gpuOnly, (unsigned long long)c.lit);
-  EXPECT_EQ(c.gpuOnly, 0u);
-  EXPECT_EQ(std::count(gpu.index.begin(), gpu.index.end(), uint32_t(spheres.size() - 1)), 0);
-  if (GetParam() != SphereMethod::Points) expectAgreement(name("frustum edges"), gpu, cpu);
+  expectFrustumEdges(*context, sphereMethodName(GetParam()), settings(),
+                     /* pointsMayBeLost= */ GetParam() == SphereMethod::Points);
 }
 
 TEST_P(SphereHardwareTest, PointsClampToTheLargestPoint) {
-  // A sphere whose bounds exceed the device's largest point: sphere-points draws it clipped to a square
-  // of that size and counts it; every other pipeline draws it whole. The image is a little larger than
-  // the largest point; at 90 degrees the sphere's disc has a radius of 1.05 half-images (r / d =
-  // sin(atan(1.05))), so its bounds are 1.05 images wide, and a small sphere shows in the corner.
-  float maxPoint = context->properties().limits.pointSizeRange[1];
-  uint32_t side = uint32_t(std::min(4096.0f, maxPoint + 64));
-  ParticleSet set =
-      makeSet({{{0, 0, -3}, 3 * std::sin(std::atan(1.05)), 0xFF80C0FFu}, {{8.1, 8.1, -9}, 0.2, 0xFF00FF00u}});
-  Camera camera = axisCamera();
-  GpuFrame gpu = renderGpu(*context, set, camera, side, side, {}, settings());
-  SphereRaycast cpu = renderCpu(set, camera, side, side);
-  size_t big = std::count(cpu.index.begin(), cpu.index.end(), 0u);
-  size_t drawn = std::count(gpu.index.begin(), gpu.index.end(), 0u);
-  std::printf("%s: %u x %u image, largest point %.0f, big sphere on %zu of %zu pixels, %llu clamped\n",
-              sphereMethodName(GetParam()), side, side, maxPoint, drawn, big,
-              (unsigned long long)gpu.stats.clampedSpheres);
-  EXPECT_GT(std::count(gpu.index.begin(), gpu.index.end(), 1u), 0);
-  if (GetParam() == SphereMethod::Points) {
-    EXPECT_EQ(gpu.stats.clampedSpheres, 1u);
-    EXPECT_LT(drawn, big);
-    EXPECT_GE(drawn, size_t(0.75 * maxPoint * maxPoint)) << "the clamped square is drawn";
-  } else {
-    EXPECT_EQ(gpu.stats.clampedSpheres, 0u);
-    expectAgreement(name("larger than the largest point"), gpu, cpu);
-  }
+  // sphere-points draws the sphere clipped to a square of the largest point; every other pipeline whole.
+  expectLargestPoint(*context, sphereMethodName(GetParam()), settings(),
+                     /* clamps= */ GetParam() == SphereMethod::Points);
 }
 
 TEST_P(SphereHardwareTest, CameraBillboardsAgreeWithCpuInEveryLayout) {
-  std::vector<SphereSpec> spheres = randomSpheres(3000, 23, 10, 0.05, 0.6);
-  Camera camera = lookAt({-14, -20, 9}, {0, 0, 0});
-  ParticleSet perParticle = makeSet(spheres);
-  ParticleSet globalBoth = makeSet(spheres, true, true);
-  SphereRaycast cpuPerParticle = renderCpu(perParticle, camera, 192, 128);
-  SphereRaycast cpuGlobal = renderCpu(globalBoth, camera, 192, 128);
   SphereSettings s = settings();
   s.billboard = SphereBillboard::Camera;
-  for (ParticleLayout layout :
-       {ParticleLayout::Soa8, ParticleLayout::Vec4x2, ParticleLayout::Aos, ParticleLayout::Xyz}) {
-    bool global = !layoutHolds(layout, perParticle);
-    ParticleUploadOptions upload;
-    upload.layout = layout;
-    GpuFrame gpu = renderGpu(*context, global ? globalBoth : perParticle, camera, 192, 128, upload, s);
-    expectAgreement(name(std::string("camera billboards ") + particleLayoutName(layout)), gpu,
-                    global ? cpuGlobal : cpuPerParticle);
-  }
+  expectAgreementInEveryLayout(*context, name("camera billboards "), s, 23);
 }
 
 namespace {

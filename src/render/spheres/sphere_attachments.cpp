@@ -34,6 +34,19 @@ SphereAttachments::SphereAttachments(gpu::Context& context, uint32_t width, uint
       depth_(context, width, height, kDepthFormat,
              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "sphere depth") {}
 
+gpu::GraphicsOptions SphereAttachments::pipelineOptions(uint32_t layout, const SphereSettings& settings) {
+  const uint32_t billboard = settings.billboard == SphereBillboard::Camera ? shared::kSphereBillboardCamera
+                                                                           : shared::kSphereBillboardScreen;
+  gpu::GraphicsOptions options;
+  options.colorFormat = kColorFormat;
+  options.depthFormat = kDepthFormat;
+  options.depthCompare = VK_COMPARE_OP_GREATER; // reverse-Z
+  options.secondColorFormat = kIndexFormat;
+  options.conservative = settings.conservative;
+  options.spec = {{/* LAYOUT= */ 0, layout}, {/* BILLBOARD= */ 2, billboard}};
+  return options;
+}
+
 void SphereAttachments::begin(VkCommandBuffer cmd, uint32_t background) {
   // Every attachment is cleared on load: old contents are discarded (UNDEFINED). The color image waits
   // for the previous frame's copy out of it, the others for the previous frame's writes and readbacks.

@@ -7,14 +7,13 @@
 //   2. the listed chunks, one per workgroup iteration, one pixel per thread;
 //   3. resolve: shade the winning sphere at each pixel.
 #include <algorithm>
-#include <bit>
-#include <limits>
 #include <map>
 
 #include "base/parallel.h"
 #include "gpu/context.h"
 #include "gpu/program.h"
 #include "render/spheres/sphere_method.h"
+#include "render/spheres/sphere_visibility.h"
 
 namespace pointrast {
 
@@ -73,28 +72,11 @@ public:
     push.groupsX = largeGroups_;
     p.large.dispatch(cmd, largeGroups_, 1, push);
     gpu::fullBarrier(cmd);
-    gpu::Grid grid = gpu::gridFor(pixels_, p.resolve.groupSize());
-    push.groupsX = grid.x;
-    p.resolve.dispatch(cmd, grid.x, grid.y, push);
-    gpu::fullBarrier(cmd);
+    recordSphereResolve(cmd, p.resolve, targets.frame.address(), pixels_);
   }
 
-  std::vector<float> depth() override {
-    std::vector<uint64_t> words = readWords();
-    std::vector<float> depth(words.size());
-    for (size_t i = 0; i < words.size(); ++i)
-      depth[i] = words[i] == shared::kEmptyPixel ? std::numeric_limits<float>::infinity()
-                                                 : std::bit_cast<float>(uint32_t(words[i] >> 32));
-    return depth;
-  }
-
-  std::vector<uint32_t> indices() override {
-    std::vector<uint64_t> words = readWords();
-    std::vector<uint32_t> index(words.size());
-    for (size_t i = 0; i < words.size(); ++i)
-      index[i] = words[i] == shared::kEmptyPixel ? kNoParticle : uint32_t(words[i]);
-    return index;
-  }
+  std::vector<float> depth() override { return readVisibilityDepth(context_, framebuffer_, pixels_); }
+  std::vector<uint32_t> indices() override { return readVisibilityIndices(context_, framebuffer_, pixels_); }
 
   void addCounters(SphereStats& stats) override {
     struct {
@@ -108,12 +90,6 @@ public:
   }
 
 private:
-  std::vector<uint64_t> readWords() {
-    std::vector<uint64_t> words(pixels_);
-    gpu::readBuffer(context_, framebuffer_, 0, words.data(), words.size() * 8);
-    return words;
-  }
-
   // Pipelines per particle layout (the layout is specialization constant 0 of every sphere shader).
   const Programs& programs(uint32_t layout) {
     auto found = programs_.find(layout);

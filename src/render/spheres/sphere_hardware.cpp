@@ -10,50 +10,26 @@
 // Every pipeline takes both billboards of the study (SphereSettings::billboard: the tight screen-space box
 // of the projection, or the camera-aligned square of sphere_impostor.inc.glsl) and optionally overestimating
 // conservative rasterization; the images are the same, only the fragments spent on them differ.
-// Attachments: RGBA8 color (copied into the shared image at the end of a frame, like hw-points), R32_UINT
-// particle index and D32 depth (read back for tests only). The timed frame is clear + draw + copy.
-#include <algorithm>
-#include <cstring>
-#include <limits>
+// Attachments and frame in SphereAttachments (RGBA8 color copied into the shared image at the end of a
+// frame, like hw-points; particle index and depth read back for tests only). The timed frame is clear +
+// draw + copy.
 #include <map>
 #include <tuple>
 
 #include "base/error.h"
 #include "gpu/context.h"
 #include "gpu/graphics.h"
-#include "gpu/image.h"
+#include "render/spheres/sphere_attachments.h"
 #include "render/spheres/sphere_method.h"
 
 namespace pointrast {
 
 namespace {
 
-constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM; // byte order r, g, b, a = the image's uint
-constexpr VkFormat kIndexFormat = VK_FORMAT_R32_UINT;
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-constexpr VkPipelineStageFlags2 kDepthStages =
-    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-constexpr VkAccessFlags2 kDepthAccess =
-    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-
-const gpu::ImageUse kColorAttachment{VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
-const gpu::ImageUse kDepthAttachment{kDepthStages, kDepthAccess, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
-const gpu::ImageUse kCopySource{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
-                                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-
 class SphereHardwareMethod : public SphereMethodImpl {
 public:
   SphereHardwareMethod(gpu::Context& context, uint32_t width, uint32_t height, SphereMethod method)
-      : context_(context), method_(method),
-        color_(context, width, height, kColorFormat,
-               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "sphere color"),
-        index_(context, width, height, kIndexFormat,
-               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-               "sphere particle index"),
-        depth_(context, width, height, kDepthFormat,
-               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "sphere depth"),
+      : context_(context), method_(method), attachments_(context, width, height),
         counters_(context, 16, gpu::kBufferUsage, gpu::MemoryKind::Device, "sphere frame counters") {}
 
   void prepare(const SphereSettings&, shared::SphereFrame& frame) override {
@@ -68,46 +44,7 @@ public:
         this->program(particleLayoutInfo(draw.particles.layout()).shaderId, draw.settings);
     gpu::vkCmdFillBuffer(cmd, counters_.handle(), 0, 16, 0);
     gpu::fullBarrier(cmd);
-    // Every attachment is cleared on load: old contents are discarded (UNDEFINED). The color image waits
-    // for the previous frame's copy out of it.
-    gpu::imageBarrier(cmd, color_,
-                      {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_UNDEFINED},
-                      kColorAttachment);
-    gpu::imageBarrier(cmd, index_,
-                      {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                       VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED},
-                      kColorAttachment);
-    gpu::imageBarrier(cmd, depth_,
-                      {kDepthStages | VK_PIPELINE_STAGE_2_COPY_BIT,
-                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED},
-                      kDepthAttachment);
-
-    VkRenderingAttachmentInfo colors[2] = {{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO},
-                                           {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO}};
-    colors[0].imageView = color_.view();
-    colors[0].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    colors[0].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    colors[0].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    // k / 255 converts back to exactly k in a UNORM attachment (round to nearest).
-    for (int c = 0; c < 4; ++c)
-      colors[0].clearValue.color.float32[c] = float((draw.settings.background >> (8 * c)) & 0xFFu) / 255.0f;
-    colors[1] = colors[0];
-    colors[1].imageView = index_.view();
-    colors[1].clearValue.color.uint32[0] = kNoParticle;
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = depth_.view();
-    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE; // read back by depth()
-    depth.clearValue.depthStencil = {0.0f, 0};    // reverse-Z: 0 is infinitely far
-    VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    rendering.renderArea = {{0, 0}, {targets.width, targets.height}};
-    rendering.layerCount = 1;
-    rendering.colorAttachmentCount = 2;
-    rendering.pColorAttachments = colors;
-    rendering.pDepthAttachment = &depth;
-    gpu::vkCmdBeginRendering(cmd, &rendering);
-    gpu::setViewport(cmd, targets.width, targets.height);
+    attachments_.begin(cmd, draw.settings.background);
     shared::SpherePush push{};
     push.frame = targets.frame.address();
     for (const ParticlePart& part : draw.particles.parts()) {
@@ -126,27 +63,11 @@ public:
         break;
       }
     }
-    gpu::vkCmdEndRendering(cmd);
-
-    gpu::imageBarrier(cmd, color_, kColorAttachment, kCopySource);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {targets.width, targets.height, 1};
-    gpu::vkCmdCopyImageToBuffer(cmd, color_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                targets.image.handle(), 1, &region);
-    gpu::fullBarrier(cmd);
+    attachments_.end(cmd, targets);
   }
 
-  std::vector<float> depth() override {
-    std::vector<float> z = readImage<float>(depth_, kDepthAttachment, VK_IMAGE_ASPECT_DEPTH_BIT);
-    for (float& d : z)
-      d = d > 0 ? nearW_ / d : std::numeric_limits<float>::infinity();
-    return z;
-  }
-
-  std::vector<uint32_t> indices() override {
-    return readImage<uint32_t>(index_, kColorAttachment, VK_IMAGE_ASPECT_COLOR_BIT);
-  }
+  std::vector<float> depth() override { return attachments_.depth(nearW_); }
+  std::vector<uint32_t> indices() override { return attachments_.indices(); }
 
   void addCounters(SphereStats& stats) override {
     uint32_t counters[4];
@@ -155,42 +76,13 @@ public:
   }
 
 private:
-  // Copies an attachment of the last frame into host memory and leaves it in its attachment layout.
-  template <class T>
-  std::vector<T> readImage(const gpu::Image& image, gpu::ImageUse use, VkImageAspectFlags aspect) {
-    std::vector<T> pixels(uint64_t(image.width()) * image.height());
-    gpu::Buffer staging(context_, pixels.size() * sizeof(T), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                        gpu::MemoryKind::Readback, "attachment readback");
-    context_.submitAndWait([&](VkCommandBuffer cmd) {
-      gpu::imageBarrier(cmd, image, use, kCopySource);
-      VkBufferImageCopy region{};
-      region.imageSubresource = {aspect, 0, 0, 1};
-      region.imageExtent = {image.width(), image.height(), 1};
-      gpu::vkCmdCopyImageToBuffer(cmd, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(),
-                                  1, &region);
-      gpu::imageBarrier(cmd, image, kCopySource, use);
-      gpu::fullBarrier(cmd);
-    });
-    staging.invalidate();
-    std::memcpy(pixels.data(), staging.mapped(), pixels.size() * sizeof(T));
-    return pixels;
-  }
-
   // Pipelines per particle layout (specialization constant 0 of every sphere shader), billboard
   // (constant 2 of the vertex stage) and conservative rasterization.
   const gpu::GraphicsProgram& program(uint32_t layout, const SphereSettings& settings) {
-    const uint32_t billboard = settings.billboard == SphereBillboard::Camera ? shared::kSphereBillboardCamera
-                                                                             : shared::kSphereBillboardScreen;
-    const std::tuple<uint32_t, uint32_t, bool> key{layout, billboard, settings.conservative};
+    const std::tuple<uint32_t, SphereBillboard, bool> key{layout, settings.billboard, settings.conservative};
     auto found = programs_.find(key);
     if (found != programs_.end()) return found->second;
-    gpu::GraphicsOptions options;
-    options.colorFormat = kColorFormat;
-    options.depthFormat = kDepthFormat;
-    options.depthCompare = VK_COMPARE_OP_GREATER;
-    options.secondColorFormat = kIndexFormat;
-    options.conservative = settings.conservative;
-    options.spec = {{/* LAYOUT= */ 0, layout}, {/* BILLBOARD= */ 2, billboard}};
+    gpu::GraphicsOptions options = SphereAttachments::pipelineOptions(layout, settings);
     std::string vertex;
     switch (method_) {
     case SphereMethod::Points:
@@ -217,10 +109,10 @@ private:
 
   gpu::Context& context_;
   SphereMethod method_;
-  gpu::Image color_, index_, depth_;
+  SphereAttachments attachments_;
   gpu::Buffer counters_;
   float nearW_ = 0;
-  std::map<std::tuple<uint32_t, uint32_t, bool>, gpu::GraphicsProgram> programs_;
+  std::map<std::tuple<uint32_t, SphereBillboard, bool>, gpu::GraphicsProgram> programs_;
 };
 
 } // namespace

@@ -189,20 +189,13 @@ private:
   // Pipelines per particle layout (specialization constant 0 of every sphere shader), billboard (2),
   // conservative rasterization, meshlet and task culling (the meshlet is constant 1 of the task shader).
   const gpu::GraphicsProgram& program(uint32_t layout, const SphereSettings& settings) {
-    uint32_t billboard = settings.billboard == SphereBillboard::Camera ? shared::kSphereBillboardCamera
-                                                                       : shared::kSphereBillboardScreen;
-    auto key = std::make_tuple(layout, billboard, settings.conservative, settings.meshlet, settings.taskCull);
+    auto key = std::make_tuple(layout, settings.billboard, settings.conservative, settings.meshlet,
+                               settings.taskCull);
     auto found = programs_.find(key);
     if (found != programs_.end()) return found->second;
-    gpu::GraphicsOptions options;
-    options.colorFormat = SphereAttachments::kColorFormat;
-    options.depthFormat = SphereAttachments::kDepthFormat;
-    options.depthCompare = VK_COMPARE_OP_GREATER; // reverse-Z, as every sphere pipeline
-    options.secondColorFormat = SphereAttachments::kIndexFormat;
-    options.conservative = settings.conservative;
+    gpu::GraphicsOptions options = SphereAttachments::pipelineOptions(layout, settings);
     options.meshShader = true;
     options.topology = points_ ? VK_PRIMITIVE_TOPOLOGY_POINT_LIST : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    options.spec = {{/* LAYOUT= */ 0, layout}, {/* BILLBOARD= */ 2, billboard}};
     if (settings.taskCull) {
       options.taskShader = "sphere_mesh.task";
       options.spec.push_back({/* MESHLET= */ 1, settings.meshlet});
@@ -218,7 +211,7 @@ private:
   SphereAttachments attachments_;
   gpu::Buffer counters_;
   float nearW_ = 0;
-  std::map<std::tuple<uint32_t, uint32_t, bool, uint32_t, bool>, gpu::GraphicsProgram> programs_;
+  std::map<std::tuple<uint32_t, SphereBillboard, bool, uint32_t, bool>, gpu::GraphicsProgram> programs_;
 };
 
 } // namespace

@@ -12,10 +12,8 @@
 #include "render/spheres/sphere_rt.h"
 
 #include <algorithm>
-#include <bit>
 #include <cassert>
 #include <cstring>
-#include <limits>
 #include <map>
 
 #include "base/error.h"
@@ -23,6 +21,7 @@
 #include "gpu/ray_tracing.h"
 #include "gpu/timer.h"
 #include "render/spheres/sphere_method.h"
+#include "render/spheres/sphere_visibility.h"
 
 namespace pointrast {
 
@@ -234,38 +233,13 @@ public:
     shared::SphereRtPush trace{targets.frame.address(), tlas_.address()};
     p.trace.traceRays(cmd, width_, height_, trace);
     gpu::fullBarrier(cmd);
-    gpu::Grid grid = gpu::gridFor(pixels_, p.resolve.groupSize());
-    shared::SpherePush push{};
-    push.frame = targets.frame.address();
-    push.groupsX = grid.x;
-    p.resolve.dispatch(cmd, grid.x, grid.y, push);
-    gpu::fullBarrier(cmd);
+    recordSphereResolve(cmd, p.resolve, targets.frame.address(), pixels_);
   }
 
-  std::vector<float> depth() override {
-    std::vector<uint64_t> words = readWords();
-    std::vector<float> depth(words.size());
-    for (size_t i = 0; i < words.size(); ++i)
-      depth[i] = words[i] == shared::kEmptyPixel ? std::numeric_limits<float>::infinity()
-                                                 : std::bit_cast<float>(uint32_t(words[i] >> 32));
-    return depth;
-  }
-
-  std::vector<uint32_t> indices() override {
-    std::vector<uint64_t> words = readWords();
-    std::vector<uint32_t> index(words.size());
-    for (size_t i = 0; i < words.size(); ++i)
-      index[i] = words[i] == shared::kEmptyPixel ? kNoParticle : uint32_t(words[i]);
-    return index;
-  }
+  std::vector<float> depth() override { return readVisibilityDepth(context_, framebuffer_, pixels_); }
+  std::vector<uint32_t> indices() override { return readVisibilityIndices(context_, framebuffer_, pixels_); }
 
 private:
-  std::vector<uint64_t> readWords() {
-    std::vector<uint64_t> words(pixels_);
-    gpu::readBuffer(context_, framebuffer_, 0, words.data(), words.size() * 8);
-    return words;
-  }
-
   // Programs per particle layout (specialization constant 0 of every sphere shader).
   const Programs& programs(uint32_t layout) {
     auto found = programs_.find(layout);
