@@ -89,7 +89,7 @@ int runRenderSpheres(const RenderArgs& a) {
   ParticleSet set = loadParticles(spec);
   std::string why;
   if (upload.layout && !layoutHolds(*upload.layout, set, &why)) throw InputError(why);
-  Bounds bounds = sphereSetBounds(set);
+  Bounds bounds = sphereBounds(set);
   Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
   if (!a.eye.empty()) {
     camera.eye = parseVec3(a.eye, "--eye");

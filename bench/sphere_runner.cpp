@@ -154,7 +154,7 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
       outcome.points = set.size();
       outcome.description = set.source;
       note(d.label + ": " + set.source + " ready in " + printf1("%.1f s", secondsSince()));
-      const Bounds bounds = sphereSetBounds(set);
+      const Bounds bounds = sphereBounds(set);
       std::vector<std::vector<Camera>> cameras;
       for (Orbit orbit : config.orbits) {
         cameras.push_back(orbitCameras(orbit, bounds, aspect, config.fovY, config.cameras));

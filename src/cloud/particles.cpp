@@ -47,21 +47,16 @@ void computeBounds(ParticleSet& set) {
 }
 
 Bounds sphereBounds(const ParticleSet& set) {
+  // Computed from the particles, not from set.bounds, so a set built by hand needs no computeBounds().
   const uint64_t n = set.size();
-  if (!set.perParticleRadius()) {
-    Bounds b = set.bounds;
-    if (!b.empty()) {
-      b.min -= glm::dvec3(set.globalRadius);
-      b.max += glm::dvec3(set.globalRadius);
-    }
-    return b;
-  }
   std::vector<Bounds> boxes((n + kBlock - 1) / kBlock);
   parallelBlocks(n, kBlock, [&](uint64_t block, uint64_t begin, uint64_t end) {
     Bounds box;
     for (uint64_t i = begin; i < end; ++i) {
-      const glm::dvec3 p = set.world(i);
-      const double r = set.radius[i];
+      const glm::dvec3 p(set.xyz[3 * i], set.xyz[3 * i + 1], set.xyz[3 * i + 2]);
+      const double r = set.radiusOf(i);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !(r > 0) || !std::isfinite(r))
+        continue; // no renderer draws it
       box.expand(p - r);
       box.expand(p + r);
     }
@@ -70,6 +65,10 @@ Bounds sphereBounds(const ParticleSet& set) {
   Bounds bounds;
   for (const Bounds& b : boxes)
     bounds.expand(b);
+  if (!bounds.empty()) {
+    bounds.min += set.origin;
+    bounds.max += set.origin;
+  }
   return bounds;
 }
 

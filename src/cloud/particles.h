@@ -38,7 +38,9 @@ struct ParticleSet {
 // (every reader and generator guarantees it).
 void computeBounds(ParticleSet& set);
 
-// Bounds of the spheres: each center expanded by its radius, in double precision. Empty for an empty set.
+// Bounds of the spheres: each center expanded by its radius, in double precision, from the particles
+// themselves. Particles with a non-finite center or a radius that is not a positive finite number (which
+// no renderer draws) are left out. Empty for an empty set.
 Bounds sphereBounds(const ParticleSet& set);
 
 // Smallest and largest radius over the particles: {globalRadius, globalRadius} without per-particle

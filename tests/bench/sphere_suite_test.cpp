@@ -33,7 +33,7 @@ struct Seen {
 Seen seen(const ParticleSet& set, const Camera& camera) {
   const glm::dvec3 origin = set.origin;
   const glm::dmat4 vp = viewProjection(camera, origin, kAspect);
-  const double nearW = defaultNear(sphereSetBounds(set));
+  const double nearW = defaultNear(sphereBounds(set));
   auto pixel = [&](glm::dvec3 p, double& px, double& py) {
     glm::dvec4 c = vp * glm::dvec4(p - origin, 1.0);
     if (!(c.w > nearW)) return false;
@@ -75,7 +75,7 @@ protected:
 
 TEST_P(Orbits, ShortOrbitIsInsideTheBoundsAndSeesPartOfTheSet) {
   const ParticleSet set = setFor(GetParam());
-  const Bounds bounds = sphereSetBounds(set);
+  const Bounds bounds = sphereBounds(set);
   const std::vector<Camera> cameras = bench::orbitCameras(bench::Orbit::Short, bounds, kAspect);
   ASSERT_EQ(cameras.size(), 10u);
   for (size_t k = 0; k < cameras.size(); ++k) {
@@ -93,7 +93,7 @@ TEST_P(Orbits, ShortOrbitIsInsideTheBoundsAndSeesPartOfTheSet) {
 
 TEST_P(Orbits, LongOrbitIsOutsideTheBoundsAndSeesEverySphereWhole) {
   const ParticleSet set = setFor(GetParam());
-  const Bounds bounds = sphereSetBounds(set);
+  const Bounds bounds = sphereBounds(set);
   const std::vector<Camera> cameras = bench::orbitCameras(bench::Orbit::Long, bounds, kAspect);
   ASSERT_EQ(cameras.size(), 10u);
   for (size_t k = 0; k < cameras.size(); ++k) {

@@ -85,7 +85,7 @@ SphereRaycast raycastSpheres(const ParticleSet& set, const Camera& camera, uint3
   cam.up = glm::cross(cam.right, cam.forward);
   cam.tanY = std::tan(glm::radians(camera.fovY) / 2);
   cam.tanX = cam.tanY * double(width) / double(height);
-  double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(sphereSetBounds(set));
+  double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(sphereBounds(set));
 
   // Spheres relative to the eye (exact: set.origin - eye in double, plus the float offsets), culled.
   glm::dvec3 originFromEye = set.origin - camera.eye;

@@ -34,7 +34,7 @@ struct SphereRaycastOptions {
   bool bruteForce = false;
 };
 
-// near = camera.nearW, or defaultNear(sphereSetBounds(set)) when it is 0 (as the GPU renderer does).
+// near = camera.nearW, or defaultNear(sphereBounds(set)) when it is 0 (as the GPU renderer does).
 SphereRaycast raycastSpheres(const ParticleSet& set, const Camera& camera, uint32_t width, uint32_t height,
                              const SphereRaycastOptions& options = {});
 

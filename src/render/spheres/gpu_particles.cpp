@@ -143,7 +143,7 @@ ParticleLayout compactLayout(const ParticleSet& set) {
 
 GpuParticles::GpuParticles(gpu::Context& context, const ParticleSet& set,
                            const ParticleUploadOptions& options)
-    : count_(set.size()), origin_(set.origin), bounds_(sphereSetBounds(set)), globalRadius_(set.globalRadius),
+    : count_(set.size()), origin_(set.origin), bounds_(sphereBounds(set)), globalRadius_(set.globalRadius),
       globalColor_(set.globalColor) {
   assert(set.xyz.size() % 3 == 0);
   assert(set.radius.empty() || set.radius.size() == count_);

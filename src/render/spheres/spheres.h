@@ -11,8 +11,4 @@ namespace pointrast {
 // Particle index of a pixel that no sphere covers (shared.h).
 constexpr uint32_t kNoParticle = shared::kNoParticle;
 
-// Bounds of the spheres (centers +- radius) in world coordinates; particles with a non-finite center or
-// a radius that is not a positive finite number (which no renderer draws) are left out.
-Bounds sphereSetBounds(const ParticleSet& set);
-
 } // namespace pointrast
