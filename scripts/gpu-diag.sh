@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Short targeted GPU checks used to chase a hang without losing the whole device call: each argument is
-# one bench process, RELEASE:METHODS (RELEASE = the busyloop release mode, see raster_busyloop.comp.glsl),
+# one bench process, METHODS[:ENV=VALUE ...] (environment for that process only),
 # on a 4 M-point tls cloud, all views and orders, with a short GPU timeout; a process that does not exit
 # DIAG_KILL_S seconds after it starts is killed (a stalled GPU can hold the exit for minutes).
 # Same setup as gpu-check.sh.
@@ -17,13 +17,13 @@ export XDG_RUNTIME_DIR=/tmp POINTRAST_VALIDATION=0 POINTRAST_GPU_TIMEOUT_S=${DIA
 n=0
 for spec in "$@"; do
   n=$((n + 1))
-  IFS=: read -r release methods extra <<< "$spec"
+  IFS=: read -r methods extra <<< "$spec"
   start=$(date +%s%N)
-  env $extra POINTRAST_BUSYLOOP_RELEASE=$release timeout -s KILL "${DIAG_KILL_S:-30}" $pr bench tls --points 4M \
+  env $extra timeout -s KILL "${DIAG_KILL_S:-30}" $pr bench tls --points 4M \
     --views "${DIAG_VIEWS:-all}" --methods "$methods" --orders "${DIAG_ORDERS:-all}" --frames 15 --out /tmp/diag --name "d$n" > "$OUT/diag-$n.log" 2>&1
   rc=$?
   stalled=$(grep -m1 'n/a' "$OUT/diag-$n.log" | sed 's/:.*//')
-  printf '== %-2s release=%s %-50s rc=%s %6s ms, first n/a: %s\n' "$n" "$release" "$methods $extra" "$rc" \
+  printf '== %-2s %-50s rc=%s %6s ms, first n/a: %s\n' "$n" "$methods $extra" "$rc" \
     "$((($(date +%s%N) - start) / 1000000))" "${stalled:-none}"
 done
 dmesg 2>/dev/null | grep -i -E 'xid|nvrm' | tail -20 || true

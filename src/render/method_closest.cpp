@@ -1,7 +1,5 @@
 // The closest-point methods: atomicmin, earlyz, reduce, reduce-earlyz, dedup (NV and ballot), justset
 // (raster_closest*.comp with specialization constants) and busyloop (its own shader and layout).
-#include <cstdlib>
-
 #include "base/error.h"
 #include "gpu/context.h"
 #include "render/method.h"
@@ -27,7 +25,6 @@ public:
     if (method == Method::BusyLoop) {
       // No release ordering on CPU devices: see the shader for why lavapipe needs that.
       uint32_t release = context.info().software() ? 0u : 2u;
-      if (const char* forced = std::getenv("POINTRAST_BUSYLOOP_RELEASE")) release = uint32_t(std::atoi(forced));
       raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp", {{/* RELEASE= */ 0, release}});
       pointsPerGroup_ = raster_.groupSize();
     } else if (method == Method::Dedup) {

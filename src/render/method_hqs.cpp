@@ -1,7 +1,5 @@
 // High-quality splatting: a depth pass (the early-z closest-point shader), an accumulation pass that
 // blends every point within 1 % of the closest depth, and a resolve that divides.
-#include <cstdlib>
-
 #include "base/error.h"
 #include "gpu/context.h"
 #include "render/method.h"
@@ -20,7 +18,7 @@ public:
         gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
                     oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
     // The depth pass is the fastest closest-point method the device has, reading positions only.
-    bool partitioned = context.features().subgroupPartitionedNV && !std::getenv("POINTRAST_HQS_PORTABLE");
+    bool partitioned = context.features().subgroupPartitionedNV;
     if (partitioned)
       depth_ = gpu::ComputeProgram(context, "raster_dedup_nv.comp",
                                    {{/* EARLY_Z= */ 0, 1}, {/* DEPTH_ONLY= */ 3, 1}});
