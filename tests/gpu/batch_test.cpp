@@ -105,14 +105,7 @@ PointCloud autzen() {
 std::map<std::string, PointCloud> testClouds() {
   std::map<std::string, PointCloud> clouds;
   std::mt19937_64 rng(21);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<glm::dvec3> points;
-  std::vector<uint32_t> colors;
-  for (int i = 0; i < 100'000; ++i) {
-    points.push_back({u(rng) * 20, u(rng) * 10, u(rng) * 5});
-    colors.push_back(0xFF000000u | uint32_t(rng() & 0xFFFFFF));
-  }
-  clouds["random"] = cloudFromPoints(points, colors);
+  clouds["random"] = randomBoxCloud(rng, 100'000, {20, 10, 5});
   GenerateOptions options;
   options.points = 80'000;
   options.progress = false;
@@ -451,14 +444,7 @@ TEST_F(GpuTest, BatchStatisticsAreExactOnAHandBuiltScene) {
 
 TEST_F(GpuTest, BatchPartsAndScenesGiveTheFramebufferOfOnePart) {
   std::mt19937_64 rng(13);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<glm::dvec3> points(100'000);
-  std::vector<uint32_t> colors(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i] = {u(rng) * 5, u(rng) * 5, u(rng) * 5};
-    colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
-  }
-  PointCloud cloud = cloudFromPoints(points, colors);
+  PointCloud cloud = randomBoxCloud(rng, 100'000, {5, 5, 5});
   Camera camera = overviewCamera(cloud.bounds, 2.0);
   GpuScene whole(*context, cloud, batched());
   ASSERT_EQ(whole.parts().size(), 1u);

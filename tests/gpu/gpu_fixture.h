@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,6 +59,19 @@ inline PointCloud cloudFromPoints(const std::vector<glm::dvec3>& points, const s
   cloud.colors = colors;
   computeBounds(cloud);
   return cloud;
+}
+
+// `count` points uniform in the box [-half, half] with random opaque colors, drawing from rng in the order
+// x, y, z, color per point (callers may go on using rng afterwards).
+inline PointCloud randomBoxCloud(std::mt19937_64& rng, size_t count, glm::dvec3 half) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<glm::dvec3> points(count);
+  std::vector<uint32_t> colors(count);
+  for (size_t i = 0; i < count; ++i) {
+    points[i] = {u(rng) * half.x, u(rng) * half.y, u(rng) * half.z};
+    colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
+  }
+  return cloudFromPoints(points, colors);
 }
 
 // Camera at the origin looking down -z with a 90 degree field of view: a point (x, y, -d) lands at

@@ -130,14 +130,7 @@ TEST_F(GpuTest, HwPointsHandBuiltContract) {
 
 TEST_F(GpuTest, HwPointsAgreesWithAtomicMinOnRandomCloud) {
   std::mt19937_64 rng(23);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<glm::dvec3> points(100'000);
-  std::vector<uint32_t> colors(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i] = {u(rng) * 20, u(rng) * 10, u(rng) * 5};
-    colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
-  }
-  compareWithAtomicMin(*context, "random", cloudFromPoints(points, colors), 160, 100);
+  compareWithAtomicMin(*context, "random", randomBoxCloud(rng, 100'000, {20, 10, 5}), 160, 100);
 }
 
 TEST_F(GpuTest, HwPointsAgreesWithAtomicMinOnTerrain) {

@@ -42,16 +42,10 @@ Result draw(gpu::Context& context, const GpuScene& scene, const Camera& camera, 
 std::map<std::string, PointCloud> testClouds() {
   std::map<std::string, PointCloud> clouds;
   std::mt19937_64 rng(11);
+  clouds["box"] = randomBoxCloud(rng, 60'000, {20, 10, 5});
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<glm::dvec3> points;
   std::vector<uint32_t> colors;
-  for (int i = 0; i < 60'000; ++i) {
-    points.push_back({u(rng) * 20, u(rng) * 10, u(rng) * 5});
-    colors.push_back(0xFF000000u | uint32_t(rng() & 0xFFFFFF));
-  }
-  clouds["box"] = cloudFromPoints(points, colors);
-  points.clear();
-  colors.clear();
   for (int i = 0; i < 60'000; ++i) {
     points.push_back({u(rng) * 0.05, u(rng) * 0.05, u(rng) * 0.05});
     colors.push_back(0xFF000000u | uint32_t(rng() & 0xFF)); // few colors: many equal depths break by color

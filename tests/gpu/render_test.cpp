@@ -90,14 +90,7 @@ TEST_F(GpuTest, ClosestPointWinsWhateverTheOrder) {
 
 TEST_F(GpuTest, RandomCloudMatchesCpuReference) {
   std::mt19937_64 rng(42);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<glm::dvec3> points(200'000);
-  std::vector<uint32_t> colors(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i] = {u(rng) * 50, u(rng) * 30, u(rng) * 10};
-    colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
-  }
-  PointCloud cloud = cloudFromPoints(points, colors);
+  PointCloud cloud = randomBoxCloud(rng, 200'000, {50, 30, 10});
   uint32_t w = 320, h = 200;
   std::vector<Camera> cameras = {overviewCamera(cloud.bounds, double(w) / h)};
   Camera inside;
@@ -142,14 +135,7 @@ TEST_F(GpuTest, AutzenMatchesCpuReference) {
 
 TEST_F(GpuTest, PartsAndSeparateScenesGiveIdenticalFramebuffers) {
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<glm::dvec3> points(100'000);
-  std::vector<uint32_t> colors(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i] = {u(rng) * 5, u(rng) * 5, u(rng) * 5};
-    colors[i] = 0xFF000000u | uint32_t(rng() & 0xFFFFFF);
-  }
-  PointCloud cloud = cloudFromPoints(points, colors);
+  PointCloud cloud = randomBoxCloud(rng, 100'000, {5, 5, 5});
   Camera camera = overviewCamera(cloud.bounds, 2.0);
   std::vector<uint64_t> whole = renderWords(*context, cloud, camera, 256, 128);
 
