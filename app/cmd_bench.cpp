@@ -1,6 +1,7 @@
 // pointrast bench FILE|SCENE... | --suite paper2021: the method x order x view matrix, timed on the GPU;
 // --suite spheres2023: the sphere method x layout x billboard x conservative x orbit matrix.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,8 @@ struct BenchArgs {
   std::string layouts = "all", billboards = "all", conservative = "all", orbits = "all";
   uint32_t cameras = 10;
   double scale = 1.0, fov = 60;
+  double budget = 2.0;    // --budget: GPU seconds per combination
+  double timeLimit = 0.0; // --time-limit: wall seconds before no further combination starts
   uint32_t width = 1920, height = 1080, frames = 50;
   uint64_t seed = 1;
   std::optional<uint32_t> device;
@@ -54,6 +57,18 @@ struct BenchArgs {
 // Timed frames per camera of the sphere suites unless --frames says otherwise: 5 x 10 cameras = 50 frames
 // per combination, as many as the point suites time.
 constexpr uint32_t kSphereSuiteFrames = 5;
+
+double timeLimitSeconds(const BenchArgs& a) {
+  if (!(a.timeLimit >= 0) || !std::isfinite(a.timeLimit))
+    throw InputError("--time-limit must be 0 (no limit) or a positive number of seconds");
+  return a.timeLimit;
+}
+
+double budgetSeconds(const BenchArgs& a) {
+  if (!(a.budget >= 0) || !std::isfinite(a.budget))
+    throw InputError("--budget must be 0 (no limit) or a positive number of seconds");
+  return a.budget;
+}
 
 // "a,b" -> {"a", "b"}, or every choice for "all"; each name parsed (InputError names the choices),
 // duplicates dropped, first occurrence kept.
@@ -250,6 +265,8 @@ int runSphereSuite(const BenchArgs& a) {
   config.width = a.width;
   config.height = a.height;
   config.frames = a.framesGiven ? a.frames : kSphereSuiteFrames;
+  config.secondsPerCombination = budgetSeconds(a);
+  config.timeLimitSeconds = timeLimitSeconds(a);
   config.fovY = a.fov;
   config.copyBytes = parseCount(a.copySize, "--copy-size");
   if (config.copyBytes == 0) throw InputError("--copy-size must be at least 1");
@@ -305,6 +322,8 @@ int runBench(const BenchArgs& a) {
   config.width = a.width;
   config.height = a.height;
   config.frames = a.frames;
+  config.secondsPerCombination = budgetSeconds(a);
+  config.timeLimitSeconds = timeLimitSeconds(a);
   config.fovY = a.fov;
   config.orderSeed = a.seed;
   config.copyBytes = parseCount(a.copySize, "--copy-size");
@@ -439,6 +458,16 @@ Command addBench(CLI::App& app) {
                   "Timed frames per combination (spheres2023: per camera, default 5); the median is reported")
       ->capture_default_str()
       ->each([a](const std::string&) { a->framesGiven = true; });
+  cmd->add_option("--budget", a->budget,
+                  "GPU seconds per combination: a method whose first frame shows that warm-up + --frames "
+                  "would take longer is timed over as many frames as fit (at least 3 after 1 warm-up; "
+                  "spheres2023: over all cameras, at least 1 per camera); the reports list them; 0 = always "
+                  "--frames")
+      ->capture_default_str();
+  cmd->add_option("--time-limit", a->timeLimit,
+                  "Wall seconds after which no further combination starts; the reports then hold what was "
+                  "measured and say where the run stopped (0 = no limit)")
+      ->capture_default_str();
   auto sphereOption = [a](const std::string&) { a->sphereOptionsGiven = true; };
   cmd->add_option("--layouts", a->layouts, "spheres2023: particle layouts soa8, vec4x2, aos, xyz, or all")
       ->capture_default_str()

@@ -154,8 +154,7 @@ nlohmann::json datasetJson(const DatasetOutcome& d) {
 
 // The Markdown report's first lines: title, device, copy bandwidth, and an early stop.
 void markdownHeader(std::ostringstream& md, const ReportInfo& info, const gpu::DeviceInfo& device,
-                    uint64_t deviceLocalBytes, const gpu::CopyBandwidth& copy,
-                    const std::string& deviceFault) {
+                    uint64_t deviceLocalBytes, const gpu::CopyBandwidth& copy, const std::string& stopped) {
   md << "# pointrast bench: " << info.title << "\n\n";
   md << "- Device: **" << device.name << "** (" << device.typeName << ", driver " << device.driver
      << ", Vulkan " << apiVersion(device.apiVersion) << "), " << bytesText(deviceLocalBytes)
@@ -167,7 +166,7 @@ void markdownHeader(std::ostringstream& md, const ReportInfo& info, const gpu::D
      << bytesText(copy.bytes) << " between two device buffers, median of " << copy.repeats
      << ". It counts bytes read + bytes written per second (a copy moves every byte through memory twice): "
         "the rate at which a method that only reads its points could at most stream them.\n";
-  if (!deviceFault.empty()) md << "- **Stopped early**: " << deviceFault << ".\n";
+  if (!stopped.empty()) md << "- **Stopped early**: " << stopped << ".\n";
 }
 
 // The lines after the run's own settings: how to read the figures, when and how the run was made.
@@ -394,7 +393,7 @@ nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   j["bytes_per_point"] = r.bytesPerPoint;
   j["effective_gb_per_s"] = r.effectiveBytesPerSecond * 1e-9;
   j["copy_gb_per_s"] = run.copy.bytesPerSecond * 1e-9;
-  if (!run.deviceFault.empty()) j["device_fault"] = run.deviceFault;
+  if (!run.stopped.empty()) j["stopped"] = run.stopped;
   j["copy_fraction"] = r.copyFraction;
   if (r.stats.batch) j["batch_stats"] = batchStatsJson(*r.stats.batch);
   j["camera"] = r.camera;
@@ -408,6 +407,7 @@ nlohmann::json runJson(const BenchRun& run, const ReportInfo& info) {
   settings["height"] = run.config.height;
   settings["frames"] = run.config.frames;
   settings["warmup"] = run.warmup;
+  settings["seconds_per_combination"] = run.config.secondsPerCombination;
   settings["fov"] = run.config.fovY;
   settings["order_seed"] = run.config.orderSeed;
   settings["timing"] =
@@ -433,10 +433,31 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
   const ResultIndex index(run);
   const auto datasets = measuredDatasets(run.datasets);
   std::ostringstream md;
-  markdownHeader(md, info, run.device, run.deviceLocalBytes, run.copy, run.deviceFault);
+  markdownHeader(md, info, run.device, run.deviceLocalBytes, run.copy, run.stopped);
   md << "- Image " << c.width << "x" << c.height << ", vertical field of view " << printf1("%g", c.fovY)
      << " degrees; each cell is the median GPU time of " << c.frames << " frames after " << run.warmup
      << " warm-up frames, a frame being clear + render + resolve, timed with timestamp queries.\n";
+  {
+    // Combinations the time budget shortened, grouped by method: "hw-points 12 (3-5 frames)".
+    std::map<std::string, std::pair<size_t, std::pair<uint32_t, uint32_t>>> shortened;
+    for (const Result& r : run.results)
+      if (r.ok() && r.stats.frames < c.frames) {
+        auto [it, fresh] =
+            shortened.try_emplace(methodName(r.method), 0, std::pair{r.stats.frames, r.stats.frames});
+        ++it->second.first;
+        it->second.second.first = std::min(it->second.second.first, r.stats.frames);
+        it->second.second.second = std::max(it->second.second.second, r.stats.frames);
+      }
+    if (!shortened.empty()) {
+      md << "- Time budget " << printf1("%g", c.secondsPerCombination)
+         << " s per combination: slower combinations were timed over fewer frames after 1 warm-up frame "
+            "(JSON `frames`):";
+      for (const auto& [name, v] : shortened)
+        md << " " << name << " " << v.first << "x (" << v.second.first
+           << (v.second.second != v.second.first ? "-" + std::to_string(v.second.second) : "") << " frames);";
+      md << "\n";
+    }
+  }
   markdownFooter(md, info, run.seconds);
 
   auto table = [&](View view, auto&& cell) {
@@ -660,7 +681,7 @@ nlohmann::json sphereResultJson(const SphereBenchRun& run, const SphereResult& r
   j["clamped_spheres"] = r.clampedSpheres;
   j["large_chunks"] = r.largeChunks;
   j["spilled_spheres"] = r.spilledSpheres;
-  if (!run.deviceFault.empty()) j["device_fault"] = run.deviceFault;
+  if (!run.stopped.empty()) j["stopped"] = run.stopped;
   return j;
 }
 
@@ -673,6 +694,7 @@ nlohmann::json sphereRunJson(const SphereBenchRun& run, const ReportInfo& info) 
   settings["cameras"] = c.cameras;
   settings["frames"] = c.frames;
   settings["warmup"] = run.warmup;
+  settings["seconds_per_combination"] = c.secondsPerCombination;
   settings["fov"] = c.fovY;
   settings["timing"] =
       "per camera: GPU time of clear + draw + resolve per frame from timestamp queries, median "
@@ -710,12 +732,25 @@ std::string sphereMarkdownReport(const SphereBenchRun& run, const ReportInfo& in
   const auto datasets = measuredDatasets(run.datasets);
   const std::vector<SphereVariant> variants = sphereVariants(c);
   std::ostringstream md;
-  markdownHeader(md, info, run.device, run.deviceLocalBytes, run.copy, run.deviceFault);
+  markdownHeader(md, info, run.device, run.deviceLocalBytes, run.copy, run.stopped);
   md << "- Image " << c.width << "x" << c.height << ", vertical field of view " << printf1("%g", c.fovY)
      << " degrees. Per combination, each of an orbit's " << c.cameras << " cameras renders " << run.warmup
      << " warm-up frames and " << c.frames << (c.frames == 1 ? " timed frame" : " timed frames")
      << " (a frame being clear + draw + resolve or attachment copy, timed with timestamp queries); a cell is "
         "the median over the cameras of each camera's median.\n";
+  {
+    size_t shortened = 0;
+    uint32_t fewest = c.frames;
+    for (const SphereResult& r : run.results)
+      if (r.ok() && r.frames < c.frames) {
+        ++shortened;
+        fewest = std::min(fewest, r.frames);
+      }
+    if (shortened > 0)
+      md << "- Time budget " << printf1("%g", c.secondsPerCombination) << " s per combination: " << shortened
+         << " slower combinations were timed over fewer frames per camera (down to " << fewest
+         << ", without warm-up after one probe frame; JSON `frames`).\n";
+  }
   md << "- Orbits around the center of the spheres' bounds, looking at it, z up: **short** inside the bounds "
         "(an ellipse at half their extent along x and y, a quarter of the half height above the center), "
         "**long** outside them (20 degrees above the horizon, as far as keeps the bounds' enclosing sphere "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -68,8 +69,25 @@ std::string deviceFaultText(const DeviceFault& fault) {
   return std::string(fault.what()) + "; the run stopped there, later combinations were not run";
 }
 
+void checkTimeLimit(std::chrono::steady_clock::time_point start, double limitSeconds, size_t done,
+                    size_t total) {
+  if (!(limitSeconds > 0)) return;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (seconds > limitSeconds)
+    throw TimeLimitReached("time limit of " + printf1("%g", limitSeconds) + " s reached after " +
+                           std::to_string(done) + " of " + std::to_string(total) +
+                           " combinations; the rest were not run");
+}
+
 uint32_t warmupFrames(uint32_t frames) {
   return std::max(2u, frames / 10);
+}
+
+uint32_t budgetedFrames(uint32_t frames, uint32_t warmup, double probeSeconds, double budget,
+                        uint32_t minFrames) {
+  if (!(budget > 0) || !(probeSeconds > 0) || probeSeconds * double(warmup + frames) <= budget) return frames;
+  const auto fit = uint32_t(std::min(std::floor(budget / probeSeconds + 1e-9), double(frames)));
+  return std::max(std::min(minFrames, frames), fit);
 }
 
 std::string MemoryEstimate::describe() const {
@@ -190,6 +208,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
   try {
     for (DatasetOutcome& outcome : run.datasets) {
       if (outcome.skipped) continue;
+      checkTimeLimit(start, config.timeLimitSeconds, done, total); // preparing a data set takes a while
       const Dataset& d = outcome.dataset;
       auto since = std::chrono::steady_clock::now();
       auto secondsSince = [&since] {
@@ -201,6 +220,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       outcome.description = cloud.source;
       note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince()));
       for (Order order : ordersOf(d, config)) {
+        checkTimeLimit(start, config.timeLimitSeconds, done, total);
         since = std::chrono::steady_clock::now();
         // One scene per layout the methods read (a suite mixing 2021 and batch methods holds both).
         std::map<SceneLayout, std::unique_ptr<GpuScene>> scenes;
@@ -225,6 +245,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
         for (View view : viewsOf(d, config)) {
           const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
           for (Method method : config.methods) {
+            checkTimeLimit(start, config.timeLimitSeconds, done, total);
             Result r;
             r.dataset = d.name;
             r.order = order;
@@ -247,7 +268,20 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
               settings.frames = config.frames;
               settings.warmup = run.warmup;
               measureGuarded(
-                  r, [&] { r.stats = renderer.render(*scenes[layout], camera, settings); },
+                  r,
+                  [&] {
+                    if (config.secondsPerCombination > 0) {
+                      // One frame timed first decides how many the budget allows.
+                      RenderSettings probe = settings;
+                      probe.frames = 1;
+                      probe.warmup = 0;
+                      const double seconds = renderer.render(*scenes[layout], camera, probe).medianMs * 1e-3;
+                      settings.frames =
+                          budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
+                      if (settings.frames < config.frames) settings.warmup = 1;
+                    }
+                    r.stats = renderer.render(*scenes[layout], camera, settings);
+                  },
                   [&](const Result& faulted) {
                     run.results.push_back(faulted);
                     ++done;
@@ -271,8 +305,11 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       }
     }
   } catch (const DeviceFault& e) {
-    run.deviceFault = deviceFaultText(e);
-    note("stopped: " + run.deviceFault);
+    run.stopped = deviceFaultText(e);
+    note("stopped: " + run.stopped);
+  } catch (const TimeLimitReached& e) {
+    run.stopped = e.what();
+    note("stopped: " + run.stopped);
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;

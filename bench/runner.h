@@ -9,8 +9,10 @@
 // batch methods: 16 B/point each).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,6 +45,13 @@ struct BenchConfig {
   std::vector<View> views;
   uint32_t width = 1920, height = 1080;
   uint32_t frames = 50; // timed frames per combination; warm-up is warmupFrames(frames)
+  // GPU seconds one combination may take (0 = no limit): a method whose frame, timed once first, would
+  // make warm-up + frames exceed it is timed over fewer frames (budgetedFrames) after one warm-up frame,
+  // so the paper-sized suites fit a session while the fast methods keep every frame.
+  double secondsPerCombination = 0;
+  // Wall seconds after which no further combination starts (0 = no limit): the run ends as after a device
+  // fault, with what it measured, so a lease or a CI job that must end by a time still gets its reports.
+  double timeLimitSeconds = 0;
   double fovY = 60.0;
   uint64_t orderSeed = 1; // for the shuffled orders
   uint64_t copyBytes = uint64_t(1) << 30;
@@ -60,6 +69,11 @@ std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);
+// Frames to time for a method whose probe frame took probeSeconds: `frames` if warm-up + frames fit in
+// `budget` seconds (or budget is 0), else as many as fit, at least minFrames (and at most frames).
+constexpr uint32_t kMinBudgetedFrames = 3;
+uint32_t budgetedFrames(uint32_t frames, uint32_t warmup, double probeSeconds, double budget,
+                        uint32_t minFrames = kMinBudgetedFrames);
 
 // Bytes per pixel of the render targets of every method a Renderer may hold at once: framebuffer (8),
 // image (4), canonical words (8), HQS accumulators (16), HQS1R's (24) and batch-hqs's (24), rounded up.
@@ -119,9 +133,9 @@ struct BenchRun {
   std::vector<DatasetOutcome> datasets;
   std::vector<Result> results;
   double seconds = 0; // wall time of the whole run (not a GPU figure)
-  // Set when the GPU stopped making progress: the run ends there (every later submission would wait on
-  // the stuck one) and the reports hold what was measured before.
-  std::string deviceFault;
+  // Why the run ended before its last combination: the GPU stopped making progress (every later submission
+  // would wait on the stuck one) or the time limit passed. The reports hold what was measured before.
+  std::string stopped;
 };
 
 struct BenchCallbacks {
@@ -154,8 +168,17 @@ void measureGuarded(R& result, Measure&& measure, Record&& record) {
   }
 }
 
-// The line a run that met a device fault ends with (BenchRun::deviceFault).
+// The line a run that met a device fault ends with (BenchRun::stopped).
 std::string deviceFaultText(const DeviceFault& fault);
+
+// Thrown by checkTimeLimit between combinations: the run ends there like after a device fault.
+struct TimeLimitReached : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// Throws TimeLimitReached when limitSeconds > 0 and more than that has passed since start; `done` and
+// `total` combinations go into the message.
+void checkTimeLimit(std::chrono::steady_clock::time_point start, double limitSeconds, size_t done,
+                    size_t total);
 
 // Runs the whole matrix. Data sets that do not fit are skipped and say why (DatasetOutcome). Throws
 // InputError for an unreadable file, UnsupportedError if the copy buffers cannot be had.

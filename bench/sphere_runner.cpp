@@ -145,6 +145,7 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
     for (size_t k = 0; k < run.datasets.size(); ++k) {
       DatasetOutcome& outcome = run.datasets[k];
       if (outcome.skipped) continue;
+      checkTimeLimit(start, config.timeLimitSeconds, done, total); // generating a set takes a while
       const Dataset& d = outcome.dataset;
       auto since = std::chrono::steady_clock::now();
       auto secondsSince = [&since] {
@@ -179,6 +180,7 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
              printf1("%.1f s", secondsSince()));
         for (size_t o = 0; o < config.orbits.size(); ++o) {
           for (SphereResult r : combinations) {
+            checkTimeLimit(start, config.timeLimitSeconds, done, total);
             r.dataset = d.name;
             r.layout = layout;
             r.orbit = config.orbits[o];
@@ -202,6 +204,21 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
               measureGuarded(
                   r,
                   [&] {
+                    if (config.secondsPerCombination > 0 && !cameras[o].empty()) {
+                      // One frame of the first camera decides how many frames per camera the budget
+                      // allows; a slow pipeline is then timed over fewer frames per camera, without
+                      // warm-up (the probe warmed it), so the medians still cover every camera.
+                      SphereSettings probe = settings;
+                      probe.frames = 1;
+                      probe.warmup = 0;
+                      const double seconds =
+                          renderer.render(*particles, cameras[o][0], probe).medianMs * 1e-3;
+                      settings.frames =
+                          budgetedFrames(config.frames, run.warmup, seconds,
+                                         config.secondsPerCombination / double(cameras[o].size()), 1);
+                      if (settings.frames < config.frames) settings.warmup = 0;
+                      r.frames = settings.frames;
+                    }
                     for (const Camera& camera : cameras[o]) {
                       const SphereStats stats = renderer.render(*particles, camera, settings);
                       r.cameraMs.push_back(stats.medianMs);
@@ -230,8 +247,11 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
       }
     }
   } catch (const DeviceFault& e) {
-    run.deviceFault = deviceFaultText(e);
-    note("stopped: " + run.deviceFault);
+    run.stopped = deviceFaultText(e);
+    note("stopped: " + run.stopped);
+  } catch (const TimeLimitReached& e) {
+    run.stopped = e.what();
+    note("stopped: " + run.stopped);
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;

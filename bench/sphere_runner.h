@@ -30,6 +30,10 @@ struct SphereBenchConfig {
   uint32_t cameras = 10; // per orbit
   uint32_t width = 1920, height = 1080;
   uint32_t frames = 5; // timed frames per camera; warm-up is warmupFrames(frames)
+  // GPU seconds one combination may take over all cameras (0 = no limit): a pipeline whose first frame
+  // shows it would take longer is timed over fewer frames per camera (at least one, no warm-up).
+  double secondsPerCombination = 0;
+  double timeLimitSeconds = 0; // as BenchConfig::timeLimitSeconds
   double fovY = 60.0;
   uint64_t copyBytes = uint64_t(1) << 30;
   int copyRepeats = 10;
@@ -95,8 +99,8 @@ struct SphereBenchRun {
   std::vector<SphereResult> results;
   // Layouts a data set cannot be held in exactly (xyz drops per-particle colors), one line each.
   std::vector<std::string> skippedLayouts;
-  double seconds = 0;      // wall time of the whole run (not a GPU figure)
-  std::string deviceFault; // as BenchRun::deviceFault: the run stopped there
+  double seconds = 0;  // wall time of the whole run (not a GPU figure)
+  std::string stopped; // as BenchRun::stopped: the run stopped there
 };
 
 struct SphereBenchCallbacks {
@@ -113,7 +117,7 @@ struct SphereBenchCallbacks {
 std::vector<SphereResult> sphereCombinations(const SphereBenchConfig& config);
 
 // Runs the whole matrix. Data sets that do not fit are skipped and say why; a device fault ends the run with
-// what was measured before (SphereBenchRun::deviceFault). Throws UnsupportedError if the copy buffers cannot
+// what was measured before (SphereBenchRun::stopped). Throws UnsupportedError if the copy buffers cannot
 // be had, InputError for an unknown particle scene.
 SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& config,
                               const SphereBenchCallbacks& callbacks = {});

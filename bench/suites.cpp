@@ -110,6 +110,12 @@ SuiteDefaults suiteDefaults(std::string_view suite) {
   SuiteDefaults d;
   if (isSphereSuite(suite)) return d;
   entriesOf(suite); // throws for an unknown name
+  if (suite == "paper2021") {
+    // The 2021 family and its hardware baseline: every method that reads the float layout. The batch
+    // methods are the 2022 suite's (they can still be asked for with --methods).
+    for (const MethodInfo& m : methodTable())
+      if (m.layout == SceneLayout::Float) d.methods.push_back(m.method);
+  }
   if (suite == "paper2022") {
     // The paper's comparison: the hardware baseline, its three methods, and the best 2021 methods.
     d.methods = {Method::HwPoints, Method::Batch, Method::BatchPrefetch,

@@ -6,8 +6,8 @@
 # Then run on that machine: scripts/gpu-check.sh (carry .gpu and .vkrt).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-grep -qx '/.gpu/' .git/info/exclude 2>/dev/null || echo '/.gpu/' >> .git/info/exclude
-grep -qx '/.vkrt/' .git/info/exclude 2>/dev/null || echo '/.vkrt/' >> .git/info/exclude
+mkdir -p .git/info; grep -qx '/.gpu/' .git/info/exclude 2>/dev/null || echo '/.gpu/' >> .git/info/exclude
+mkdir -p .git/info; grep -qx '/.vkrt/' .git/info/exclude 2>/dev/null || echo '/.vkrt/' >> .git/info/exclude
 cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O2" -DPOINTRAST_STATIC_RUNTIME=ON
 cmake --build build-gpu -j"$(nproc)" --target pointrast gpu_tests cli_tests bench_tests
 rm -rf .gpu && mkdir -p .gpu/bin .gpu/data/las .gpu/data/laz .gpu/data/las/permutations

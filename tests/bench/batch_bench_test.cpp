@@ -44,7 +44,12 @@ TEST(Suites, Paper2022SizesOrdersViewsAndDefaults) {
                                                    Method::BatchHqs, Method::Dedup, Method::Hqs}));
   EXPECT_EQ(layoutsOf(defaults.methods),
             std::vector<SceneLayout>({SceneLayout::Float, SceneLayout::Batched}));
-  EXPECT_TRUE(suiteDefaults("paper2021").methods.empty()) << "paper2021 runs every method";
+  const std::vector<Method> family = suiteDefaults("paper2021").methods;
+  EXPECT_EQ(family.size(), 11u)
+      << "hw-points, the closest-point family (6 with dedup-ballot), busyloop, justset, hqs, hqs1r";
+  EXPECT_EQ(layoutsOf(family), std::vector<SceneLayout>({SceneLayout::Float})) << "no batch method";
+  EXPECT_NE(std::find(family.begin(), family.end(), Method::HwPoints), family.end());
+  EXPECT_NE(std::find(family.begin(), family.end(), Method::Hqs1r), family.end());
   EXPECT_EQ(suiteDefaults("paper2021").width, 1920u);
   EXPECT_THROW(suiteDefaults("paper1999"), InputError);
   EXPECT_THROW(suiteDatasets("paper2022", 1.0, 1, {"retz=/x.las"}), InputError) << "a paper2021 name";

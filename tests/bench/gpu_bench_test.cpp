@@ -1,6 +1,7 @@
 // The GPU side of the benchmark on whatever device is present (lavapipe in CI): copy bandwidth, the
 // outside view drawing nothing, reordered copies keeping every point.
 #include <algorithm>
+#include <chrono>
 
 #include <gtest/gtest.h>
 
@@ -123,6 +124,80 @@ TEST(BenchCloud, ReorderedCopyIsAPermutationWithTheSameBounds) {
     EXPECT_EQ(keys(copy), keys(cloud)) << orderName(order);
     EXPECT_NE(copy.positions, cloud.positions) << orderName(order) << " changed nothing";
   }
+}
+
+TEST(BenchBudget, SlowMethodsGetFewerFramesFastOnesAll) {
+  // 10 frames after 2 warm-up: 12 probe-lengths must fit the budget.
+  EXPECT_EQ(bench::budgetedFrames(10, 2, 0.1, 1.2), 10u);
+  EXPECT_EQ(bench::budgetedFrames(10, 2, 0.1, 1.1), 10u) << "11 fit: every frame still timed";
+  EXPECT_EQ(bench::budgetedFrames(10, 2, 0.2, 1.2), 6u);
+  EXPECT_EQ(bench::budgetedFrames(10, 2, 2.0, 1.0), 3u) << "never fewer than 3";
+  EXPECT_EQ(bench::budgetedFrames(10, 2, 2.0, 1.0, 1), 1u);
+  EXPECT_EQ(bench::budgetedFrames(2, 2, 2.0, 1.0), 2u) << "never more than asked for";
+  EXPECT_EQ(bench::budgetedFrames(10, 2, 5.0, 0.0), 10u) << "0 = no limit";
+}
+
+TEST_F(BenchGpu, BudgetShortensEveryCombinationOfASlowRun) {
+  bench::BenchConfig config;
+  config.datasets = {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}};
+  config.methods = {Method::AtomicMin, Method::Hqs1r};
+  config.orders = {Order::Original};
+  config.views = {bench::View::Overview};
+  config.width = 64;
+  config.height = 32;
+  config.frames = 10;
+  // Far less than any frame takes: every combination is timed over the minimum of 3 frames.
+  config.secondsPerCombination = 1e-9;
+  config.copyBytes = 1 << 20;
+  config.copyRepeats = 2;
+  config.progress = false;
+  bench::BenchRun run = bench::runBench(*context, config, {});
+  ASSERT_EQ(run.results.size(), 2u);
+  for (const bench::Result& r : run.results) {
+    ASSERT_TRUE(r.ok()) << r.reason;
+    EXPECT_EQ(r.stats.frames, bench::kMinBudgetedFrames) << methodName(r.method);
+    EXPECT_GT(r.stats.medianMs, 0.0);
+  }
+  config.secondsPerCombination = 0;
+  run = bench::runBench(*context, config, {});
+  for (const bench::Result& r : run.results)
+    EXPECT_EQ(r.stats.frames, 10u) << methodName(r.method);
+}
+
+TEST(BenchTimeLimit, StopsOnlyOnceTheLimitHasPassed) {
+  const auto now = std::chrono::steady_clock::now();
+  EXPECT_NO_THROW(bench::checkTimeLimit(now - std::chrono::hours(1), 0, 1, 2)) << "0 = no limit";
+  EXPECT_NO_THROW(bench::checkTimeLimit(now, 3600, 1, 2));
+  try {
+    bench::checkTimeLimit(now - std::chrono::seconds(10), 5, 3, 7);
+    ADD_FAILURE() << "no TimeLimitReached";
+  } catch (const bench::TimeLimitReached& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "time limit of 5 s reached after 3 of 7 combinations; the rest were not run");
+  }
+}
+
+TEST_F(BenchGpu, TimeLimitEndsTheRunWithWhatItMeasured) {
+  bench::BenchConfig config;
+  config.datasets = {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}};
+  config.methods = {Method::AtomicMin, Method::EarlyZ};
+  config.orders = {Order::Original, Order::Morton};
+  config.views = {bench::View::Overview};
+  config.width = 64;
+  config.height = 32;
+  config.frames = 3;
+  config.copyBytes = 1 << 20;
+  config.copyRepeats = 2;
+  config.progress = false;
+  config.timeLimitSeconds = 1e-9; // passed before the first data set is prepared
+  bench::BenchRun run = bench::runBench(*context, config, {});
+  EXPECT_TRUE(run.results.empty());
+  EXPECT_NE(run.stopped.find("time limit of 1e-09 s reached after 0 of 4 combinations"), std::string::npos)
+      << run.stopped;
+  config.timeLimitSeconds = 3600;
+  run = bench::runBench(*context, config, {});
+  EXPECT_EQ(run.results.size(), 4u);
+  EXPECT_TRUE(run.stopped.empty()) << run.stopped;
 }
 
 } // namespace

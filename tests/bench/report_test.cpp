@@ -72,6 +72,20 @@ ReportInfo info() {
   return {"made-up", "made-up run", "pointrast bench x", "2024-01-01T00:00:00Z"};
 }
 
+TEST(Report, MarkdownListsCombinationsTheBudgetShortened) {
+  BenchRun run = madeUpRun();
+  run.config.secondsPerCombination = 2;
+  EXPECT_EQ(markdownReport(run, info()).find("Time budget"), std::string::npos) << "nothing shortened";
+  int n = 0;
+  for (Result& r : run.results)
+    if (r.ok() && r.method == Method::AtomicMin) r.stats.frames = ++n % 2 ? 3 : 5;
+  const std::string md = markdownReport(run, info());
+  EXPECT_NE(md.find("- Time budget 2 s per combination"), std::string::npos) << md;
+  EXPECT_NE(md.find("atomicmin " + std::to_string(n) + "x (3-5 frames)"), std::string::npos) << md;
+  EXPECT_EQ(md.find("earlyz 4x"), std::string::npos);
+  EXPECT_EQ(runJson(run, info())["settings"]["seconds_per_combination"], 2.0);
+}
+
 TEST(Report, MarkdownHasOneTablePerViewWithDatasetOrderRows) {
   std::string md = markdownReport(madeUpRun(), info());
   EXPECT_NE(md.find("## overview: median GPU time per frame, ms"), std::string::npos);
