@@ -1,52 +1,89 @@
-// The single-atomic HQS accumulation of the 2022 paper (hqs1r's layout, resolved by resolve_hqs.comp with
-// ONE_ROUND = 1): one uint64_t per pixel packs r, g, b, count in 16 bits each; a pixel stays exact up to 255
-// points (255 x 255 < 2^16), later points go to two 32-bit-per-channel fallback words per pixel after the
-// packed words. Lanes of a subgroup that all blend into one pixel add up first (dense views), in 32 bits.
-// Needs the subgroup basic/vote/arithmetic extensions and common.inc.glsl.
+// Blending for high-quality splatting, shared by hqs, hqs1r and batch-hqs: subgroup aggregation, then the
+// atomics of either accumulator layout. Needs the subgroup basic/vote/ballot/arithmetic/shuffle extensions
+// and common.inc.glsl.
+//
+// Contention decides the speed of HQS: in a dense overview every pixel blends hundreds of points, and the
+// lanes of a subgroup (consecutive points in Morton or scan order) mostly share a few pixels. So lanes first
+// add within the subgroup, one round per distinct pixel (a ballot picks the lowest pending lane, every lane
+// on its pixel adds to it), for at most kHqsRounds pixels; lanes still pending after that add alone. One
+// atomic (hqs1r) or two (hqs) per distinct pixel of a subgroup instead of one or two per point. On the H200
+// this beat VK_NV_shader_subgroup_partitioned by far (bench/NOTES.md), and it runs on every device.
 
-// acc: packed words [0, pixels), then fallback (r << 32 | g, b << 32 | count) pairs.
+// Distinct pixels a subgroup combines before the rest add alone: bounds the rounds where a subgroup's points
+// scatter (shuffled orders), while ordered clouds rarely have more pixels per subgroup.
+const uint kHqsRounds = 4u;
+
+// The single-atomic layout of the 2022 paper (hqs1r, batch-hqs; resolved by resolve_hqs.comp with
+// ONE_ROUND = 1): acc holds one uint64_t per pixel packing r, g, b, count in 16 bits each, exact up to 255
+// points (255 x 255 < 2^16), then two 32-bit-per-channel fallback words per pixel for later points:
+// packed words [0, pixels), then (r << 32 | g, b << 32 | count) pairs.
 void hqsAccumulate(Uint64Array acc, uint pixels, uint pixel, uint r, uint g, uint b, uint count) {
-  uint64_t packed = uint64_t(r) | (uint64_t(g) << 16) | (uint64_t(b) << 32) | (uint64_t(count) << 48);
-  // A pixel already full (as a plain read shows it) goes to the fallback sums at once: in dense views
-  // thousands of points share a pixel, and the add-then-take-back pair below would put two atomics per
-  // point on one hot address. The read may count adds that are about to be taken back; such a point then
-  // uses the fallback although it might have fitted, which changes nothing in the resolved sums.
-  if (uint(acc.v[pixel] >> 48) + count <= kHqs1rMaxCount) {
-    uint64_t before = atomicAdd(acc.v[pixel], packed);
-    if (uint(before >> 48) + count <= kHqs1rMaxCount) return;
-    // The word would pass 255 points: take the add back (modular addition undoes exactly, whatever
-    // carries happened meanwhile) and add to the 32-bit fallback sums instead. Adds that stay always saw
-    // a total of at most 255 including themselves, so the packed fields never overflow in the final sums.
-    atomicAdd(acc.v[pixel], -packed);
+  // count <= 255 bounds r, g, b by 255 x 255: the packed fields cannot carry into each other.
+  if (count <= kHqs1rMaxCount) {
+    uint64_t packed = uint64_t(r) | (uint64_t(g) << 16) | (uint64_t(b) << 32) | (uint64_t(count) << 48);
+    // A pixel already full (as a plain read shows it) goes to the fallback sums at once: in dense views
+    // thousands of points share a pixel, and the add-then-take-back pair below would put two atomics per
+    // point on one hot address. The read may count adds that are about to be taken back; such a point then
+    // uses the fallback although it might have fitted, which changes nothing in the resolved sums.
+    if (uint(acc.v[pixel] >> 48) + count <= kHqs1rMaxCount) {
+      uint64_t before = atomicAdd(acc.v[pixel], packed);
+      if (uint(before >> 48) + count <= kHqs1rMaxCount) return;
+      // The word would pass 255 points: take the add back (modular addition undoes exactly, whatever
+      // carries happened meanwhile) and add to the 32-bit fallback sums instead. Adds that stay always saw
+      // a total of at most 255 including themselves, so the packed fields never overflow in the final sums.
+      atomicAdd(acc.v[pixel], -packed);
+    }
   }
   atomicAdd(acc.v[pixels + 2 * pixel], (uint64_t(r) << 32) | uint64_t(g));
   atomicAdd(acc.v[pixels + 2 * pixel + 1], (uint64_t(b) << 32) | uint64_t(count));
 }
 
-// The sums one lane adds for one point per lane (pixel == 0xFFFFFFFF: none) of RGBA8 `color`, and whether
-// this lane adds them (`writes`). Call in uniform control flow: when the whole subgroup shares one pixel,
-// one lane adds the subgroup's sums (<= 128 lanes x 255 per channel, so they fit the 16-bit fields).
-void hqsSubgroupSums(uint pixel, uint color, out uint r, out uint g, out uint b, out uint count,
-                     out bool writes) {
-  bool blended = pixel != 0xFFFFFFFFu;
-  r = blended ? color & 0xFFu : 0u;
-  g = blended ? (color >> 8) & 0xFFu : 0u;
-  b = blended ? (color >> 16) & 0xFFu : 0u;
-  count = blended ? 1u : 0u;
-  writes = blended;
-  if (subgroupAllEqual(pixel)) {
-    r = subgroupAdd(r);
-    g = subgroupAdd(g);
-    b = subgroupAdd(b);
-    count = subgroupAdd(count);
-    writes = blended && subgroupElect();
-  }
+// The two-atomic layout of the 2019 paper (hqs): acc holds (r << 32 | g, b << 32 | count) per pixel.
+void hqsAccumulateTwo(Uint64Array acc, uint pixel, uint r, uint g, uint b, uint count) {
+  atomicAdd(acc.v[2 * pixel], (uint64_t(r) << 32) | uint64_t(g));
+  atomicAdd(acc.v[2 * pixel + 1], (uint64_t(b) << 32) | uint64_t(count));
 }
 
-// Blends one point per lane into the single-atomic layout. Call in uniform control flow.
-void hqsBlend(Uint64Array acc, uint pixels, uint pixel, uint color) {
-  uint r, g, b, count;
+// Sums over the lanes of the subgroup: every lane brings the sums of the points it blends into `pixel`
+// (0xFFFFFFFF: none) and leaves with `writes` set if it is to add the sums it then holds. Call in uniform
+// control flow. Sums stay in 32 bits (a subgroup has at most 128 lanes).
+void hqsSubgroupSums(uint pixel, inout uint r, inout uint g, inout uint b, inout uint count, out bool writes) {
+  bool pending = pixel != 0xFFFFFFFFu;
+  writes = false;
+  for (uint round = 0u; round < kHqsRounds && subgroupAny(pending); ++round) {
+    uint leader = subgroupBallotFindLSB(subgroupBallot(pending));
+    uint leaderPixel = subgroupShuffle(pixel, leader);
+    bool mine = pending && pixel == leaderPixel;
+    uint sr = subgroupAdd(mine ? r : 0u), sg = subgroupAdd(mine ? g : 0u);
+    uint sb = subgroupAdd(mine ? b : 0u), sc = subgroupAdd(mine ? count : 0u);
+    bool lead = gl_SubgroupInvocationID == leader;
+    r = lead ? sr : r;
+    g = lead ? sg : g;
+    b = lead ? sb : b;
+    count = lead ? sc : count;
+    writes = writes || lead;
+    pending = pending && !mine;
+  }
+  writes = writes || pending; // past kHqsRounds pixels: alone
+}
+
+// Blends one group of points per lane (`pixel` 0xFFFFFFFF: none; r, g, b, count their sums) into the
+// accumulators: the single-atomic layout if oneRound, else the two-atomic one. Call in uniform control flow;
+// a subgroup with nothing to blend returns at once.
+void hqsBlend(Uint64Array acc, uint pixels, bool oneRound, uint pixel, uint r, uint g, uint b, uint count) {
+  if (!subgroupAny(pixel != 0xFFFFFFFFu)) return; // uniform: no lane blends
   bool writes;
-  hqsSubgroupSums(pixel, color, r, g, b, count, writes);
-  if (writes) hqsAccumulate(acc, pixels, pixel, r, g, b, count);
+  hqsSubgroupSums(pixel, r, g, b, count, writes);
+  if (!writes) return;
+  if (oneRound)
+    hqsAccumulate(acc, pixels, pixel, r, g, b, count);
+  else
+    hqsAccumulateTwo(acc, pixel, r, g, b, count);
+}
+
+// The channel sums of one RGBA8 color.
+void hqsChannels(uint color, out uint r, out uint g, out uint b) {
+  r = color & 0xFFu;
+  g = (color >> 8) & 0xFFu;
+  b = (color >> 16) & 0xFFu;
 }

@@ -7,6 +7,8 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_EXT_control_flow_attributes : require
 #include "batch.inc.glsl"
 #include "hqs_accumulate.inc.glsl"
@@ -35,7 +37,7 @@ void main() {
       }
       // Four points in flight: project all, then their pixels' closest depths and the colors of those that
       // blend are read together, then they blend.
-      uint pixel[4], color[4];
+      uint pixel[4];
       float depth[4];
       [[unroll]] for (uint k = 0u; k < 4u; ++k) {
         // (projectPoint leaves its out parameters undefined when it drops a point.)
@@ -53,14 +55,29 @@ void main() {
         float closest = uintBitsToFloat(uint(fb.v[pixel[k]] >> 32));
         if (depth[k] > closest * float(PR_HQS_DEPTH_FACTOR)) pixel[k] = kNoPixel; // hidden: not blended
       }
+      // Colors of the points that blend; a thread's four points are consecutive and often share a pixel,
+      // so the sums of a shared pixel go with its first point (fewer lanes for the subgroup to combine).
+      uint r[4], g[4], b[4], n[4];
       [[unroll]] for (uint k = 0u; k < 4u; ++k) {
-        color[k] = 0u;
+        r[k] = g[k] = b[k] = n[k] = 0u;
         if (pixel[k] == kNoPixel) continue;
-        color[k] = UintArray(pc.colors).v[first + local + k];
+        hqsChannels(UintArray(pc.colors).v[first + local + k], r[k], g[k], b[k]);
+        n[k] = 1u;
         ++blended;
       }
+      [[unroll]] for (uint k = 1u; k < 4u; ++k) {
+        [[unroll]] for (uint e = 0u; e < k; ++e) {
+          if (pixel[k] != kNoPixel && pixel[k] == pixel[e]) {
+            r[e] += r[k];
+            g[e] += g[k];
+            b[e] += b[k];
+            n[e] += n[k];
+            pixel[k] = kNoPixel;
+          }
+        }
+      }
       [[unroll]] for (uint k = 0u; k < 4u; ++k)
-        hqsBlend(acc, width * height, pixel[k], color[k]);
+        hqsBlend(acc, width * height, true, pixel[k], r[k], g[k], b[k], n[k]);
     }
   }
   endStats(frame.f.stats, kStatPointsBlended, blended, false, v.words, count);

@@ -8,6 +8,9 @@ namespace pointrast {
 
 namespace {
 
+// Points per thread of both passes, as the closest-point methods (method_closest.cpp).
+constexpr uint32_t kPointsPerThread = 4;
+
 class HqsMethod : public PointMethod {
 public:
   HqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
@@ -17,16 +20,16 @@ public:
     accumulators_ =
         gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
                     oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
-    // The depth pass is the fastest closest-point method the device has, reading positions only.
-    bool partitioned = context.features().subgroupPartitionedNV;
-    if (partitioned)
-      depth_ = gpu::ComputeProgram(context, "raster_dedup_nv.comp",
-                                   {{/* EARLY_Z= */ 0, 1}, {/* DEPTH_ONLY= */ 3, 1}});
-    else
-      depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
-                                   {{/* EARLY_Z= */ 0, 1}, {/* REDUCE= */ 1, 1}, {/* DEPTH_ONLY= */ 3, 1}});
-    accumulate_ = gpu::ComputeProgram(context, partitioned ? "raster_hqs_nv.comp" : "raster_hqs.comp",
-                                      {{/* ONE_ROUND= */ 0, oneRound_}});
+    // The depth pass is the fastest closest-point shader on the H200 (reduce-earlyz, 4 points per thread;
+    // bench/NOTES.md), reading positions only. The accumulation pass draws points in the same order.
+    depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
+                                 {{/* EARLY_Z= */ 0, 1},
+                                  {/* REDUCE= */ 1, 1},
+                                  {/* DEPTH_ONLY= */ 3, 1},
+                                  {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
+    accumulate_ = gpu::ComputeProgram(
+        context, "raster_hqs.comp",
+        {{/* ONE_ROUND= */ 0, oneRound_}, {/* POINTS_PER_THREAD= */ 1, kPointsPerThread}});
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, oneRound_}});
   }
 
@@ -40,10 +43,10 @@ public:
     base.framebuffer = targets.framebuffer.address();
     base.aux = accumulators_.address();
     forEachPart(
-        frame, targets, depth_.groupSize(), base,
+        frame, targets, depth_.groupSize() * kPointsPerThread, base,
         [&](const shared::RasterPush& push, gpu::Grid grid) { depth_.dispatch(cmd, grid.x, grid.y, push); });
     gpu::fullBarrier(cmd);
-    forEachPart(frame, targets, accumulate_.groupSize(), base,
+    forEachPart(frame, targets, accumulate_.groupSize() * kPointsPerThread, base,
                 [&](const shared::RasterPush& push, gpu::Grid grid) {
                   accumulate_.dispatch(cmd, grid.x, grid.y, push);
                 });
