@@ -436,7 +436,9 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
   markdownHeader(md, info, run.device, run.deviceLocalBytes, run.copy, run.stopped);
   md << "- Image " << c.width << "x" << c.height << ", vertical field of view " << printf1("%g", c.fovY)
      << " degrees; each cell is the median GPU time of " << c.frames << " frames after " << run.warmup
-     << " warm-up frames, a frame being clear + render + resolve, timed with timestamp queries.\n";
+     << " warm-up frames, a frame being clear + render + resolve, timed with timestamp queries. After each "
+        "upload, frames of the first method are rendered until their time settles, so that GPU clocks that "
+        "fell to idle during the host's work are up again.\n";
   {
     // Combinations the time budget shortened, grouped by method: "hw-points 12 (3-5 frames)".
     std::map<std::string, std::pair<size_t, std::pair<uint32_t, uint32_t>>> shortened;
@@ -737,7 +739,9 @@ std::string sphereMarkdownReport(const SphereBenchRun& run, const ReportInfo& in
      << " degrees. Per combination, each of an orbit's " << c.cameras << " cameras renders " << run.warmup
      << " warm-up frames and " << c.frames << (c.frames == 1 ? " timed frame" : " timed frames")
      << " (a frame being clear + draw + resolve or attachment copy, timed with timestamp queries); a cell is "
-        "the median over the cameras of each camera's median.\n";
+        "the median over the cameras of each camera's median. After each upload, frames of the first "
+        "combination are rendered until their time settles, so that GPU clocks that fell to idle during the "
+        "host's work are up again.\n";
   {
     size_t shortened = 0;
     uint32_t fewest = c.frames;

@@ -67,6 +67,14 @@ std::string printf1(const char* format, double value);
 // write, 953.7 MiB copied, median of 10)".
 std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 
+// GPU clocks fall to idle while the host prepares a data set for seconds (an H200 idles at 345 MHz and
+// boosts to 1980), and they may stay there through a whole submission: on the H200, a method timed first
+// after such a pause ran 5.7x slow in all 17 frames of its one submission (bench/NOTES.md). So before the
+// first combination of each scene, renderMs(frames) (which renders that many frames in one submission and
+// returns their median ms) is called in rounds of about 30 ms of GPU work until two rounds agree within 3 %
+// after at least 0.2 s, or 3 s have passed. Returns the wall seconds it took.
+double settleClocks(const std::function<double(uint32_t frames)>& renderMs);
+
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);
 // Frames to time for a method whose probe frame took probeSeconds: `frames` if warm-up + frames fit in

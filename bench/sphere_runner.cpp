@@ -178,6 +178,25 @@ SphereBenchRun runSphereBench(gpu::Context& context, const SphereBenchConfig& co
         }
         note(d.label + " / " + particleLayoutName(layout) + ": uploaded in " +
              printf1("%.1f s", secondsSince()));
+        // Clocks up again after the host's work (settleClocks), with the first combination the device has.
+        for (const SphereResult& c : combinations) {
+          if (!particles || cameras.empty() || cameras[0].empty()) break;
+          SphereSettings settle;
+          settle.method = c.method;
+          settle.billboard = c.billboard;
+          settle.conservative = c.conservative;
+          settle.warmup = 0;
+          if (!SphereRenderer::supports(context, settle)) continue;
+          try {
+            settleClocks([&](uint32_t frames) {
+              settle.frames = frames;
+              return renderer.render(*particles, cameras[0][0], settle).medianMs;
+            });
+          } catch (const UnsupportedError&) {
+          } catch (const InputError&) {
+          }
+          break;
+        }
         for (size_t o = 0; o < config.orbits.size(); ++o) {
           for (SphereResult r : combinations) {
             checkTimeLimit(start, config.timeLimitSeconds, done, total);
