@@ -9,6 +9,13 @@
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer DMat4Ref { dmat4 m; };
 #endif
 
+// The first point of this thread when each thread draws pointsPerThread points a workgroup size apart
+// (first + k * kPointGroupSize, k < pointsPerThread), so that the lanes of a subgroup hold consecutive points.
+uint firstPointOfThread(uint pointsPerThread) {
+  uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
+  return group * (kPointGroupSize * pointsPerThread) + gl_LocalInvocationIndex;
+}
+
 vec3 loadPosition(uint i) {
   FloatArray pos = FloatArray(pc.positions);
   return vec3(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2]);

@@ -27,8 +27,7 @@ const uint kNoPixel = 0xFFFFFFFFu;
 
 void main() {
   // No early return anywhere: the subgroup operations of hqsBlend need every lane.
-  uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
-  uint first = group * (kPointGroupSize * POINTS_PER_THREAD) + gl_LocalInvocationIndex;
+  uint first = firstPointOfThread(POINTS_PER_THREAD);
   vec3 positions[POINTS_PER_THREAD];
   for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
     uint i = first + k * kPointGroupSize;

@@ -21,6 +21,23 @@ using test::GpuTest;
 
 class BenchGpu : public GpuTest {};
 
+// A run small enough for lavapipe: 64x32 pixels, a 1 MiB copy measured twice, no progress lines.
+bench::BenchConfig smallConfig(std::vector<bench::Dataset> datasets, std::vector<Method> methods,
+                               std::vector<Order> orders, std::vector<bench::View> views, uint32_t frames) {
+  bench::BenchConfig config;
+  config.datasets = std::move(datasets);
+  config.methods = std::move(methods);
+  config.orders = std::move(orders);
+  config.views = std::move(views);
+  config.width = 64;
+  config.height = 32;
+  config.frames = frames;
+  config.copyBytes = 1 << 20;
+  config.copyRepeats = 2;
+  config.progress = false;
+  return config;
+}
+
 TEST_F(BenchGpu, CopyBandwidthIsMeasured) {
   gpu::CopyBandwidth copy = gpu::measureCopy(*context, 16 << 20, 3);
   EXPECT_EQ(copy.bytes, uint64_t(16) << 20);
@@ -55,20 +72,12 @@ TEST_F(BenchGpu, OutsideViewDrawsOnlyBackground) {
 }
 
 TEST_F(BenchGpu, RunSkipsWhatDoesNotFitAndSaysSo) {
-  bench::BenchConfig config;
   bench::Dataset tiny{"tiny", "tiny (terrain, 2k)", "terrain", 2000, 1, false};
   // More points than any device holds: skipped from the estimate alone, never generated.
   bench::Dataset huge{"huge", "huge (tls, 1T)", "tls", uint64_t(1) << 40, 1, false};
-  config.datasets = {huge, tiny};
-  config.methods = {Method::AtomicMin, Method::Dedup};
-  config.orders = {Order::Original, Order::ShuffledMorton};
-  config.views = {bench::View::Closeup};
-  config.width = 64;
-  config.height = 32;
-  config.frames = 1;
-  config.copyBytes = 1 << 20;
-  config.copyRepeats = 2;
-  config.progress = false;
+  bench::BenchConfig config =
+      smallConfig({huge, tiny}, {Method::AtomicMin, Method::Dedup}, {Order::Original, Order::ShuffledMorton},
+                  {bench::View::Closeup}, 1);
   std::vector<std::string> notes;
   size_t calls = 0, lastTotal = 0;
   bench::BenchCallbacks callbacks;
@@ -140,19 +149,11 @@ TEST(BenchBudget, SlowMethodsGetFewerFramesFastOnesAll) {
 }
 
 TEST_F(BenchGpu, BudgetShortensEveryCombinationOfASlowRun) {
-  bench::BenchConfig config;
-  config.datasets = {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}};
-  config.methods = {Method::AtomicMin, Method::Hqs1r};
-  config.orders = {Order::Original};
-  config.views = {bench::View::Overview};
-  config.width = 64;
-  config.height = 32;
-  config.frames = 10;
+  bench::BenchConfig config =
+      smallConfig({bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}},
+                  {Method::AtomicMin, Method::Hqs1r}, {Order::Original}, {bench::View::Overview}, 10);
   // Far less than any frame takes: every combination is timed over the minimum of 3 frames.
   config.secondsPerCombination = 1e-9;
-  config.copyBytes = 1 << 20;
-  config.copyRepeats = 2;
-  config.progress = false;
   bench::BenchRun run = bench::runBench(*context, config, {});
   ASSERT_EQ(run.results.size(), 2u);
   for (const bench::Result& r : run.results) {
@@ -180,17 +181,9 @@ TEST(BenchTimeLimit, StopsOnlyOnceTheLimitHasPassed) {
 }
 
 TEST_F(BenchGpu, TimeLimitEndsTheRunWithWhatItMeasured) {
-  bench::BenchConfig config;
-  config.datasets = {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}};
-  config.methods = {Method::AtomicMin, Method::EarlyZ};
-  config.orders = {Order::Original, Order::Morton};
-  config.views = {bench::View::Overview};
-  config.width = 64;
-  config.height = 32;
-  config.frames = 3;
-  config.copyBytes = 1 << 20;
-  config.copyRepeats = 2;
-  config.progress = false;
+  bench::BenchConfig config = smallConfig(
+      {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}},
+      {Method::AtomicMin, Method::EarlyZ}, {Order::Original, Order::Morton}, {bench::View::Overview}, 3);
   config.timeLimitSeconds = 1e-9; // passed before the first data set is prepared
   bench::BenchRun run = bench::runBench(*context, config, {});
   EXPECT_TRUE(run.results.empty());
