@@ -270,10 +270,19 @@ struct SphereAabbPush {
   uint groupsX;       // workgroups per row of the 2D dispatch
 };
 
+// sphere-rt splits a part into pieces of SphereRtPush::pieceParticles particles, one bottom-level structure
+// and one instance each, when one structure for the whole part would need a build scratch buffer larger than
+// the device's largest buffer (4.51 GiB for 64 M spheres on an H200, whose largest buffer is 4 GiB). An
+// instance's 24-bit custom index is part << kSphereRtPieceBits | piece: 64 pieces of a part (at 64 M
+// particles a part, pieces of 1 M at the least), 262,144 parts.
+PR_CONST kSphereRtPieceBits = 6;
+
 // Push constants of the sphere-rt ray tracing pipeline (shaders/sphere_rt.*.glsl).
 struct SphereRtPush {
-  uint64_t frame; // SphereFrame
-  uint64_t tlas;  // device address of the top-level acceleration structure
+  uint64_t frame;      // SphereFrame
+  uint64_t tlas;       // device address of the top-level acceleration structure
+  uint pieceParticles; // particles per piece of a part (kSphereRtPieceBits); the last piece may have fewer
+  uint pad;
 };
 
 PR_NAMESPACE_END

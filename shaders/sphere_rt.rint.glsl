@@ -7,12 +7,14 @@
 // particle from the committed instance and primitive (an attribute written before a report that traversal
 // then rejects came out as another sphere's index on Mesa 25's lavapipe).
 #include "sphere_rt.inc.glsl"
+#include "sphere_rt_hit.inc.glsl"
 
 void main() {
   frame = SphereFrameRef(pc.frame).f;
-  // One instance per part (custom index = part), one AABB per particle of the part (primitive = local).
-  SpherePartRef part = PartTable(frame.parts).v[gl_InstanceCustomIndexEXT];
-  Sphere s = loadSphere(part.address, part.count, gl_PrimitiveID);
+  // One instance per piece of a part (custom index = part << kSphereRtPieceBits | piece), one AABB per
+  // particle of the piece (primitive = index in the piece).
+  SpherePartRef part = PartTable(frame.parts).v[gl_InstanceCustomIndexEXT >> kSphereRtPieceBits];
+  Sphere s = loadSphere(part.address, part.count, sphereRtLocalIndex());
   vec3 center;
   if (!viewSphere(s, center)) return;
   float depth;

@@ -48,7 +48,7 @@ static_assert(offsetof(SpherePush, first) == 16);
 static_assert(offsetof(SpherePush, firstGroup) == 28);
 static_assert(sizeof(SphereAabbPush) == 32);
 static_assert(offsetof(SphereAabbPush, count) == 24);
-static_assert(sizeof(SphereRtPush) == 16);
+static_assert(sizeof(SphereRtPush) == 24 && offsetof(SphereRtPush, pieceParticles) == 16);
 static_assert(kSphereTaskSpheres % kSphereTaskGroupSize == 0 && kSphereTaskGroupSize <= 32); // one mask word
 
 } // namespace pointrast::shared

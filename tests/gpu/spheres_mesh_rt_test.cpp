@@ -502,6 +502,33 @@ TEST_P(SphereMeshRtTest, ManyPartsAndMostSpheresOutsideTheView) {
   expectAgreement(name("many parts, most culled"), gpu, renderCpu(set, camera, 160, 120));
 }
 
+TEST_P(SphereMeshRtTest, RayTracingSplitsPartsIntoPieces) {
+  // A device whose largest buffer cannot hold the build scratch of a whole part gets several bottom-level
+  // structures per part (custom index = part << kSphereRtPieceBits | piece); forced here with pieces of 256:
+  // 5 parts of up to 900 spheres, 4 pieces each, the last piece of every part and the last part partial.
+  if (GetParam().method != SphereMethod::RayTracing) GTEST_SKIP() << "sphere-rt only";
+  std::vector<SphereSpec> spheres = randomSpheres(4000, 37, 30, 0.05, 0.5);
+  ParticleSet set = makeSet(spheres);
+  Camera camera = lookAt({0, 0, 0}, {1, 0.2, 0.1}, 40);
+  ParticleUploadOptions upload;
+  upload.maxPartParticles = 900;
+  SphereSettings s = settings();
+  s.rtPieceParticles = 256;
+  GpuFrame gpu = renderGpu(*context, set, camera, 160, 120, upload, s);
+  EXPECT_EQ(gpu.stats.rtBottomLevels, 4u * 4 + 2) << "900 x 4 + 400: 4 pieces of 256 each, then 2";
+  expectAgreement(name("parts in pieces of 256"), gpu, renderCpu(set, camera, 160, 120));
+  s.rtPieceParticles = 1; // a structure per sphere
+  upload.maxPartParticles = 0;
+  std::vector<SphereSpec> few(spheres.begin(), spheres.begin() + 60);
+  ParticleSet small = makeSet(few);
+  gpu = renderGpu(*context, small, camera, 160, 120, upload, s);
+  EXPECT_EQ(gpu.stats.rtBottomLevels, 60u);
+  expectAgreement(name("pieces of one sphere"), gpu, renderCpu(small, camera, 160, 120));
+  s.rtPieceParticles = 0; // as many as the device allows: one structure for the part
+  gpu = renderGpu(*context, small, camera, 160, 120, upload, s);
+  EXPECT_EQ(gpu.stats.rtBottomLevels, 1u);
+}
+
 TEST_P(SphereMeshRtTest, AgreesWithSphereCompute) {
   expectAgreesWithSphereCompute(*context, variantName(GetParam()), settings());
 }

@@ -85,6 +85,9 @@ struct SphereSettings {
   // (render() throws InputError for others), and a task shader that culls spheres before the mesh stage.
   uint32_t meshlet = 31;
   bool taskCull = false;
+  // sphere-rt: particles per bottom-level structure; 0 = a whole part while the build's scratch fits the
+  // device's largest buffer, else halved until it does. Tests set a small one to exercise the pieces.
+  uint32_t rtPieceParticles = 0;
 };
 
 struct SphereStats {
@@ -98,6 +101,7 @@ struct SphereStats {
   // sphere-rt: GPU time of building the acceleration structures (AABBs, bottom and top levels) before the
   // frames, timestamp queries; not part of the frame times above.
   double buildMs = 0;
+  uint64_t rtBottomLevels = 0; // sphere-rt: bottom-level structures built (a piece of a part each)
 };
 
 class SphereMethodImpl;

@@ -1,11 +1,13 @@
 // sphere-rt: the ray-tracing baseline of Gralka et al., "Efficient Sphere Rendering Revisited" (2023), on
 // VK_KHR_ray_tracing_pipeline. Before the frames (SphereMethodImpl::build, timed apart from them):
-//   1. per part, one AABB per particle in the particles' frame (sphere_rt_aabbs.comp.glsl), then a
-//      bottom-level structure of that AABB geometry (one per part: a part has at most 64 M particles,
-//      below every device's maxPrimitiveCount of >= 2^29), the parts built one after another through one
-//      AABB buffer and one scratch buffer so that memory stays at one part's worth;
-//   2. a top-level structure with one instance per part (identity transform, custom index = part index;
-//      one instance for a set of one part).
+//   1. per part, one AABB per particle in the particles' frame (sphere_rt_aabbs.comp.glsl), then
+//      bottom-level structures of that AABB geometry: one per piece of the part, a piece being the whole
+//      part unless the build's scratch buffer would exceed the device's largest buffer (64 M spheres need
+//      4.51 GiB on an H200, which allows 4 GiB), then the same number of particles per piece, halved until
+//      it fits. Parts and pieces are built one after another through one AABB buffer (a part) and one
+//      scratch buffer, so that memory stays at one part's worth;
+//   2. a top-level structure with one instance per piece (identity transform, custom index = part <<
+//      kSphereRtPieceBits | piece).
 // A frame: one ray per pixel center (sphere_rt.rgen.glsl); the intersection shader ray-casts the sphere
 // with the shared robust intersection and reports the hit at its view depth; the closest hit writes
 // sphere-compute's visibility word (depth << 32 | particle index) and sphere-compute's resolve shades it.
@@ -90,8 +92,9 @@ public:
                                "sphere-rt visibility buffer");
   }
 
-  void prepare(const SphereSettings&, shared::SphereFrame& frame) override {
+  void prepare(const SphereSettings& settings, shared::SphereFrame& frame) override {
     frame.framebuffer = framebuffer_.address();
+    pieceParticles_ = settings.rtPieceParticles; // build() settles the count the device allows
   }
 
   double build(const GpuParticles& particles, SphereTargets& targets) override {
@@ -100,15 +103,19 @@ public:
     const Programs& p = programs(particleLayoutInfo(particles.layout()).shaderId);
     blas_.clear();
     tlas_ = {};
-    // Parts with particles, by their index in the part table (the instance's custom index, 24 bits).
+    // Parts with particles, by their index in the part table.
     std::vector<uint32_t> parts;
+    uint64_t maxCount = 1;
     for (uint32_t k = 0; k < particles.parts().size(); ++k)
-      if (particles.parts()[k].count > 0) parts.push_back(k);
-    if (particles.parts().size() > (1u << 24) || parts.size() > limits.maxInstanceCount)
-      throw UnsupportedError("sphere-rt: " + std::to_string(parts.size()) +
-                             " parts are more instances than one top-level structure takes");
+      if (particles.parts()[k].count > 0) {
+        parts.push_back(k);
+        maxCount = std::max<uint64_t>(maxCount, particles.parts()[k].count);
+      }
+    if (particles.parts().size() > (1u << (24 - shared::kSphereRtPieceBits)))
+      throw UnsupportedError("sphere-rt: " + std::to_string(particles.parts().size()) +
+                             " parts are more than an instance's custom index tells apart");
 
-    // Sizes: one bottom-level structure per part, built with the same AABB geometry description.
+    // Sizes: one bottom-level structure per piece, built with the same AABB geometry description.
     VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
     geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
     geometry.geometry.aabbs = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR};
@@ -121,25 +128,61 @@ public:
     bottom.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
     bottom.geometryCount = 1;
     bottom.pGeometries = &geometry;
-    uint64_t scratchBytes = 0, maxCount = 1;
-    for (uint32_t k : parts) {
-      uint32_t count = uint32_t(particles.parts()[k].count);
-      if (count > limits.maxPrimitiveCount)
-        throw UnsupportedError("sphere-rt: a part of " + std::to_string(count) +
-                               " particles exceeds the device's largest bottom-level structure");
+    auto sizesFor = [&](uint32_t count) {
       VkAccelerationStructureBuildSizesInfoKHR sizes{
           VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
       gpu::vkGetAccelerationStructureBuildSizesKHR(
           context_.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &bottom, &count, &sizes);
-      blas_.emplace_back(context_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-                         sizes.accelerationStructureSize,
-                         "sphere-rt bottom level, part " + std::to_string(k));
-      scratchBytes = std::max(scratchBytes, sizes.buildScratchSize);
-      maxCount = std::max<uint64_t>(maxCount, count);
+      return sizes;
+    };
+    // Particles per piece: the whole largest part, or the forced count, halved while the scratch (plus
+    // its alignment) or the structure would not fit one buffer.
+    const uint64_t bufferLimit = std::min(context_.maxBufferSize(), context_.maxAllocationSize()) -
+                                 std::max<uint64_t>(limits.minAccelerationStructureScratchOffsetAlignment, 1);
+    uint64_t piece = pieceParticles_ > 0 ? std::min<uint64_t>(pieceParticles_, maxCount) : maxCount;
+    for (;;) {
+      if (piece > limits.maxPrimitiveCount) {
+        piece = (piece + 1) / 2;
+        continue;
+      }
+      VkAccelerationStructureBuildSizesInfoKHR sizes = sizesFor(uint32_t(piece));
+      if ((sizes.buildScratchSize <= bufferLimit && sizes.accelerationStructureSize <= bufferLimit) ||
+          piece == 1)
+        break;
+      piece = (piece + 1) / 2;
     }
+    pieceParticles_ = uint32_t(piece); // for the frames (SphereRtPush)
+    if ((maxCount + piece - 1) / piece > (1u << shared::kSphereRtPieceBits))
+      throw UnsupportedError("sphere-rt: a part of " + std::to_string(maxCount) +
+                             " particles needs more than " +
+                             std::to_string(1u << shared::kSphereRtPieceBits) +
+                             " bottom-level structures of " + std::to_string(piece) + " on this device");
+    struct Piece {
+      uint32_t part, index; // the part (in the part table) and the piece's number in it
+      uint64_t first;       // its first particle in the part
+      uint32_t count;
+    };
+    std::vector<Piece> pieces;
+    uint64_t scratchBytes = 0;
+    for (uint32_t k : parts) {
+      const uint64_t count = particles.parts()[k].count;
+      for (uint64_t first = 0, index = 0; first < count; first += piece, ++index) {
+        Piece next{k, uint32_t(index), first, uint32_t(std::min(piece, count - first))};
+        VkAccelerationStructureBuildSizesInfoKHR sizes = sizesFor(next.count);
+        blas_.emplace_back(
+            context_, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize,
+            "sphere-rt bottom level, part " + std::to_string(k) + " piece " + std::to_string(index));
+        scratchBytes = std::max(scratchBytes, sizes.buildScratchSize);
+        pieces.push_back(next);
+      }
+    }
+    if (pieces.size() > limits.maxInstanceCount)
+      throw UnsupportedError(
+          "sphere-rt: " + std::to_string(pieces.size()) +
+          " bottom-level structures are more instances than one top-level structure takes");
 
     // The instances, written by the host before the submission (which makes them visible to the build).
-    uint32_t instanceCount = uint32_t(parts.size());
+    uint32_t instanceCount = uint32_t(pieces.size());
     gpu::Buffer instances(context_,
                           std::max<uint64_t>(instanceCount, 1) * sizeof(VkAccelerationStructureInstanceKHR),
                           VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
@@ -150,7 +193,7 @@ public:
       instance[i] = {};
       instance[i].transform.matrix[0][0] = instance[i].transform.matrix[1][1] =
           instance[i].transform.matrix[2][2] = 1;
-      instance[i].instanceCustomIndex = parts[i];
+      instance[i].instanceCustomIndex = pieces[i].part << shared::kSphereRtPieceBits | pieces[i].index;
       instance[i].mask = 0xFF;
       instance[i].instanceShaderBindingTableRecordOffset = 0;
       instance[i].flags = VK_GEOMETRY_INSTANCE_FORCE_OPAQUE_BIT_KHR;
@@ -189,22 +232,26 @@ public:
     context_.submitAndWait([&](VkCommandBuffer cmd) {
       timer.reset(cmd);
       timer.begin(cmd, 0);
-      for (size_t i = 0; i < parts.size(); ++i) {
-        const ParticlePart& part = particles.parts()[parts[i]];
-        // The previous build has read the AABBs (write after read: an execution dependency suffices).
-        if (i > 0)
-          memoryBarrier(cmd, kBuildStage, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_NONE);
-        recordSphereAabbs(cmd, p.aabbs, targets.frameStaging.address(), part, aabbs.address());
+      for (size_t i = 0; i < pieces.size(); ++i) {
+        const Piece& built = pieces[i];
+        if (built.index == 0) {
+          // A new part's AABBs; the previous builds have read the old ones (write after read: an execution
+          // dependency suffices).
+          if (i > 0)
+            memoryBarrier(cmd, kBuildStage, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                          VK_ACCESS_2_NONE);
+          recordSphereAabbs(cmd, p.aabbs, targets.frameStaging.address(), particles.parts()[built.part],
+                            aabbs.address());
+        }
         // Build inputs are read as shader reads of the build stage; the scratch, reused, is written and
         // read as acceleration structure memory by the previous build and this one.
         memoryBarrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | kBuildStage,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
                       kBuildStage, VK_ACCESS_2_SHADER_READ_BIT | kStructureAccess);
-        geometry.geometry.aabbs.data.deviceAddress = aabbs.address();
+        geometry.geometry.aabbs.data.deviceAddress = aabbs.address() + built.first * kSphereAabbBytes;
         bottom.dstAccelerationStructure = blas_[i].handle();
         bottom.scratchData.deviceAddress = scratch.address();
-        VkAccelerationStructureBuildRangeInfoKHR range{uint32_t(part.count), 0, 0, 0};
+        VkAccelerationStructureBuildRangeInfoKHR range{built.count, 0, 0, 0};
         const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
         gpu::vkCmdBuildAccelerationStructuresKHR(cmd, 1, &bottom, &ranges);
       }
@@ -230,11 +277,13 @@ public:
     assert(tlas_.handle() && "build() comes before the frames");
     const Programs& p = programs(particleLayoutInfo(draw.particles.layout()).shaderId);
     // Every pixel's word is written by its ray (kEmptyPixel on a miss): no clear.
-    shared::SphereRtPush trace{targets.frame.address(), tlas_.address()};
+    shared::SphereRtPush trace{targets.frame.address(), tlas_.address(), pieceParticles_, 0};
     p.trace.traceRays(cmd, width_, height_, trace);
     gpu::fullBarrier(cmd);
     recordSphereResolve(cmd, p.resolve, targets.frame.address(), pixels_);
   }
+
+  void addCounters(SphereStats& stats) override { stats.rtBottomLevels = blas_.size(); }
 
   std::vector<float> depth() override { return readVisibilityDepth(context_, framebuffer_, pixels_); }
   std::vector<uint32_t> indices() override { return readVisibilityIndices(context_, framebuffer_, pixels_); }
@@ -257,8 +306,9 @@ private:
   uint32_t width_, height_;
   uint64_t pixels_;
   gpu::Buffer framebuffer_;
-  std::vector<gpu::AccelerationStructure> blas_;
+  std::vector<gpu::AccelerationStructure> blas_; // one per piece of a part, in instance order
   gpu::AccelerationStructure tlas_;
+  uint32_t pieceParticles_ = 0; // particles per piece (SphereRtPush)
   std::map<uint32_t, Programs> programs_;
 };
 
