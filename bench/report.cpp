@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -440,23 +441,26 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
         "upload, frames of the first method are rendered until their time settles, so that GPU clocks that "
         "fell to idle during the host's work are up again.\n";
   {
-    // Combinations the time budget shortened, grouped by method: "hw-points 12 (3-5 frames)".
-    std::map<std::string, std::pair<size_t, std::pair<uint32_t, uint32_t>>> shortened;
+    // Combinations the time budget shortened, grouped by method: "hw-points 12x (3-5 frames)".
+    struct Shortened {
+      size_t combinations = 0;
+      uint32_t fewest = UINT32_MAX, most = 0; // frames
+    };
+    std::map<std::string, Shortened> shortened;
     for (const Result& r : run.results)
       if (r.ok() && r.stats.frames < c.frames) {
-        auto [it, fresh] =
-            shortened.try_emplace(methodName(r.method), 0, std::pair{r.stats.frames, r.stats.frames});
-        ++it->second.first;
-        it->second.second.first = std::min(it->second.second.first, r.stats.frames);
-        it->second.second.second = std::max(it->second.second.second, r.stats.frames);
+        Shortened& s = shortened[methodName(r.method)];
+        ++s.combinations;
+        s.fewest = std::min(s.fewest, r.stats.frames);
+        s.most = std::max(s.most, r.stats.frames);
       }
     if (!shortened.empty()) {
       md << "- Time budget " << printf1("%g", c.secondsPerCombination)
          << " s per combination: slower combinations were timed over fewer frames after 1 warm-up frame "
             "(JSON `frames`):";
-      for (const auto& [name, v] : shortened)
-        md << " " << name << " " << v.first << "x (" << v.second.first
-           << (v.second.second != v.second.first ? "-" + std::to_string(v.second.second) : "") << " frames);";
+      for (const auto& [name, s] : shortened)
+        md << " " << name << " " << s.combinations << "x (" << s.fewest
+           << (s.most != s.fewest ? "-" + std::to_string(s.most) : "") << " frames);";
       md << "\n";
     }
   }

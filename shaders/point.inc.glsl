@@ -53,6 +53,11 @@ uint64_t withColor(uint64_t word, uint i) {
 #endif
 }
 
+// Point i's position, or 0 past the part's end (threads that draw several points load them all first).
+vec3 loadPositionOrZero(uint i) {
+  return i < pc.pointCount ? loadPosition(i) : vec3(0.0);
+}
+
 // withColor = false leaves the payload 0 and skips the color read (depth-only passes read 12 B a point).
 bool pointWord(uint i, bool color, out uint pixel, out uint64_t word) {
   if (!depthWordOf(loadPosition(i), pixel, word)) return false;

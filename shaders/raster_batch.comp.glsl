@@ -13,7 +13,6 @@
 layout(constant_id = 0) const uint PREFETCH = 0;
 layout(constant_id = 1) const uint DEPTH_ONLY = 0;
 
-
 // The low word: the visibility index of point `index` of the part, or 0 in a depth pass.
 uint payloadOf(uint index) {
   return DEPTH_ONLY != 0u ? 0u : (pc.part << kVisibilityPartShift) | index;
@@ -51,7 +50,7 @@ void main() {
     }
   } else if (v.words != 0u) {
     Uvec4Array high = Uvec4Array(pc.high), medium = Uvec4Array(pc.medium), low = Uvec4Array(pc.low);
-    // (Loading the next step's words before this step's points were drawn made batch-prefetch about 20 %
+    // (Loading the next step's words before this step's points were drawn made batch-prefetch 18 %
     // slower on the H200: bench/NOTES.md.)
     for (uint j = 0u; j < kBatchPrefetchSteps; ++j) {
       uint local = 4u * (gl_LocalInvocationIndex + j * kPointGroupSize);

@@ -40,7 +40,6 @@ void main() {
       uint pixel[4];
       float depth[4];
       [[unroll]] for (uint k = 0u; k < 4u; ++k) {
-        // (projectPoint leaves its out parameters undefined when it drops a point.)
         uint p, depthBits;
         pixel[k] = kNoPixel;
         depth[k] = 0.0;

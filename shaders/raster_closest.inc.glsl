@@ -124,10 +124,8 @@ void main() {
   // No early return anywhere: the subgroup operations in settle() need every lane of the subgroup.
   uint first = firstPointOfThread(POINTS_PER_THREAD);
   vec3 positions[POINTS_PER_THREAD];
-  for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
-    uint i = first + k * kPointGroupSize;
-    positions[k] = i < pc.pointCount ? loadPosition(i) : vec3(0.0);
-  }
+  for (uint k = 0; k < POINTS_PER_THREAD; ++k)
+    positions[k] = loadPositionOrZero(first + k * kPointGroupSize);
   for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
     uint i = first + k * kPointGroupSize;
     uint pixel = kNoPixel;

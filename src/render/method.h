@@ -48,6 +48,10 @@ public:
   virtual std::optional<BatchStats> readStats() { return std::nullopt; }
 };
 
+// Points per thread of the raster_closest and raster_hqs shaders (POINTS_PER_THREAD): a thread loads 4
+// positions before projecting any, four loads in flight instead of one (bench/NOTES.md has the measurements).
+constexpr uint32_t kPointsPerThread = 4;
+
 // Calls draw(push, grid) for every part of every scene, with `base` completed for that part: the matrix
 // relative to the scene's origin (float, and the double copy in targets.matrices), the part's addresses
 // and point count, and the workgroup grid. `base` brings the method's framebuffer/aux addresses.

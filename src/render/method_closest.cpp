@@ -8,10 +8,6 @@ namespace pointrast {
 
 namespace {
 
-// Points per thread of the raster_closest shaders: a thread loads 4 positions before projecting any,
-// four loads in flight instead of one (bench/NOTES.md has the measurements).
-constexpr uint32_t kPointsPerThread = 4;
-
 class ClosestMethod : public PointMethod {
 public:
   ClosestMethod(gpu::Context& context, Method method, DepthMode depth) : method_(method), depth_(depth) {

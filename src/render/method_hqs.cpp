@@ -8,9 +8,6 @@ namespace pointrast {
 
 namespace {
 
-// Points per thread of both passes, as the closest-point methods (method_closest.cpp).
-constexpr uint32_t kPointsPerThread = 4;
-
 class HqsMethod : public PointMethod {
 public:
   HqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)

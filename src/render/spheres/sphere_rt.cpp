@@ -94,7 +94,7 @@ public:
 
   void prepare(const SphereSettings& settings, shared::SphereFrame& frame) override {
     frame.framebuffer = framebuffer_.address();
-    pieceParticles_ = settings.rtPieceParticles; // build() settles the count the device allows
+    requestedPieceParticles_ = settings.rtPieceParticles;
   }
 
   double build(const GpuParticles& particles, SphereTargets& targets) override {
@@ -139,7 +139,8 @@ public:
     // its alignment) or the structure would not fit one buffer.
     const uint64_t bufferLimit = std::min(context_.maxBufferSize(), context_.maxAllocationSize()) -
                                  std::max<uint64_t>(limits.minAccelerationStructureScratchOffsetAlignment, 1);
-    uint64_t piece = pieceParticles_ > 0 ? std::min<uint64_t>(pieceParticles_, maxCount) : maxCount;
+    uint64_t piece =
+        requestedPieceParticles_ > 0 ? std::min<uint64_t>(requestedPieceParticles_, maxCount) : maxCount;
     for (;;) {
       if (piece > limits.maxPrimitiveCount) {
         piece = (piece + 1) / 2;
@@ -308,7 +309,8 @@ private:
   gpu::Buffer framebuffer_;
   std::vector<gpu::AccelerationStructure> blas_; // one per piece of a part, in instance order
   gpu::AccelerationStructure tlas_;
-  uint32_t pieceParticles_ = 0; // particles per piece (SphereRtPush)
+  uint32_t requestedPieceParticles_ = 0; // SphereSettings::rtPieceParticles of this frame's settings
+  uint32_t pieceParticles_ = 0;          // particles per piece of the structures built (SphereRtPush)
   std::map<uint32_t, Programs> programs_;
 };
 
