@@ -25,11 +25,29 @@ const uint kNoPixel = 0xFFFFFFFFu;
 // under 1e-5, so no test on the box drops a point that the per-point test would keep.
 const float kCullMargin = 1e-5;
 
+// How a batch's points reach the screen: the first word gives 1 + f/1024 per axis (f the 10-bit field,
+// exact in a float's mantissa), further words add theirs 2^-10 and 2^-20 lower; call that sum g. A point's
+// position is then an affine function of g, and so are the three homogeneous screen coordinates
+//   X = W/2 (c.x + c.w),  Y = H/2 (c.w - c.y),  Z = c.w,   pixel (X/Z, Y/Z)   (project.inc.glsl's contract),
+// so the workgroup folds the batch's origin, quantization step, view-projection and viewport into one
+// 3x4 map, and a point costs 9 fused multiply-adds and one reciprocal. Every batch pass projects through
+// it, so all of them put a point on the same pixel. A three-word (full precision) point is the exception:
+// its g would round away the last 6 of its 30 bits, so it is decoded to its position the way the 2021
+// methods' floats are and projected by project.inc.glsl, which puts it where they do (ties of equal depth
+// and pixel borders included: the full-precision tests compare winners pixel by pixel).
+//   ROUND_BY_ADD 0: pixel = float-to-int conversion of X/Z (a quarter-rate instruction on NVIDIA GPUs);
+//                1: the map yields X/Z - 1/2, and adding 2^23 rounds it to the nearest integer in the
+//                   mantissa: the same pixel except where X/Z is an odd integer exactly (then one to the
+//                   left), at the cost of one full-rate add.
+layout(constant_id = 8) const uint ROUND_BY_ADD = 0;
+
 // What a workgroup decided about its batch.
 struct BatchView {
-  uint words;   // coordinate words its points load: 1..3; 0 = culled
-  vec3 base;  // the centre of the batch's first cell, relative to the scene origin: min corner + centre steps
-  vec3 scale; // size / (2^30 - 1): units per quantization step
+  uint words;  // coordinate words its points load: 1..3; 0 = culled
+  bool inside; // every point of the box projects in front of the near plane and inside the image
+  vec3 cx, cy, cz; // screen map: X = cx.x g.x + cx.y g.y + cx.z g.z + offset.x; Y, Z likewise
+  vec3 offset;
+  vec3 lo, step; // the batch's min corner (relative to the scene origin) and 2^30 quantization steps
 };
 
 BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool culling) {
@@ -41,7 +59,10 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
   vec3 a = max(abs(lo), abs(hi));
   vec4 e = kCullMargin * (abs(m[0]) * a.x + abs(m[1]) * a.y + abs(m[2]) * a.z + abs(m[3]));
   // Outside a clip plane: all corners beyond it. A point is kept if near < w and -w <= x < w, -w < y <= w.
+  // Inside: all corners within every plane by the margin, so every point of the box is, whatever the
+  // rounding of its projection.
   bool left = true, right = true, below = true, above = true, behind = true, nearOrBehind = false;
+  bool inside = true;
   float wMin = 3.0e38;
   vec2 ndcMax = vec2(0.0);
   for (uint k = 0u; k < 8u; ++k) {
@@ -55,11 +76,13 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
     above = above && c.y - c.w > e.y + e.w;
     behind = behind && c.w + e.w < pc.nearW;
     nearOrBehind = nearOrBehind || c.w - e.w <= pc.nearW;
+    inside = inside && c.x + c.w > e.x + e.w && c.w - c.x > e.x + e.w && c.y + c.w > e.y + e.w &&
+             c.w - c.y > e.y + e.w;
     wMin = min(wMin, c.w - e.w);
     ndcMax = max(ndcMax, abs(c.xy) / c.w);
   }
   BatchView v;
-  v.scale = size * (1.0 / float(kBatchCoordinateMax));
+  vec3 scale = size * (1.0 / float(kBatchCoordinateMax)); // units per quantization step
   v.words = 3u;
   if (forcedWords != 0u) {
     v.words = forcedWords;
@@ -77,29 +100,100 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
     float pixels = perUnit * length(size) * 1.001; // 1.001: the 30-bit rounding (2^-31) and float slack
     v.words = pixels * (1.0 / 2048.0) < 0.5 ? 1u : pixels * (1.0 / 2097152.0) < 0.5 ? 2u : 3u;
   }
-  // The cell-centre rule of decodeBatchWords: half the range of the unknown low bits, in steps.
+  v.inside = inside && !nearOrBehind;
+  // The cell-centre rule of decodeBatchWords: half the range of the unknown low bits, in steps. A point
+  // sits at lo + (q + centre) scale, q its 30-bit coordinate, and q = 2^30 (g - k) with k = 1, 1 + 2^-10
+  // or 1 + 2^-10 + 2^-20 for 1, 2, 3 words: at (lo + centre scale - k step) + g step, step = 2^30 scale.
   float centre = v.words == 1u ? 524288.0 : v.words == 2u ? 512.0 : 0.0; // 2^19, 2^9, 0
-  v.base = lo + centre * v.scale;
+  float k = v.words == 1u ? 1.0 : v.words == 2u ? 1.0 + 1.0 / 1024.0 : 1.0 + 1.0 / 1024.0 + 1.0 / 1048576.0;
+  vec3 step = scale * 1073741824.0;
+  vec4 origin = vec4(lo + centre * scale - k * step, 1.0);
+  // Screen rows of the map; with ROUND_BY_ADD, X and Y lose Z/2 so that X/Z is the pixel's x - 1/2.
+  float halfPixel = ROUND_BY_ADD != 0u ? 0.5 : 0.0;
+  vec4 rowW = vec4(m[0].w, m[1].w, m[2].w, m[3].w);
+  vec4 rowX = 0.5 * float(width) * (vec4(m[0].x, m[1].x, m[2].x, m[3].x) + rowW) - halfPixel * rowW;
+  vec4 rowY = 0.5 * float(height) * (rowW - vec4(m[0].y, m[1].y, m[2].y, m[3].y)) - halfPixel * rowW;
+  v.cx = rowX.xyz * step;
+  v.cy = rowY.xyz * step;
+  v.cz = rowW.xyz * step;
+  v.offset = vec3(dot(rowX, origin), dot(rowY, origin), dot(rowW, origin));
+  v.lo = lo;
+  v.step = step;
   if (culling && (left || right || below || above || behind)) v.words = 0u;
   return v;
 }
 
-// The three 10-bit fields of a coordinate word (x in bits 0-9, y 10-19, z 20-29) as floats. Each field is
-// put into the mantissa of 2^23 and 2^23 subtracted, which is exact below 2^23: three integer ops and a
-// float add instead of int-to-float conversions, which run at a quarter of the float rate on NVIDIA GPUs
-// (16 per clock and multiprocessor on Hopper), and the 1G-point overview decodes 3 G fields a frame.
-vec3 tenBitFields(uint word) {
-  return uintBitsToFloat((uvec3(word, word >> 10, word >> 20) & 0x3FFu) | 0x4B000000u) - 8388608.0;
+// 1 + f/1024 for the three 10-bit fields f of a coordinate word (x in bits 0-9, y 10-19, z 20-29): each
+// field is moved to the top of a float's mantissa under the exponent of 1. Two integer ops a field and no
+// int-to-float conversion, which runs at a quarter of the float rate on NVIDIA GPUs.
+vec3 wordFields(uint word) {
+  return uintBitsToFloat((uvec3(word << 13, word << 3, word >> 7) & 0x7FE000u) | 0x3F800000u);
 }
 
-// A point from its first v.words words (the others are ignored), relative to the scene origin: the batch's
-// min corner plus the cell centre plus each word's fields in its own step (2^20, 2^10 and 1 quantization
-// steps), one fused multiply-add per word and axis.
-vec3 decodePoint(BatchView v, uint high, uint medium, uint low) {
-  vec3 p = v.base + tenBitFields(high) * (v.scale * 1048576.0);
-  if (v.words >= 2u) p += tenBitFields(medium) * (v.scale * 1024.0);
-  if (v.words >= 3u) p += tenBitFields(low) * v.scale;
-  return p;
+// g of a point from its first `words` words (the others are ignored); exact for one and two words, within
+// 2^-24 of the batch for three.
+vec3 pointFields(uint words, uint high, uint medium, uint low) {
+  vec3 g = wordFields(high);
+  if (words >= 2u) g = fma(wordFields(medium), vec3(1.0 / 1024.0), g);
+  if (words >= 3u) g = fma(wordFields(low), vec3(1.0 / 1048576.0), g);
+  return g;
+}
+
+// Homogeneous screen coordinates (X, Y, Z) of a point with fields g.
+vec3 screenOf(BatchView v, vec3 g) {
+  return vec3(fma(g.z, v.cx.z, fma(g.y, v.cx.y, fma(g.x, v.cx.x, v.offset.x))),
+              fma(g.z, v.cy.z, fma(g.y, v.cy.y, fma(g.x, v.cy.x, v.offset.y))),
+              fma(g.z, v.cz.z, fma(g.y, v.cz.y, fma(g.x, v.cz.x, v.offset.z))));
+}
+
+// The pixel column or row of X/Z (already less 1/2 with ROUND_BY_ADD), for a value known to lie in the image.
+uint pixelCoordinate(float s) {
+  return ROUND_BY_ADD != 0u ? floatBitsToUint(s + 8388608.0) - 0x4B000000u : uint(s);
+}
+
+// The pixel and depth bits of a point of an `inside` batch: no test can fail. The clamps only keep a
+// rounding surprise inside the framebuffer.
+void projectInside(vec3 s, uint width, uint height, out uint pixel, out uint depthBits) {
+  float r = 1.0 / s.z;
+  uint px = min(pixelCoordinate(s.x * r), width - 1u);
+  uint py = min(pixelCoordinate(s.y * r), height - 1u);
+  pixel = py * width + px;
+  depthBits = floatBitsToUint(s.z);
+}
+
+// The same with project.inc.glsl's tests: false for a point behind the near plane or outside the image.
+bool projectChecked(vec3 s, uint width, uint height, out uint pixel, out uint depthBits) {
+  pixel = kNoPixel; // out parameters are written on every path (see projectPoint)
+  depthBits = 0xFFFFFFFFu;
+  if (!(s.z > pc.nearW)) return false; // also drops NaN
+  float r = 1.0 / s.z;
+  float x = s.x * r, y = s.y * r;
+  float lo = ROUND_BY_ADD != 0u ? -0.5 : 0.0;
+  // Compare as floats before converting: a huge or NaN coordinate must not wrap into the image.
+  if (!(x >= lo && x < float(width) + lo && y >= lo && y < float(height) + lo)) return false;
+  projectInside(s, width, height, pixel, depthBits);
+  return true;
+}
+
+// The position of a point from all three words, relative to the scene origin: the min corner plus each
+// word's fields in its own step (2^20, 2^10 and 1 quantization steps; g - 1 and the steps are exact).
+vec3 fullPrecisionPosition(BatchView v, uint high, uint medium, uint low) {
+  vec3 p = v.lo + (wordFields(high) - 1.0) * v.step;
+  p += (wordFields(medium) - 1.0) * (v.step * (1.0 / 1024.0));
+  return p + (wordFields(low) - 1.0) * (v.step * (1.0 / 1048576.0));
+}
+
+// The pixel and depth bits of a point of batch v decoded from `words` words (a constant where the caller
+// can make it one). `checked`: with the near-plane and image tests (false only for an `inside` batch).
+bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint medium, uint low, uint width,
+                       uint height, out uint pixel, out uint depthBits) {
+  if (words == 3u)
+    return projectPoint(pc.viewProj, fullPrecisionPosition(v, high, medium, low), width, height, pc.nearW,
+                        pixel, depthBits);
+  vec3 s = screenOf(v, pointFields(words, high, medium, low));
+  if (checked) return projectChecked(s, width, height, pixel, depthBits);
+  projectInside(s, width, height, pixel, depthBits);
+  return true;
 }
 
 // Statistics (shared.h, kStat*): a thread counts in a register, the workgroup sums in shared memory, and

@@ -1,99 +1,126 @@
 #version 460
 // batch and batch-prefetch (see batch.inc.glsl): each point of a batch that is not culled is decoded,
-// projected, tested against the framebuffer (early-z) and, if closer, written with one 64-bit atomicMin of
-// depth << 32 | visibility index (part << 26 | index in the part). Colors are fetched by the resolve, for
-// visible points only.
+// projected, tested against the framebuffer (early-z) and, if not farther, written with one 64-bit
+// atomicMin of depth << 32 | visibility index (part << 26 | index in the part). Colors are fetched by the
+// resolve, for visible points only.
 //   PREFETCH   0: thread t draws points t + 128 j (j < 80), one 32-bit load per word
 //              1: thread t loads the words of points 4 (t + 128 j) .. + 3 (j < 20) with one 128-bit load
-//                 per word, four points in flight
+//                 per word
 //   DEPTH_ONLY 1: the word is depth << 32 alone (the depth pass of batch-hqs)
+//   GROUP      points a thread has in flight (a multiple of 4 with PREFETCH): their words are loaded
+//              together, then all are projected, then their pixels read, then the atomics done, so that
+//              neither the loads of the words nor those of the pixels wait for one another.
+//   MERGE      1: a thread's point that shares its pixel with the thread's previous point of the group
+//              takes the closer of the two and the previous one is dropped (fewer atomics when
+//              consecutive points share pixels, as in Morton order).
 #extension GL_EXT_control_flow_attributes : require
 #include "batch.inc.glsl"
 
 layout(constant_id = 0) const uint PREFETCH = 0;
 layout(constant_id = 1) const uint DEPTH_ONLY = 0;
+layout(constant_id = 2) const uint GROUP = 4;
+layout(constant_id = 3) const uint MERGE = 0;
 
-// The low word: the visibility index of point `index` of the part, or 0 in a depth pass.
-uint payloadOf(uint index) {
-  return DEPTH_ONLY != 0u ? 0u : (pc.part << kVisibilityPartShift) | index;
+// The framebuffer word's high half (the depth) of pixel p is word 2p + 1 of this view (little-endian).
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer DepthHalves { uint v[]; };
+
+// Index in the batch of point u (< GROUP) of a thread's step `step`.
+uint pointOfStep(uint step, uint u) {
+  if (PREFETCH == 0u) return gl_LocalInvocationIndex + (step * GROUP + u) * kPointGroupSize;
+  return 4u * (gl_LocalInvocationIndex + (step * (GROUP / 4u) + u / 4u) * kPointGroupSize) + (u & 3u);
 }
 
-// 1 if the point did the atomic, else 0.
-uint drawPoint(vec3 p, uint index, Uint64Array fb, uint width, uint height) {
-  uint pixel, depthBits;
-  if (!projectPoint(pc.viewProj, p, width, height, pc.nearW, pixel, depthBits)) return 0u;
-  uint64_t word = (uint64_t(depthBits) << 32) | uint64_t(payloadOf(index));
-  if (word >= fb.v[pixel]) return 0u; // early-z: cannot win
-  atomicMin(fb.v[pixel], word);
-  return 1u;
+// Draws the batch's points: `words` of them per point, `checked` = test each point against the batch's
+// point count, the near plane and the image (a batch that is not entirely inside, or a part's last batch).
+// Called with constant arguments, so each combination compiles to its own loop. Returns the atomics done.
+uint drawBatch(BatchView v, uint words, bool checked, uint first, uint count, uint width, uint height) {
+  uint64_t framebuffer = FrameRef(pc.frame).f.framebuffer;
+  Uint64Array fb = Uint64Array(framebuffer);
+  DepthHalves depths = DepthHalves(framebuffer);
+  UintArray high1 = UintArray(pc.high), medium1 = UintArray(pc.medium), low1 = UintArray(pc.low);
+  Uvec4Array high4 = Uvec4Array(pc.high), medium4 = Uvec4Array(pc.medium), low4 = Uvec4Array(pc.low);
+  uint rendered = 0u;
+  for (uint step = 0u; step < kBatchPointsPerThread / GROUP; ++step) {
+    uint h[GROUP], m[GROUP], l[GROUP];
+    if (PREFETCH == 0u) {
+      [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
+        uint local = pointOfStep(step, u);
+        h[u] = m[u] = l[u] = 0u;
+        if (checked && local >= count) continue;
+        h[u] = high1.v[first + local];
+        if (words >= 2u) m[u] = medium1.v[first + local];
+        if (words >= 3u) l[u] = low1.v[first + local];
+      }
+    } else {
+      [[unroll]] for (uint q = 0u; q < GROUP / 4u; ++q) {
+        uint local = pointOfStep(step, 4u * q);
+        // Word buffers are padded to a multiple of 4 points, and `first` is a multiple of 10240.
+        uvec4 hq = uvec4(0u), mq = uvec4(0u), lq = uvec4(0u);
+        if (!checked || local < count) {
+          uint g = (first + local) / 4u;
+          hq = high4.v[g];
+          if (words >= 2u) mq = medium4.v[g];
+          if (words >= 3u) lq = low4.v[g];
+        }
+        [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+          h[4u * q + k] = hq[k];
+          m[4u * q + k] = mq[k];
+          l[4u * q + k] = lq[k];
+        }
+      }
+    }
+    uint pixel[GROUP], depth[GROUP], payload[GROUP];
+    [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
+      uint local = pointOfStep(step, u);
+      payload[u] = DEPTH_ONLY != 0u ? 0u : (pc.part << kVisibilityPartShift) | (first + local);
+      if ((checked && local >= count) ||
+          !projectBatchPoint(v, words, checked, h[u], m[u], l[u], width, height, pixel[u], depth[u])) {
+        pixel[u] = kNoPixel;
+        depth[u] = 0xFFFFFFFFu; // above any seen value: no atomic
+      }
+      if (MERGE != 0u && u > 0u && pixel[u] == pixel[u - 1u] && pixel[u] != kNoPixel) {
+        // Keep the smaller word: the closer point, or on equal depth the lower index (u - 1).
+        if (depth[u - 1u] <= depth[u]) {
+          depth[u] = depth[u - 1u];
+          payload[u] = payload[u - 1u];
+        }
+        pixel[u - 1u] = kNoPixel;
+        depth[u - 1u] = 0xFFFFFFFFu;
+      }
+    }
+    uint seen[GROUP];
+    [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
+      bool live = checked || MERGE != 0u ? pixel[u] != kNoPixel : true; // else every point is in the image
+      seen[u] = live ? depths.v[2u * pixel[u] + 1u] : 0u;
+    }
+    [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
+      // Early-z on the depth half: a point not farther than the pixel's closest may still win (equal
+      // depths are decided by the index in the atomic). Dropped points have seen = 0 < depth.
+      if (depth[u] <= seen[u]) {
+        atomicMin(fb.v[pixel[u]], (uint64_t(depth[u]) << 32) | uint64_t(payload[u]));
+        ++rendered;
+      }
+    }
+  }
+  return rendered;
 }
 
 void main() {
   beginStats();
   FrameRef frame = FrameRef(pc.frame);
   uint width = frame.f.width, height = frame.f.height;
-  Uint64Array fb = Uint64Array(frame.f.framebuffer);
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
   BatchView v = viewBatch(gl_WorkGroupID.x, width, height, frame.f.forcedWords, frame.f.culling != 0u);
   uint rendered = 0u;
-  if (v.words != 0u && PREFETCH == 0u) {
-    UintArray high = UintArray(pc.high), medium = UintArray(pc.medium), low = UintArray(pc.low);
-    for (uint j = 0u; j < kBatchPointsPerThread; ++j) {
-      uint local = gl_LocalInvocationIndex + j * kPointGroupSize;
-      if (local >= count) break;
-      uint i = first + local;
-      uint h = high.v[i], m = 0u, l = 0u;
-      if (v.words >= 2u) m = medium.v[i];
-      if (v.words >= 3u) l = low.v[i];
-      rendered += drawPoint(decodePoint(v, h, m, l), i, fb, width, height);
-    }
-  } else if (v.words != 0u) {
-    Uvec4Array high = Uvec4Array(pc.high), medium = Uvec4Array(pc.medium), low = Uvec4Array(pc.low);
-    // (Loading the next step's words before this step's points were drawn made batch-prefetch 18 %
-    // slower on the H200: bench/NOTES.md.)
-    for (uint j = 0u; j < kBatchPrefetchSteps; ++j) {
-      uint local = 4u * (gl_LocalInvocationIndex + j * kPointGroupSize);
-      if (local >= count) break;
-      uint g = (first + local) / 4u; // first is a multiple of 10240; word buffers are padded to 4 points
-      uvec4 h = high.v[g], m = uvec4(0u), l = uvec4(0u);
-      if (v.words >= 2u) m = medium.v[g];
-      if (v.words >= 3u) l = low.v[g];
-      // Project the four points, read their pixels, then do the atomics: the reads are independent and go out
-      // together.
-      uint pixel[4];
-      uint64_t word[4], seen[4];
-      [[unroll]] for (uint k = 0u; k < 4u; ++k) {
-        uint p, depthBits;
-        pixel[k] = kNoPixel;
-        word[k] = kEmptyPixel;
-        if (local + k < count && projectPoint(pc.viewProj, decodePoint(v, h[k], m[k], l[k]), width, height,
-                                              pc.nearW, p, depthBits)) {
-          pixel[k] = p;
-          word[k] = (uint64_t(depthBits) << 32) | uint64_t(payloadOf(first + local + k));
-        }
-      }
-      // Consecutive points often share a pixel: the closest of the four on a pixel stands for the others, so
-      // reading all four pixels before writing adds no atomics for points that share one.
-      [[unroll]] for (uint k = 1u; k < 4u; ++k) {
-        [[unroll]] for (uint e = 0u; e < k; ++e) {
-          if (pixel[k] != kNoPixel && pixel[k] == pixel[e]) {
-            word[e] = min(word[e], word[k]);
-            pixel[k] = kNoPixel;
-          }
-        }
-      }
-      [[unroll]] for (uint k = 0u; k < 4u; ++k) {
-        seen[k] = 0ul;
-        if (pixel[k] != kNoPixel) seen[k] = fb.v[pixel[k]];
-      }
-      [[unroll]] for (uint k = 0u; k < 4u; ++k) {
-        if (word[k] < seen[k]) { // early-z; seen is 0 for dropped points
-          atomicMin(fb.v[pixel[k]], word[k]);
-          ++rendered;
-        }
-      }
-    }
+  if (v.inside && count == kBatchPoints) {
+    if (v.words == 1u) rendered = drawBatch(v, 1u, false, first, count, width, height);
+    else if (v.words == 2u) rendered = drawBatch(v, 2u, false, first, count, width, height);
+    else if (v.words == 3u) rendered = drawBatch(v, 3u, false, first, count, width, height);
+  } else {
+    if (v.words == 1u) rendered = drawBatch(v, 1u, true, first, count, width, height);
+    else if (v.words == 2u) rendered = drawBatch(v, 2u, true, first, count, width, height);
+    else if (v.words == 3u) rendered = drawBatch(v, 3u, true, first, count, width, height);
   }
   endStats(frame.f.stats, kStatPointsRendered, rendered, true, v.words, count);
 }

@@ -43,8 +43,8 @@ void main() {
         uint p, depthBits;
         pixel[k] = kNoPixel;
         depth[k] = 0.0;
-        if (local + k < count && projectPoint(pc.viewProj, decodePoint(v, h[k], m[k], l[k]), width, height,
-                                              pc.nearW, p, depthBits)) {
+        if (local + k < count &&
+            projectBatchPoint(v, v.words, true, h[k], m[k], l[k], width, height, p, depthBits)) {
           pixel[k] = p;
           depth[k] = uintBitsToFloat(depthBits);
         }

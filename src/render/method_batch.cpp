@@ -41,9 +41,14 @@ class BatchMethod : public PointMethod {
 public:
   BatchMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
       : context_(context), hqs_(method == Method::BatchHqs) {
-    uint32_t prefetch = method != Method::Batch; // batch-hqs draws its depth pass with prefetch
+    // batch: 32-bit loads, 4 points in flight; batch-prefetch (and batch-hqs's depth pass): one 128-bit
+    // load of 4 consecutive points, which often share a pixel, so a point merges with the previous one.
+    uint32_t prefetch = method != Method::Batch;
     raster_ = gpu::ComputeProgram(context, "raster_batch.comp",
-                                  {{/* PREFETCH= */ 0, prefetch}, {/* DEPTH_ONLY= */ 1, uint32_t(hqs_)}});
+                                  {{/* PREFETCH= */ 0, prefetch},
+                                   {/* DEPTH_ONLY= */ 1, uint32_t(hqs_)},
+                                   {/* GROUP= */ 2, 4},
+                                   {/* MERGE= */ 3, prefetch}});
     if (hqs_) {
       accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp");
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
