@@ -3,7 +3,8 @@
 # validation layer, the CLI tests, and the checks and benchmarks named by the arguments. Results go to
 # $OUT (default ./gpu-out). Suites: SUITE_LIMIT (bench --time-limit: wall seconds after which no further
 # combination starts; the process is killed 90 s later if it still runs), SUITE_FRAMES,
-# SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS.
+# SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS;
+# BIG4G_METHOD (default batch).
 #   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -91,16 +92,23 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite spheres2023 --scale "${SUITE_SCALE:-1}" \
       --budget "${SUITE_BUDGET:-2}" ${SUITE_ARGS:-} --out "$OUT" --name spheres2023 --json > "$OUT/spheres2023.jsonl" || status=1
     ;;
+  batch1g)
+    # The batch methods against dedup on the 1,000 M terrain overview of paper2022 (Morton, 2560x1140), in
+    # one process so that their ratios are sound; SUITE_METHODS picks the methods.
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench terrain --points 1G --orders morton --views overview \
+      --width 2560 --height 1140 --methods "${SUITE_METHODS:-batch,batch-prefetch,dedup}" --frames "${SUITE_FRAMES:-30}" \
+      --time-limit "${SUITE_LIMIT:-470}" --out "$OUT" --name batch1g --json > "$OUT/batch1g.jsonl" || status=1
+    ;;
   big4g)
     # 4 billion generated points (the 2022 target: >= 60 fps on an H200), batched layout, in the terrain's
     # flight-strip scan order: a Morton reorder of 4 G points needs a second copy of the positions (48 GB)
     # beside the cloud (64 GB) and its permutation, more than the 128 GB such a machine has.
-    echo "== 4 G points, batch-prefetch"
-    POINTRAST_VALIDATION=0 $pr render terrain --points 4G --method batch-prefetch --width 2560 \
+    echo "== 4 G points, ${BIG4G_METHOD:-batch}"
+    POINTRAST_VALIDATION=0 $pr render terrain --points 4G --method "${BIG4G_METHOD:-batch}" --width 2560 \
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
