@@ -35,11 +35,10 @@ const float kCullMargin = 1e-5;
 // its g would round away the last 6 of its 30 bits, so it is decoded to its position the way the 2021
 // methods' floats are and projected by project.inc.glsl, which puts it where they do (ties of equal depth
 // and pixel borders included: the full-precision tests compare winners pixel by pixel).
-//   ROUND_BY_ADD 0: pixel = float-to-int conversion of X/Z (a quarter-rate instruction on NVIDIA GPUs);
-//                1: the map yields X/Z - 1/2, and adding 1.5 x 2^23 rounds it to the nearest integer in
-//                   the mantissa: the same pixel except where X/Z is an odd integer exactly (then one to the
-//                   left), at the cost of one full-rate add.
-layout(constant_id = 8) const uint ROUND_BY_ADD = 1; // 1.5 % faster on the H200 (bench/NOTES.md)
+// The map yields X/Z - 1/2, and adding 1.5 x 2^23 rounds that to the nearest integer in the mantissa:
+// floor(X/Z) except where X/Z is an odd integer exactly (then one less), one full-rate add where a
+// float-to-int conversion is a quarter-rate instruction on NVIDIA GPUs (1.5 % faster on the H200:
+// bench/NOTES.md, session 4).
 
 // What a workgroup decided about its batch.
 struct BatchView {
@@ -108,11 +107,10 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
   float k = v.words == 1u ? 1.0 : v.words == 2u ? 1.0 + 1.0 / 1024.0 : 1.0 + 1.0 / 1024.0 + 1.0 / 1048576.0;
   vec3 step = scale * 1073741824.0;
   vec4 origin = vec4(lo + centre * scale - k * step, 1.0);
-  // Screen rows of the map; with ROUND_BY_ADD, X and Y lose Z/2 so that X/Z is the pixel's x - 1/2.
-  float halfPixel = ROUND_BY_ADD != 0u ? 0.5 : 0.0;
+  // Screen rows of the map; X and Y lose Z/2 so that X/Z is the pixel's x - 1/2.
   vec4 rowW = vec4(m[0].w, m[1].w, m[2].w, m[3].w);
-  vec4 rowX = 0.5 * float(width) * (vec4(m[0].x, m[1].x, m[2].x, m[3].x) + rowW) - halfPixel * rowW;
-  vec4 rowY = 0.5 * float(height) * (rowW - vec4(m[0].y, m[1].y, m[2].y, m[3].y)) - halfPixel * rowW;
+  vec4 rowX = 0.5 * float(width) * (vec4(m[0].x, m[1].x, m[2].x, m[3].x) + rowW) - 0.5 * rowW;
+  vec4 rowY = 0.5 * float(height) * (rowW - vec4(m[0].y, m[1].y, m[2].y, m[3].y)) - 0.5 * rowW;
   v.cx = rowX.xyz * step;
   v.cy = rowY.xyz * step;
   v.cz = rowW.xyz * step;
@@ -146,11 +144,11 @@ vec3 screenOf(BatchView v, vec3 g) {
               fma(g.z, v.cz.z, fma(g.y, v.cz.y, fma(g.x, v.cz.x, v.offset.z))));
 }
 
-// The pixel column or row of X/Z (already less 1/2 with ROUND_BY_ADD), for a value known to lie in the image.
+// The pixel column or row of X/Z - 1/2, for a value known to lie in the image: 1.5 x 2^23 keeps the sum in
+// [2^23, 2^24), where floats are the integers, for any s in (-2^22, 2^22) (2^23 alone would put s in
+// (-1/2, 0) below 2^23, where the step is 1/2).
 uint pixelCoordinate(float s) {
-  // 1.5 x 2^23: the sum stays in [2^23, 2^24), where floats are the integers, for any s in (-2^22, 2^22);
-  // (2^23 alone would put s in (-1/2, 0) below 2^23, where the step is 1/2.)
-  return ROUND_BY_ADD != 0u ? floatBitsToUint(s + 12582912.0) - 0x4B400000u : uint(s);
+  return floatBitsToUint(s + 12582912.0) - 0x4B400000u;
 }
 
 // The pixel and depth bits of a point of an `inside` batch: no test can fail. The clamp only keeps a
@@ -168,9 +166,9 @@ bool projectChecked(vec3 s, uint width, uint height, out uint pixel, out uint de
   if (!(s.z > pc.nearW)) return false; // also drops NaN
   float r = 1.0 / s.z;
   float x = s.x * r, y = s.y * r;
-  float lo = ROUND_BY_ADD != 0u ? -0.5 : 0.0;
-  // Compare as floats before converting: a huge or NaN coordinate must not wrap into the image.
-  if (!(x >= lo && x < float(width) + lo && y >= lo && y < float(height) + lo)) return false;
+  // Compare as floats before rounding (x, y are the pixel's coordinates less 1/2): a huge or NaN
+  // coordinate must not wrap into the image.
+  if (!(x >= -0.5 && x < float(width) - 0.5 && y >= -0.5 && y < float(height) - 0.5)) return false;
   projectInside(s, width, height, pixel, depthBits);
   return true;
 }
@@ -194,6 +192,14 @@ bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint me
   if (checked) return projectChecked(s, width, height, pixel, depthBits);
   projectInside(s, width, height, pixel, depthBits);
   return true;
+}
+
+// The words of points 4g .. 4g + 3 of the part (uvec4 g of each word buffer), the first `words` of them;
+// zeros for the others.
+void loadQuad(uint g, uint words, out uvec4 high, out uvec4 medium, out uvec4 low) {
+  high = Uvec4Array(pc.high).v[g];
+  medium = words >= 2u ? Uvec4Array(pc.medium).v[g] : uvec4(0u);
+  low = words >= 3u ? Uvec4Array(pc.low).v[g] : uvec4(0u);
 }
 
 // Statistics (shared.h, kStat*): a thread counts in a register, the workgroup sums in shared memory, and

@@ -7,19 +7,18 @@
 //              1: thread t loads the words of points 4 (t + 128 j) .. + 3 (j < 20) with one 128-bit load
 //                 per word
 //   DEPTH_ONLY 1: the word is depth << 32 alone (the depth pass of batch-hqs)
-//   GROUP      points a thread has in flight (a multiple of 4 with PREFETCH): their words are loaded
-//              together, then all are projected, then their pixels read, then the atomics done, so that
-//              neither the loads of the words nor those of the pixels wait for one another.
-//   MERGE      1: a thread's point that shares its pixel with the thread's previous point of the group
-//              takes the closer of the two and the previous one is dropped (fewer atomics when
-//              consecutive points share pixels, as in Morton order).
+//   Either way a thread has 4 points in flight: their words are loaded together, then all 4 projected,
+//   then their pixels read, then the atomics done, so that neither the loads of the words nor those of the
+//   pixels wait for one another. A point on the same pixel as the thread's previous point of the four takes
+//   the closer of the two words and the previous one is dropped before its read (fewer atomics where
+//   consecutive points share pixels, as in Morton order). The variants timed before choosing this shape
+//   are in bench/NOTES.md (session 4).
 #extension GL_EXT_control_flow_attributes : require
 #include "batch.inc.glsl"
 
 layout(constant_id = 0) const uint PREFETCH = 0;
 layout(constant_id = 1) const uint DEPTH_ONLY = 0;
-layout(constant_id = 2) const uint GROUP = 4;
-layout(constant_id = 3) const uint MERGE = 0;
+const uint GROUP = 4u; // points in flight per thread
 
 // The framebuffer word's high half (the depth) of pixel p is word 2p + 1 of this view (little-endian).
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer DepthHalves { uint v[]; };
@@ -27,7 +26,7 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Dep
 // Index in the batch of point u (< GROUP) of a thread's step `step`.
 uint pointOfStep(uint step, uint u) {
   if (PREFETCH == 0u) return gl_LocalInvocationIndex + (step * GROUP + u) * kPointGroupSize;
-  return 4u * (gl_LocalInvocationIndex + (step * (GROUP / 4u) + u / 4u) * kPointGroupSize) + (u & 3u);
+  return 4u * (gl_LocalInvocationIndex + step * kPointGroupSize) + u;
 }
 
 // Draws the batch's points: `words` of them per point, `checked` = test each point against the batch's
@@ -37,8 +36,7 @@ uint drawBatch(BatchView v, uint words, bool checked, uint first, uint count, ui
   uint64_t framebuffer = FrameRef(pc.frame).f.framebuffer;
   Uint64Array fb = Uint64Array(framebuffer);
   DepthHalves depths = DepthHalves(framebuffer);
-  UintArray high1 = UintArray(pc.high), medium1 = UintArray(pc.medium), low1 = UintArray(pc.low);
-  Uvec4Array high4 = Uvec4Array(pc.high), medium4 = Uvec4Array(pc.medium), low4 = Uvec4Array(pc.low);
+  UintArray high = UintArray(pc.high), medium = UintArray(pc.medium), low = UintArray(pc.low);
   uint rendered = 0u;
   for (uint step = 0u; step < kBatchPointsPerThread / GROUP; ++step) {
     uint h[GROUP], m[GROUP], l[GROUP];
@@ -47,26 +45,19 @@ uint drawBatch(BatchView v, uint words, bool checked, uint first, uint count, ui
         uint local = pointOfStep(step, u);
         h[u] = m[u] = l[u] = 0u;
         if (checked && local >= count) continue;
-        h[u] = high1.v[first + local];
-        if (words >= 2u) m[u] = medium1.v[first + local];
-        if (words >= 3u) l[u] = low1.v[first + local];
+        h[u] = high.v[first + local];
+        if (words >= 2u) m[u] = medium.v[first + local];
+        if (words >= 3u) l[u] = low.v[first + local];
       }
     } else {
-      [[unroll]] for (uint q = 0u; q < GROUP / 4u; ++q) {
-        uint local = pointOfStep(step, 4u * q);
-        // Word buffers are padded to a multiple of 4 points, and `first` is a multiple of 10240.
-        uvec4 hq = uvec4(0u), mq = uvec4(0u), lq = uvec4(0u);
-        if (!checked || local < count) {
-          uint g = (first + local) / 4u;
-          hq = high4.v[g];
-          if (words >= 2u) mq = medium4.v[g];
-          if (words >= 3u) lq = low4.v[g];
-        }
-        [[unroll]] for (uint k = 0u; k < 4u; ++k) {
-          h[4u * q + k] = hq[k];
-          m[4u * q + k] = mq[k];
-          l[4u * q + k] = lq[k];
-        }
+      uint local = pointOfStep(step, 0u);
+      // Word buffers are padded to a multiple of 4 points, and `first` is a multiple of 10240.
+      uvec4 hq = uvec4(0u), mq = uvec4(0u), lq = uvec4(0u);
+      if (!checked || local < count) loadQuad((first + local) / 4u, words, hq, mq, lq);
+      [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
+        h[u] = hq[u];
+        m[u] = mq[u];
+        l[u] = lq[u];
       }
     }
     uint pixel[GROUP], depth[GROUP], payload[GROUP];
@@ -78,7 +69,7 @@ uint drawBatch(BatchView v, uint words, bool checked, uint first, uint count, ui
         pixel[u] = kNoPixel;
         depth[u] = 0xFFFFFFFFu; // above any seen value: no atomic
       }
-      if (MERGE != 0u && u > 0u && pixel[u] == pixel[u - 1u] && pixel[u] != kNoPixel) {
+      if (u > 0u && pixel[u] == pixel[u - 1u] && pixel[u] != kNoPixel) {
         // Keep the smaller word: the closer point, or on equal depth the lower index (u - 1).
         if (depth[u - 1u] <= depth[u]) {
           depth[u] = depth[u - 1u];
@@ -89,10 +80,8 @@ uint drawBatch(BatchView v, uint words, bool checked, uint first, uint count, ui
       }
     }
     uint seen[GROUP];
-    [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
-      bool live = checked || MERGE != 0u ? pixel[u] != kNoPixel : true; // else every point is in the image
-      seen[u] = live ? depths.v[2u * pixel[u] + 1u] : 0u;
-    }
+    [[unroll]] for (uint u = 0u; u < GROUP; ++u)
+      seen[u] = pixel[u] != kNoPixel ? depths.v[2u * pixel[u] + 1u] : 0u;
     [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
       // Early-z on the depth half: a point not farther than the pixel's closest may still win (equal
       // depths are decided by the index in the atomic). Dropped points have seen = 0 < depth.

@@ -25,16 +25,10 @@ void main() {
   uint blended = 0u;
   // No early exit from the loops: hqsBlend's subgroup operations need every lane (v is uniform).
   if (v.words != 0u) {
-    Uvec4Array high = Uvec4Array(pc.high), medium = Uvec4Array(pc.medium), low = Uvec4Array(pc.low);
     for (uint j = 0u; j < kBatchPrefetchSteps; ++j) {
       uint local = 4u * (gl_LocalInvocationIndex + j * kPointGroupSize);
       uvec4 h = uvec4(0u), m = uvec4(0u), l = uvec4(0u);
-      if (local < count) {
-        uint g = (first + local) / 4u;
-        h = high.v[g];
-        if (v.words >= 2u) m = medium.v[g];
-        if (v.words >= 3u) l = low.v[g];
-      }
+      if (local < count) loadQuad((first + local) / 4u, v.words, h, m, l);
       // Four points in flight: project all, then their pixels' closest depths and the colors of those that
       // blend are read together, then they blend.
       uint pixel[4];

@@ -42,14 +42,10 @@ public:
   BatchMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
       : context_(context), hqs_(method == Method::BatchHqs) {
     // batch: 32-bit loads; batch-prefetch (and batch-hqs's depth pass): one 128-bit load of 4
-    // consecutive points. Both: 4 points in flight per thread, a point merging with the thread's previous
-    // one on the same pixel (the fastest of the variants timed on the H200: bench/NOTES.md, session 4).
+    // consecutive points.
     uint32_t prefetch = method != Method::Batch;
     raster_ = gpu::ComputeProgram(context, "raster_batch.comp",
-                                  {{/* PREFETCH= */ 0, prefetch},
-                                   {/* DEPTH_ONLY= */ 1, uint32_t(hqs_)},
-                                   {/* GROUP= */ 2, 4},
-                                   {/* MERGE= */ 3, 1}});
+                                  {{/* PREFETCH= */ 0, prefetch}, {/* DEPTH_ONLY= */ 1, uint32_t(hqs_)}});
     if (hqs_) {
       accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp");
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
