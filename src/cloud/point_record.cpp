@@ -12,6 +12,7 @@ void appendRecords(PointCloud& cloud, const PointRecord* records, size_t count, 
   if (fields.intensity) cloud.intensity.resize(first + count);
   if (fields.classification) cloud.classification.resize(first + count);
   if (fields.returnNumber) cloud.returnNumber.resize(first + count);
+  if (fields.pointSourceId) cloud.pointSourceId.resize(first + count);
   for (size_t i = 0; i < count; ++i) {
     const PointRecord& r = records[i];
     int32_t* p = &cloud.positions[3 * (first + i)];
@@ -24,6 +25,7 @@ void appendRecords(PointCloud& cloud, const PointRecord* records, size_t count, 
     if (fields.intensity) cloud.intensity[first + i] = r.intensity;
     if (fields.classification) cloud.classification[first + i] = r.classification;
     if (fields.returnNumber) cloud.returnNumber[first + i] = r.returnNumber;
+    if (fields.pointSourceId) cloud.pointSourceId[first + i] = r.pointSourceId;
   }
 }
 

@@ -53,6 +53,7 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
   const bool intensity = cloud.intensity.size() == n && n > 0;
   const bool classification = cloud.classification.size() == n && n > 0;
   const bool returns = cloud.returnNumber.size() == n && n > 0;
+  const bool sourceIds = cloud.pointSourceId.size() == n && n > 0;
   const bool extended = las::isExtended(f.pointFormat);
   const int rgbOffset = las::kRgbOffset[static_cast<size_t>(f.pointFormat)];
 
@@ -130,10 +131,12 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
         rn &= 0x0F;
         r[14] = static_cast<uint8_t>(rn | (rn << 4)); // return number bits 0-3, number of returns 4-7
         r[16] = cls;
+        storeLE<uint16_t>(r + 20, sourceIds ? cloud.pointSourceId[i] : 0);
       } else {
         rn &= 0x07;
         r[14] = static_cast<uint8_t>(rn | (rn << 3)); // return number bits 0-2, number of returns 3-5
         r[15] = cls & 0x1F;                           // classes above 31 do not fit formats 0-5
+        storeLE<uint16_t>(r + 18, sourceIds ? cloud.pointSourceId[i] : 0);
       }
       if (color) {
         // 16-bit channels: v * 257 (= v << 8 | v) maps 0..255 onto the full 0..65535 range.
