@@ -79,8 +79,8 @@ struct ResolvePush {
 // every method's resolve writes (ResolvePush::words).
 //   splat   points larger than one pixel: each pixel takes the smallest word among the pixels whose
 //           point's square or disc covers it (the same image as rasterizing the shapes with atomicMin)
-//   dilate  depth-aware hole filling: a pixel that is empty, or farther than closer points on two
-//           opposite sides of it, takes the closest of them
+//   dilate  depth-aware hole filling: a pixel that is empty, or farther than the closer points of its
+//           window, takes the closest of them when it lies within their convex hull
 //   compose eye-dome lighting (optional), background, RGBA8 image and the final words
 // ------------------------------------------------------------------------------------------------------
 
