@@ -3,8 +3,8 @@
 // more than 1 % behind closer points of its window, is a hole when it lies within the convex hull of
 // those closer points (no open half-plane through the pixel holds them all); it then takes the closest of
 // them. A hole takes a nearer point only, so a far point never covers a near one; the pixels outside a
-// convex silhouette can be separated from it by a line, so objects do not grow; what fills is a gap
-// between points, at most 2r pixels wide.
+// convex silhouette can be separated from it by a line, so objects do not grow; a gap fills where it is at
+// most r pixels wide.
 #include "post.inc.glsl"
 
 int cross2(ivec2 a, ivec2 b) {
