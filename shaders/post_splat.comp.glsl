@@ -10,10 +10,13 @@
 // image draws nothing.
 //   SHAPE       kPointShapeSquare or kPointShapeDisc (shared.h gives the pixels of each)
 //   ATTENUATED  0: every point has size pc.pointSize; 1: pc.pointSize / depth, clamped to [1, max]
+//   AXIS        0: the whole window; fixed squares, whose window is a product of two ranges, are cut into
+//               a pass along rows (1) and one along columns (2): 2n words read a pixel instead of n^2
 #include "post.inc.glsl"
 
 layout(constant_id = 0) const uint SHAPE = kPointShapeSquare;
 layout(constant_id = 1) const uint ATTENUATED = 0;
+layout(constant_id = 2) const uint AXIS = 0;
 
 float sizeOf(uint64_t word) {
   if (ATTENUATED == 0u) return pc.pointSize;
@@ -31,9 +34,24 @@ bool covers(float s, ivec2 d) {
   return d.x >= lo && d.x <= hi && d.y >= lo && d.y <= hi;
 }
 
+// The smallest word over the pixels p - d, d = (k, 0) (AXIS 1) or (0, k) (AXIS 2), k in a square's range.
+uint64_t axisMinimum(ivec2 p) {
+  int n = int(pc.pointSize + 0.5);
+  uint64_t best = kEmptyPixel;
+  for (int k = -((n - 1) >> 1); k <= n >> 1; ++k) {
+    ivec2 u = p - (AXIS == 1u ? ivec2(k, 0) : ivec2(0, k));
+    if (insideImage(u)) best = min(best, sourceWord(u));
+  }
+  return best;
+}
+
 void main() {
   ivec2 p;
   if (!postPixel(p)) return;
+  if (AXIS != 0u) {
+    Words(pc.target).v[uint(p.y) * pc.targetPitch + uint(p.x)] = axisMinimum(p);
+    return;
+  }
   int r = int(pc.radius);
   uint64_t best = kEmptyPixel;
   for (int dy = -r; dy <= r; ++dy) {

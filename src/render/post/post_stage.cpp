@@ -82,6 +82,17 @@ gpu::Buffer& PostStage::scratch(int index, uint64_t pixels) {
   return b;
 }
 
+const gpu::ComputeProgram& PostStage::splat(bool disc, bool attenuated, uint32_t axis) {
+  gpu::ComputeProgram& program = splat_[disc][attenuated][axis];
+  if (program.name().empty())
+    program =
+        gpu::ComputeProgram(context_, "post_splat.comp",
+                            {{/* SHAPE= */ 0, disc ? shared::kPointShapeDisc : shared::kPointShapeSquare},
+                             {/* ATTENUATED= */ 1, uint32_t(attenuated)},
+                             {/* AXIS= */ 2, axis}});
+  return program;
+}
+
 void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSettings& settings,
                        gpu::TimestampPool* timestamps, uint32_t firstSpan) {
   const uint64_t pixels = uint64_t(view.width) * view.height;
@@ -90,45 +101,49 @@ void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSett
   push.height = view.height;
   push.source = view.words;
   push.sourcePitch = view.pitch;
-  int next = 0; // scratch buffer the next filter writes
-  // Runs one filter pass from the current source into a scratch buffer, which becomes the source.
-  auto filter = [&](const gpu::ComputeProgram& program, uint32_t span, bool run) {
+  int next = 0; // scratch buffer the next filter pass writes
+  // One filter pass from the current source into a scratch buffer, which becomes the source.
+  auto pass = [&](const gpu::ComputeProgram& program) {
+    gpu::Buffer& target = scratch(next, pixels);
+    push.target = target.address();
+    push.targetPitch = view.width;
+    program.dispatch(cmd, tiles(view.width), tiles(view.height), push);
+    gpu::fullBarrier(cmd);
+    push.source = push.target;
+    push.sourcePitch = push.targetPitch;
+    next ^= 1;
+  };
+  auto begin = [&](uint32_t span) {
     if (timestamps) timestamps->begin(cmd, firstSpan + span);
-    if (run) {
-      gpu::Buffer& target = scratch(next, pixels);
-      push.target = target.address();
-      push.targetPitch = view.width;
-      program.dispatch(cmd, tiles(view.width), tiles(view.height), push);
-      push.source = push.target;
-      push.sourcePitch = push.targetPitch;
-      next ^= 1;
-    }
+  };
+  auto end = [&](uint32_t span) {
     if (timestamps) timestamps->end(cmd, firstSpan + span);
-    if (run) gpu::fullBarrier(cmd);
   };
 
-  const bool splats = settings.splats();
-  if (splats) {
+  begin(0);
+  if (settings.splats()) {
     const bool disc = settings.shape == PointShape::Disc;
     const bool attenuated = settings.sizeMode == PointSizeMode::Attenuated;
-    gpu::ComputeProgram& program = splat_[disc][attenuated];
-    if (program.name().empty())
-      program =
-          gpu::ComputeProgram(context_, "post_splat.comp",
-                              {{/* SHAPE= */ 0, disc ? shared::kPointShapeDisc : shared::kPointShapeSquare},
-                               {/* ATTENUATED= */ 1, uint32_t(attenuated)}});
-    const float largest = attenuated ? settings.maxPointSize : settings.pointSize;
-    // A square of side n reaches n / 2 pixels, a disc of diameter s floor(s / 2).
-    push.radius = disc ? uint32_t(largest / 2) : uint32_t(largest + 0.5f) / 2;
     push.pointSize = attenuated ? settings.pointSize * view.referenceDepth : settings.pointSize;
     push.maxPointSize = settings.maxPointSize;
+    if (!disc && !attenuated) {
+      pass(splat(false, false, 1)); // rows, then columns
+      pass(splat(false, false, 2));
+    } else {
+      const float largest = attenuated ? settings.maxPointSize : settings.pointSize;
+      // A square of side n reaches n / 2 pixels, a disc of diameter s floor(s / 2).
+      push.radius = disc ? uint32_t(largest / 2) : uint32_t(largest + 0.5f) / 2;
+      pass(splat(disc, attenuated, 0));
+    }
   }
-  filter(splat_[settings.shape == PointShape::Disc][settings.sizeMode == PointSizeMode::Attenuated], 0,
-         splats);
-  push.radius = settings.dilate;
-  filter(dilate_, 1, settings.dilate > 0);
+  end(0);
 
-  if (timestamps) timestamps->begin(cmd, firstSpan + 2);
+  begin(1);
+  push.radius = settings.dilate;
+  if (settings.dilate > 0) pass(dilate_);
+  end(1);
+
+  begin(2);
   push.target = view.image;
   push.targetPitch = view.pitch;
   // The final words go back where the method left its own, unless they are still those.
@@ -137,8 +152,8 @@ void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSett
   push.edlStrength = settings.edlStrength;
   push.edlRadius = settings.edlRadius;
   compose_.dispatch(cmd, tiles(view.width), tiles(view.height), push);
-  if (timestamps) timestamps->end(cmd, firstSpan + 2);
   gpu::fullBarrier(cmd);
+  end(2);
 }
 
 PostStats PostStage::stats(const std::vector<double>& spanMs, uint32_t frames) {
