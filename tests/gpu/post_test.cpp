@@ -73,7 +73,7 @@ Drawn draw(gpu::Context& context, const PointCloud& cloud, Method method, const 
   settings.depth = depth;
   settings.background = kBackground;
   settings.post = post;
-  settings.captureWords = post.enabled() || methodInfo(method).closest;
+  settings.captureWords = post.enabled() || hasCanonicalWords(methodInfo(method));
   Drawn d;
   d.stats = renderer.render(scene, axisCamera(), settings);
   d.image = renderer.image();
@@ -154,7 +154,7 @@ std::vector<uint32_t> cpuShapes(const std::vector<Dot>& dots, PointShape shape,
   return ::testing::AssertionFailure() << differ << " pixels differ:" << first;
 }
 
-const Method kMethods[] = {Method::AtomicMin, Method::Batch, Method::Hqs};
+const Method kMethods[] = {pointMethod("atomicmin"), pointMethod("batch"), pointMethod("hqs")};
 
 float gSize = 0; // the size the sizeOf functions below read (they are plain function pointers)
 double fixedSize(const Dot&) {
@@ -200,7 +200,7 @@ TEST_F(GpuTest, FixedPointSizeEqualsRasterizingShapesWithADepthTest) {
         EXPECT_TRUE(sameImage(d.image, expected))
             << methodName(method) << ", " << pointShapeName(shape) << " of " << size << " px";
       }
-      Drawn int40 = draw(*context, cloud, Method::AtomicMin, post, DepthMode::Int40);
+      Drawn int40 = draw(*context, cloud, pointMethod("atomicmin"), post, DepthMode::Int40);
       EXPECT_TRUE(sameImage(int40.image, expected)) << "int40, " << pointShapeName(shape) << " of " << size;
     }
   }
@@ -230,11 +230,11 @@ TEST_F(GpuTest, PointSizeWordsKeepTheWinnersDepth) {
   // within reach, never a new one.
   std::vector<Dot> dots = randomDots(5, 120, 1.0, 6.0);
   PointCloud cloud = cloudOf(dots);
-  Drawn one = draw(*context, cloud, Method::AtomicMin, {});
+  Drawn one = draw(*context, cloud, pointMethod("atomicmin"), {});
   std::set<uint64_t> present(one.words.begin(), one.words.end());
   PostSettings post;
   post.pointSize = 5;
-  Drawn five = draw(*context, cloud, Method::AtomicMin, post);
+  Drawn five = draw(*context, cloud, pointMethod("atomicmin"), post);
   size_t lit = 0;
   for (size_t i = 0; i < five.words.size(); ++i) {
     EXPECT_TRUE(present.count(five.words[i])) << "pixel " << i;
@@ -304,7 +304,7 @@ TEST_F(GpuTest, DilationFillsAOnePixelHoleInAFlatSurface) {
   PointCloud cloud = cloudOf(dots);
   PostSettings dilate;
   dilate.dilate = 1;
-  for (Method method : {Method::AtomicMin, Method::Batch}) {
+  for (Method method : {pointMethod("atomicmin"), pointMethod("batch")}) {
     Drawn before = draw(*context, cloud, method, {});
     Drawn after = draw(*context, cloud, method, dilate);
     for (auto [hx, hy] : {std::pair{20, 20}, std::pair{30, 12}}) {
@@ -334,8 +334,8 @@ TEST_F(GpuTest, DilationNeverLetsAFarPointCoverANearOne) {
   for (uint32_t r : {1u, 2u, 3u}) {
     PostSettings dilate;
     dilate.dilate = r;
-    Drawn before = draw(*context, cloud, Method::AtomicMin, {});
-    Drawn after = draw(*context, cloud, Method::AtomicMin, dilate);
+    Drawn before = draw(*context, cloud, pointMethod("atomicmin"), {});
+    Drawn after = draw(*context, cloud, pointMethod("atomicmin"), dilate);
     for (size_t i = 0; i < before.words.size(); ++i) {
       ASSERT_LE(depthOf(after.words[i]), depthOf(before.words[i])) << "pixel " << i << ", radius " << r;
       if (depthOf(before.words[i]) < 10) {
@@ -361,7 +361,7 @@ TEST_F(GpuTest, DilationNeverLetsAFarPointCoverANearOne) {
 TEST_F(GpuTest, DilationEqualsTheCpuRuleOnASparseScene) {
   std::vector<Dot> dots = randomDots(6, 700, 1.0, 3.0);
   PointCloud cloud = cloudOf(dots);
-  for (Method method : {Method::AtomicMin, Method::BatchPrefetch}) {
+  for (Method method : {pointMethod("atomicmin"), pointMethod("batch-prefetch")}) {
     Drawn before = draw(*context, cloud, method, {});
     for (int r : {1, 2}) {
       PostSettings dilate;
@@ -428,7 +428,7 @@ TEST_F(GpuTest, EyeDomeLightingMatchesACpuImplementationOfTheFormula) {
     edl.edlRadius = radius;
     std::vector<uint32_t> expected;
     Drawn plain;
-    for (Method method : {Method::AtomicMin, Method::Batch}) {
+    for (Method method : {pointMethod("atomicmin"), pointMethod("batch")}) {
       plain = draw(*context, cloud, method, {});
       expected = cpuEdl(plain.words, strength, radius);
       Drawn lit = draw(*context, cloud, method, edl);
@@ -499,7 +499,7 @@ TEST_F(GpuTest, EachColorModeMapsAHandBuiltCloud) {
   // Every point is at world z = -4: Turbo's ends and middle for ranges that put -4 at 0, 0.5 and 1.
   std::vector<std::pair<ColorRange, uint32_t>> elevation = {
       {{-4, 0}, packRgba(35, 23, 27)}, {{-5, -3}, packRgba(152, 250, 79)}, {{-8, -4}, packRgba(144, 13, 0)}};
-  for (Method method : {Method::AtomicMin, Method::Batch}) {
+  for (Method method : {pointMethod("atomicmin"), pointMethod("batch")}) {
     for (auto& [source, colors] : expected) {
       UploadOptions upload;
       upload.progress = false;
@@ -531,7 +531,7 @@ TEST_F(GpuTest, EachColorModeMapsAHandBuiltCloud) {
 TEST_F(GpuTest, RecoloringEqualsUploadingInTheMode) {
   using Source = DisplayColorMode::Source;
   PointCloud cloud = attributeCloud();
-  for (Method method : {Method::AtomicMin, Method::Batch}) {
+  for (Method method : {pointMethod("atomicmin"), pointMethod("batch")}) {
     UploadOptions upload;
     upload.progress = false;
     upload.layout = methodInfo(method).layout;
@@ -561,7 +561,8 @@ TEST_F(GpuTest, PostStageOnOneEyeOfAWiderBufferEqualsItAlone) {
   std::vector<uint64_t> eyes[2];
   for (int e = 0; e < 2; ++e)
     eyes[e] =
-        draw(*context, cloudOf(randomDots(10 + uint64_t(e), 300, 1.0, 2.0)), Method::AtomicMin, {}).words;
+        draw(*context, cloudOf(randomDots(10 + uint64_t(e), 300, 1.0, 2.0)), pointMethod("atomicmin"), {})
+            .words;
   PostSettings post;
   post.pointSize = 4;
   post.dilate = 2;
@@ -637,18 +638,18 @@ TEST_F(GpuTest, PostSettingsOutOfRangeAndHwPointsAreClearErrors) {
   };
   PostSettings big;
   big.pointSize = 33;
-  EXPECT_TRUE(refused(big, Method::AtomicMin, "1..32"));
+  EXPECT_TRUE(refused(big, pointMethod("atomicmin"), "1..32"));
   PostSettings adaptive;
   adaptive.sizeMode = PointSizeMode::Adaptive;
-  EXPECT_TRUE(refused(adaptive, Method::AtomicMin, "LOD"));
+  EXPECT_TRUE(refused(adaptive, pointMethod("atomicmin"), "LOD"));
   PostSettings wide;
   wide.dilate = 9;
-  EXPECT_TRUE(refused(wide, Method::AtomicMin, "0..8"));
+  EXPECT_TRUE(refused(wide, pointMethod("atomicmin"), "0..8"));
   PostSettings edl;
   edl.edlStrength = 1;
-  EXPECT_TRUE(refused(edl, Method::HwPoints, "hw-points"));
+  EXPECT_TRUE(refused(edl, pointMethod("hw-points"), "hw-points"));
   edl.edlRadius = 0;
-  EXPECT_TRUE(refused(edl, Method::AtomicMin, "radius"));
+  EXPECT_TRUE(refused(edl, pointMethod("atomicmin"), "radius"));
 }
 
 TEST_F(GpuTest, PostPassesAreTimed) {
@@ -656,13 +657,13 @@ TEST_F(GpuTest, PostPassesAreTimed) {
   PostSettings post;
   post.pointSize = 3;
   post.edlStrength = 1;
-  Drawn d = draw(*context, cloud, Method::AtomicMin, post);
+  Drawn d = draw(*context, cloud, pointMethod("atomicmin"), post);
   ASSERT_TRUE(d.stats.post);
   EXPECT_GT(d.stats.post->splatMs, 0.0);
   EXPECT_GE(d.stats.post->dilateMs, 0.0);
   EXPECT_GT(d.stats.post->composeMs, 0.0);
   EXPECT_GE(d.stats.medianMs, d.stats.post->splatMs);
-  Drawn plain = draw(*context, cloud, Method::AtomicMin, {});
+  Drawn plain = draw(*context, cloud, pointMethod("atomicmin"), {});
   EXPECT_FALSE(plain.stats.post);
 }
 
