@@ -10,6 +10,7 @@
 #include "base/progress.h"
 #include "commands.h"
 #include "input.h"
+#include "io/format_table.h"
 #include "io/writer.h"
 
 namespace pointrast::app {
@@ -40,7 +41,7 @@ Command addConvert(CLI::App& app) {
       "shuffled as wholes). Output: LAS 1.2 point format 3, or 1.4 format 7 with --las 1.4 or when\n"
       "the cloud has more than 4,294,967,295 points.\n\n"
       "Example:\n  pointrast convert scan.ply scan_morton.las --order morton");
-  cmd->add_option("IN", a->input, "LAS/PLY/XYZ file")->required();
+  cmd->add_option("IN", a->input, "Point cloud file: " + io::formatList(io::FormatUse::Cloud))->required();
   cmd->add_option("OUT", a->output, "LAS file to write")->required();
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the shuffled orders")->capture_default_str();
