@@ -19,6 +19,7 @@
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
 #include "input.h"
+#include "io/format_table.h"
 #include "io/writer.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
@@ -349,7 +350,9 @@ Command addRender(CLI::App& app) {
       "  pointrast render particles-drops --points 10M --method sphere-compute -o d.png\n"
       "  pointrast render md.mmpld --method sphere-compute --layout soa8 -o md.png --json\n"
       "  pointrast render particles-laser --points 10M --method sphere-strip --billboard camera -o l.png");
-  cmd->add_option("FILE", a->input, "LAS/PLY/XYZ file, or a scene name (terrain, tls)");
+  cmd->add_option("FILE", a->input,
+                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + "), particle file (" +
+                      io::formatList(io::FormatUse::Particles) + ") or a scene name (terrain, tls)");
   cmd->add_option("-o,--output", a->output, "PNG to write")->required();
   cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
   cmd->add_option("--height", a->height, "Image height in pixels")->capture_default_str();
