@@ -1,0 +1,62 @@
+// GLFW's input callbacks, routed to Dear ImGui (when the panel wants the mouse or keyboard) or to the
+// session: mouse drags, double-clicks (which GLFW does not report), the wheel, keys.
+#pragma once
+
+#include <optional>
+#include <utility>
+
+#include <glm/glm.hpp>
+
+struct GLFWwindow;
+struct ImGuiIO;
+
+namespace pointrast::view {
+
+class Session;
+
+// Two left clicks within this time and distance make a double-click.
+constexpr double kDoubleClickSeconds = 0.4;
+constexpr double kDoubleClickPixels = 4.0;
+
+// ImGui 1.86 reads keys through io.KeyMap into io.KeysDown, indexed by GLFW key codes here.
+void mapImGuiKeys(ImGuiIO& io);
+
+struct WheelInput {
+  glm::dvec2 position;
+  double steps;
+};
+
+class DesktopInput {
+public:
+  // Installs the callbacks on the window (and its user pointer).
+  DesktopInput(GLFWwindow* window, Session& session);
+
+  void setPanelVisible(bool visible) { panelVisible_ = visible; }
+  // Whether any event arrived since the last call (the panel must be redrawn).
+  bool takeArrived() { return std::exchange(arrived_, false); }
+  // Wheel steps gathered since the last call, at the cursor's last position: the viewer reads the depth
+  // under the cursor once for all of them.
+  std::optional<WheelInput> takeWheel();
+
+private:
+  static DesktopInput& of(GLFWwindow* window);
+  glm::dvec2 toPixels(double x, double y) const;
+  bool panelWantsMouse() const;
+  bool panelWantsKeyboard() const;
+  void cursor(double x, double y);
+  void button(int button, int action);
+  void scroll(double y);
+  void key(int key, int action, int mods);
+
+  GLFWwindow* window_;
+  Session& session_;
+  bool panelVisible_ = true;
+  bool arrived_ = true;
+  bool dragging_ = false;
+  glm::dvec2 cursor_{0};
+  double lastClickTime_ = -1;
+  glm::dvec2 lastClick_{0};
+  double wheel_ = 0;
+};
+
+} // namespace pointrast::view
