@@ -126,6 +126,22 @@ bool DesktopInput::panelWantsMouse() const {
   return panelVisible_ && ImGui::GetIO().WantCaptureMouse;
 }
 
+bool DesktopInput::overPanel() const {
+  const std::array<float, 4>& r = panelRect_;
+  return panelVisible_ && cursor_.x >= r[0] && cursor_.y >= r[1] && cursor_.x < r[0] + r[2] &&
+         cursor_.y < r[1] + r[3];
+}
+
+void DesktopInput::panelFrameDone() {
+  ImGuiIO& io = ImGui::GetIO();
+  for (int b = 0; b < 3; ++b) {
+    if (releasePending_[b]) io.MouseDown[b] = false;
+    if (releasePending_[b]) arrived_ = true; // one more frame, for ImGui to see the release
+    releasePending_[b] = false;
+    pressedThisFrame_[b] = false;
+  }
+}
+
 bool DesktopInput::panelWantsKeyboard() const {
   return panelVisible_ && ImGui::GetIO().WantCaptureKeyboard;
 }
@@ -139,7 +155,14 @@ void DesktopInput::cursor(double x, double y) {
 
 void DesktopInput::button(int button, int action) {
   arrived_ = true;
-  if (button >= 0 && button < 3) ImGui::GetIO().MouseDown[button] = action == GLFW_PRESS;
+  if (button >= 0 && button < 3) {
+    bool pressed = action == GLFW_PRESS;
+    if (pressed) pressedThisFrame_[button] = true;
+    if (!pressed && pressedThisFrame_[button])
+      releasePending_[button] = true;
+    else
+      ImGui::GetIO().MouseDown[button] = pressed;
+  }
   MouseButton which = button == GLFW_MOUSE_BUTTON_LEFT    ? MouseButton::Left
                       : button == GLFW_MOUSE_BUTTON_RIGHT ? MouseButton::Right
                                                           : MouseButton::Middle;
@@ -148,7 +171,7 @@ void DesktopInput::button(int button, int action) {
     dragging_ = false;
     return;
   }
-  if (panelWantsMouse()) return;
+  if (panelWantsMouse() || overPanel()) return;
   double now = glfw::glfwGetTime();
   if (which == MouseButton::Left && now - lastClickTime_ < kDoubleClickSeconds &&
       glm::length(cursor_ - lastClick_) <= kDoubleClickPixels) {

@@ -2,6 +2,7 @@
 // session: mouse drags, double-clicks (which GLFW does not report), the wheel, keys.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <utility>
 
@@ -32,6 +33,12 @@ public:
   DesktopInput(GLFWwindow* window, Session& session);
 
   void setPanelVisible(bool visible) { panelVisible_ = visible; }
+  // The panel window's rectangle (x, y, width, height) in the last frame: a press inside it belongs to the
+  // panel, whatever ImGui's capture flag said in that frame (the cursor may just have arrived).
+  void setPanelRect(const std::array<float, 4>& rect) { panelRect_ = rect; }
+  // After ImGui::NewFrame: releases that came in the same frame as their press are handed over now, so
+  // that ImGui 1.86, which polls the button state once a frame, sees a quick click as a click.
+  void panelFrameDone();
   // Whether any event arrived since the last call (the panel must be redrawn).
   bool takeArrived() { return std::exchange(arrived_, false); }
   // Wheel steps gathered since the last call, at the cursor's last position: the viewer reads the depth
@@ -42,6 +49,7 @@ private:
   static DesktopInput& of(GLFWwindow* window);
   glm::dvec2 toPixels(double x, double y) const;
   bool panelWantsMouse() const;
+  bool overPanel() const;
   bool panelWantsKeyboard() const;
   void cursor(double x, double y);
   void button(int button, int action);
@@ -51,6 +59,9 @@ private:
   GLFWwindow* window_;
   Session& session_;
   bool panelVisible_ = true;
+  std::array<float, 4> panelRect_{0, 0, 0, 0};
+  bool pressedThisFrame_[3] = {false, false, false};
+  bool releasePending_[3] = {false, false, false};
   bool arrived_ = true;
   bool dragging_ = false;
   glm::dvec2 cursor_{0};

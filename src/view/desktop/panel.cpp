@@ -126,6 +126,8 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
                       "double-click: pivot  WASD QE: fly (Shift: fast)\n"
                       "8 2 5 0 4 6: views  F: frame all  K: keyframe\n"
                       "C: print camera  F12: screenshot  H: hide panel");
+  ImVec2 position = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  items["panel"] = {position.x, position.y, size.x, size.y};
   ImGui::End();
   return actions;
 }

@@ -124,6 +124,7 @@ private:
   PanelItems items_;
   ShownImage shown_;
   int presentsPending_ = 1;
+  size_t savedKeyframes_ = 0;
   bool swapchainStale_ = false;
   bool running_ = true;
 };
@@ -152,6 +153,7 @@ Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Conte
   if (std::filesystem::exists(options.pathFile, error)) {
     CameraPath loaded = CameraPath::load(options.pathFile);
     session_.path() = loaded;
+    savedKeyframes_ = loaded.keyframes().size();
   }
   info_.device = context.info().name;
   info_.input = cloud.source;
@@ -168,9 +170,11 @@ ImDrawData* Viewer::buildPanelFrame(double seconds) {
   io.DisplaySize = ImVec2(float(swapchain_.width()), float(swapchain_.height()));
   io.DeltaTime = float(std::max(seconds, 1e-4));
   ImGui::NewFrame();
+  input_.panelFrameDone();
   ViewSettings edited = session_.settings();
   PanelActions actions = buildPanel(session_, info_, edited, items_);
   ImGui::Render();
+  input_.setPanelRect(items_["panel"]);
   session_.setSettings(edited);
   handlePanel(actions);
   return ImGui::GetDrawData();
@@ -193,6 +197,7 @@ void Viewer::handlePanel(const PanelActions& actions) {
 
 void Viewer::saveKeyframes() {
   session_.path().save(options_.pathFile);
+  savedKeyframes_ = session_.path().keyframes().size();
   if (options_.events)
     emit({{"event", "keyframes"},
           {"count", session_.path().keyframes().size()},
@@ -221,7 +226,6 @@ void Viewer::takeScreenshot() {
 }
 
 void Viewer::handleRequests() {
-  size_t keyframes = session_.path().keyframes().size();
   if (auto wheel = input_.takeWheel()) {
     std::optional<double> depth =
         scene_.depthAt(session_.camera(), session_.settings(), session_.viewport(), wheel->position);
@@ -249,7 +253,8 @@ void Viewer::handleRequests() {
   }
   if (r.screenshot) takeScreenshot();
   if (r.quit) running_ = false;
-  if (session_.path().keyframes().size() != keyframes) saveKeyframes();
+  // K records in the session as the key arrives; the file follows here.
+  if (session_.path().keyframes().size() != savedKeyframes_) saveKeyframes();
 }
 
 void Viewer::showFrame() {
