@@ -19,8 +19,8 @@ namespace {
 RenderSettings pickSettings(const ViewSettings& view) {
   RenderSettings settings = renderSettings(view);
   const MethodInfo& info = methodInfo(view.method);
-  if (!info.closest || view.method == Method::JustSet)
-    settings.method = info.layout == SceneLayout::Batched ? Method::Batch : Method::AtomicMin;
+  if (info.output != MethodOutput::Closest)
+    settings.method = info.layout == SceneLayout::Batched ? pointMethod("batch") : pointMethod("atomicmin");
   settings.depth = DepthMode::Float;
   settings.captureWords = true;
   return settings;

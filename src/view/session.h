@@ -21,7 +21,7 @@ namespace pointrast::view {
 // What a frame is rendered with. Every change goes through Session::setSettings, which compares, so an
 // unchanged panel costs no frame.
 struct ViewSettings {
-  Method method = Method::AtomicMin;
+  Method method; // the first row of the method table: atomicmin
   uint32_t background = 0xFF000000u; // RGBA8
   // The level-of-detail controls (point budget, threshold) and the resolve options (point size, dilation,
   // eye-dome lighting, coloring) join this struct when their render stages exist; each is compared in

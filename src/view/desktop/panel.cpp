@@ -28,7 +28,7 @@ void methodCombo(const PanelInfo& info, ViewSettings& settings, PanelItems& item
     for (Method m : info.methods) {
       bool selected = m == settings.method;
       if (ImGui::Selectable(methodName(m), selected)) settings.method = m;
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", methodInfo(m).description);
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", methodInfo(m).help);
       if (selected) ImGui::SetItemDefaultFocus();
     }
     ImGui::EndCombo();

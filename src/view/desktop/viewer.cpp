@@ -159,8 +159,8 @@ Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Conte
   info_.input = cloud.source;
   info_.points = cloud.size();
   info_.pathFile = options.pathFile.string();
-  for (const MethodInfo& m : methodTable())
-    if (Renderer::supports(context, m.method)) info_.methods.push_back(m.method);
+  for (Method m : allMethods())
+    if (Renderer::supports(context, m)) info_.methods.push_back(m);
 }
 
 ImDrawData* Viewer::buildPanelFrame(double seconds) {
