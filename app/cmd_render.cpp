@@ -257,6 +257,7 @@ int runRender(const RenderArgs& a) {
   std::vector<const GpuScene*> drawn;
   for (auto& s : scenes)
     drawn.push_back(s.get());
+  if (pathMode && cameraPath.empty()) cameraPath = view::orbitPath(camera);
   if (pathMode)
     return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
   FrameStats stats = renderer.render(drawn, camera, settings);

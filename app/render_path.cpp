@@ -18,7 +18,8 @@ namespace pointrast::app {
 void addPathOptions(CLI::App& render, PathOutput& out) {
   render.add_option("--path", out.path,
                     "Render a camera path (JSON keyframes, saved by `pointrast view` with K) into --video or "
-                    "--frames-dir instead of one PNG");
+                    "--frames-dir instead of one PNG; `orbit`: one turn around the target (of --eye/--target "
+                    "or the overview) in 5 s");
   render.add_option("--video", out.video, "--path: the video to write (.mp4 or .mkv, H.264 through ffmpeg)");
   render.add_option("--frames-dir", out.framesDir,
                     "--path: write numbered PNG frames (frame_000000.png, ...) into this folder");
@@ -38,6 +39,8 @@ view::CameraPath loadPathForRender(const PathOutput& out, uint32_t width, uint32
     if (width % 2 || height % 2)
       throw InputError("--video needs an even --width and --height (H.264 halves the color resolution)");
   }
+  // The turntable is built once the camera is known (renderCameraPath's caller).
+  if (out.path == view::kOrbitPathName) return {};
   return view::CameraPath::load(out.path);
 }
 

@@ -30,7 +30,8 @@ struct PathOutput {
 void addPathOptions(CLI::App& render, PathOutput& out);
 
 // Checks the options before anything is loaded (exactly one of --video and --frames-dir, an even size for
-// video, a sensible frame rate) and loads the path. Throws InputError.
+// video, a sensible frame rate) and loads the path; an empty path for `orbit`, which the caller makes
+// with view::orbitPath once it has the camera. Throws InputError.
 view::CameraPath loadPathForRender(const PathOutput& out, uint32_t width, uint32_t height);
 
 // Renders every frame of the path and writes the video or the frames; prints a summary line (or one JSON

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.h"
+#include "view/navigation.h"
 
 namespace pointrast::view {
 
@@ -90,6 +91,20 @@ Camera CameraPath::sample(double time) const {
   if (glm::length(up) > 1e-9) camera.up = up;
   camera.fovY = k[i].camera.fovY + (k[i + 1].camera.fovY - k[i].camera.fovY) * u;
   return camera;
+}
+
+CameraPath orbitPath(const Camera& start, double seconds) {
+  assert(seconds > 0);
+  constexpr int kSteps = 64; // the one-sided end tangents then stray < 0.1 % from the circle
+  CameraPath path;
+  glm::dvec3 vertical = glm::normalize(start.up);
+  for (int k = 0; k <= kSteps; ++k) {
+    Camera c =
+        k == 0 ? start : orbit(start, start.target, vertical, 2 * 3.14159265358979323846 * k / kSteps, 0);
+    c.up = start.up;
+    path.append(c, seconds / kSteps);
+  }
+  return path;
 }
 
 CameraPath CameraPath::parse(const std::string& text, const std::string& name) {

@@ -58,4 +58,10 @@ private:
   std::vector<Keyframe> keyframes_;
 };
 
+// The name `render --path` takes for a turntable instead of a file.
+constexpr const char* kOrbitPathName = "orbit";
+// A turntable: the camera turned once around its target about `up` in `seconds`, as keyframes every
+// 1/64 turn (the spline through them stays within 0.1 % of the circle's radius).
+CameraPath orbitPath(const Camera& start, double seconds = 5.0);
+
 } // namespace pointrast::view

@@ -1,5 +1,6 @@
 #include "view/camera_path.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -121,6 +122,24 @@ TEST(CameraPath, RefusesBadFilesWithOneClearError) {
   refuse(head + R"([{"time":0,"eye":[0,0,1e999],"target":[0,0,0]}]})", "");
   EXPECT_THROW(CameraPath::load("/nonexistent/path.json"), InputError);
   EXPECT_THROW(CameraPath::load("/tmp"), InputError);
+}
+
+TEST(CameraPath, OrbitTurnsOnceAroundTheTarget) {
+  Camera start = cam({10, 0, 5}, {0, 0, 0});
+  CameraPath orbit = orbitPath(start, 4.0);
+  EXPECT_DOUBLE_EQ(orbit.duration(), 4.0);
+  EXPECT_EQ(orbit.sample(0).eye, start.eye);
+  // A quarter turn counterclockwise seen from above; between keyframes the spline stays near the circle.
+  glm::dvec3 quarter = orbit.sample(1.0).eye;
+  EXPECT_NEAR(quarter.x, 0, 1e-9);
+  EXPECT_NEAR(quarter.y, 10, 1e-9);
+  EXPECT_NEAR(quarter.z, 5, 1e-9);
+  for (double t = 0; t <= 4; t += 0.01) {
+    glm::dvec3 e = orbit.sample(t).eye;
+    EXPECT_NEAR(std::hypot(e.x, e.y), 10, 0.01) << t;
+    EXPECT_EQ(orbit.sample(t).target, start.target);
+  }
+  EXPECT_LT(glm::length(orbit.sample(4.0).eye - start.eye), 1e-9);
 }
 
 } // namespace
