@@ -1,5 +1,6 @@
 #include "view/path_render.h"
 
+#include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <condition_variable>
@@ -70,7 +71,8 @@ private:
 } // namespace
 
 PngFrameSink::PngFrameSink(std::filesystem::path folder, uint32_t width, uint32_t height)
-    : folder_(std::move(folder)), width_(width), height_(height) {
+    : folder_(std::move(folder)), width_(width), height_(height),
+      threads_(std::max(1u, std::thread::hardware_concurrency())) {
   std::error_code error;
   std::filesystem::create_directories(folder_, error);
   if (!std::filesystem::is_directory(folder_))
@@ -83,8 +85,27 @@ std::filesystem::path PngFrameSink::frameName(const std::filesystem::path& folde
   return folder / name;
 }
 
+PngFrameSink::~PngFrameSink() {
+  // An unfinished render (an error): let the frames in flight end; their errors no longer matter.
+  for (std::future<void>& f : pending_)
+    if (f.valid()) f.wait();
+}
+
 void PngFrameSink::write(uint64_t index, const std::vector<uint32_t>& rgba) {
-  io::writePng(frameName(folder_, index), width_, height_, rgba.data());
+  if (pending_.size() >= threads_) {
+    pending_.front().get(); // rethrows a write error
+    pending_.pop_front();
+  }
+  pending_.push_back(std::async(std::launch::async, [this, index, frame = rgba] {
+    io::writePng(frameName(folder_, index), width_, height_, frame.data());
+  }));
+}
+
+void PngFrameSink::finish() {
+  while (!pending_.empty()) {
+    pending_.front().get();
+    pending_.pop_front();
+  }
 }
 
 VideoFrameSink::VideoFrameSink(std::unique_ptr<io::VideoWriter> writer) : writer_(std::move(writer)) {}

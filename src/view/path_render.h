@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <span>
 #include <vector>
@@ -28,17 +30,21 @@ public:
 };
 
 // frame_000000.png, frame_000001.png, ... in a folder (created when missing). Each PNG is complete or
-// absent (io::writePng).
+// absent (io::writePng). PNG compression is slower than rendering, so frames are compressed on as many
+// threads as the machine has, in any order.
 class PngFrameSink : public FrameSink {
 public:
   PngFrameSink(std::filesystem::path folder, uint32_t width, uint32_t height);
+  ~PngFrameSink() override;
   void write(uint64_t index, const std::vector<uint32_t>& rgba) override;
-  void finish() override {}
+  void finish() override;
   static std::filesystem::path frameName(const std::filesystem::path& folder, uint64_t index);
 
 private:
   std::filesystem::path folder_;
   uint32_t width_, height_;
+  size_t threads_;
+  std::deque<std::future<void>> pending_;
 };
 
 class VideoFrameSink : public FrameSink {
