@@ -63,12 +63,12 @@ std::vector<uint32_t> boxDownsample(std::span<const uint32_t> rgba, uint32_t wid
   return out;
 }
 
-SceneView::SceneView(gpu::Context& context, const PointCloud& cloud, bool progress)
+GpuCloud::GpuCloud(gpu::Context& context, const PointCloud& cloud, bool progress)
     : context_(context), cloud_(cloud), progress_(progress) {}
 
-SceneView::~SceneView() = default;
+GpuCloud::~GpuCloud() = default;
 
-const GpuScene& SceneView::scene(SceneLayout layout) {
+const GpuScene& GpuCloud::scene(SceneLayout layout) {
   std::unique_ptr<GpuScene>& slot = scenes_[int(layout)];
   if (!slot) {
     UploadOptions upload;
@@ -79,18 +79,27 @@ const GpuScene& SceneView::scene(SceneLayout layout) {
   return *slot;
 }
 
-const Bounds& SceneView::bounds() const {
+const Bounds& GpuCloud::bounds() const {
   return cloud_.bounds;
 }
 
-uint64_t SceneView::pointCount() const {
+uint64_t GpuCloud::pointCount() const {
   return cloud_.size();
 }
 
-uint64_t SceneView::gpuBytes() const {
+uint64_t GpuCloud::bytes() const {
   uint64_t bytes = 0;
   for (const auto& s : scenes_)
     if (s) bytes += s->bytes();
+  return bytes;
+}
+
+SceneView::SceneView(gpu::Context& context, GpuCloud& cloud) : context_(context), cloud_(cloud) {}
+
+SceneView::~SceneView() = default;
+
+uint64_t SceneView::gpuBytes() const {
+  uint64_t bytes = cloud_.bytes();
   // Framebuffer (8 B), image (4 B) and, once a pick asked for them, canonical words (8 B) per pixel.
   if (renderer_) bytes += uint64_t(renderer_->width()) * renderer_->height() * 20;
   return bytes;

@@ -1,6 +1,8 @@
 // The GPU side of an interactive session, shared by the front ends: a cloud uploaded in the layouts its
-// methods read (each on first use), one Renderer at the viewport's size, picking the point under a pixel
-// from the framebuffer words, and screenshots (optionally supersampled).
+// methods read (each on first use, GpuCloud), and per view one Renderer at the viewport's size, picking
+// the point under a pixel from the framebuffer words, and screenshots (optionally supersampled). Views
+// of one GpuCloud share its uploads: the browser viewer's clients each have a SceneView (their own
+// camera and image size) drawing one GpuCloud. Like the rest of the gpu layer, one thread at a time.
 #pragma once
 
 #include <cstdint>
@@ -36,11 +38,29 @@ constexpr uint32_t kPickRadius = 2;
 std::vector<uint32_t> boxDownsample(std::span<const uint32_t> rgba, uint32_t width, uint32_t height,
                                     uint32_t factor);
 
+class GpuCloud {
+public:
+  // Keeps a reference to the cloud (it must outlive this) to upload a layout when a method first needs
+  // it. Uploads throw UnsupportedError when the device lacks the memory.
+  GpuCloud(gpu::Context& context, const PointCloud& cloud, bool progress = true);
+  ~GpuCloud();
+  const GpuScene& scene(SceneLayout layout);
+  const Bounds& bounds() const;
+  uint64_t pointCount() const;
+  // Bytes of GPU memory of the layouts uploaded so far.
+  uint64_t bytes() const;
+
+private:
+  gpu::Context& context_;
+  const PointCloud& cloud_;
+  bool progress_;
+  std::unique_ptr<GpuScene> scenes_[2]; // by SceneLayout
+};
+
 class SceneView : public ContentSource {
 public:
-  // Keeps a reference to the cloud (it must outlive the view) to upload the other layout when a method
-  // needs it. Throws UnsupportedError when the device lacks the memory.
-  SceneView(gpu::Context& context, const PointCloud& cloud, bool progress = true);
+  // The cloud must outlive the view.
+  SceneView(gpu::Context& context, GpuCloud& cloud);
   ~SceneView() override;
 
   // Renders a frame; recreates the renderer when the viewport changed.
@@ -63,10 +83,8 @@ public:
                                    uint32_t supersample);
 
   // The scenes a method reads, uploaded on first use.
-  const GpuScene& scene(SceneLayout layout);
-  const Bounds& bounds() const;
-  uint64_t pointCount() const;
-  // Bytes of GPU memory of the uploaded scenes and the renderer's targets.
+  const GpuScene& scene(SceneLayout layout) { return cloud_.scene(layout); }
+  // Bytes of GPU memory of the uploaded scenes and this view's targets.
   uint64_t gpuBytes() const;
 
   // The level-of-detail hook: the brute-force scenes never change; an octree source will answer whether
@@ -82,9 +100,7 @@ private:
   std::optional<Picked> pickPoint(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                   glm::dvec2 position);
   gpu::Context& context_;
-  const PointCloud& cloud_;
-  bool progress_;
-  std::unique_ptr<GpuScene> scenes_[2]; // by SceneLayout
+  GpuCloud& cloud_;
   std::unique_ptr<Renderer> renderer_;
 };
 

@@ -26,8 +26,8 @@ protected:
   // Three points in front of a camera looking along +y: one near the image center (inside a pixel, not
   // on a border, where the batch methods' quantization could move it across), one up-left, one twice as
   // far on the first one's line of sight (hidden by it).
-  PointCloud cloud =
-      test::cloudFromPoints({{0.05, 10, 0.07}, {-2, 10, 1.5}, {0.1, 20, 0.14}}, {0xFF0000FFu, 0xFF00FF00u, 0xFFFF0000u});
+  PointCloud cloud = test::cloudFromPoints({{0.05, 10, 0.07}, {-2, 10, 1.5}, {0.1, 20, 0.14}},
+                                           {0xFF0000FFu, 0xFF00FF00u, 0xFFFF0000u});
   Camera camera() const {
     Camera c;
     c.eye = {0, 0, 0};
@@ -39,7 +39,8 @@ protected:
 };
 
 TEST_F(SceneViewTest, PicksTheClosestPointUnderTheCursor) {
-  SceneView view(*context, cloud, false);
+  GpuCloud gpuCloud(*context, cloud, false);
+  SceneView view(*context, gpuCloud);
   ViewSettings settings;
   for (const char* name : {"atomicmin", "batch", "hqs", "hw-points"}) {
     SCOPED_TRACE(name);
@@ -67,7 +68,8 @@ TEST_F(SceneViewTest, PicksTheClosestPointUnderTheCursor) {
 }
 
 TEST_F(SceneViewTest, FramesAndScreenshots) {
-  SceneView view(*context, cloud, false);
+  GpuCloud gpuCloud(*context, cloud, false);
+  SceneView view(*context, gpuCloud);
   ViewSettings settings;
   FrameReport report = view.render(camera(), settings, viewport);
   EXPECT_EQ(report.points, 3u);
@@ -85,6 +87,13 @@ TEST_F(SceneViewTest, FramesAndScreenshots) {
   view.render(camera(), settings, {32, 32});
   EXPECT_EQ(view.renderer().width(), 32u);
   EXPECT_FALSE(view.changedSinceLastFrame());
+  // A second view of the same cloud (another client of the browser viewer) shares its uploads.
+  uint64_t uploaded = gpuCloud.bytes();
+  SceneView other(*context, gpuCloud);
+  other.render(camera(), settings, {16, 16});
+  EXPECT_EQ(gpuCloud.bytes(), uploaded);
+  EXPECT_EQ(other.renderer().width(), 16u);
+  EXPECT_EQ(view.renderer().width(), 32u);
 }
 
 } // namespace

@@ -116,6 +116,7 @@ private:
   gpu::Context& context_;
   GLFWwindow* window_;
   gpu::Swapchain& swapchain_;
+  GpuCloud gpuCloud_;
   SceneView scene_;
   Session session_;
   DesktopInput input_;
@@ -143,7 +144,7 @@ Viewport framebufferViewport(GLFWwindow* window) {
 Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Context& context,
                GLFWwindow* window, gpu::Swapchain& swapchain)
     : cloud_(cloud), options_(options), context_(context), window_(window), swapchain_(swapchain),
-      scene_(context, cloud),
+      gpuCloud_(context, cloud), scene_(context, gpuCloud_),
       session_(cloud.bounds, startCamera(cloud, options, {swapchain.width(), swapchain.height()}),
                {swapchain.width(), swapchain.height()}, options.settings),
       input_(window, session_), presenter_(context, swapchain) {
