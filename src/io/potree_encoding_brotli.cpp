@@ -21,7 +21,8 @@ using namespace detail;
 
 namespace {
 
-// PotreeConverter compresses at 6; 5 is measured to give nearly the same size faster (potree.h).
+// PotreeConverter compresses at 6. On autzen_trim (110,000 points in 709 nodes) quality 5 gave 1,034,064
+// bytes against 6's 1,033,736 (+0.03 %) in about three quarters of the time; 4 gave 3 % more, 7 no less.
 constexpr int kQuality = 5;
 constexpr uint64_t kCode48 = (uint64_t(1) << 48) - 1;
 constexpr uint64_t kMaxRatio = 4096;
