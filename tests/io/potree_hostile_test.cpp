@@ -274,7 +274,7 @@ protected:
 TEST_P(HostileRecords, ByteRangePastTheEnd) {
   const uint64_t size = std::filesystem::file_size(dir_ / "o" / "octree.bin");
   patchRecord(dir_ / "o", withPoints_, false, [&](potree::Record& r) { r.byteOffset = int64_t(size); });
-  EXPECT_NE(refused().find("octree.bin, which holds"), std::string::npos);
+  EXPECT_NE(refused().find("of octree.bin, which holds"), std::string::npos);
 }
 
 TEST_P(HostileRecords, NegativeAndHugeRanges) {
