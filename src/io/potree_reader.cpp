@@ -73,6 +73,7 @@ private:
     uint8_t mask = 0;
     bool proxy = false; // offset/size locate the node's hierarchy chunk, not yet read
     uint64_t offset = 0, size = 0;
+    std::string damage; // why its chunk could not be read (said again on every later request)
   };
 
   // All below: mutex_ held.
@@ -128,7 +129,16 @@ PotreeSource::Node& PotreeSource::find(const lod::NodeKey& key) {
 
 PotreeSource::Node& PotreeSource::resolved(const lod::NodeKey& key) {
   Node& node = find(key);
-  if (node.proxy) loadChunk(key, int64_t(node.offset), int64_t(node.size));
+  if (!node.damage.empty()) throw InputError(node.damage);
+  if (!node.proxy) return node;
+  try {
+    loadChunk(key, int64_t(node.offset), int64_t(node.size));
+  } catch (const InputError& e) {
+    // Part of the chunk may have been taken in; the proxy stays unresolved and keeps the reason, so a
+    // later request gets the same sentence rather than a confusing one about the half-read chunk.
+    find(key).damage = e.what();
+    throw;
+  }
   return find(key); // the map may have rehashed
 }
 
