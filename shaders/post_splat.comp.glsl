@@ -12,11 +12,16 @@
 //   ATTENUATED  0: every point has size pc.pointSize; 1: pc.pointSize / depth, clamped to [1, max]
 //   AXIS        0: the whole window; fixed squares, whose window is a product of two ranges, are cut into
 //               a pass along rows (1) and one along columns (2): 2n words read a pixel instead of n^2
+//   SCATTER     1: the same image pushed instead of gathered: each pixel's word goes with atomicMin to the
+//               pixels its shape covers (the target filled with kEmptyPixel first). Attenuated sizes use it:
+//               a gather reads the largest shape's window at every pixel, a scatter only what the shapes
+//               cover, mostly small ones.
 #include "post.inc.glsl"
 
 layout(constant_id = 0) const uint SHAPE = kPointShapeSquare;
 layout(constant_id = 1) const uint ATTENUATED = 0;
 layout(constant_id = 2) const uint AXIS = 0;
+layout(constant_id = 3) const uint SCATTER = 0;
 
 float sizeOf(uint64_t word) {
   if (ATTENUATED == 0u) return pc.pointSize;
@@ -45,9 +50,32 @@ uint64_t axisMinimum(ivec2 p) {
   return best;
 }
 
+// Pushes pixel p's word to every pixel its shape covers.
+void scatter(ivec2 p) {
+  uint64_t w = sourceWord(p);
+  if (w == kEmptyPixel) return;
+  float s = sizeOf(w);
+  int n = int(s + 0.5);
+  int lo = SHAPE == kPointShapeDisc ? -int(0.5 * s) : -((n - 1) >> 1);
+  int hi = SHAPE == kPointShapeDisc ? int(0.5 * s) : n >> 1;
+  Uint64Array target = Uint64Array(pc.target);
+  for (int dy = lo; dy <= hi; ++dy) {
+    for (int dx = lo; dx <= hi; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (!insideImage(q) || !covers(s, ivec2(dx, dy))) continue;
+      uint at = uint(q.y) * pc.targetPitch + uint(q.x);
+      if (w < target.v[at]) atomicMin(target.v[at], w); // read first: most covered pixels are taken
+    }
+  }
+}
+
 void main() {
   ivec2 p;
   if (!postPixel(p)) return;
+  if (SCATTER != 0u) {
+    scatter(p);
+    return;
+  }
   if (AXIS != 0u) {
     Words(pc.target).v[uint(p.y) * pc.targetPitch + uint(p.x)] = axisMinimum(p);
     return;

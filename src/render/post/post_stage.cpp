@@ -89,7 +89,8 @@ const gpu::ComputeProgram& PostStage::splat(bool disc, bool attenuated, uint32_t
         gpu::ComputeProgram(context_, "post_splat.comp",
                             {{/* SHAPE= */ 0, disc ? shared::kPointShapeDisc : shared::kPointShapeSquare},
                              {/* ATTENUATED= */ 1, uint32_t(attenuated)},
-                             {/* AXIS= */ 2, axis}});
+                             {/* AXIS= */ 2, axis < 3 ? axis : 0},
+                             {/* SCATTER= */ 3, uint32_t(axis == 3)}});
   return program;
 }
 
@@ -129,11 +130,14 @@ void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSett
     if (!disc && !attenuated) {
       pass(splat(false, false, 1)); // rows, then columns
       pass(splat(false, false, 2));
+    } else if (attenuated) {
+      // Scattered into a cleared buffer: the cost follows the sizes drawn, not the largest allowed.
+      gpu::vkCmdFillBuffer(cmd, scratch(next, pixels).handle(), 0, pixels * 8, 0xFFFFFFFFu); // kEmptyPixel
+      gpu::fullBarrier(cmd);
+      pass(splat(disc, true, 3));
     } else {
-      const float largest = attenuated ? settings.maxPointSize : settings.pointSize;
-      // A square of side n reaches n / 2 pixels, a disc of diameter s floor(s / 2).
-      push.radius = disc ? uint32_t(largest / 2) : uint32_t(largest + 0.5f) / 2;
-      pass(splat(disc, attenuated, 0));
+      push.radius = uint32_t(settings.pointSize / 2); // a disc of diameter s reaches floor(s / 2) pixels
+      pass(splat(true, false, 0));
     }
   }
   end(0);

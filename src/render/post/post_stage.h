@@ -47,9 +47,10 @@ public:
 
 private:
   gpu::Buffer& scratch(int index, uint64_t pixels);
+  // AXIS 0..2 gather (post_splat.comp), 3 scatters.
   const gpu::ComputeProgram& splat(bool disc, bool attenuated, uint32_t axis);
   gpu::Context& context_;
-  gpu::ComputeProgram splat_[2][2][3]; // [disc][attenuated][axis], made on first use
+  gpu::ComputeProgram splat_[2][2][4]; // [disc][attenuated][axis or scatter], made on first use
   gpu::ComputeProgram dilate_;
   gpu::ComputeProgram compose_;
   gpu::Buffer scratch_[2]; // ping-pong words, width x height each
