@@ -525,7 +525,7 @@ Command addRender(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--dilate", a->dilate,
                   "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
-                  "point never covers a near one, and silhouettes do not grow")
+                  "point never covers a near one, and convex outlines do not grow")
       ->capture_default_str();
   cmd->add_flag("--edl", a->edl,
                 "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
