@@ -1,0 +1,108 @@
+#include "render/lod/lod_render.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "gpu/context.h"
+#include "gpu/timer.h"
+
+namespace pointrast::lod {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void timeOnePass(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
+                 const LodCamera& cam, const RenderSettings& settings, LodRenderResult& result) {
+  passes.setList(scene.drawList());
+  const uint32_t frames = std::max(1u, settings.frames);
+  gpu::TimestampPool timestamps(context, frames);
+  context.submitAndWait([&](VkCommandBuffer cmd) {
+    timestamps.reset(cmd);
+    for (uint32_t w = 0; w < settings.warmup; ++w)
+      passes.recordFrame(cmd, cam, targets, settings);
+    for (uint32_t f = 0; f < frames; ++f) {
+      timestamps.begin(cmd, f);
+      passes.recordFrame(cmd, cam, targets, settings);
+      timestamps.end(cmd, f);
+    }
+  });
+  const std::vector<double> ms = timestamps.milliseconds();
+  result.frame.frames = frames;
+  result.frame.medianMs = gpu::median(ms);
+  result.frame.minMs = *std::min_element(ms.begin(), ms.end());
+  result.frame.maxMs = *std::max_element(ms.begin(), ms.end());
+}
+
+// Each pass streamed in, then drawn in its own submission (lod-hqs: every pass's depths, then every pass's
+// blending, streaming the passes twice). One frame, its time the sum of the submissions'.
+void timePasses(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
+                const LodCamera& cam, const RenderSettings& settings,
+                const std::vector<std::vector<uint32_t>>& split, LodRenderResult& result) {
+  std::vector<LodPhase> phases = passes.hqs() ? std::vector<LodPhase>{LodPhase::Depth, LodPhase::Blend}
+                                              : std::vector<LodPhase>{LodPhase::Closest};
+  const uint32_t spans = uint32_t(split.size() * phases.size());
+  gpu::TimestampPool timestamps(context, spans);
+  uint32_t span = 0;
+  for (LodPhase phase : phases) {
+    uint32_t rank = 0;
+    for (const std::vector<uint32_t>& pass : split) {
+      const auto start = std::chrono::steady_clock::now();
+      scene.makeResident(pass, rank);
+      result.streamSeconds += secondsSince(start);
+      rank += uint32_t(pass.size());
+      passes.setList(scene.drawList());
+      const bool first = span == 0, last = span + 1 == spans;
+      context.submitAndWait([&](VkCommandBuffer cmd) {
+        if (first) timestamps.reset(cmd);
+        timestamps.begin(cmd, span);
+        if (first) passes.recordBegin(cmd, targets);
+        passes.recordPass(cmd, cam, targets, settings, phase);
+        if (last) passes.recordFinish(cmd, targets, settings);
+        timestamps.end(cmd, span);
+      });
+      ++span;
+    }
+  }
+  const std::vector<double> ms = timestamps.milliseconds();
+  double total = 0;
+  for (double m : ms)
+    total += m;
+  result.frame.frames = 1;
+  result.frame.medianMs = result.frame.minMs = result.frame.maxMs = total;
+}
+
+} // namespace
+
+LodCamera lodCamera(const LodScene& scene, const Camera& camera, uint32_t width, uint32_t height) {
+  LodCamera cam;
+  cam.viewProj = glm::mat4(viewProjection(camera, scene.origin(), double(width) / double(height)));
+  cam.nearW = float(scene.nearW(camera));
+  return cam;
+}
+
+LodRenderResult renderOctree(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
+                             const Camera& camera, const RenderSettings& settings, const LodView& view) {
+  validateCamera(camera);
+  LodRenderResult result;
+  const auto start = std::chrono::steady_clock::now();
+  const Selection selection = scene.selectAll(camera, targets.width, targets.height, view);
+  const std::vector<std::vector<uint32_t>> split = scene.splitPasses(selection);
+  const LodCamera cam = lodCamera(scene, camera, targets.width, targets.height);
+  result.passes = uint32_t(std::max<size_t>(1, split.size()));
+  if (split.size() <= 1) {
+    scene.makeResident(split.empty() ? std::vector<uint32_t>{} : split[0], 0);
+    result.streamSeconds = secondsSince(start);
+    timeOnePass(context, scene, passes, targets, cam, settings, result);
+  } else {
+    timePasses(context, scene, passes, targets, cam, settings, split, result);
+  }
+  result.frame.points = selection.points;
+  result.frame.batch = passes.readStats();
+  result.lod = scene.stats();
+  return result;
+}
+
+} // namespace pointrast::lod
