@@ -37,17 +37,6 @@ constexpr uint64_t kGatherBlock = uint64_t(1) << 16;
 
 } // namespace
 
-std::string bytesText(uint64_t bytes) {
-  char text[32];
-  if (bytes >= (uint64_t(1) << 30))
-    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t(1) << 30));
-  else if (bytes >= (uint64_t(1) << 20))
-    std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(uint64_t(1) << 20));
-  else
-    std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / 1024.0);
-  return text;
-}
-
 std::string printf1(const char* format, double value) {
   char text[64];
   std::snprintf(text, sizeof text, format, value);

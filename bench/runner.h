@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "base/text.h" // bytesText
 #include "bench/views.h"
 #include "cloud/order.h"
 #include "gpu/bandwidth.h"
@@ -59,8 +60,6 @@ struct BenchConfig {
   bool progress = true; // generation, reading and upload progress (drawn only on a terminal)
 };
 
-// "512 KiB", "3.1 MiB", "12.7 GiB": memory sizes in messages and reports.
-std::string bytesText(uint64_t bytes);
 // One number through a printf format: printf1("%.1f s", 2.34) = "2.3 s" (at most 63 characters).
 std::string printf1(const char* format, double value);
 // The line both runners log once the copy bandwidth is measured: "copy bandwidth: 4305.4 GB/s (read +

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "base/error.h"
 #include "cloud/generate.h"
@@ -260,7 +261,8 @@ TEST_F(GpuTest, LodWithATenthOfTheOctreeInGpuMemoryIsBitIdentical) {
     const PointCloud all = tree.cloud();
     for (auto& [viewName, camera] : views(all.bounds, double(w) / h)) {
       const std::string where = name + " / " + viewName;
-      for (uint32_t precision : {0u, 3u}) {
+      for (uint32_t precision :
+           viewName == "overview" ? std::vector<uint32_t>{0, 3} : std::vector<uint32_t>{0}) {
         LodDrawn whole = drawOctree(*context, tree, camera, w, h, {false, precision});
         LodDrawn parts = drawOctree(*context, tree, camera, w, h, {false, precision, 0, 0, tenth});
         EXPECT_EQ(whole.result.passes, 1u) << where;
@@ -279,6 +281,439 @@ TEST_F(GpuTest, LodWithATenthOfTheOctreeInGpuMemoryIsBitIdentical) {
       EXPECT_EQ(partsHqs.result.frame.batch->pointsBlended, wholeHqs.result.frame.batch->pointsBlended)
           << where;
     }
+  }
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+
+namespace {
+
+// The hand-built octree of the exact-statistics tests, seen by axisCamera() (eye at the origin looking down
+// -z, 90 degrees) in a 64 x 64 image. Root cube [-16, 16]^3; each node's points sit at pixel centres, one
+// point a pixel, inside the node's cube:
+//   r       100 points anywhere in view                             projected size: eye inside, infinite
+//   r0      200 points, cube [-16, 0]^3 (lower left of the image)    eye on its sphere: infinite
+//   r6      300 points, cube [0, 16]^2 x [-16, 0] (upper right)      infinite
+//   r1      400 points, cube [-16, 0]^2 x [0, 16], whose corner is the eye, all behind the eye: taken by the
+//           CPU (its cube reaches into the frustum), culled on the GPU (its points' bounds do not);
+//           projected size infinite. Its child r12 (10 points, [-16, -8] x [-8, 0] x [0, 8]) is culled on
+//           the CPU and never read.
+//   r61      50 points, cube [0, 8]^2 x [-8, 0]                      infinite
+//   r64      60 points, cube [8, 16] x [0, 8] x [-16, -8]            12.7 pixels
+//   r65      70 points, cube [8, 16] x [0, 8] x [-8, 0], all outside the image (x > -z): culled on the GPU
+//                                                                    16.7 pixels
+constexpr uint32_t kHandSize = 64;
+
+struct HandTree {
+  MemoryOctree tree;
+  std::map<std::string, uint32_t> colorOf; // one color per node
+};
+
+void handBuiltOctree(HandTree& hand) {
+  MemoryOctree& tree = hand.tree;
+  tree.meta.source = "hand-built octree";
+  tree.meta.scale = glm::dvec3(1e-5);
+  tree.meta.cube.min = glm::dvec3(-16);
+  tree.meta.cube.max = glm::dvec3(16);
+  tree.meta.spacing = 0.25;
+  tree.meta.fields.color = true;
+  tree.meta.fields.colorMax = 255;
+  std::set<uint32_t> used;
+  auto add = [&](const std::string& name, int count, uint32_t color, bool onScreen) {
+    lod::NodeKey key;
+    for (size_t i = 1; i < name.size(); ++i)
+      key = key.child(name[i] - '0');
+    const Bounds cube = tree.meta.nodeCube(key);
+    std::vector<PointRecord>& records = tree.nodes[key];
+    hand.colorOf[name] = color;
+    auto record = [&](glm::dvec3 p) {
+      PointRecord r;
+      r.x = int32_t(std::llround(p.x / 1e-5));
+      r.y = int32_t(std::llround(p.y / 1e-5));
+      r.z = int32_t(std::llround(p.z / 1e-5));
+      r.rgb[0] = uint16_t(color & 0xFF);
+      r.rgb[1] = uint16_t((color >> 8) & 0xFF);
+      r.rgb[2] = uint16_t((color >> 16) & 0xFF);
+      records.push_back(r);
+    };
+    if (!onScreen) { // outside the image or behind the eye, inside the cube
+      for (int i = 0; i < count; ++i)
+        record(cube.min + (cube.max - cube.min) * glm::dvec3(0.8, 0.3 + 0.4 * i / count, 0.6));
+      return;
+    }
+    for (uint32_t pixel = 0; pixel < kHandSize * kHandSize && int(records.size()) < count; ++pixel) {
+      if (used.count(pixel)) continue;
+      const double sx = (pixel % kHandSize + 0.5) / (kHandSize / 2.0) - 1.0;
+      const double sy = 1.0 - (pixel / kHandSize + 0.5) / (kHandSize / 2.0);
+      for (double depth = 0.5; depth < 16; depth += 0.25) {
+        const glm::dvec3 p{sx * depth, sy * depth, -depth};
+        if (glm::all(glm::greaterThan(p, cube.min + 0.01)) && glm::all(glm::lessThan(p, cube.max - 0.01))) {
+          record(p);
+          used.insert(pixel);
+          break;
+        }
+      }
+    }
+  };
+  add("r", 100, 0x000001, true);
+  add("r0", 200, 0x000002, true);
+  add("r6", 300, 0x000003, true);
+  add("r1", 400, 0x000004, false);
+  add("r12", 10, 0x000005, false);
+  add("r61", 50, 0x000006, true);
+  add("r64", 60, 0x000007, true);
+  add("r65", 70, 0x000008, false);
+  Bounds all;
+  for (const auto& [key, records] : tree.nodes)
+    for (const PointRecord& r : records)
+      all.expand(glm::dvec3(r.x, r.y, r.z) * 1e-5);
+  tree.meta.bounds = all;
+  for (const auto& [key, records] : tree.nodes)
+    tree.meta.pointCount += records.size();
+}
+
+std::map<uint32_t, size_t> colorCounts(const std::vector<uint32_t>& image) {
+  std::map<uint32_t, size_t> counts;
+  for (uint32_t c : image)
+    if (c) ++counts[c & 0xFFFFFF];
+  return counts;
+}
+
+} // namespace
+
+TEST_F(GpuTest, LodStatisticsAreExactOnAHandBuiltOctree) {
+  HandTree hand;
+  handBuiltOctree(hand);
+  for (const auto& [name, size] :
+       std::map<std::string, size_t>{{"r", 100}, {"r0", 200}, {"r6", 300}, {"r61", 50}, {"r64", 60}}) {
+    lod::NodeKey key;
+    for (size_t i = 1; i < name.size(); ++i)
+      key = key.child(name[i] - '0');
+    ASSERT_EQ(hand.tree.nodes[key].size(), size)
+        << name << ": the test's placement found room for every point";
+  }
+  struct Case {
+    double minNodePx;
+    uint64_t budget;
+    uint64_t nodes, points;           // selected
+    uint64_t processed, rendered;     // nodes on the GPU: drawn, not culled
+    uint64_t pointsProcessed, pixels; // points of rendered nodes; lit pixels (one point each)
+  };
+  const Case cases[] = {
+      // Taken in the order r, r0, r1, r6 (infinite sizes, key order), r61, r65, r64; r1 and r65 culled on the
+      // GPU.
+      {0, 0, 7, 1180, 7, 5, 710, 710},    {14, 0, 6, 1120, 6, 4, 650, 650}, // r64 (12.7 px) LOD-culled
+      {20, 0, 5, 1050, 5, 4, 650, 650},                                     // r65 (16.7 px) too
+      {0, 1050, 5, 1050, 5, 4, 650, 650},                                   // the budget stops before r65
+      {0, 1049, 4, 1000, 4, 3, 600, 600},                                   // ... before r61
+  };
+  for (bool hqs : {false, true}) {
+    for (const Case& c : cases) {
+      const std::string where = std::string(hqs ? "lod-hqs" : "lod") + ", min-node-px " +
+                                std::to_string(c.minNodePx) + ", budget " + std::to_string(c.budget);
+      LodDrawn d = drawOctree(*context, hand.tree, axisCamera(), kHandSize, kHandSize,
+                              {hqs, 0, c.minNodePx, c.budget});
+      const lod::LodStats& s = d.result.lod;
+      EXPECT_EQ(s.nodesSelected, c.nodes) << where;
+      EXPECT_EQ(s.pointsSelected, c.points) << where;
+      EXPECT_EQ(s.nodesDrawn, c.processed) << where;
+      ASSERT_TRUE(d.result.frame.batch) << where;
+      const BatchStats& b = *d.result.frame.batch;
+      EXPECT_EQ(b.batchesProcessed, c.processed) << where;
+      EXPECT_EQ(b.batchesRendered, c.rendered) << where;
+      EXPECT_EQ(b.pointsProcessed, c.pointsProcessed) << where;
+      EXPECT_EQ(b.pointsRendered, c.pixels) << where;
+      EXPECT_EQ(b.pointsBlended, hqs ? c.pixels : 0u) << where;
+      EXPECT_EQ(litCount(d.image), c.pixels) << where;
+      // Nodes outside the view frustum are never drawn: no pixel has their colors.
+      const std::map<uint32_t, size_t> counts = colorCounts(d.image);
+      for (const char* outside : {"r1", "r12", "r65"})
+        EXPECT_EQ(counts.count(hand.colorOf[outside]), 0u) << where << ": " << outside;
+      // What was streamed: the selected nodes, not r1 and its subtree.
+      EXPECT_EQ(s.nodesLoaded, c.nodes) << where;
+      EXPECT_EQ(s.bytesStreamed, 24 * c.points) << where;
+    }
+  }
+  EXPECT_EQ(hand.tree.info({}).childMask, 0b01000011);
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+
+namespace {
+
+// A viewer's frame loop: update, upload and draw in one submission, then free the staging blocks.
+class FrameLoop {
+public:
+  FrameLoop(gpu::Context& context, lod::NodeSource& source, uint32_t w, uint32_t h,
+            const lod::LodOptions& options)
+      : context_(context), w_(w), h_(h), targets_(makeTargets(context, w, h)),
+        scene_(context, source, options), passes_(context, false, w, h) {}
+
+  // One frame; returns whether the scene said it changed.
+  bool frame(const Camera& camera, const lod::LodView& view) {
+    const bool changed = scene_.update(camera, w_, h_, view);
+    passes_.setList(scene_.drawList());
+    const lod::LodCamera cam = lod::lodCamera(scene_, camera, w_, h_);
+    const RenderSettings settings = lodSettings(0);
+    context_.submitAndWait([&](VkCommandBuffer cmd) {
+      scene_.recordUploads(cmd);
+      passes_.recordFrame(cmd, cam, targets_, settings);
+    });
+    scene_.uploadsFinished();
+    return changed;
+  }
+  // Frames until converged (at most `limit`), pausing briefly between them as a display would.
+  uint32_t converge(const Camera& camera, const lod::LodView& view, uint32_t limit = 3000) {
+    for (uint32_t n = 1; n <= limit; ++n) {
+      frame(camera, view);
+      if (scene_.converged()) return n;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return 0;
+  }
+  std::vector<uint64_t> words() {
+    std::vector<uint64_t> out(targets_.pixels());
+    gpu::readBuffer(context_, targets_.words, 0, out.data(), out.size() * 8);
+    return out;
+  }
+  std::vector<uint32_t> image() {
+    std::vector<uint32_t> out(targets_.pixels());
+    gpu::readBuffer(context_, targets_.image, 0, out.data(), out.size() * 4);
+    return out;
+  }
+  lod::LodScene& scene() { return scene_; }
+
+private:
+  gpu::Context& context_;
+  uint32_t w_, h_;
+  Targets targets_;
+  lod::LodScene scene_;
+  lod::LodPasses passes_;
+};
+
+} // namespace
+
+TEST_F(GpuTest, LodFramesRefineFromResidentAncestorsToTheFullImage) {
+  const uint32_t w = 160, h = 100;
+  GenerateOptions options;
+  options.points = 100'000;
+  options.progress = false;
+  MemoryOctree tree;
+  buildOctree(tree, generateScene(Scene::Terrain, options), 1000);
+  const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+  const lod::LodView view{0, 0};
+  LodDrawn offline = drawOctree(*context, tree, camera, w, h, {false, 0});
+
+  lod::LodOptions slow = smallOptions(64ull << 20);
+  slow.uploadBytesPerFrame = 2 * shared::kLodPageBytes; // a node or two a frame: many partial frames
+  FrameLoop loop(*context, tree, w, h, slow);
+  uint64_t drawnBefore = 0;
+  uint32_t frames = 0, partial = 0;
+  for (; frames < 3000 && !loop.scene().converged(); ++frames) {
+    EXPECT_TRUE(loop.frame(camera, view) || loop.scene().converged()) << "frame " << frames;
+    const lod::LodStats& s = loop.scene().stats();
+    EXPECT_GE(s.pointsDrawn, drawnBefore) << "frame " << frames << ": a fixed camera only refines";
+    EXPECT_LE(s.pointsDrawn, s.pointsSelected);
+    drawnBefore = s.pointsDrawn;
+    if (s.pointsDrawn > 0 && s.pointsDrawn < s.pointsSelected) {
+      ++partial;
+      if (partial == 3) savePng("lod refining", w, h, loop.image());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(loop.scene().converged()) << "not converged after " << frames << " frames";
+  EXPECT_GT(partial, 3u) << "the frames before convergence drew resident ancestors";
+  EXPECT_EQ(loop.words(), offline.words);
+  EXPECT_EQ(loop.image(), offline.image);
+  // Converged, same camera: nothing changed, nothing to draw again.
+  EXPECT_FALSE(loop.frame(camera, view));
+  EXPECT_FALSE(loop.frame(camera, view));
+  Camera moved = camera;
+  moved.eye.z += 1.0;
+  EXPECT_TRUE(loop.frame(moved, view));
+}
+
+TEST_F(GpuTest, LodCacheEvictsAcrossCameraJumpsAndConvergesEachTime) {
+  const uint32_t w = 160, h = 100;
+  GenerateOptions options;
+  options.points = 150'000;
+  options.progress = false;
+  MemoryOctree tree;
+  buildOctree(tree, generateScene(Scene::Terrain, options), 1000);
+  tree.colorsAreIndices();
+  const uint64_t quarter = octreeBytes(tree) / 4; // the union of the views' selections is larger
+  const Bounds& b = tree.meta.bounds;
+  const lod::LodView view{15, 0};
+  FrameLoop loop(*context, tree, w, h, smallOptions(quarter));
+  for (int jump = 0; jump < 6; ++jump) {
+    // Low views over the terrain's four quarters, then the overview.
+    Camera camera = overviewCamera(b, double(w) / h);
+    if (jump < 4) {
+      const glm::dvec3 size = b.size();
+      camera.target = b.min + size * glm::dvec3(jump % 2 ? 0.75 : 0.25, jump / 2 ? 0.75 : 0.25, 0.3);
+      camera.eye = camera.target + glm::dvec3(-0.1 * size.x, -0.1 * size.y, 0.1 * size.x);
+    }
+    const std::string where = "jump " + std::to_string(jump);
+    const uint32_t frames = loop.converge(camera, view);
+    ASSERT_GT(frames, 0u) << where << ": not converged";
+    const lod::LodStats& s = loop.scene().stats();
+    EXPECT_LE(s.residentBytes, quarter) << where;
+    EXPECT_FALSE(s.budgetReached) << where << ": the view's selection fits the cache";
+    LodDrawn offline = drawOctree(*context, tree, camera, w, h, {false, 0, view.minNodePx});
+    EXPECT_EQ(loop.image(), offline.image) << where;
+    savePng("lod jump " + std::to_string(jump), w, h, loop.image());
+  }
+  EXPECT_GT(loop.scene().stats().nodesEvicted, 0u);
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+
+namespace {
+
+// An octree whose hierarchy lies about a node's children.
+class LyingOctree : public MemoryOctree {
+public:
+  lod::NodeKey liar;
+  std::vector<lod::NodeInfo> children(const lod::NodeInfo& node) override {
+    std::vector<lod::NodeInfo> kids = MemoryOctree::children(node);
+    if (node.key == liar && !kids.empty()) kids.front().key = kids.front().key.child(0); // a grandchild
+    return kids;
+  }
+};
+
+// An octree that returns fewer points than its hierarchy claims for one node.
+class ShortOctree : public MemoryOctree {
+public:
+  lod::NodeKey shortNode;
+  std::vector<PointRecord> readNode(const lod::NodeInfo& node) override {
+    std::vector<PointRecord> records = MemoryOctree::readNode(node);
+    if (node.key == shortNode) records.resize(records.size() / 2);
+    return records;
+  }
+};
+
+void buildTestOctree(MemoryOctree& tree) {
+  GenerateOptions options;
+  options.points = 40'000;
+  options.progress = false;
+  buildOctree(tree, generateScene(Scene::Terrain, options), 1000);
+}
+
+// The deepest node of a tree (a leaf the full selection reaches last).
+lod::NodeKey deepest(const MemoryOctree& tree) {
+  lod::NodeKey deep;
+  for (const auto& [key, records] : tree.nodes)
+    if (key.level >= deep.level) deep = key;
+  return deep;
+}
+
+template <class Run> std::string errorOf(Run&& run) {
+  try {
+    run();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+} // namespace
+
+TEST_F(GpuTest, LodDamagedNodeWhileStreamingIsOneClearError) {
+  const uint32_t w = 96, h = 64;
+  MemoryOctree tree;
+  buildTestOctree(tree);
+  const lod::NodeKey bad = deepest(tree);
+  ASSERT_GT(bad.level, 1);
+  tree.damagedPoints.insert(bad);
+  const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+  for (bool hqs : {false, true}) {
+    for (uint64_t budget : {uint64_t(64) << 20, octreeBytes(tree) / 10}) { // one pass, several passes
+      const std::string message = errorOf([&] {
+        drawOctree(*context, tree, camera, w, h, {hqs, 0, 0, 0, budget});
+      });
+      EXPECT_NE(message.find("memory octree: node " + bad.potreeName() + " ends past the end of octree.bin"),
+                std::string::npos)
+          << message;
+    }
+  }
+  // Frame by frame: frames go on until the reader meets the node; then update() throws that error.
+  FrameLoop loop(*context, tree, w, h, smallOptions(64ull << 20));
+  const std::string message = errorOf([&] { loop.converge(camera, {0, 0}); });
+  EXPECT_NE(message.find("node " + bad.potreeName() + " ends past the end"), std::string::npos) << message;
+}
+
+TEST_F(GpuTest, LodDamagedHierarchyIsOneClearError) {
+  const uint32_t w = 96, h = 64;
+  {
+    MemoryOctree tree;
+    buildTestOctree(tree);
+    const lod::NodeKey bad = deepest(tree).parent();
+    tree.damagedChildren.insert(bad);
+    const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+    const std::string message = errorOf([&] { drawOctree(*context, tree, camera, w, h, {}); });
+    EXPECT_NE(message.find("the hierarchy below node " + bad.potreeName() + " is truncated"),
+              std::string::npos)
+        << message;
+  }
+  {
+    LyingOctree tree;
+    buildTestOctree(tree);
+    tree.liar = lod::NodeKey{}.child(0);
+    while (!tree.nodes.count(tree.liar))
+      tree.liar = tree.liar.parent().child(tree.liar.childIndex() + 1);
+    const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+    const std::string message = errorOf([&] { drawOctree(*context, tree, camera, w, h, {}); });
+    EXPECT_NE(message.find("memory octree: node "), std::string::npos) << message;
+    EXPECT_NE(message.find("is not one of its eight"), std::string::npos) << message;
+  }
+  {
+    ShortOctree tree;
+    buildTestOctree(tree);
+    tree.shortNode = deepest(tree);
+    const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+    const std::string message = errorOf([&] { drawOctree(*context, tree, camera, w, h, {}); });
+    EXPECT_NE(message.find("node " + tree.shortNode.potreeName() + " of memory octree holds"),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("points where its hierarchy says"), std::string::npos) << message;
+  }
+}
+
+TEST_F(GpuTest, LodNodeLargerThanTheCacheIsAClearError) {
+  MemoryOctree tree;
+  buildTestOctree(tree);
+  const Camera camera = overviewCamera(tree.meta.bounds, 1.5);
+  try {
+    drawOctree(*context, tree, camera, 96, 64, {false, 0, 0, 0, shared::kLodPageBytes / 2});
+    ADD_FAILURE() << "no error for a cache without a page";
+  } catch (const UnsupportedError& e) {
+    EXPECT_NE(std::string(e.what()).find("holds no page"), std::string::npos) << e.what();
+  }
+  // The root alone (all it selects from far away) fits one page; a cache of one page draws the root in one
+  // pass, and a full selection in as many passes as it has nodes.
+  LodDrawn one = drawOctree(*context, tree, camera, 96, 64, {false, 0, 0, 0, shared::kLodPageBytes});
+  EXPECT_EQ(one.result.passes, one.result.lod.nodesSelected);
+  // A node of two pages in a cache of one.
+  MemoryOctree big;
+  std::mt19937_64 rng(3);
+  buildOctree(big, randomBoxCloud(rng, shared::kLodPagePoints + 1, {1, 1, 1}), shared::kLodPagePoints + 1);
+  ASSERT_EQ(big.nodes.size(), 1u);
+  try {
+    drawOctree(*context, big, overviewCamera(big.meta.bounds, 1.5), 96, 64,
+               {false, 0, 0, 0, shared::kLodPageBytes});
+    ADD_FAILURE() << "no error for a node larger than the cache";
+  } catch (const UnsupportedError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("node r of memory octree needs 128 KiB of GPU memory, more than the node "
+                                   "cache's budget of 64 KiB (--gpu-memory)"),
+        std::string::npos)
+        << e.what();
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/text.h"
 #include "gpu/context.h"
 #include "render/lod/node_encoding.h"
 #include "render/lod/node_readers.h"
@@ -32,10 +33,6 @@ bool finite(const Bounds& b) {
 
 bool sameCamera(const Camera& a, const Camera& b) {
   return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fovY == b.fovY && a.nearW == b.nearW;
-}
-
-std::string bytesText(uint64_t bytes) {
-  return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB";
 }
 
 } // namespace
@@ -243,6 +240,7 @@ bool LodScene::update(const Camera& camera, uint32_t width, uint32_t height, con
   const Selection sel = selectNodes(*hierarchy_, camera, width, height, origin_, nearW(camera), limits);
   stats_.nodesSelected = sel.nodes.size();
   stats_.pointsSelected = sel.points;
+  stats_.budgetReached = sel.limited;
   for (uint32_t id : sel.nodes)
     touch(id);
   uploadArrived(sel.nodes, options_.uploadBytesPerFrame);
@@ -299,6 +297,7 @@ Selection LodScene::selectAll(const Camera& camera, uint32_t width, uint32_t hei
     Selection sel = selectNodes(*hierarchy_, camera, width, height, origin_, nearW(camera), limits);
     stats_.nodesSelected = sel.nodes.size();
     stats_.pointsSelected = sel.points;
+    stats_.budgetReached = sel.limited;
     if (sel.unexpanded.empty()) return sel;
     request({}, sel.unexpanded);
     readers_->wait(kWaitSeconds);

@@ -65,6 +65,7 @@ struct LodView {
 // holds, and the streaming totals since the scene was made.
 struct LodStats {
   uint64_t nodesSelected = 0, pointsSelected = 0; // the CPU's selection
+  bool budgetReached = false;                     // a budget (points, or the cache's pages) cut it short
   uint64_t nodesDrawn = 0, pointsDrawn = 0;       // the draw list (the resident part of the selection)
   uint64_t pagesDrawn = 0;
   uint64_t nodesLoaded = 0;   // nodes read and uploaded
