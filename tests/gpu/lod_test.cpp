@@ -10,8 +10,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <random>
 #include <thread>
+
+#include <unistd.h>
 
 #include "base/error.h"
 #include "cloud/generate.h"
@@ -20,6 +23,8 @@
 #include "gpu/shared_types.h"
 #include "gpu/spirv_reflect.h"
 #include "gpu_fixture.h"
+#include "io/octree_source.h"
+#include "io/potree.h"
 #include "io/writer.h"
 #include "lod_octree.h"
 #include "render/lod/lod_render.h"
@@ -40,19 +45,10 @@ struct LodDraw {
 struct LodDrawn {
   std::vector<uint64_t> words;
   std::vector<uint32_t> image;
-  lod::LodRenderResult result;
+  FrameStats stats;
+  const lod::LodStats& lod() const { return *stats.lod; }
+  const BatchStats& gpu() const { return *stats.batch; }
 };
-
-Targets makeTargets(gpu::Context& context, uint32_t w, uint32_t h) {
-  Targets t;
-  t.width = w;
-  t.height = h;
-  t.framebuffer =
-      gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
-  t.image = gpu::Buffer(context, t.pixels() * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "image");
-  t.words = gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "words");
-  return t;
-}
 
 lod::LodOptions smallOptions(uint64_t gpuBytes) {
   lod::LodOptions o;
@@ -62,10 +58,13 @@ lod::LodOptions smallOptions(uint64_t gpuBytes) {
   return o;
 }
 
-RenderSettings lodSettings(uint32_t precision) {
+RenderSettings lodSettings(const LodDraw& d) {
   RenderSettings s;
-  s.precision = precision;
-  s.captureWords = true;
+  s.method = d.hqs ? pointMethod("lod-hqs") : pointMethod("lod");
+  s.precision = d.precision;
+  s.minNodePx = d.minNodePx;
+  s.pointBudget = d.pointBudget;
+  s.captureWords = !d.hqs;
   s.background = 0;
   s.frames = 1;
   s.warmup = 0;
@@ -74,18 +73,13 @@ RenderSettings lodSettings(uint32_t precision) {
 
 LodDrawn drawOctree(gpu::Context& context, lod::NodeSource& source, const Camera& camera, uint32_t w,
                     uint32_t h, const LodDraw& d) {
-  Targets targets = makeTargets(context, w, h);
+  Renderer renderer(context, w, h);
   lod::LodScene scene(context, source, smallOptions(d.gpuBytes));
-  lod::LodPasses passes(context, d.hqs, w, h);
-  lod::LodView view{d.minNodePx, d.pointBudget};
   LodDrawn out;
-  out.result = lod::renderOctree(context, scene, passes, targets, camera, lodSettings(d.precision), view);
-  out.image.resize(targets.pixels());
-  gpu::readBuffer(context, targets.image, 0, out.image.data(), out.image.size() * 4);
-  if (!d.hqs) {
-    out.words.resize(targets.pixels());
-    gpu::readBuffer(context, targets.words, 0, out.words.data(), out.words.size() * 8);
-  }
+  out.stats = renderer.render(scene, camera, lodSettings(d));
+  EXPECT_TRUE(out.stats.lod && out.stats.batch);
+  out.image = renderer.image();
+  if (!d.hqs) out.words = renderer.framebufferWords();
   return out;
 }
 
@@ -102,7 +96,7 @@ Reference drawBruteForce(gpu::Context& context, const PointCloud& cloud, const C
   Renderer renderer(context, w, h);
   RenderSettings s;
   s.method = method;
-  s.captureWords = methodInfo(method).closest;
+  s.captureWords = hasCanonicalWords(methodInfo(method));
   s.background = 0;
   renderer.render(scene, camera, s);
   Reference r;
@@ -204,7 +198,7 @@ TEST_F(GpuTest, LodDrawsEveryPointAndMatchesAtomicMin) {
     const PointCloud all = tree.cloud();
     for (auto& [viewName, camera] : views(all.bounds, double(w) / h)) {
       const std::string where = name + " / " + viewName;
-      Reference reference = drawBruteForce(*context, all, camera, w, h, Method::AtomicMin);
+      Reference reference = drawBruteForce(*context, all, camera, w, h, pointMethod("atomicmin"));
       LodDrawn lod = drawOctree(*context, tree, camera, w, h, {false, 3});
       savePng("lod " + where, w, h, lod.image);
       savePng("atomicmin " + where, w, h, reference.image);
@@ -214,15 +208,14 @@ TEST_F(GpuTest, LodDrawsEveryPointAndMatchesAtomicMin) {
       const double same = equalLitFraction(lod.image, reference.image);
       EXPECT_GE(same, 0.999) << where;
       if (same < 1.0) std::printf("%s: %.4f %% of lit pixels equal\n", where.c_str(), 100 * same);
-      const lod::LodStats& s = lod.result.lod;
+      const lod::LodStats& s = lod.lod();
       if (viewName == "overview") {
         EXPECT_EQ(s.nodesSelected, tree.nodes.size()) << where << ": every node, with no LOD culling";
         EXPECT_EQ(s.pointsSelected, all.size()) << where;
       }
       EXPECT_EQ(s.pointsDrawn, s.pointsSelected) << where;
-      EXPECT_EQ(lod.result.passes, 1u) << where;
-      ASSERT_TRUE(lod.result.frame.batch) << where;
-      const BatchStats& b = *lod.result.frame.batch;
+      EXPECT_EQ(lod.lod().passes, 1u) << where;
+      const BatchStats& b = lod.gpu();
       EXPECT_EQ(b.batchesProcessed, s.nodesDrawn) << where;
       EXPECT_EQ(b.pointsByWords[2], b.pointsProcessed) << where << ": precision forced to 3 words";
       EXPECT_GE(b.pointsRendered, litCount(lod.image)) << where;
@@ -237,7 +230,7 @@ TEST_F(GpuTest, LodHqsMatchesHqs) {
     buildOctree(tree, cloud);
     const PointCloud all = tree.cloud();
     const Camera camera = overviewCamera(all.bounds, double(w) / h);
-    Reference hqs = drawBruteForce(*context, all, camera, w, h, Method::Hqs);
+    Reference hqs = drawBruteForce(*context, all, camera, w, h, pointMethod("hqs"));
     LodDrawn lod = drawOctree(*context, tree, camera, w, h, {true, 3});
     savePng("lod-hqs " + name, w, h, lod.image);
     savePng("hqs " + name, w, h, hqs.image);
@@ -246,8 +239,7 @@ TEST_F(GpuTest, LodHqsMatchesHqs) {
     maxChannelDiff(lod.image, hqs.image, &withinOne);
     // As batch-hqs against hqs: points on pixel borders may switch pixels after quantization.
     EXPECT_GE(withinOne, 0.998) << name;
-    ASSERT_TRUE(lod.result.frame.batch);
-    EXPECT_GT(lod.result.frame.batch->pointsBlended, litCount(lod.image)) << name;
+    EXPECT_GT(lod.gpu().pointsBlended, litCount(lod.image)) << name;
   }
 }
 
@@ -265,21 +257,19 @@ TEST_F(GpuTest, LodWithATenthOfTheOctreeInGpuMemoryIsBitIdentical) {
            viewName == "overview" ? std::vector<uint32_t>{0, 3} : std::vector<uint32_t>{0}) {
         LodDrawn whole = drawOctree(*context, tree, camera, w, h, {false, precision});
         LodDrawn parts = drawOctree(*context, tree, camera, w, h, {false, precision, 0, 0, tenth});
-        EXPECT_EQ(whole.result.passes, 1u) << where;
+        EXPECT_EQ(whole.lod().passes, 1u) << where;
         if (viewName == "overview") {
-          EXPECT_GE(parts.result.passes, 10u) << where;
+          EXPECT_GE(parts.lod().passes, 10u) << where;
         }
-        EXPECT_LE(parts.result.lod.residentBytes, tenth) << where;
+        EXPECT_LE(parts.lod().residentBytes, tenth) << where;
         EXPECT_EQ(parts.words, whole.words) << where << ", precision " << precision;
         EXPECT_EQ(parts.image, whole.image) << where << ", precision " << precision;
-        EXPECT_EQ(parts.result.frame.batch->pointsProcessed, whole.result.frame.batch->pointsProcessed)
-            << where;
+        EXPECT_EQ(parts.gpu().pointsProcessed, whole.gpu().pointsProcessed) << where;
       }
       LodDrawn wholeHqs = drawOctree(*context, tree, camera, w, h, {true, 0});
       LodDrawn partsHqs = drawOctree(*context, tree, camera, w, h, {true, 0, 0, 0, tenth});
       EXPECT_EQ(partsHqs.image, wholeHqs.image) << where << ", lod-hqs";
-      EXPECT_EQ(partsHqs.result.frame.batch->pointsBlended, wholeHqs.result.frame.batch->pointsBlended)
-          << where;
+      EXPECT_EQ(partsHqs.gpu().pointsBlended, wholeHqs.gpu().pointsBlended) << where;
     }
   }
 }
@@ -415,12 +405,11 @@ TEST_F(GpuTest, LodStatisticsAreExactOnAHandBuiltOctree) {
                                 std::to_string(c.minNodePx) + ", budget " + std::to_string(c.budget);
       LodDrawn d = drawOctree(*context, hand.tree, axisCamera(), kHandSize, kHandSize,
                               {hqs, 0, c.minNodePx, c.budget});
-      const lod::LodStats& s = d.result.lod;
+      const lod::LodStats& s = d.lod();
       EXPECT_EQ(s.nodesSelected, c.nodes) << where;
       EXPECT_EQ(s.pointsSelected, c.points) << where;
       EXPECT_EQ(s.nodesDrawn, c.processed) << where;
-      ASSERT_TRUE(d.result.frame.batch) << where;
-      const BatchStats& b = *d.result.frame.batch;
+      const BatchStats& b = d.gpu();
       EXPECT_EQ(b.batchesProcessed, c.processed) << where;
       EXPECT_EQ(b.batchesRendered, c.rendered) << where;
       EXPECT_EQ(b.pointsProcessed, c.pointsProcessed) << where;
@@ -445,54 +434,39 @@ namespace pointrast::test {
 
 namespace {
 
-// A viewer's frame loop: update, upload and draw in one submission, then free the staging blocks.
+// A viewer's frame loop: Renderer::renderFrame, one frame at a time.
 class FrameLoop {
 public:
   FrameLoop(gpu::Context& context, lod::NodeSource& source, uint32_t w, uint32_t h,
             const lod::LodOptions& options)
-      : context_(context), w_(w), h_(h), targets_(makeTargets(context, w, h)),
-        scene_(context, source, options), passes_(context, false, w, h) {}
+      : renderer_(context, w, h), scene_(context, source, options) {}
 
   // One frame; returns whether the scene said it changed.
   bool frame(const Camera& camera, const lod::LodView& view) {
-    const bool changed = scene_.update(camera, w_, h_, view);
-    passes_.setList(scene_.drawList());
-    const lod::LodCamera cam = lod::lodCamera(scene_, camera, w_, h_);
-    const RenderSettings settings = lodSettings(0);
-    context_.submitAndWait([&](VkCommandBuffer cmd) {
-      scene_.recordUploads(cmd);
-      passes_.recordFrame(cmd, cam, targets_, settings);
-    });
-    scene_.uploadsFinished();
-    return changed;
+    LodDraw d;
+    d.minNodePx = view.minNodePx;
+    d.pointBudget = view.pointBudget;
+    last_ = renderer_.renderFrame(scene_, camera, lodSettings(d));
+    return last_.lod->changed;
   }
   // Frames until converged (at most `limit`), pausing briefly between them as a display would.
   uint32_t converge(const Camera& camera, const lod::LodView& view, uint32_t limit = 3000) {
     for (uint32_t n = 1; n <= limit; ++n) {
       frame(camera, view);
-      if (scene_.converged()) return n;
+      if (last_.lod->converged) return n;
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return 0;
   }
-  std::vector<uint64_t> words() {
-    std::vector<uint64_t> out(targets_.pixels());
-    gpu::readBuffer(context_, targets_.words, 0, out.data(), out.size() * 8);
-    return out;
-  }
-  std::vector<uint32_t> image() {
-    std::vector<uint32_t> out(targets_.pixels());
-    gpu::readBuffer(context_, targets_.image, 0, out.data(), out.size() * 4);
-    return out;
-  }
+  std::vector<uint64_t> words() { return renderer_.framebufferWords(); }
+  std::vector<uint32_t> image() { return renderer_.image(); }
   lod::LodScene& scene() { return scene_; }
+  const FrameStats& last() const { return last_; }
 
 private:
-  gpu::Context& context_;
-  uint32_t w_, h_;
-  Targets targets_;
+  Renderer renderer_;
   lod::LodScene scene_;
-  lod::LodPasses passes_;
+  FrameStats last_;
 };
 
 } // namespace
@@ -698,7 +672,7 @@ TEST_F(GpuTest, LodNodeLargerThanTheCacheIsAClearError) {
   // The root alone (all it selects from far away) fits one page; a cache of one page draws the root in one
   // pass, and a full selection in as many passes as it has nodes.
   LodDrawn one = drawOctree(*context, tree, camera, 96, 64, {false, 0, 0, 0, shared::kLodPageBytes});
-  EXPECT_EQ(one.result.passes, one.result.lod.nodesSelected);
+  EXPECT_EQ(one.lod().passes, one.lod().nodesSelected);
   // A node of two pages in a cache of one.
   MemoryOctree big;
   std::mt19937_64 rng(3);
@@ -715,6 +689,48 @@ TEST_F(GpuTest, LodNodeLargerThanTheCacheIsAClearError) {
         std::string::npos)
         << e.what();
   }
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+
+TEST_F(GpuTest, LodStreamsAPotreeFolderAsItDrawsTheSameOctreeInMemory) {
+  const uint32_t w = 160, h = 100;
+  GenerateOptions options;
+  options.points = 60'000;
+  options.progress = false;
+  MemoryOctree tree;
+  buildOctree(tree, generateScene(Scene::Tls, options), 1500);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("pointrast-lod-test-" + std::to_string(::getpid())) / "octree";
+  std::filesystem::remove_all(dir.parent_path());
+  std::filesystem::create_directories(dir.parent_path());
+  {
+    io::PotreeWriter writer(dir, tree.meta, {});
+    for (const auto& [key, records] : tree.nodes)
+      writer.writeNode(key, records.data(), records.size());
+    writer.commit();
+  }
+  ASSERT_TRUE(io::looksLikeOctree(dir));
+  std::unique_ptr<lod::NodeSource> folder = io::openOctree(dir);
+  const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+  for (bool hqs : {false, true}) {
+    for (uint64_t budget : {uint64_t(64) << 20, octreeBytes(tree) / 10}) {
+      LodDrawn fromMemory = drawOctree(*context, tree, camera, w, h, {hqs, 0, 0, 0, budget});
+      LodDrawn fromFolder = drawOctree(*context, *folder, camera, w, h, {hqs, 0, 0, 0, budget});
+      EXPECT_EQ(fromFolder.image, fromMemory.image) << (hqs ? "lod-hqs" : "lod") << ", budget " << budget;
+      EXPECT_EQ(fromFolder.words, fromMemory.words);
+      EXPECT_EQ(fromFolder.lod().pointsDrawn, tree.points());
+      EXPECT_GT(fromFolder.lod().bytesStreamed, 0u);
+    }
+  }
+  if (const char* keep = std::getenv("POINTRAST_TEST_PNG"); keep && *keep)
+    std::filesystem::copy(dir, std::filesystem::path(keep) / "octree",
+                          std::filesystem::copy_options::recursive |
+                              std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::remove_all(dir.parent_path());
+  EXPECT_THROW(io::openOctree(dir), InputError);
 }
 
 } // namespace pointrast::test

@@ -34,12 +34,12 @@ TableLayout layoutOf(uint64_t nodes, uint64_t pages) {
 
 } // namespace
 
-LodPasses::LodPasses(gpu::Context& context, bool hqs, uint32_t width, uint32_t height)
-    : context_(context), hqs_(hqs) {
+LodPasses::LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
+    : context_(context), hqs_(method.output == MethodOutput::Blend) {
   nodes_ = gpu::ComputeProgram(context, "lod_nodes.comp");
-  raster_ = gpu::ComputeProgram(context, "raster_lod.comp",
-                                {{/* PREFETCH= */ 0, 1}, {/* DEPTH_ONLY= */ 1, uint32_t(hqs)}});
-  if (hqs) {
+  // The row's constants: PREFETCH and, for lod-hqs, DEPTH_ONLY (the depth pass before the accumulation).
+  raster_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
+  if (hqs_) {
     accumulate_ = gpu::ComputeProgram(context, "raster_lod_hqs.comp");
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
     // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.

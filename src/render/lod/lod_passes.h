@@ -34,7 +34,9 @@ enum class LodPhase {
 
 class LodPasses {
 public:
-  LodPasses(gpu::Context& context, bool hqs, uint32_t width, uint32_t height);
+  // The passes of a LOD row of the method table: its shader and specialization constants draw the pages;
+  // Blend output (lod-hqs) adds the accumulation pass.
+  LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height);
   bool hqs() const { return hqs_; }
 
   // The list the next recorded commands draw (host-written tables, copied to the GPU by each pass). One list

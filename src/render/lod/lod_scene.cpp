@@ -155,7 +155,7 @@ bool LodScene::upload(ReadPoints& read) {
   resident_.emplace(read.id, std::move(r));
   ++stats_.nodesLoaded;
   stats_.bytesStreamed += read.sourceBytes;
-  stats_.bytesUploaded += pages * shared::kLodPageBytes;
+  stats_.bytesUploaded += 16 * ((uint64_t(read.points) + 3) & ~3ull); // 4 sections of 4 B a point
   return true;
 }
 

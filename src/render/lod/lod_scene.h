@@ -31,6 +31,7 @@
 #include "gpu/vulkan_api.h"
 #include "render/camera.h"
 #include "render/lod/hierarchy.h"
+#include "render/lod/lod_stats.h"
 #include "render/lod/selection.h"
 
 namespace pointrast::gpu {
@@ -59,22 +60,6 @@ uint64_t defaultGpuBytes(const gpu::Context& context);
 struct LodView {
   double minNodePx = 100;   // LOD culling: smallest projected radius drawn, in pixels (selection.h)
   uint64_t pointBudget = 0; // most points a frame selects; 0: no limit
-};
-
-// Counts for the reports: the selection of the last update() or selectAll(), what the last drawList()
-// holds, and the streaming totals since the scene was made.
-struct LodStats {
-  uint64_t nodesSelected = 0, pointsSelected = 0; // the CPU's selection
-  bool budgetReached = false;                     // a budget (points, or the cache's pages) cut it short
-  uint64_t nodesDrawn = 0, pointsDrawn = 0;       // the draw list (the resident part of the selection)
-  uint64_t pagesDrawn = 0;
-  uint64_t nodesLoaded = 0;   // nodes read and uploaded
-  uint64_t bytesStreamed = 0; // bytes of the source's files those nodes occupy (NodeSource::nodeBytes)
-  uint64_t bytesUploaded = 0; // bytes copied into the node cache
-  uint64_t nodesEvicted = 0;
-  uint64_t hierarchyReads = 0; // children lists read
-  uint64_t residentBytes = 0;  // node cache pages in use
-  uint64_t cacheBytes = 0;     // the cache's budget (whole pages)
 };
 
 // A frame's nodes for the GPU (shared.h): nodes in key order with their pages.
@@ -108,6 +93,7 @@ public:
   void uploadsFinished();                        // their staging blocks are free again
   const LodDrawList& drawList() const { return drawList_; }
   const LodStats& stats() const { return stats_; }
+  const Hierarchy& hierarchy() const { return *hierarchy_; }
 
   // --- Offline ---
   // The whole selection for a camera (no cache limit), after reading every hierarchy part it reaches.
