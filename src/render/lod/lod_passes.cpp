@@ -51,6 +51,8 @@ LodPasses::LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t w
     finish_ = gpu::ComputeProgram(context, "resolve_lod.comp", {{/* MODE= */ 0, 2}});
   }
   stats_ = gpu::Buffer(context, kStatsBytes, gpu::kBufferUsage, gpu::MemoryKind::Device, "lod statistics");
+  statsReadback_ = gpu::Buffer(context, kStatsBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                               gpu::MemoryKind::Readback, "lod statistics readback");
   setList({});
 }
 
@@ -99,6 +101,12 @@ void LodPasses::recordTables(VkCommandBuffer cmd) {
       {l.nodes, l.nodes, std::max<uint64_t>(1, nodeCount_) * sizeof(shared::LodNode)},
       {l.uploadPages, l.pages, std::max<uint64_t>(1, pageCount_) * sizeof(shared::LodPage)}};
   gpu::vkCmdCopyBuffer(cmd, upload_.handle(), tables_.handle(), 3, regions);
+}
+
+void LodPasses::recordStatsCopy(VkCommandBuffer cmd) {
+  VkBufferCopy region{0, 0, kStatsBytes};
+  gpu::vkCmdCopyBuffer(cmd, stats_.handle(), statsReadback_.handle(), 1, &region);
+  gpu::fullBarrier(cmd);
 }
 
 void LodPasses::recordNodes(VkCommandBuffer cmd, const LodCamera& camera) {
@@ -160,6 +168,7 @@ void LodPasses::recordFrame(VkCommandBuffer cmd, const LodCamera& camera, Target
     recordResolve(cmd, resolve_, targets, settings, tables_.address(), true);
   }
   gpu::fullBarrier(cmd);
+  recordStatsCopy(cmd);
 }
 
 void LodPasses::recordBegin(VkCommandBuffer cmd, Targets& targets) {
@@ -199,11 +208,13 @@ void LodPasses::recordFinish(VkCommandBuffer cmd, Targets& targets, const Render
   else
     recordResolve(cmd, finish_, targets, settings, tables_.address(), true);
   gpu::fullBarrier(cmd);
+  recordStatsCopy(cmd);
 }
 
-BatchStats LodPasses::readStats() {
+BatchStats LodPasses::readStats() const {
   uint64_t rows[shared::kBatchStatSlots][shared::kBatchStatCount];
-  gpu::readBuffer(context_, stats_, 0, rows, sizeof rows);
+  statsReadback_.invalidate();
+  std::memcpy(rows, statsReadback_.mapped(), sizeof rows);
   uint64_t sum[shared::kBatchStatCount] = {};
   for (const auto& row : rows)
     for (uint32_t k = 0; k < shared::kBatchStatCount; ++k)

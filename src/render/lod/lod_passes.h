@@ -51,12 +51,14 @@ public:
                   const RenderSettings& settings, LodPhase phase);
   void recordFinish(VkCommandBuffer cmd, Targets& targets, const RenderSettings& settings);
 
-  // Counts since the last recordFrame or recordBegin (nodes in the batch fields), after the submission.
-  BatchStats readStats();
+  // Counts since the last recordFrame or recordBegin (nodes in the batch fields), after the submission of
+  // recordFrame or recordFinish (which copy them where the host reads them: no submission of its own).
+  BatchStats readStats() const;
 
 private:
   void writeFrame(const Targets& targets, const RenderSettings& settings, bool nodeStats);
   void recordTables(VkCommandBuffer cmd);
+  void recordStatsCopy(VkCommandBuffer cmd);
   void recordNodes(VkCommandBuffer cmd, const LodCamera& camera);
   void recordPages(VkCommandBuffer cmd, const gpu::ComputeProgram& program, const LodCamera& camera);
   void recordResolve(VkCommandBuffer cmd, const gpu::ComputeProgram& program, const Targets& targets,
@@ -73,6 +75,7 @@ private:
   gpu::Buffer accumulators_;       // lod-hqs
   gpu::Buffer composite_;          // lod, several passes
   gpu::Buffer stats_;
+  gpu::Buffer statsReadback_;
   gpu::Buffer upload_; // LodFrame, nodes, pages, written by the host
   gpu::Buffer tables_; // LodFrame, nodes, views, pages on the GPU
   uint64_t capacityNodes_ = 0, capacityPages_ = 0;

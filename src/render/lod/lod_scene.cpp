@@ -196,11 +196,11 @@ void LodScene::request(const std::vector<uint32_t>& wanted, const std::vector<ui
     waiting.insert(r.id);
   std::vector<ReadJob> jobs;
   for (uint32_t id : expand)
-    jobs.push_back({ReadJob::Kind::Children, id, hierarchy_->node(id).info, hierarchy_->describe(id)});
+    jobs.push_back({ReadJob::Kind::Children, id, hierarchy_->node(id).info});
   for (uint32_t id : wanted) {
     if (residentOrEmpty(id) || waiting.count(id)) continue;
     checkFits(id);
-    jobs.push_back({ReadJob::Kind::Points, id, hierarchy_->node(id).info, hierarchy_->describe(id)});
+    jobs.push_back({ReadJob::Kind::Points, id, hierarchy_->node(id).info});
   }
   readers_->want(jobs);
 }

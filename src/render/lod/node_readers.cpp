@@ -83,10 +83,14 @@ void NodeReaders::run() {
     } catch (const std::exception& e) {
       // Anything else a source throws (a failed allocation, a system error) still names the node.
       std::lock_guard lock(mutex_);
-      if (!error_) error_ = std::make_exception_ptr(InputError(job.name + ": " + e.what()));
+      if (!error_) error_ = std::make_exception_ptr(InputError(describe(job) + ": " + e.what()));
     }
     finished_.notify_all();
   }
+}
+
+std::string NodeReaders::describe(const ReadJob& job) const {
+  return "node " + job.info.key.potreeName() + " of " + source_.metadata().source;
 }
 
 void NodeReaders::perform(const ReadJob& job) {
@@ -98,7 +102,7 @@ void NodeReaders::perform(const ReadJob& job) {
   }
   std::vector<PointRecord> records = source_.readNode(job.info);
   if (records.size() != job.info.pointCount)
-    throw InputError(job.name + " holds " + std::to_string(records.size()) +
+    throw InputError(describe(job) + " holds " + std::to_string(records.size()) +
                      " points where its hierarchy says " + std::to_string(job.info.pointCount));
   ReadPoints result;
   result.id = job.id;

@@ -26,7 +26,6 @@ struct ReadJob {
   Kind kind = Kind::Points;
   uint32_t id = 0; // the node's id in the renderer's hierarchy
   NodeInfo info;
-  std::string name; // for messages: Hierarchy::describe
 };
 
 struct ReadPoints {
@@ -63,6 +62,7 @@ private:
   using JobKey = std::pair<uint32_t, ReadJob::Kind>;
   void run();
   void perform(const ReadJob& job);
+  std::string describe(const ReadJob& job) const; // "node r07 of cloud/metadata.json", for messages
 
   NodeSource& source_;
   const NodeEncoder& encoder_;
