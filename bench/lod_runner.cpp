@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "bench/suites.h"
-#include "io/octree_source.h"
+#include "io/format_table.h"
 #include "render/lod/lod_scene.h"
 
 namespace pointrast::bench {
@@ -32,7 +32,7 @@ OpenOctree openOctree(gpu::Context& context, const BenchConfig& config, const Da
     if (!config.octrees) throw InputError("no octree: this run has no octree builder or cache");
     DatasetOctree octree =
         config.octrees(octreeKey(dataset), [&]() -> const PointCloud& { return cloud; });
-    o.source = io::openOctree(octree.path);
+    o.source = io::openNodeSource(octree.path);
     o.scene = std::make_unique<lod::LodScene>(context, *o.source);
     run.octrees.emplace_back(dataset.name, std::move(octree));
   } catch (const InputError& e) {

@@ -12,7 +12,7 @@
 
 #include "bench/lod_runner.h"
 #include "gpu/shared_types.h"
-#include "io/octree_source.h"
+#include "io/format_table.h"
 #include "render/lod/lod_scene.h"
 
 namespace pointrast::bench {
@@ -255,7 +255,7 @@ LodSuiteRun runLodSuite(gpu::Context& context, const LodSuiteConfig& config,
       try {
         if (!config.octrees) throw InputError("no octree: this run has no octree builder or cache");
         octree = config.octrees(octreeKey(d), points);
-        source = io::openOctree(octree.path);
+        source = io::openNodeSource(octree.path);
       } catch (const InputError& e) {
         outcome.skipped = true;
         outcome.reason = e.what();

@@ -23,7 +23,7 @@
 #include "gpu/shared_types.h"
 #include "gpu/spirv_reflect.h"
 #include "gpu_fixture.h"
-#include "io/octree_source.h"
+#include "io/format_table.h"
 #include "io/potree.h"
 #include "io/writer.h"
 #include "lod_octree.h"
@@ -712,8 +712,8 @@ TEST_F(GpuTest, LodStreamsAPotreeFolderAsItDrawsTheSameOctreeInMemory) {
       writer.writeNode(key, records.data(), records.size());
     writer.commit();
   }
-  ASSERT_TRUE(io::looksLikeOctree(dir));
-  std::unique_ptr<lod::NodeSource> folder = io::openOctree(dir);
+  ASSERT_TRUE(io::detectFormat(dir) && io::detectFormat(dir)->openNodes);
+  std::unique_ptr<lod::NodeSource> folder = io::openNodeSource(dir);
   const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
   for (bool hqs : {false, true}) {
     for (uint64_t budget : {uint64_t(64) << 20, octreeBytes(tree) / 10}) {
@@ -730,7 +730,7 @@ TEST_F(GpuTest, LodStreamsAPotreeFolderAsItDrawsTheSameOctreeInMemory) {
                           std::filesystem::copy_options::recursive |
                               std::filesystem::copy_options::overwrite_existing);
   std::filesystem::remove_all(dir.parent_path());
-  EXPECT_THROW(io::openOctree(dir), InputError);
+  EXPECT_THROW(io::openNodeSource(dir), InputError);
 }
 
 } // namespace pointrast::test
