@@ -734,3 +734,35 @@ TEST_F(GpuTest, LodStreamsAPotreeFolderAsItDrawsTheSameOctreeInMemory) {
 }
 
 } // namespace pointrast::test
+
+namespace pointrast::test {
+
+TEST_F(GpuTest, LodFullRenderAfterViewerFramesOnTheSameScene) {
+  // Frames ask the readers for many nodes; a full render of the same scene right after must neither wait on
+  // readers blocked by the small staging area nor draw anything but its own selection.
+  const uint32_t w = 120, h = 80;
+  MemoryOctree tree;
+  GenerateOptions options;
+  options.points = 60'000;
+  options.progress = false;
+  buildOctree(tree, generateScene(Scene::Terrain, options), 300);
+  const Camera camera = overviewCamera(tree.meta.bounds, double(w) / h);
+  lod::LodOptions small = smallOptions(64ull << 20);
+  small.stagingBytes = 2 * shared::kLodPageBytes;
+  Renderer renderer(*context, w, h);
+  lod::LodScene scene(*context, tree, small);
+  LodDraw d;
+  RenderSettings settings = lodSettings(d);
+  // The first frame knows the root only and asks for its children; the second asks for the points of the
+  // level below, which fill the staging blocks while the deeper hierarchy is still unread.
+  renderer.renderFrame(scene, camera, settings);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  renderer.renderFrame(scene, camera, settings);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const FrameStats full = renderer.render(scene, camera, settings);
+  EXPECT_EQ(full.lod->pointsDrawn, tree.points());
+  LodDrawn fresh = drawOctree(*context, tree, camera, w, h, d);
+  EXPECT_EQ(renderer.image(), fresh.image);
+}
+
+} // namespace pointrast::test

@@ -299,6 +299,9 @@ Selection LodScene::selectAll(const Camera& camera, uint32_t width, uint32_t hei
     stats_.pointsSelected = sel.points;
     stats_.budgetReached = sel.limited;
     if (sel.unexpanded.empty()) return sel;
+    // Points read for earlier frames give their staging blocks back: a reader waiting for blocks must not
+    // hold up the hierarchy reads this selection waits for.
+    uploadArrived({}, 0);
     request({}, sel.unexpanded);
     readers_->wait(kWaitSeconds);
   }
