@@ -768,3 +768,47 @@ TEST_F(GpuTest, LodFullRenderAfterViewerFramesOnTheSameScene) {
 }
 
 } // namespace pointrast::test
+
+namespace pointrast::test {
+
+TEST_F(GpuTest, LodHqsMatchesHqsWithinOneEverywherePastThePackedWordsLimit) {
+  // As batch-hqs against hqs: points near pixel centres at depths well within 1 % of the pixel's front
+  // surface or 3 % behind it, and one pixel with 1,500 blended points (past the packed word's 255, so the
+  // fallback sums are used), spread over the octree's nodes.
+  constexpr uint32_t W = 64, H = 64;
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3), layer(0.0, 0.004);
+  std::vector<glm::dvec3> points;
+  std::vector<uint32_t> colors;
+  auto add = [&](uint32_t px, uint32_t py, double depth, uint32_t color) {
+    double sx = (px + 0.5 + jitter(rng)) / (W / 2.0) - 1.0, sy = 1.0 - (py + 0.5 + jitter(rng)) / (H / 2.0);
+    points.push_back({sx * depth, sy * depth, -depth});
+    colors.push_back(color);
+  };
+  for (uint32_t py = 0; py < H; ++py)
+    for (uint32_t px = 0; px < W; ++px) {
+      if ((px * 7 + py * 3) % 11 == 0) continue;
+      double front = 2.0 + 0.5 * std::sin(px * 0.2) + 0.3 * std::cos(py * 0.3);
+      int count = 1 + int(rng() % 6);
+      for (int k = 0; k < count; ++k)
+        add(px, py, front * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+      add(px, py, front * 1.03, 0xFF0000FFu);
+    }
+  for (int k = 0; k < 1500; ++k)
+    add(10, 20, 1.5 * (1.0 + layer(rng)), 0xFF000000u | uint32_t(rng() & 0xFFFFFF));
+  const PointCloud cloud = cloudFromPoints(points, colors, 1e-7);
+  MemoryOctree tree;
+  buildOctree(tree, cloud, 2000);
+  ASSERT_GT(tree.nodes.size(), 4u);
+  const PointCloud all = tree.cloud();
+  Reference hqs = drawBruteForce(*context, all, axisCamera(), W, H, pointMethod("hqs"));
+  for (uint32_t precision : {3u, 0u})
+    for (uint64_t budget : {uint64_t(64) << 20, octreeBytes(tree) / 10}) {
+      LodDrawn lod = drawOctree(*context, tree, axisCamera(), W, H, {true, precision, 0, 0, budget});
+      EXPECT_LE(maxChannelDiff(lod.image, hqs.image), 1)
+          << "precision " << precision << ", budget " << budget;
+      EXPECT_NE(lod.image[20 * W + 10], 0u);
+    }
+}
+
+} // namespace pointrast::test
