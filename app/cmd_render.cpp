@@ -12,9 +12,12 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "base/text.h"
+#include "bench/lod_report.h"
 #include "bench/report.h"
 #include "cli_util.h"
 #include "cloud/attribute_colors.h"
+#include "cloud/generate.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
 #include "gpu/context.h"
@@ -22,6 +25,7 @@
 #include "input.h"
 #include "io/format_table.h"
 #include "io/writer.h"
+#include "render/lod/lod_scene.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
 #include "render_path.h"
@@ -34,6 +38,10 @@ struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
   std::string precision = "adaptive"; // batch methods
+  double minNodePx = 100;             // LOD methods
+  std::string pointBudget = "0";      // LOD methods; 0: no limit
+  std::string gpuMemory;              // LOD methods: node cache budget; empty: half the device
+  bool lodOptionsGiven = false;       // one of the three above was given
   std::string layout = "auto";        // sphere methods
   std::string billboard;              // sphere methods that rasterize billboards; empty: screen
   bool conservative = false;          // the same: VK_EXT_conservative_rasterization
@@ -231,6 +239,113 @@ int runRenderSpheres(const RenderArgs& a) {
   return 0;
 }
 
+// The camera of the point methods: --eye/--target/--up/--fov/--near, or the overview of `bounds`.
+Camera cameraFor(const RenderArgs& a, const Bounds& bounds) {
+  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
+  if (!a.eye.empty()) {
+    camera.eye = parseVec3(a.eye, "--eye");
+    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
+    camera.up = parseVec3(a.up, "--up");
+  }
+  camera.nearW = a.nearW;
+  validateCamera(camera);
+  return camera;
+}
+
+void printLodStats(const lod::LodStats& s, const BatchStats& b) {
+  std::printf("  nodes: %llu selected (%s points%s), %llu drawn in %u pass%s, %llu rendered; points: %s "
+              "processed, %s rendered\n",
+              (unsigned long long)s.nodesSelected, humanCount(double(s.pointsSelected)).c_str(),
+              s.budgetReached ? ", point budget reached" : "", (unsigned long long)s.nodesDrawn, s.passes,
+              s.passes == 1 ? "" : "es", (unsigned long long)b.batchesRendered,
+              humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsRendered)).c_str());
+  std::printf("  streamed %s of %llu nodes in %.2f s (%s uploaded, node cache %s)\n",
+              bytesText(s.bytesStreamed).c_str(), (unsigned long long)s.nodesLoaded, s.streamSeconds,
+              bytesText(s.bytesUploaded).c_str(), bytesText(s.cacheBytes).c_str());
+}
+
+// The LOD methods (--method lod, lod-hqs): an octree streamed through the node cache.
+int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
+  if (!a.path.path.empty())
+    throw InputError("--path renders the methods that draw a loaded cloud, not " + a.method + " (an octree)");
+  if (a.order != "original" || a.parts != 1 || a.depth != "float")
+    throw InputError("--order, --parts and --depth do not apply to " + a.method +
+                     ", which draws an octree's nodes in their stored order");
+  if (!(a.minNodePx >= 0)) throw InputError("--min-node-px must be 0 or more");
+  settings.minNodePx = a.minNodePx;
+  settings.pointBudget = parseCount(a.pointBudget, "--point-budget");
+  settings.background = parseRgb(a.background, "--background");
+  settings.frames = a.frames;
+  if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (std::filesystem::path(a.output).extension() != ".png")
+    throw InputError("-o " + a.output + ": the output must be a .png file");
+  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  if (a.input.empty() || isSceneName(a.input))
+    throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
+                     a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
+                     "): build one with `pointrast lod FILE -o DIR`");
+  lod::LodOptions options;
+  if (!a.gpuMemory.empty()) options.gpuBytes = parseBytes(a.gpuMemory, "--gpu-memory");
+  std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
+  const Camera camera =
+      cameraFor(a, source->metadata().bounds.empty() ? source->metadata().cube : source->metadata().bounds);
+
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = a.device;
+  contextOptions.announce = !a.quiet;
+  gpu::Context context(contextOptions);
+  std::string why;
+  if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
+  Renderer renderer(context, a.width, a.height);
+  lod::LodScene octree(context, *source, options);
+  FrameStats stats = renderer.render(octree, camera, settings);
+  std::vector<uint32_t> pixels = renderer.image();
+  if (context.validationErrors() > 0)
+    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                     " error(s)");
+  io::writePng(a.output, a.width, a.height, pixels.data());
+  const double perSecond = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
+  if (a.json) {
+    nlohmann::json j;
+    j["device"] = context.info().name;
+    j["device_type"] = context.info().typeName;
+    j["method"] = methodName(settings.method);
+    j["input"] = source->metadata().source;
+    j["format"] = source->metadata().format;
+    j["octree_points"] = source->metadata().pointCount;
+    j["points"] = stats.points;
+    j["width"] = a.width;
+    j["height"] = a.height;
+    j["frames"] = stats.frames;
+    j["median_ms"] = stats.medianMs;
+    j["min_ms"] = stats.minMs;
+    j["max_ms"] = stats.maxMs;
+    j["points_per_second"] = perSecond;
+    j["precision"] = a.precision;
+    j["min_node_px"] = settings.minNodePx;
+    j["point_budget"] = settings.pointBudget;
+    j["batch_stats"] = bench::batchStatsJson(*stats.batch);
+    j["lod_stats"] = bench::lodStatsJson(*stats.lod);
+    j["camera"] = describeCamera(camera);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
+    j["image_hash"] = hex;
+    j["output"] = a.output;
+    std::printf("%s\n", j.dump().c_str());
+  } else if (!a.quiet) {
+    std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
+                "points/s\n",
+                a.output.c_str(), humanCount(double(stats.points)).c_str(),
+                humanCount(double(source->metadata().pointCount)).c_str(), a.width, a.height,
+                methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+                humanCount(perSecond).c_str());
+    printLodStats(*stats.lod, *stats.batch);
+  }
+  return 0;
+}
+
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   // -o is the single image; --path renders a camera path into --video or --frames-dir instead.
@@ -261,9 +376,14 @@ int runRender(const RenderArgs& a) {
   settings.depth = parseDepthMode(a.depth);
   settings.precision = parsePrecision(a.precision);
   const SceneLayout layout = methodInfo(settings.method).layout;
-  if (settings.precision != 0 && layout != SceneLayout::Batched)
-    throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
-                     ")");
+  if (settings.precision != 0 && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
+    throw InputError("--precision applies to the batch and LOD methods (" +
+                     methodNamesReading(SceneLayout::Batched) + ", " +
+                     methodNamesReading(SceneLayout::Octree) + ")");
+  if (layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  if (a.lodOptionsGiven)
+    throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
+                     methodNamesReading(SceneLayout::Octree) + ")");
   settings.background = parseRgb(a.background, "--background");
   settings.post = postSettings(a);
   if (settings.post.enabled() && methodInfo(settings.method).output == MethodOutput::ColorOnly)
@@ -477,6 +597,22 @@ Command addRender(CLI::App& app) {
                   "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
                   "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
       ->capture_default_str();
+  auto lodOption = [a](const std::string&) { a->lodOptionsGiven = true; };
+  cmd->add_option(
+         "--min-node-px", a->minNodePx,
+         "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
+         "sphere) is smaller, with their subtrees; 0 draws every point")
+      ->capture_default_str()
+      ->each(lodOption);
+  cmd->add_option("--point-budget", a->pointBudget,
+                  "LOD methods: most points drawn, largest nodes first (e.g. 100M; 0: no limit)")
+      ->capture_default_str()
+      ->each(lodOption);
+  cmd->add_option(
+         "--gpu-memory", a->gpuMemory,
+         "LOD methods: GPU memory for the node cache (e.g. 8G; default: half the device's); a larger "
+         "selection is drawn in several passes")
+      ->each(lodOption);
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
       ->capture_default_str();

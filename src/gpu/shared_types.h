@@ -37,6 +37,16 @@ static_assert(kBatchPoints == 10240 && kBatchPrefetchSteps * 4 == kBatchPointsPe
 static_assert(uint64_t(kMaxPartBatches) * kBatchPoints <= kVisibilityLocalMask + 1ull);
 static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 32);
 
+// The LOD passes: LodNode, LodPage, LodNodeView and LodFrame live in buffers read with std430 rules; LodPush
+// is a push-constant block.
+static_assert(sizeof(LodNode) == 48 && offsetof(LodNode, firstIndex) == 32 && offsetof(LodNode, rank) == 44);
+static_assert(sizeof(LodPage) == 16 && offsetof(LodPage, node) == 8);
+static_assert(sizeof(LodNodeView) == 96);
+static_assert(sizeof(LodFrame) == 88 && offsetof(LodFrame, width) == 56 &&
+              offsetof(LodFrame, pageCount) == 76);
+static_assert(sizeof(LodPush) == 80 && offsetof(LodPush, frame) == 64 && offsetof(LodPush, groupsX) == 76);
+static_assert(kLodPageSteps * 4 * kPointGroupSize == kLodPagePoints && kLodPagePoints % 4 == 0);
+
 // Spheres: SphereFrame lives in a buffer read with std430 rules (struct alignment 16 for its mat4/vec4).
 static_assert(sizeof(SphereFrame) == 160);
 static_assert(offsetof(SphereFrame, pixelToRay) == 64);

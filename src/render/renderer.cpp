@@ -7,6 +7,7 @@
 #include "base/error.h"
 #include "gpu/context.h"
 #include "gpu/timer.h"
+#include "render/lod/lod_render.h"
 #include "render/method.h"
 #include "render/post/post_stage.h"
 
@@ -142,6 +143,9 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
   case MethodFamily::Batch:
     created = createBatchMethod(context_, info, targets_->width, targets_->height);
     break;
+  case MethodFamily::Lod:
+    throw InputError(std::string(info.name) +
+                     " draws octrees streamed from a node source, not uploaded scenes");
   }
   return *methods_.emplace(key, std::move(created)).first->second;
 }
@@ -234,6 +238,47 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
     stats.points += scene->pointCount();
   stats.batch = m.readStats();
   if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), frames);
+  return stats;
+}
+
+lod::LodPasses& Renderer::lodPasses(const RenderSettings& settings) {
+  const MethodInfo& info = methodInfo(settings.method);
+  if (info.layout != SceneLayout::Octree)
+    throw InputError(std::string(info.name) + " reads scenes in the " + sceneLayoutName(info.layout) +
+                     " layout, not octrees; the LOD methods are " + methodNamesReading(SceneLayout::Octree));
+  if (settings.depth != DepthMode::Float)
+    throw InputError(std::string(info.name) + " has no int40 depth encoding, only float");
+  if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
+  std::string why;
+  if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
+  auto found = lodPasses_.find(settings.method);
+  if (found != lodPasses_.end()) return *found->second;
+  auto created = std::make_unique<lod::LodPasses>(context_, info, targets_->width, targets_->height);
+  return *lodPasses_.emplace(settings.method, std::move(created)).first->second;
+}
+
+FrameStats Renderer::render(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings) {
+  validateCamera(camera);
+  lod::LodPasses& passes = lodPasses(settings);
+  Targets& t = *targets_;
+  if (settings.captureWords && !t.words)
+    t.words =
+        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
+  FrameStats stats = lod::renderOctree(context_, octree, passes, t, camera, settings);
+  wordsCaptured_ = settings.captureWords && hasCanonicalWords(methodInfo(settings.method));
+  return stats;
+}
+
+FrameStats Renderer::renderFrame(lod::LodScene& octree, const Camera& camera,
+                                 const RenderSettings& settings) {
+  validateCamera(camera);
+  lod::LodPasses& passes = lodPasses(settings);
+  Targets& t = *targets_;
+  if (settings.captureWords && !t.words)
+    t.words =
+        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
+  FrameStats stats = lod::renderResidentFrame(context_, octree, passes, t, camera, settings);
+  wordsCaptured_ = settings.captureWords && hasCanonicalWords(methodInfo(settings.method));
   return stats;
 }
 

@@ -34,7 +34,7 @@ uint64_t roundUp4(uint64_t n) {
 } // namespace
 
 const char* sceneLayoutName(SceneLayout layout) {
-  return layout == SceneLayout::Batched ? "batched" : "float";
+  return layout == SceneLayout::Batched ? "batched" : layout == SceneLayout::Octree ? "octree" : "float";
 }
 
 uint64_t ScenePart::batchCount() const {

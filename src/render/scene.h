@@ -25,6 +25,7 @@ class Context;
 enum class SceneLayout {
   Float,   // float xyz relative to the origin + RGBA8: the 2019/2021 methods and hw-points
   Batched, // the 2022 batch methods: three words of batch-relative coordinates + RGBA8, bounds per batch
+  Octree,  // the LOD methods: no GpuScene, an octree streamed into a node cache (render/lod/lod_scene.h)
 };
 const char* sceneLayoutName(SceneLayout layout);
 
