@@ -9,6 +9,7 @@
 #include <optional>
 #include <thread>
 
+#include "base/cpu_time.h"
 #include "base/error.h"
 #include "base/parallel.h"
 #include "base/progress.h"
@@ -47,6 +48,18 @@ uint64_t totalPoints(const Pieces& pieces) {
 
 } // namespace
 
+PhaseClock::PhaseClock() : wall_(Clock::now()), cpu_(processCpuSeconds()) {}
+
+LodPhase PhaseClock::done(std::string name, uint64_t points, uint64_t bytes) const {
+  LodPhase p;
+  p.name = std::move(name);
+  p.seconds = since(wall_);
+  p.cpuSeconds = processCpuSeconds() - cpu_;
+  p.points = points;
+  p.bytes = bytes;
+  return p;
+}
+
 void checkCancel(const LodRunOptions& options) {
   if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw Interrupted();
 }
@@ -84,8 +97,8 @@ std::vector<uint64_t> countPoints(const LodGrid& grid, const Pieces& pieces, con
   return counts;
 }
 
-std::vector<PointRecord> distributePoints(const LodGrid& grid, const std::vector<uint64_t>& counts,
-                                          Pieces& pieces, const LodRunOptions& options) {
+LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uint64_t>& counts,
+                                      Pieces& pieces, const LodRunOptions& options) {
   std::vector<uint64_t> next(counts.size());
   uint64_t total = 0;
   for (size_t c = 0; c < counts.size(); ++c) {
@@ -93,7 +106,7 @@ std::vector<PointRecord> distributePoints(const LodGrid& grid, const std::vector
     total += counts[c];
   }
   assert(total == totalPoints(pieces));
-  std::vector<PointRecord> out(total);
+  LargeBuffer<LodItem> out(static_cast<size_t>(total));
   const std::vector<Task> tasks = tasksOf(pieces);
   // A piece is freed by the task that finishes it last, so memory drops while the phase runs.
   std::vector<std::atomic<size_t>> remaining(pieces.size());
@@ -104,16 +117,23 @@ std::vector<PointRecord> distributePoints(const LodGrid& grid, const std::vector
     checkCancel(options);
     const Task& task = tasks[t];
     const PointRecord* src = pieces[task.piece].data();
-    // Runs of points in one cell (input is usually spatially coherent) claim their slots at once.
-    size_t i = task.begin;
-    while (i < task.end) {
-      const uint64_t cell = grid.code(src[i]) >> shift;
-      size_t j = i + 1;
-      while (j < task.end && grid.code(src[j]) >> shift == cell)
-        ++j;
-      const uint64_t at = std::atomic_ref<uint64_t>(next[cell]).fetch_add(j - i, std::memory_order_relaxed);
-      std::copy(src + i, src + j, out.begin() + ptrdiff_t(at));
-      i = j;
+    // Codes of a block first, then runs of points in one cell (input is usually spatially coherent)
+    // claim their slots at once.
+    constexpr size_t kBlock = 512;
+    uint64_t codes[kBlock];
+    for (size_t b = task.begin; b < task.end; b += kBlock) {
+      const size_t n = std::min(kBlock, task.end - b);
+      for (size_t i = 0; i < n; ++i)
+        codes[i] = grid.code(src[b + i]);
+      for (size_t i = 0; i < n;) {
+        const uint64_t cell = codes[i] >> shift;
+        size_t j = i + 1;
+        while (j < n && codes[j] >> shift == cell)
+          ++j;
+        uint64_t at = std::atomic_ref<uint64_t>(next[cell]).fetch_add(j - i, std::memory_order_relaxed);
+        for (; i < j; ++i, ++at)
+          out[at] = {codes[i], src[b + i]};
+      }
     }
     if (remaining[task.piece].fetch_sub(1, std::memory_order_acq_rel) == 1)
       std::vector<PointRecord>().swap(pieces[task.piece]);
@@ -122,10 +142,10 @@ std::vector<PointRecord> distributePoints(const LodGrid& grid, const std::vector
   return out;
 }
 
-IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const ChunkLoader& load, const LodGrid& grid,
-                       const LodParams& params, OctreeAssembler& assembler, size_t window,
-                       const LodRunOptions& options) {
-  const auto start = Clock::now();
+IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<uint64_t>& counts,
+                       const ChunkLoader& load, const LodGrid& grid, const LodParams& params,
+                       OctreeAssembler& assembler, size_t window, const LodRunOptions& options) {
+  const PhaseClock clock;
   IndexTimes times;
   const size_t n = chunks.size();
   uint64_t points = 0;
@@ -147,7 +167,7 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const ChunkLoader& l
 
   auto worker = [&] {
     IndexScratch scratch;
-    std::vector<PointRecord> storage;
+    std::vector<LodItem> storage;
     std::unique_lock lock(mutex);
     for (;;) {
       wake.wait(lock, [&] { return stop || nextClaim >= n || nextClaim < nextWrite + window; });
@@ -163,10 +183,13 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const ChunkLoader& l
       lock.unlock();
       try {
         checkCancel(options);
-        const std::span<const PointRecord> records = load(i, storage);
-        assert(records.size() == chunks[i].points);
-        indexChunk(*result, scratch, grid, chunks[i].key, records.data(), records.size(), params);
-        if (progress) progress->advance(records.size());
+        const std::span<LodItem> items = load(i, storage);
+        const LodChunk& chunk = chunks[i];
+        assert(items.size() == chunk.points);
+        indexChunk(*result, scratch, grid, chunk.key, items.data(), items.size(),
+                   counts.data() + chunk.firstCell, static_cast<size_t>(chunk.endCell - chunk.firstCell),
+                   params);
+        if (progress) progress->advance(items.size());
         lock.lock();
         done[i] = std::move(result);
         if (writing) continue;
@@ -205,13 +228,22 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const ChunkLoader& l
   assembler.finish();
   times.writeSeconds += since(finishStart);
   if (progress) progress->finish();
-  times.seconds = since(start);
+  times.index = clock.done("index", points);
   return times;
+}
+
+LodPhase writePhase(const IndexTimes& times, uint64_t points) {
+  LodPhase p;
+  p.name = "write";
+  p.seconds = times.writeSeconds;
+  p.points = points;
+  p.overlapped = true;
+  return p;
 }
 
 uint64_t inMemoryChunkLimit(uint64_t points, unsigned threads, uint64_t leafPoints) {
   const uint64_t perThread = points / (uint64_t(std::max(threads, 1u)) * 4) + 1;
-  return std::max<uint64_t>({leafPoints, 1, std::min<uint64_t>(perThread, uint64_t(4) << 20)});
+  return std::max<uint64_t>({leafPoints, 1, std::min<uint64_t>(perThread, uint64_t(1) << 20)});
 }
 
 LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams& params, NodeSink& sink,
@@ -220,32 +252,33 @@ LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams&
   const uint64_t n = totalPoints(pieces);
   const unsigned threads = options.threads ? options.threads : hardwareThreads();
 
-  auto t = Clock::now();
+  PhaseClock clock;
   const std::vector<uint64_t> counts = countPoints(grid, pieces, options);
-  stats.phases.push_back({"count", since(t), n, 0});
+  stats.phases.push_back(clock.done("count", n));
 
-  t = Clock::now();
+  clock = PhaseClock();
   const uint64_t chunkLimit = options.chunkPoints ? std::max(options.chunkPoints, params.leafPoints)
                                                   : inMemoryChunkLimit(n, threads, params.leafPoints);
   const std::vector<LodChunk> chunks = planChunks(counts, grid.countLevel(), chunkLimit);
   stats.chunks = chunks.size();
-  stats.phases.push_back({"chunk", since(t), n, 0});
+  stats.phases.push_back(clock.done("chunk", n));
 
-  t = Clock::now();
-  const std::vector<PointRecord> all = distributePoints(grid, counts, pieces, options);
-  stats.phases.push_back({"distribute", since(t), n, 0});
+  clock = PhaseClock();
+  LargeBuffer<LodItem> all = distributePoints(grid, counts, pieces, options);
+  stats.phases.push_back(clock.done("distribute", n));
 
   // Chunk i is the contiguous range of its histogram cells in `all`.
   std::vector<uint64_t> firstPoint(chunks.size() + 1, 0);
   for (size_t c = 0; c < chunks.size(); ++c)
     firstPoint[c + 1] = firstPoint[c] + chunks[c].points;
-  ChunkLoader load = [&](size_t c, std::vector<PointRecord>&) {
-    return std::span<const PointRecord>(all.data() + firstPoint[c], static_cast<size_t>(chunks[c].points));
+  ChunkLoader load = [&](size_t c, std::vector<LodItem>&) {
+    return std::span<LodItem>(all.data() + firstPoint[c], static_cast<size_t>(chunks[c].points));
   };
   OctreeAssembler assembler(sink);
-  const IndexTimes times = indexChunks(chunks, load, grid, params, assembler, 2 * size_t(threads), options);
-  stats.phases.push_back({"index", times.seconds, n, 0});
-  stats.phases.push_back({"write", times.writeSeconds, n, 0, true});
+  const IndexTimes times =
+      indexChunks(chunks, counts, load, grid, params, assembler, 2 * size_t(threads), options);
+  stats.phases.push_back(times.index);
+  stats.phases.push_back(writePhase(times, n));
   stats.octree = assembler.stats();
   return stats;
 }

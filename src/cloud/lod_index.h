@@ -46,22 +46,31 @@ struct ChunkNodes {
   std::vector<PointRecord> records;
 };
 
+// A point with its Morton code, as chunks hold them while they are indexed (32 B).
+struct LodItem {
+  uint64_t code; // LodGrid::code(record); bit 63 marks a point taken by a subsample while indexing
+  PointRecord record;
+};
+static_assert(sizeof(LodItem) == 32);
+
 // Buffers one thread reuses from chunk to chunk.
 struct IndexScratch {
-  struct Entry {
-    uint64_t code;  // Morton code; bit 63 marks a point taken by a subsample
-    uint64_t index; // into the chunk's records
-  };
-  std::vector<Entry> entries;      // the chunk's points in canonical order
-  std::vector<PointRecord> sorted; // their records, in the same order
-  std::vector<uint64_t> buckets;
+  std::vector<LodItem> items;   // a sort's scatter target
+  std::vector<uint64_t> counts; // a sort's bucket positions
 };
 
-// Builds the part of the octree that the chunk's points make: records are every input point in the
-// chunk's cube (any order); chunk.level <= grid.countLevel(), and its ancestors must be inner nodes (their
-// cubes hold more than params.leafPoints points), which planChunks guarantees when chunkLimit >=
-// leafPoints.
+// Builds the part of the octree that the chunk's points make. items: every input point in the chunk's cube,
+// grouped by count-level cell (grid.countLevel()), cells in Morton order, any order inside a cell;
+// cellCounts: the points of each of those cells (the chunk's range of the histogram, empty cells
+// included). The items are sorted in place and marked. chunk.level <= grid.countLevel(), and the chunk's
+// ancestors must be inner nodes (their cubes hold more than params.leafPoints points), which planChunks
+// guarantees when chunkLimit >= leafPoints.
 void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, const NodeKey& chunk,
-                const PointRecord* records, size_t count, const LodParams& params);
+                LodItem* items, size_t count, const uint64_t* cellCounts, size_t cells,
+                const LodParams& params);
+
+// Sorts items into canonical order: by code, then by the record's bytes. freeBits: the low bits in
+// which the codes may differ (the others are equal). For a cell's items, and for tests.
+void sortItems(LodItem* items, size_t count, int freeBits, IndexScratch& scratch);
 
 } // namespace pointrast::lod

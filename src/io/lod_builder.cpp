@@ -28,10 +28,10 @@ double since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Bytes a point costs in memory: 24 B read + 24 B distributed while both exist.
-constexpr uint64_t kInMemoryBytesPerPoint = 48;
-// Bytes a chunk point costs a thread that indexes it (sort entries 16 B, sorted records 24 B, loaded
-// records 24 B, output 24 B), plus its output's share while it waits to be written.
+// Bytes a point costs in memory: 24 B read + 32 B distributed (record and code) while both exist.
+constexpr uint64_t kInMemoryBytesPerPoint = 56;
+// Bytes a chunk point costs a thread that indexes it out of core (records read 24 B, items 32 B, a
+// cell's sort buffer up to 32 B, output 24 B).
 constexpr uint64_t kIndexBytesPerPoint = 112;
 constexpr uint64_t kFixedBytes = uint64_t(64) << 20; // histograms, chunk tables, I/O buffers
 
@@ -155,6 +155,7 @@ const lod::OctreeMetadata& OctreeBuilder::scan() {
   State& s = *state_;
   if (s.scanned) return s.metadata;
   s.start = Clock::now();
+  const lod::PhaseClock readClock;
   const auto& tasks = s.inputs.tasks();
   std::vector<BuildInputs::Scan> scans(tasks.size());
   if (s.inMemory) {
@@ -181,7 +182,7 @@ const lod::OctreeMetadata& OctreeBuilder::scan() {
   s.grid =
       lod::makeLodGrid(box, s.inputs.scale(), s.inputs.offset(),
                        lod::gridLevelsForSpacing(first.cube.max.x - first.cube.min.x, s.options.spacing));
-  s.phases.push_back({"read", since(s.start), s.inputs.points(), s.inputs.fileBytes()});
+  s.phases.push_back(readClock.done("read", s.inputs.points(), s.inputs.fileBytes()));
 
   lod::OctreeMetadata& m = s.metadata;
   m.source = s.inputs.names();
@@ -214,15 +215,15 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
     report.chunks = stats.chunks;
   } else {
     const auto& tasks = s.inputs.tasks();
-    auto t = Clock::now();
+    lod::PhaseClock clock;
     std::vector<uint64_t> counts(size_t(1) << 3 * grid.countLevel(), 0);
     s.readAll("counting", [&](unsigned, size_t task, std::vector<PointRecord>& records) {
       s.inputs.read(tasks[task], records);
       lod::countCells(counts.data(), grid, records.data(), records.size());
     });
-    s.phases.push_back({"count", since(t), n, s.inputs.fileBytes()});
+    s.phases.push_back(clock.done("count", n, s.inputs.fileBytes()));
 
-    t = Clock::now();
+    clock = lod::PhaseClock();
     // A chunk, indexed by one thread, may take its share of the memory bound.
     const uint64_t chunkLimit =
         std::max<uint64_t>(s.params.leafPoints, s.memory / (uint64_t(s.threads) * kIndexBytesPerPoint * 2));
@@ -238,9 +239,9 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
                "it is indexed in memory anyway",
                humanCount(double(largest)).c_str()));
     report.chunks = chunks.size();
-    s.phases.push_back({"chunk", since(t), n, 0});
+    s.phases.push_back(clock.done("chunk", n));
 
-    t = Clock::now();
+    clock = lod::PhaseClock();
     ChunkSpill spill(tempDir, chunks.size());
     const uint64_t bufferBytes =
         std::clamp<uint64_t>(s.memory / (4 * uint64_t(s.threads)), 1 << 16, 64 << 20);
@@ -258,18 +259,40 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
       for (auto& w : writers)
         w->flush();
     }
-    s.phases.push_back({"distribute", since(t), n, s.inputs.fileBytes() + spill.bytesWritten()});
+    s.phases.push_back(clock.done("distribute", n, s.inputs.fileBytes() + spill.bytesWritten()));
 
     const size_t window = std::clamp<size_t>(s.memory / std::max<uint64_t>(1, largest * kIndexBytesPerPoint),
                                              1, 2 * size_t(s.threads));
-    lod::ChunkLoader load = [&](size_t c, std::vector<PointRecord>& storage) {
-      spill.read(c, chunks[c].points, storage);
-      return std::span<const PointRecord>(storage);
+    lod::ChunkLoader load = [&](size_t c, std::vector<lod::LodItem>& items) {
+      const lod::LodChunk& chunk = chunks[c];
+      thread_local std::vector<PointRecord> records;
+      spill.read(c, chunk.points, records);
+      // Grouped by histogram cell, the layout indexChunk takes (as distributePoints makes in memory).
+      std::vector<uint64_t> next(static_cast<size_t>(chunk.endCell - chunk.firstCell));
+      uint64_t at = 0;
+      for (size_t i = 0; i < next.size(); ++i) {
+        next[i] = at;
+        at += counts[chunk.firstCell + i];
+      }
+      items.resize(records.size());
+      auto changed = [&] { fail(spill.dir(), "a temporary chunk file changed while the octree was built"); };
+      for (const PointRecord& r : records) {
+        const uint64_t code = grid.code(r);
+        const uint64_t cell = (code >> shift) - chunk.firstCell;
+        if (cell >= next.size() || next[cell] >= items.size()) changed();
+        items[next[cell]++] = {code, r};
+      }
+      for (size_t i = 0; i < next.size(); ++i)
+        if (next[i] != (i + 1 < next.size() ? next[i + 1] - counts[chunk.firstCell + i + 1] : items.size()))
+          changed();
+      return std::span<lod::LodItem>(items);
     };
     lod::OctreeAssembler assembler(sink);
-    const lod::IndexTimes times = lod::indexChunks(chunks, load, grid, s.params, assembler, window, s.run);
-    s.phases.push_back({"index", times.seconds, n, spill.bytesWritten()});
-    s.phases.push_back({"write", times.writeSeconds, n, 0, true});
+    const lod::IndexTimes times =
+        lod::indexChunks(chunks, counts, load, grid, s.params, assembler, window, s.run);
+    s.phases.push_back(times.index);
+    s.phases.back().bytes = spill.bytesWritten();
+    s.phases.push_back(lod::writePhase(times, n));
     report.octree = assembler.stats();
     report.spillBytes = spill.bytesWritten();
   }

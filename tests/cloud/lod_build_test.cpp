@@ -55,6 +55,30 @@ TEST(LodGrid, ExtremesLandInsideTheCube) {
   EXPECT_EQ(lod::gridLevelsForSpacing(1024, 1e-9), 14);
 }
 
+TEST(LodIndex, SortItemsGivesTheCanonicalOrder) {
+  std::mt19937_64 rng(9);
+  for (size_t n : {0, 1, 2, 23, 24, 25, 100, 5'000, 70'000}) {
+    std::vector<lod::LodItem> items(n);
+    for (auto& item : items) {
+      // Codes sharing their top 21 bits, few distinct low parts: many ties for the record bytes to break.
+      item.code = (uint64_t(12345) << 42) | (rng() % (n / 4 + 1)) << (rng() % 3 == 0 ? 20 : 0);
+      item.record.x = int32_t(rng() % 3);
+      item.record.intensity = uint16_t(rng() % 2);
+    }
+    std::vector<lod::LodItem> expected = items;
+    std::sort(expected.begin(), expected.end(), [](const lod::LodItem& a, const lod::LodItem& b) {
+      if (a.code != b.code) return a.code < b.code;
+      return std::memcmp(&a.record, &b.record, sizeof(PointRecord)) < 0;
+    });
+    lod::IndexScratch scratch;
+    lod::sortItems(items.data(), items.size(), 42, scratch);
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(items[i].code, expected[i].code) << n << " " << i;
+      ASSERT_EQ(std::memcmp(&items[i].record, &expected[i].record, sizeof(PointRecord)), 0) << n << " " << i;
+    }
+  }
+}
+
 TEST(LodChunks, LargestCellsUnderTheLimitInMortonOrder) {
   const int level = 2; // 64 cells
   std::vector<uint64_t> counts(64, 0);
