@@ -5,6 +5,7 @@
 #include "io/formats.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
+#include "io/potree.h"
 
 namespace pointrast::io {
 
@@ -22,6 +23,8 @@ const char* formatName(Format format) {
     return "XYZ";
   case Format::Mmpld:
     return "MMPLD";
+  case Format::Potree:
+    return "Potree 2.0";
   case Format::Unknown:
     break;
   }
@@ -29,6 +32,7 @@ const char* formatName(Format format) {
 }
 
 Format detectFormat(const std::filesystem::path& path) {
+  if (looksLikePotree(path)) return Format::Potree;
   InputFile file(path);
   uint8_t magic[8] = {};
   size_t got = file.readSome(0, magic, sizeof magic);
@@ -67,6 +71,8 @@ PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& optio
     return readPly(path, options);
   case Format::Xyz:
     return readXyz(path, options);
+  case Format::Potree:
+    return readPotree(path, options);
   default:
     failUnreadable(path, format);
   }
@@ -81,6 +87,8 @@ FileInfo probeFile(const std::filesystem::path& path) {
     return probePly(path);
   case Format::Xyz:
     return probeXyz(path);
+  case Format::Potree:
+    return probePotreeFolder(path);
   default:
     failUnreadable(path, format);
   }
