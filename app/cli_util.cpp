@@ -79,6 +79,44 @@ uint64_t parseCount(std::string_view text, std::string_view option) {
   return uint64_t(n);
 }
 
+uint64_t parseBytes(std::string_view text, std::string_view option) {
+  std::string s(text);
+  if (!s.empty() && (s.back() == 'B' || s.back() == 'b')) s.pop_back(); // "8GB" as "8G"
+  if (s.size() > 1 && (s.back() == 'i')) s.pop_back();                  // "8Gi" as "8G"
+  double scale = 1;
+  if (!s.empty()) {
+    switch (s.back()) {
+    case 'k':
+    case 'K':
+      scale = 1024.0;
+      break;
+    case 'm':
+    case 'M':
+      scale = 1024.0 * 1024.0;
+      break;
+    case 'g':
+    case 'G':
+      scale = 1024.0 * 1024.0 * 1024.0;
+      break;
+    case 't':
+    case 'T':
+      scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+      break;
+    default:
+      break;
+    }
+    if (scale != 1) s.pop_back();
+  }
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  const double n = std::floor(v * scale);
+  if (s.empty() || *end != '\0' || !std::isfinite(n) || n < 1 || n > 1e18)
+    throw InputError(std::string(option) +
+                     " expects a size such as 8G, 512M or 1.5G (binary multiples), got '" +
+                     std::string(text) + "'");
+  return uint64_t(n);
+}
+
 uint64_t imageHash(const uint32_t* pixels, uint64_t count) {
   uint64_t h = 0xcbf29ce484222325ull;
   auto bytes = reinterpret_cast<const unsigned char*>(pixels);

@@ -16,6 +16,10 @@ uint32_t parseRgb(std::string_view text, std::string_view option);
 // "1000000", "1e6", "2.5M", "1.2G", "800k" -> count; throws InputError if not a non-negative integer.
 uint64_t parseCount(std::string_view text, std::string_view option);
 
+// "8G", "512M", "1.5G", "100k", "4096" -> bytes, with binary multiples (G = 2^30); throws InputError
+// naming the option on anything else.
+uint64_t parseBytes(std::string_view text, std::string_view option);
+
 // 64-bit FNV-1a of the image bytes: lets two renders be compared without keeping both images.
 uint64_t imageHash(const uint32_t* pixels, uint64_t count);
 

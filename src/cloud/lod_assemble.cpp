@@ -5,9 +5,30 @@
 
 namespace pointrast::lod {
 
+std::unique_ptr<PreparedNode> NodeSink::prepare(const NodeKey&, const PointRecord*, size_t) const {
+  return nullptr;
+}
+
+void NodeSink::writePrepared(const NodeKey& key, std::unique_ptr<PreparedNode>, const PointRecord* records,
+                             size_t count) {
+  writeNode(key, records, count);
+}
+
+void OctreeAssembler::prepare(ChunkNodes& chunk) const {
+  chunk.prepared.clear();
+  chunk.prepared.reserve(chunk.nodes.size());
+  for (const ChunkNodes::Node& node : chunk.nodes)
+    chunk.prepared.push_back(
+        sink_.prepare(node.key, chunk.records.data() + node.first, static_cast<size_t>(node.count)));
+}
+
 void OctreeAssembler::write(const NodeKey& key, const PointRecord* records, size_t count) {
   if (count == 0) return; // an ancestor whose points all went to its own ancestors does not exist
   sink_.writeNode(key, records, count);
+  counted(key, count);
+}
+
+void OctreeAssembler::counted(const NodeKey& key, uint64_t count) {
   stats_.points += count;
   ++stats_.nodes;
   stats_.levels = std::max(stats_.levels, key.level + 1);
@@ -21,7 +42,7 @@ void OctreeAssembler::closeDeeperThan(int level) {
   }
 }
 
-void OctreeAssembler::add(const ChunkNodes& chunk) {
+void OctreeAssembler::add(ChunkNodes& chunk) {
   const NodeKey& key = chunk.chunk;
   // Ancestors of earlier chunks that are not ancestors of this one are complete: write them, deepest
   // first (post-order).
@@ -46,8 +67,14 @@ void OctreeAssembler::add(const ChunkNodes& chunk) {
     dst.insert(dst.end(), chunk.top.begin() + ptrdiff_t(offset), chunk.top.begin() + ptrdiff_t(offset + n));
     offset += n;
   }
-  for (const ChunkNodes::Node& node : chunk.nodes)
-    write(node.key, chunk.records.data() + node.first, static_cast<size_t>(node.count));
+  for (size_t i = 0; i < chunk.nodes.size(); ++i) {
+    const ChunkNodes::Node& node = chunk.nodes[i];
+    const PointRecord* records = chunk.records.data() + node.first;
+    sink_.writePrepared(node.key, i < chunk.prepared.size() ? std::move(chunk.prepared[i]) : nullptr, records,
+                        static_cast<size_t>(node.count));
+    counted(node.key, node.count);
+  }
+  chunk.prepared.clear();
 }
 
 void OctreeAssembler::finish() {

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "cloud/lod_index.h"
@@ -21,6 +22,16 @@ public:
   // One node's points; every node once, in the order the builder decides. Called from one thread at a
   // time (not always the same one).
   virtual void writeNode(const NodeKey& key, const PointRecord* records, size_t count) = 0;
+
+  // Optional split of writeNode for sinks with work that needs no order (encoding a node): prepare()
+  // runs on any thread, several at once, as soon as a node's points are final; writePrepared() then
+  // takes its result in the builder's order instead of writeNode(). Nodes that span chunks go through
+  // writeNode().
+  // The default prepares nothing and writes through writeNode().
+  virtual std::unique_ptr<PreparedNode> prepare(const NodeKey& key, const PointRecord* records,
+                                                size_t count) const;
+  virtual void writePrepared(const NodeKey& key, std::unique_ptr<PreparedNode> prepared,
+                             const PointRecord* records, size_t count);
 };
 
 struct AssembleStats {
@@ -33,14 +44,17 @@ class OctreeAssembler {
 public:
   explicit OctreeAssembler(NodeSink& sink) : sink_(sink) {}
 
+  // The sink's prepare() for the chunk's own nodes, on the calling thread (any, several at once).
+  void prepare(ChunkNodes& chunk) const;
   // Chunks in Morton order (planChunks' order), each once.
-  void add(const ChunkNodes& chunk);
+  void add(ChunkNodes& chunk);
   // Writes the ancestors still open. Call once, after the last chunk.
   void finish();
   const AssembleStats& stats() const { return stats_; }
 
 private:
   void write(const NodeKey& key, const PointRecord* records, size_t count);
+  void counted(const NodeKey& key, uint64_t count);
   void closeDeeperThan(int level);
 
   struct Open {

@@ -189,6 +189,7 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
         indexChunk(*result, scratch, grid, chunk.key, items.data(), items.size(),
                    counts.data() + chunk.firstCell, static_cast<size_t>(chunk.endCell - chunk.firstCell),
                    params);
+        assembler.prepare(*result);
         if (progress) progress->advance(items.size());
         lock.lock();
         done[i] = std::move(result);

@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "cloud/lod_grid.h"
@@ -29,6 +30,11 @@ namespace pointrast::lod {
 struct LodParams {
   uint64_t leafPoints = 20'000; // a node whose cube holds more input points is split
   bool averageColors = true;    // color filtering; false keeps every point's own color
+};
+
+// A node's points as a sink prepared them for writing (an encoded node), see NodeSink::prepare().
+struct PreparedNode {
+  virtual ~PreparedNode() = default;
 };
 
 // One chunk's share of the octree.
@@ -44,6 +50,8 @@ struct ChunkNodes {
   };
   std::vector<Node> nodes; // the chunk's subtree (rooted at the chunk's cell), children before parents
   std::vector<PointRecord> records;
+  // What the sink's prepare() made of each node (lod_assemble.h); empty until then.
+  std::vector<std::unique_ptr<PreparedNode>> prepared;
 };
 
 // A point with its Morton code, as chunks hold them while they are indexed (32 B).

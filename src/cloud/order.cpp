@@ -33,20 +33,9 @@ namespace {
 
 constexpr const char* kOrderNames[] = {"original", "morton", "shuffled", "shuffled-morton"};
 
+using detail::compactBits3;
 using detail::splitmixAt;
 using detail::spreadBits3;
-
-// The inverse of spreadBits3: gathers bits 0, 3, 6, ... of x into its low 21 bits, the same masks in
-// reverse order.
-inline uint32_t compactBits3(uint64_t x) {
-  x &= 0x1249249249249249ull;
-  x = (x | x >> 2) & 0x10c30c30c30c30c3ull;
-  x = (x | x >> 4) & 0x100f00f00f00f00full;
-  x = (x | x >> 8) & 0x1f0000ff0000ffull;
-  x = (x | x >> 16) & 0x1f00000000ffffull;
-  x = (x | x >> 32) & 0x1fffffull;
-  return static_cast<uint32_t>(x);
-}
 
 // ---- parallel sample sort of indices by (key(i), i) --------------------------------------------------
 
