@@ -6,10 +6,9 @@
 namespace pointrast::lod {
 
 void countCells(uint64_t* counts, const LodGrid& grid, const PointRecord* records, size_t count) {
-  const int shift = 3 * (kCodeLevels - grid.countLevel());
   uint64_t run = 0, cell = 0;
   for (size_t i = 0; i < count; ++i) {
-    const uint64_t c = grid.code(records[i]) >> shift;
+    const uint64_t c = grid.countCell(records[i]);
     if (run && c != cell) {
       std::atomic_ref<uint64_t>(counts[cell]).fetch_add(run, std::memory_order_relaxed);
       run = 0;

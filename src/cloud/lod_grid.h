@@ -53,13 +53,57 @@ struct LodGrid {
     u[1] = double(int64_t(r.y) - qmin[1]) * toCode[1];
     u[2] = double(int64_t(r.z) - qmin[2]) * toCode[2];
   }
-  uint64_t code(const PointRecord& r) const {
+  // The center of a cell, in doubled quanta (2 q), rounded to an integer: what a subsample measures
+  // distances to.
+  struct Center {
+    int64_t twice[3];
+  };
+  Center cellCenter(uint64_t cell, int cellLevel) const;
+  // How far a point is from a cell's center, as a subsample ranks points: the squared distance in doubled
+  // quanta. With equal scales on all axes (isotropic, the usual case) all integer: exact, and cheap;
+  // otherwise each axis weighted by its scale, in double.
+  bool isotropic = true;
+  int64_t edgeQuanta = 0; // the cube's edge in quanta when isotropic
+  double centerDistance(const Center& center, const PointRecord& r) const {
+    const int64_t d[3] = {2 * int64_t(r.x) - center.twice[0], 2 * int64_t(r.y) - center.twice[1],
+                          2 * int64_t(r.z) - center.twice[2]};
+    if (isotropic) return double(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const double w[3] = {double(d[0]) * scale.x, double(d[1]) * scale.y, double(d[2]) * scale.z};
+    return w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+  }
+  // The same for equal scales, in integers (isotropic must hold).
+  uint64_t centerDistanceIsotropic(const Center& center, const PointRecord& r) const {
+    const int64_t d[3] = {2 * int64_t(r.x) - center.twice[0], 2 * int64_t(r.y) - center.twice[1],
+                          2 * int64_t(r.z) - center.twice[2]};
+    return uint64_t(d[0] * d[0]) + uint64_t(d[1] * d[1]) + uint64_t(d[2] * d[2]);
+  }
+
+  // The 21-bit cell of each axis that a point's code interleaves.
+  void codeCells(const PointRecord& r, uint32_t c[3]) const {
     double u[3];
     codeSpace(r, u);
-    uint32_t c[3];
     for (int a = 0; a < 3; ++a)
       c[a] = u[a] < double((1u << kCodeLevels) - 1) ? static_cast<uint32_t>(u[a]) : (1u << kCodeLevels) - 1;
-    return detail::spreadBits3(c[0]) << 2 | detail::spreadBits3(c[1]) << 1 | detail::spreadBits3(c[2]);
+  }
+  uint64_t code(const PointRecord& r) const {
+    uint32_t c[3];
+    codeCells(r, c);
+    return spread21(c[0]) << 2 | spread21(c[1]) << 1 | spread21(c[2]);
+  }
+  // detail::spreadBits3 through the 7-bit table: three loads instead of five shift-or-mask steps.
+  static uint64_t spread21(uint32_t v) {
+    return uint64_t(detail::kSpread7.value[v & 127]) |
+           uint64_t(detail::kSpread7.value[(v >> 7) & 127]) << 21 |
+           uint64_t(detail::kSpread7.value[v >> 14]) << 42;
+  }
+  // code(r) >> 3 * (21 - countLevel()), the point's histogram cell, for less: its 7 or fewer bits per
+  // axis interleave through a table.
+  uint32_t countCell(const PointRecord& r) const {
+    uint32_t c[3];
+    codeCells(r, c);
+    const int drop = kCodeLevels - countLevel();
+    return detail::kSpread7.value[c[0] >> drop] << 2 | detail::kSpread7.value[c[1] >> drop] << 1 |
+           detail::kSpread7.value[c[2] >> drop];
   }
 };
 

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace pointrast::lod {
 
@@ -39,73 +40,82 @@ public:
 
   // Subsamples the points of [begin, end) that reach a node at `level` into dst (see lod_index.h).
   // left[c]: points of child c that remain after it, for the node's children.
-  void subsample(int level, size_t begin, size_t end, std::vector<PointRecord>& dst, uint64_t left[8]) {
+  // dst has room for every point of [begin, end); returns the end of what was written.
+  PointRecord* subsample(int level, size_t begin, size_t end, PointRecord* dst, uint64_t left[8]) {
+    if (grid_.isotropic) return subsampleCells<true>(level, begin, end, dst, left);
+    return subsampleCells<false>(level, begin, end, dst, left);
+  }
+
+  // One pass over the cells' runs: the point nearest each cell's center, the color sums, the count. A
+  // cell's center is computed only when a second point reaches it: most cells of deep nodes hold one.
+  template <bool kIsotropic>
+  PointRecord* subsampleCells(int level, size_t begin, size_t end, PointRecord* dst, uint64_t left[8]) {
     const int cellLevel = grid_.sampleLevel(level);
     const int shift = 3 * (kCodeLevels - cellLevel);
     const int childShift = 3 * (cellLevel - level - 1); // a cell's child index: (cell >> childShift) & 7
+    using Distance = std::conditional_t<kIsotropic, uint64_t, double>;
+    auto distance = [&](const LodGrid::Center& center, const PointRecord& r) -> Distance {
+      if constexpr (kIsotropic)
+        return grid_.centerDistanceIsotropic(center, r);
+      else
+        return grid_.centerDistance(center, r);
+    };
     for (size_t i = begin; i < end;) {
       const uint64_t cell = untagged(items_[i].code) >> shift;
-      // The cell's run, and its points that reached the node (most cells of deep nodes hold one).
-      size_t k = i, reached = 0, only = end;
-      for (; k < end && untagged(items_[k].code) >> shift == cell; ++k)
-        if (!(items_[k].code & kTakenBit)) {
-          ++reached;
-          only = k;
+      size_t k = i;
+      while (k < end && (items_[k].code & kTakenBit))
+        ++k;
+      if (k == end || untagged(items_[k].code) >> shift != cell) { // every point of the cell was taken
+        while (k < end && untagged(items_[k].code) >> shift == cell)
+          ++k;
+        i = k;
+        continue;
+      }
+      size_t best = k;
+      const PointRecord& first = items_[k].record;
+      uint64_t sum[3] = {first.rgb[0], first.rgb[1], first.rgb[2]}, reached = 1;
+      LodGrid::Center center{};
+      Distance bestDistance = 0;
+      for (++k; k < end && untagged(items_[k].code) >> shift == cell; ++k) {
+        if (items_[k].code & kTakenBit) continue;
+        const PointRecord& r = items_[k].record;
+        if (reached == 1) {
+          center = grid_.cellCenter(cell, cellLevel);
+          bestDistance = distance(center, items_[best].record);
         }
-      if (reached == 1) {
-        items_[only].code |= kTakenBit;
-        dst.push_back(items_[only].record);
-      } else if (reached > 1) {
-        dst.push_back(pick(cell, cellLevel, i, k));
-        left[(cell >> childShift) & 7] += reached - 1;
+        const Distance d = distance(center, r);
+        // Strictly nearer only: on a tie the first point in canonical order stays.
+        const bool nearer = d < bestDistance;
+        bestDistance = nearer ? d : bestDistance;
+        best = nearer ? k : best;
+        sum[0] += r.rgb[0];
+        sum[1] += r.rgb[1];
+        sum[2] += r.rgb[2];
+        ++reached;
       }
       i = k;
+      items_[best].code |= kTakenBit;
+      *dst = items_[best].record;
+      if (params_.averageColors && reached > 1)
+        for (int c = 0; c < 3; ++c)
+          dst->rgb[c] = static_cast<uint16_t>((sum[c] + reached / 2) / reached);
+      ++dst;
+      left[(cell >> childShift) & 7] += reached - 1;
     }
-  }
-
-  // The point of cell [begin, end) closest to the cell's center, marked taken, with the average color of
-  // the cell's points not taken before.
-  PointRecord pick(uint64_t cell, int cellLevel, size_t begin, size_t end) {
-    const double cellSize = double(uint64_t(1) << (kCodeLevels - cellLevel)); // in code units
-    const double center[3] = {(detail::compactBits3(cell >> 2) + 0.5) * cellSize,
-                              (detail::compactBits3(cell >> 1) + 0.5) * cellSize,
-                              (detail::compactBits3(cell) + 0.5) * cellSize};
-    size_t best = end;
-    double bestDistance = std::numeric_limits<double>::infinity();
-    uint64_t sum[3] = {0, 0, 0}, reached = 0;
-    for (size_t k = begin; k < end; ++k) {
-      if (items_[k].code & kTakenBit) continue;
-      const PointRecord& r = items_[k].record;
-      double u[3];
-      grid_.codeSpace(r, u);
-      const double d = (u[0] - center[0]) * (u[0] - center[0]) + (u[1] - center[1]) * (u[1] - center[1]) +
-                       (u[2] - center[2]) * (u[2] - center[2]);
-      if (d < bestDistance) {
-        bestDistance = d;
-        best = k;
-      }
-      sum[0] += r.rgb[0];
-      sum[1] += r.rgb[1];
-      sum[2] += r.rgb[2];
-      ++reached;
-    }
-    items_[best].code |= kTakenBit;
-    PointRecord out = items_[best].record;
-    if (params_.averageColors)
-      for (int c = 0; c < 3; ++c)
-        out.rgb[c] = static_cast<uint16_t>((sum[c] + reached / 2) / reached);
-    return out;
+    return dst;
   }
 
   // The subtree of the node at `level` whose cube's points are [begin, end) (at least one reaches it).
+  // Its points go to records_[used_...), which has room for every point of the chunk.
   void node(int level, size_t begin, size_t end) {
     ChunkNodes::Node n;
     n.key = keyOfCode(items_[begin].code, level);
-    n.first = out_.records.size();
+    n.first = used_;
+    PointRecord* const start = out_.records.data() + used_;
     if (end - begin > params_.leafPoints && level < kMaxLevel) {
       uint64_t left[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-      subsample(level, begin, end, out_.records, left);
-      n.count = out_.records.size() - n.first;
+      n.count = static_cast<uint64_t>(subsample(level, begin, end, start, left) - start);
+      used_ += n.count;
       const int childShift = 3 * (kCodeLevels - level - 1);
       size_t childBegin = begin;
       for (int c = 0; c < 8 && childBegin < end; ++c) {
@@ -121,13 +131,11 @@ public:
         childBegin = childEnd;
       }
     } else {
-      // resize and fill: push_back per point cost more than the zeroing resize does.
-      out_.records.resize(n.first + (end - begin));
-      PointRecord* dst = out_.records.data() + n.first;
+      PointRecord* dst = start;
       for (size_t k = begin; k < end; ++k)
         if (!(items_[k].code & kTakenBit)) *dst++ = items_[k].record;
-      n.count = static_cast<uint64_t>(dst - (out_.records.data() + n.first));
-      out_.records.resize(n.first + n.count);
+      n.count = static_cast<uint64_t>(dst - start);
+      used_ += n.count;
     }
     assert(n.count > 0);
     out_.nodes.push_back(n);
@@ -135,6 +143,7 @@ public:
 
 private:
   ChunkNodes& out_;
+  uint64_t used_ = 0;
   LodItem* items_;
   const LodGrid& grid_;
   const LodParams& params_;
@@ -182,10 +191,8 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
   assert(chunk.level >= 0 && chunk.level <= grid.countLevel());
   assert(cells == size_t(1) << 3 * (grid.countLevel() - chunk.level));
   out.chunk = chunk;
-  out.top.clear();
   out.topCounts.assign(static_cast<size_t>(chunk.level), 0);
   out.nodes.clear();
-  out.records.clear();
   if (count == 0) return;
   const int cellFreeBits = 3 * (kCodeLevels - grid.countLevel());
   size_t begin = 0;
@@ -198,14 +205,18 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
   assert(keyOfCode(items[0].code, chunk.level) == chunk &&
          keyOfCode(items[count - 1].code, chunk.level) == chunk);
 
-  out.records.reserve(count);
+  // Room for every point, in buffers that keep their size from chunk to chunk (grown, never shrunk):
+  // no zeroing per chunk. Nodes and topCounts say how much of them is in use.
+  if (out.records.size() < count) out.records.resize(count);
+  if (out.top.size() < count) out.top.resize(count);
   Indexer indexer(out, items, grid, params);
   uint64_t taken = 0, unused[8];
+  PointRecord* top = out.top.data();
   for (int level = 0; level < chunk.level; ++level) {
-    const size_t before = out.top.size();
-    indexer.subsample(level, 0, count, out.top, unused);
-    out.topCounts[static_cast<size_t>(level)] = out.top.size() - before;
-    taken += out.top.size() - before;
+    PointRecord* const levelEnd = indexer.subsample(level, 0, count, top, unused);
+    out.topCounts[static_cast<size_t>(level)] = static_cast<uint64_t>(levelEnd - top);
+    taken += out.topCounts[static_cast<size_t>(level)];
+    top = levelEnd;
   }
   if (taken < count) indexer.node(chunk.level, 0, count);
 }

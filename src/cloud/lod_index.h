@@ -41,7 +41,8 @@ struct PreparedNode {
 struct ChunkNodes {
   NodeKey chunk;
   // Points the chunk gives to its ancestors' subsamples (levels 0 .. chunk.level - 1): topCounts[L]
-  // records for level L, level after level. The ancestors are inner nodes: chunks are planned so.
+  // records for level L, level after level, from the start of `top` (which may be longer). The ancestors
+  // are inner nodes: chunks are planned so.
   std::vector<PointRecord> top;
   std::vector<uint64_t> topCounts;
   struct Node {
@@ -49,7 +50,7 @@ struct ChunkNodes {
     uint64_t first = 0, count = 0; // its points: records[first, first + count)
   };
   std::vector<Node> nodes; // the chunk's subtree (rooted at the chunk's cell), children before parents
-  std::vector<PointRecord> records;
+  std::vector<PointRecord> records; // the nodes' points (where nodes say; it may be longer)
   // What the sink's prepare() made of each node (lod_assemble.h); empty until then.
   std::vector<std::unique_ptr<PreparedNode>> prepared;
 };

@@ -254,7 +254,7 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
         ChunkSpill::Writer* writer = writers[worker].get();
         s.inputs.read(tasks[task], records);
         for (const PointRecord& r : records)
-          writer->add(chunkOf[grid.code(r) >> shift], r);
+          writer->add(chunkOf[grid.countCell(r)], r);
       });
       for (auto& w : writers)
         w->flush();

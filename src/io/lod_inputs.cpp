@@ -1,6 +1,7 @@
 #include "io/lod_inputs.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 
 #include "io/io_util.h"
@@ -123,15 +124,24 @@ void BuildInputs::read(const Task& task, std::vector<PointRecord>& out) const {
 }
 
 BuildInputs::Scan BuildInputs::scan(const std::vector<PointRecord>& records) {
-  Scan s;
+  // Plain locals, so the loop keeps them in registers (through the struct it did not).
+  int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  uint16_t colorMax = 0;
   for (const PointRecord& r : records) {
-    const int32_t q[3] = {r.x, r.y, r.z};
-    for (int a = 0; a < 3; ++a) {
-      s.box.min[a] = std::min(s.box.min[a], q[a]);
-      s.box.max[a] = std::max(s.box.max[a], q[a]);
-    }
-    s.colorMax = std::max({s.colorMax, r.rgb[0], r.rgb[1], r.rgb[2]});
+    lo[0] = std::min(lo[0], r.x);
+    hi[0] = std::max(hi[0], r.x);
+    lo[1] = std::min(lo[1], r.y);
+    hi[1] = std::max(hi[1], r.y);
+    lo[2] = std::min(lo[2], r.z);
+    hi[2] = std::max(hi[2], r.z);
+    colorMax = std::max(colorMax, std::max(r.rgb[0], std::max(r.rgb[1], r.rgb[2])));
   }
+  Scan s;
+  for (int a = 0; a < 3; ++a) {
+    s.box.min[a] = lo[a];
+    s.box.max[a] = hi[a];
+  }
+  s.colorMax = colorMax;
   return s;
 }
 

@@ -29,6 +29,11 @@ TEST(LodGrid, CubeHoldsEveryPointAndCodesNestLevels) {
   for (const PointRecord& r : records) {
     const uint64_t code = grid.code(r);
     ASSERT_LT(code, uint64_t(1) << 63);
+    ASSERT_EQ(grid.countCell(r), code >> 3 * (lod::kCodeLevels - grid.countLevel()));
+    uint32_t cells[3];
+    grid.codeCells(r, cells);
+    ASSERT_EQ(code, detail::spreadBits3(cells[0]) << 2 | detail::spreadBits3(cells[1]) << 1 |
+                        detail::spreadBits3(cells[2]));
     for (int level = 0; level <= lod::kCodeLevels; ++level) {
       const NodeKey key = lod::keyOfCode(code, level);
       ASSERT_EQ(lod::cellOfKey(key), code >> 3 * (lod::kCodeLevels - level));
@@ -158,14 +163,18 @@ TEST(LodBuild, InnerColorsAreTheAveragesOfThePointsTheyStandFor) {
         r.pointSourceId = uint16_t(y);
         records.push_back(r);
       }
-  lod::LodGrid grid = gridOf(records, glm::dvec3(0.01), glm::dvec3(100, 200, 0), 2);
-  for (bool average : {true, false}) {
-    lod::LodParams params;
-    params.leafPoints = 60;
-    params.averageColors = average;
-    Built built = build(records, grid, params, 2, 300);
-    expectValidOctree(built.sink.nodes, records, grid, params);
-    expectFilteredColors(built.sink.nodes, records, grid, params);
+  // Equal scales (integer distances) and a finer z scale (weighted distances).
+  for (glm::dvec3 scale : {glm::dvec3(0.01), glm::dvec3(0.01, 0.01, 0.001)}) {
+    lod::LodGrid grid = gridOf(records, scale, glm::dvec3(100, 200, 0), 2);
+    EXPECT_EQ(grid.isotropic, scale.z == scale.x);
+    for (bool average : {true, false}) {
+      lod::LodParams params;
+      params.leafPoints = 60;
+      params.averageColors = average;
+      Built built = build(records, grid, params, 2, 300);
+      expectValidOctree(built.sink.nodes, records, grid, params);
+      expectFilteredColors(built.sink.nodes, records, grid, params);
+    }
   }
 }
 

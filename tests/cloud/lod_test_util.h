@@ -241,20 +241,15 @@ inline void expectFilteredColors(const std::vector<WrittenNode>& nodes, const st
                                                  : original.at({p.x, p.y, p.z}).rgb[c])
             << node.key.potreeName() << " channel " << c;
       averagedOverMany += points.size() > 1;
-      // Closest to the cell's center (code units), the first in canonical order on a tie.
-      const double size = double(uint64_t(1) << (lod::kCodeLevels - cellLevel));
-      const double center[3] = {(detail::compactBits3(cell >> 2) + 0.5) * size,
-                                (detail::compactBits3(cell >> 1) + 0.5) * size,
-                                (detail::compactBits3(cell) + 0.5) * size};
-      auto distance = [&](const PointRecord& r) {
-        double u[3];
-        grid.codeSpace(r, u);
-        return (u[0] - center[0]) * (u[0] - center[0]) + (u[1] - center[1]) * (u[1] - center[1]) +
-               (u[2] - center[2]) * (u[2] - center[2]);
-      };
-      const double mine = distance(p);
-      for (const PointRecord& q : points)
-        ASSERT_LE(mine, distance(q)) << node.key.potreeName();
+      // Nearest the cell's center, as the grid measures it (doubled quanta, integers for equal scales).
+      const lod::LodGrid::Center center = grid.cellCenter(cell, cellLevel);
+      for (const PointRecord& q : points) {
+        if (grid.isotropic)
+          ASSERT_LE(grid.centerDistanceIsotropic(center, p), grid.centerDistanceIsotropic(center, q))
+              << node.key.potreeName();
+        else
+          ASSERT_LE(grid.centerDistance(center, p), grid.centerDistance(center, q)) << node.key.potreeName();
+      }
     }
   }
   EXPECT_GT(averagedOverMany, 0u) << "the cloud never puts two points in one cell: the test proves nothing";
