@@ -19,11 +19,11 @@ template <class T> class LargeBuffer {
 
 public:
   LargeBuffer() = default;
-  // Throws std::bad_alloc when the memory cannot be mapped.
+  // Throws std::bad_alloc when the memory cannot be mapped (the kernel's overcommit check refuses it up
+  // front, rather than a page fault failing later).
   explicit LargeBuffer(size_t count) : count_(count) {
     if (count == 0) return;
-    void* p =
-        ::mmap(nullptr, bytes(), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    void* p = ::mmap(nullptr, bytes(), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
     data_ = static_cast<T*>(p);
   }

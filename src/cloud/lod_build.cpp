@@ -89,10 +89,13 @@ detail::QuantBox quantBoxOf(const Pieces& pieces, const LodRunOptions& options) 
 std::vector<uint64_t> countPoints(const LodGrid& grid, const Pieces& pieces, const LodRunOptions& options) {
   std::vector<uint64_t> counts(size_t(1) << 3 * grid.countLevel(), 0);
   const std::vector<Task> tasks = tasksOf(pieces);
+  std::optional<Progress> progress;
+  if (options.progress) progress.emplace("counting", totalPoints(pieces));
   parallelBlocksOn(options.threads, tasks.size(), 1, [&](uint64_t t, uint64_t, uint64_t) {
     checkCancel(options);
     const Task& task = tasks[t];
     countCells(counts.data(), grid, pieces[task.piece].data() + task.begin, task.end - task.begin);
+    if (progress) progress->advance(task.end - task.begin);
   });
   return counts;
 }
@@ -113,6 +116,8 @@ LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uin
   for (const Task& task : tasks)
     remaining[task.piece].fetch_add(1, std::memory_order_relaxed);
   const int shift = 3 * (kCodeLevels - grid.countLevel());
+  std::optional<Progress> progress;
+  if (options.progress) progress.emplace("distributing", total);
   parallelBlocksOn(options.threads, tasks.size(), 1, [&](uint64_t t, uint64_t, uint64_t) {
     checkCancel(options);
     const Task& task = tasks[t];
@@ -135,6 +140,7 @@ LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uin
           out[at] = {codes[i], src[b + i]};
       }
     }
+    if (progress) progress->advance(task.end - task.begin);
     if (remaining[task.piece].fetch_sub(1, std::memory_order_acq_rel) == 1)
       std::vector<PointRecord>().swap(pieces[task.piece]);
   });
