@@ -15,6 +15,7 @@
 #include "base/progress.h"
 #include "cli_util.h"
 #include "commands.h"
+#include "io/format_table.h"
 #include "io/lod_potree.h"
 
 namespace pointrast::app {

@@ -12,17 +12,15 @@
 
 int main(int argc, char** argv) {
   using namespace pointrast;
-  CLI::App app{
-      "pointrast: renders billions of points and particles by software rasterization in compute "
-      "shaders (Vulkan 1.3; any GPU, or the CPU through lavapipe).\n\n"
-      "Examples:\n"
-      "  pointrast render -o demo.png                       # built-in demo scene\n"
-      "  pointrast render cloud.las -o out.png --json       # a LAS/PLY/XYZ file, timing as JSON\n"
-      "  pointrast info cloud.las                           # what a file holds\n"
-      "  pointrast generate terrain --points 10M -o t.las   # a synthetic scene as LAS\n"
-      "  pointrast convert in.ply out.las --order morton    # reorder and write LAS\n"
-      "  pointrast lod scan.las -o scan_octree              # a level-of-detail octree (Potree 2.0)\n",
-      "pointrast"};
+  CLI::App app{"pointrast: renders billions of points and particles by software rasterization in compute "
+               "shaders (Vulkan 1.3; any GPU, or the CPU through lavapipe).\n\n"
+               "Examples:\n"
+               "  pointrast render -o demo.png                       # built-in demo scene\n"
+               "  pointrast render cloud.las -o out.png --json       # a point cloud file, timing as JSON\n"
+               "  pointrast info cloud.las                           # what a file holds\n"
+               "  pointrast generate terrain --points 10M -o t.las   # a synthetic scene as LAS\n"
+               "  pointrast convert in.ply out.las --order morton    # reorder and write LAS\n",
+               "pointrast"};
   app.require_subcommand(1);
   app.fallthrough(false);
   app.set_version_flag("--version", "pointrast 0.1.0");
@@ -33,6 +31,7 @@ int main(int argc, char** argv) {
   app::Command convert = app::addConvert(app);
   app::Command generate = app::addGenerate(app);
   app::Command bench = app::addBench(app);
+  app::Command view = app::addView(app);
   app::Command lod = app::addLod(app);
 
   try {
@@ -56,6 +55,7 @@ int main(int argc, char** argv) {
       if (sub->get_name() == "convert") return convert();
       if (sub->get_name() == "generate") return generate();
       if (sub->get_name() == "bench") return bench();
+      if (sub->get_name() == "view") return view();
       if (sub->get_name() == "lod") return lod();
     }
     return 1;

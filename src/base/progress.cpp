@@ -1,6 +1,5 @@
 #include "base/progress.h"
 
-#include <cmath>
 #include <cstdio>
 #include <unistd.h>
 
@@ -61,18 +60,11 @@ void Progress::draw(bool final) {
   double pct = total_ ? 100.0 * done / static_cast<double>(total_) : 100.0;
   double rate = secs > 0 ? done / secs : 0;
   if (tty_) {
-    // Time left at the rate so far: long work says when it will end.
-    char eta[32] = "";
-    if (!final && rate > 0 && done < static_cast<double>(total_)) {
-      const double left = (static_cast<double>(total_) - done) / rate;
-      if (left < 60)
-        std::snprintf(eta, sizeof eta, "  ETA %.0f s", left);
-      else
-        std::snprintf(eta, sizeof eta, "  ETA %.0f min %02.0f s", std::floor(left / 60),
-                      std::fmod(left, 60.0));
-    }
-    std::fprintf(stderr, "\r\033[K%s: %5.1f%%  %s%s  %s%s/s%s", label_.c_str(), pct, humanCount(done).c_str(),
-                 unit_.c_str(), humanCount(rate).c_str(), unit_.c_str(), eta);
+    std::fprintf(stderr, "\r\033[K%s: %5.1f%%  %s%s  %s%s/s", label_.c_str(), pct, humanCount(done).c_str(),
+                 unit_.c_str(), humanCount(rate).c_str(), unit_.c_str());
+    // The time left at the rate so far, once there is a rate to go by.
+    if (!final && total_ && rate > 0 && done < double(total_))
+      std::fprintf(stderr, "  ETA %.0f s", (double(total_) - done) / rate);
   }
   if (final) {
     if (tty_) std::fprintf(stderr, "\r\033[K");

@@ -1,12 +1,14 @@
-// openPointSource(): one streaming interface over every point format. LAS is read piece by piece with
-// positional reads. PLY and XYZ/CSV have no random access to records (text lines, variable-size PLY
-// lists), so they are read once, whole, through readCloud() and served from memory, cut into pieces of
-// the same size as LAS pieces so that callers parallelize alike; such a source holds the file's cloud
-// (12-20 B a point) for its lifetime.
+// openPointSource(): one streaming interface over every point format, through the format table's rows.
+// Formats with a streaming source (openPoints: LAS, read piece by piece with positional reads) use it.
+// The others that read as a whole cloud (PLY and XYZ/CSV have no random access to records: text lines,
+// variable-size PLY lists; a Potree octree) are read once, whole, through their reader and served from
+// memory, cut into pieces of the same size as LAS pieces so that callers parallelize alike; such a source
+// holds the file's cloud (12-20 B a point) for its lifetime.
 #include "io/point_source.h"
 
 #include <algorithm>
 
+#include "io/format_table.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
 #include "io/las_source.h"
@@ -72,21 +74,16 @@ private:
 } // namespace
 
 std::unique_ptr<PointSource> openPointSource(const std::filesystem::path& path) {
-  const Format format = detectFormat(path);
-  switch (format) {
-  case Format::Las:
-    return openLasSource(path);
-  case Format::Ply:
-  case Format::Xyz: {
+  const FormatInfo* format = detectFormat(path);
+  if (format && format->openPoints) return format->openPoints(path);
+  if (format && format->read) {
     ReadOptions options;
     options.progress = true;
-    return std::make_unique<CloudSource>(readCloud(path, options));
+    return std::make_unique<CloudSource>(format->read(path, options));
   }
-  default:
-    // readCloud gives the one sentence for LAZ, MMPLD, empty and unrecognised files.
-    readCloud(path);
-    fail(path, "not a point cloud this build can stream");
-  }
+  // readCloud gives the one sentence for every other input (compressed, particles, empty, unknown).
+  readCloud(path);
+  fail(path, "not a point cloud this build can stream");
 }
 
 } // namespace pointrast::io
