@@ -40,6 +40,13 @@ glm::dvec3 parseVec3(std::string_view text, std::string_view option) {
   return {v[0], v[1], v[2]};
 }
 
+std::pair<double, double> parseRange(std::string_view text, std::string_view option) {
+  std::vector<double> v = parseNumbers(text, option, 2);
+  if (!(v[0] < v[1]))
+    throw InputError(std::string(option) + " expects lo,hi with lo < hi, got '" + std::string(text) + "'");
+  return {v[0], v[1]};
+}
+
 uint32_t parseRgb(std::string_view text, std::string_view option) {
   std::vector<double> v = parseNumbers(text, option, 3);
   for (double c : v)

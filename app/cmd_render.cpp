@@ -14,6 +14,7 @@
 #include "base/progress.h"
 #include "bench/report.h"
 #include "cli_util.h"
+#include "cloud/attribute_colors.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
 #include "gpu/context.h"
@@ -46,7 +47,71 @@ struct RenderArgs {
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
   PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
+  // Point methods: coloring and the resolve stage.
+  std::string color = "auto", colorRange;
+  float pointSize = 1, pointSizeMax = 16;
+  std::string pointShape = "square", pointSizeMode = "fixed";
+  uint32_t dilate = 0;
+  bool edl = false;
+  std::optional<float> edlStrength, edlRadius;
 };
+
+// Whether any option of the resolve stage or of coloring was given (the sphere methods take none).
+bool postOrColorGiven(const RenderArgs& a) {
+  return a.color != "auto" || !a.colorRange.empty() || a.pointSize != 1 || a.pointSizeMax != 16 ||
+         a.pointShape != "square" || a.pointSizeMode != "fixed" || a.dilate != 0 || a.edl || a.edlStrength ||
+         a.edlRadius;
+}
+
+// --point-size, --point-shape, --point-size-mode, --point-size-max, --dilate, --edl*.
+PostSettings postSettings(const RenderArgs& a) {
+  PostSettings post;
+  post.pointSize = a.pointSize;
+  post.shape = parsePointShape(a.pointShape);
+  post.sizeMode = parsePointSizeMode(a.pointSizeMode);
+  post.maxPointSize = a.pointSizeMax;
+  post.dilate = a.dilate;
+  // --edl-strength or --edl-radius alone turn eye-dome lighting on, with Potree's defaults for the other.
+  if (a.edl || a.edlStrength || a.edlRadius) {
+    post.edlStrength = a.edlStrength.value_or(1.0f);
+    post.edlRadius = a.edlRadius.value_or(post.edlRadius);
+  }
+  validatePostSettings(post);
+  return post;
+}
+
+// --color and --color-range: nullopt for auto (displayColorMode's choice).
+std::optional<DisplayColorMode> colorMode(const RenderArgs& a, const PointCloud& cloud) {
+  if (a.color == "auto") {
+    if (!a.colorRange.empty()) throw InputError("--color-range applies to --color intensity and elevation");
+    return std::nullopt;
+  }
+  DisplayColorMode::Source source = parseColorSource(a.color);
+  std::optional<ColorRange> range;
+  if (!a.colorRange.empty()) {
+    if (source != DisplayColorMode::Source::Intensity && source != DisplayColorMode::Source::Elevation)
+      throw InputError("--color-range applies to --color intensity and elevation, not " + a.color);
+    auto [lo, hi] = parseRange(a.colorRange, "--color-range");
+    range = ColorRange{lo, hi};
+  }
+  return displayColorMode(cloud, source, range);
+}
+
+// The resolve stage's settings and per-pass GPU times.
+nlohmann::json postJson(const PostSettings& post, const PostStats& stats) {
+  nlohmann::json j;
+  j["point_size"] = post.pointSize;
+  j["point_shape"] = pointShapeName(post.shape);
+  j["point_size_mode"] = pointSizeModeName(post.sizeMode);
+  if (post.sizeMode == PointSizeMode::Attenuated) j["point_size_max"] = post.maxPointSize;
+  j["dilate"] = post.dilate;
+  j["edl_strength"] = post.edlStrength;
+  if (post.edlStrength > 0) j["edl_radius"] = post.edlRadius;
+  j["splat_ms"] = stats.splatMs;
+  j["dilate_ms"] = stats.dilateMs;
+  j["compose_ms"] = stats.composeMs;
+  return j;
+}
 
 // The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
 // as spheres of --radius, through the SphereRenderer.
@@ -58,6 +123,9 @@ int runRenderSpheres(const RenderArgs& a) {
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
     throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
+                     a.method);
+  if (postOrColorGiven(a))
+    throw InputError("--color, --point-size, --dilate and --edl apply to the point methods, not to " +
                      a.method);
   if (!a.billboard.empty()) settings.billboard = parseSphereBillboard(a.billboard);
   settings.conservative = a.conservative;
@@ -197,6 +265,10 @@ int runRender(const RenderArgs& a) {
     throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
                      ")");
   settings.background = parseRgb(a.background, "--background");
+  settings.post = postSettings(a);
+  if (settings.post.enabled() && methodInfo(settings.method).output == MethodOutput::ColorOnly)
+    throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
+                     " keeps no depth per pixel to work on");
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.parts == 0) throw InputError("--parts must be at least 1");
@@ -217,6 +289,7 @@ int runRender(const RenderArgs& a) {
   }
 
   PointCloud cloud = loadInput(spec);
+  const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
   double aspect = double(a.width) / double(a.height);
   if (explicitCamera) {
     camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
@@ -253,6 +326,7 @@ int runRender(const RenderArgs& a) {
     upload.count = perPart;
     upload.layout = layout;
     upload.progress = !a.quiet;
+    upload.colors = colors;
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
   std::vector<const GpuScene*> drawn;
@@ -290,6 +364,8 @@ int runRender(const RenderArgs& a) {
       j["precision"] = a.precision;
       j["batch_stats"] = bench::batchStatsJson(*stats.batch);
     }
+    if (colors) j["color"] = colorSourceName(colors->source);
+    if (stats.post) j["post"] = postJson(settings.post, *stats.post);
     j["camera"] = describeCamera(camera);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
@@ -312,6 +388,11 @@ int runRender(const RenderArgs& a) {
           humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
           humanCount(double(b.pointsRendered)).c_str());
     }
+    if (stats.post)
+      std::printf(
+          "  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
+          stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
+          stats.post->composeMs);
   }
   return 0;
 }
@@ -356,6 +437,8 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
       "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
       "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
+      "  pointrast render autzen.las -o a.png --color classification --point-size 3 --edl\n"
+      "  pointrast render autzen.las -o a.png --color elevation --dilate 2\n"
       "  pointrast render autzen.las --path path.json --video fly.mp4 --fps 60 --width 3840 --height 2160\n"
       "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
       std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
@@ -419,6 +502,37 @@ Command addRender(CLI::App& app) {
   cmd->add_flag("--task-cull", a->taskCull,
                 "sphere-mesh-points, sphere-mesh-tris: a task shader culls spheres outside the view first "
                 "and launches mesh workgroups only for the rest");
+  cmd->add_option("--color", a->color,
+                  "Point colors: auto (RGB if the file has it, else intensity, else elevation), rgb, "
+                  "intensity, classification (ASPRS classes), elevation, return (return number), source "
+                  "(point source id)")
+      ->capture_default_str();
+  cmd->add_option(
+      "--color-range", a->colorRange,
+      "lo,hi mapped to the ends of the intensity or elevation ramp (default: the 0.5 % and 99.5 % "
+      "percentiles)");
+  cmd->add_option("--point-size", a->pointSize,
+                  "Point size in pixels (1..32); the closest point still wins every pixel")
+      ->capture_default_str();
+  cmd->add_option("--point-shape", a->pointShape, "Shape of points larger than a pixel: square or disc")
+      ->capture_default_str();
+  cmd->add_option(
+         "--point-size-mode", a->pointSizeMode,
+         "fixed (every point --point-size pixels) or attenuated (--point-size pixels at the target's "
+         "distance, larger nearer and smaller farther, at most --point-size-max)")
+      ->capture_default_str();
+  cmd->add_option("--point-size-max", a->pointSizeMax, "Attenuated point sizes: the largest, pixels (1..32)")
+      ->capture_default_str();
+  cmd->add_option("--dilate", a->dilate,
+                  "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
+                  "point never covers a near one, and convex outlines do not grow")
+      ->capture_default_str();
+  cmd->add_flag("--edl", a->edl,
+                "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
+                "its neighbours");
+  cmd->add_option("--edl-strength", a->edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
+  cmd->add_option("--edl-radius", a->edlRadius,
+                  "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

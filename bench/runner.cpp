@@ -159,6 +159,7 @@ PointCloud loadDataset(const Dataset& dataset, bool progress) {
   cloud.intensity = {};
   cloud.classification = {};
   cloud.returnNumber = {};
+  cloud.pointSourceId = {};
   return cloud;
 }
 

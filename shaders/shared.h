@@ -68,6 +68,59 @@ struct ResolvePush {
   uint height;
   uint background;      // RGBA8 written where no point landed
   uint groupsX;         // workgroups per row of the 2D dispatch
+  float int40Scale;     // int40 depth: if > 0, words carry floatBits(steps / int40Scale) << 32 | RGBA8, the
+                        // float-depth words the resolve stage reads; 0: the method's canonical words
+  uint reserved;
+};
+
+// ------------------------------------------------------------------------------------------------------
+// The resolve stage (src/render/post): passes that run after any point method's raster and resolve, on
+// one float-depth word per pixel (floatBits(linear depth) << 32 | RGBA8, kEmptyPixel where empty) that
+// every method's resolve writes (ResolvePush::words).
+//   splat   points larger than one pixel: each pixel takes the smallest word among the pixels whose
+//           point's square or disc covers it (the same image as rasterizing the shapes with atomicMin)
+//   dilate  depth-aware hole filling: a pixel that is empty, or farther than the closer points of its
+//           window, takes the closest of them when it lies within their convex hull
+//   compose eye-dome lighting (optional), background, RGBA8 image and the final words
+// ------------------------------------------------------------------------------------------------------
+
+// Workgroups of the post passes are 16 x 16 pixel tiles (256 threads, like kPixelGroupSize), so a window
+// of neighbours is mostly shared between the threads of a tile.
+PR_CONST kPostTile = 16;
+// Largest point side in pixels (fixed or attenuated): the splat pass reads up to 33 x 33 words a pixel.
+PR_CONST kMaxPointSize = 32;
+// Largest dilation radius: a 17 x 17 window (the 2022 paper's periphery uses 7 x 7, radius 3).
+PR_CONST kMaxDilateRadius = 8;
+// Splat shapes (specialization constant SHAPE of post_splat.comp).
+PR_CONST kPointShapeSquare = 0; // side n: offsets -((n - 1) / 2) .. n / 2 from the point's pixel
+PR_CONST kPointShapeDisc = 1;   // diameter s: pixels whose center is within s / 2 of the point's pixel center
+// A pixel counts as a hole the dilation fills when the closer point is nearer by more than this factor
+// (1 %, the HQS tolerance): surfaces seen at a slant differ less than that from one pixel to the next.
+#define PR_DILATE_DEPTH_FACTOR 1.01
+// Eye-dome lighting as Potree computes it (edl.fs): for a pixel with a point, response = the sum over 8
+// neighbours at `radius` pixels (directions k * 45 degrees, nearest pixel) that hold a point of
+// max(0, log2(depth) - log2(neighbour depth)), divided by 8; the color is scaled by
+// shade = exp(-response * PR_EDL_EXPONENT * strength). Empty pixels keep the background.
+#define PR_EDL_EXPONENT 300.0
+PR_CONST kEdlNeighbours = 8;
+
+// Push constants of the post passes. Buffers are addressed by device address and may be strided (an eye
+// of a side-by-side stereo image is a window of a wider buffer: pitch > width).
+struct PostPush {
+  uint64_t source;  // uint64_t words, sourcePitch per row
+  uint64_t target;  // splat, dilate: uint64_t words; compose: RGBA8 image; targetPitch per row
+  uint64_t words;   // compose: if not 0, receives the final words (targetPitch per row)
+  uint width;
+  uint height;
+  uint sourcePitch; // elements per row
+  uint targetPitch;
+  uint radius;      // splat: the window's reach, pixels; dilate: the window radius
+  uint background;  // compose: RGBA8 where no point landed
+  float pointSize;  // splat fixed: side (square) or diameter (disc) in pixels; attenuated: the same at
+                    // linear depth 1 (the size at depth d is pointSize / d, clamped to [1, maxPointSize])
+  float maxPointSize;
+  float edlStrength; // compose: 0 = no eye-dome lighting
+  float edlRadius;   // pixels
 };
 
 // Push constants of the shader copy that measures the device's copy bandwidth (src/gpu/bandwidth.cpp).

@@ -360,6 +360,7 @@ void applyOrder(PointCloud& cloud, const std::vector<uint64_t>& order) {
   gather<uint16_t, 1>(cloud.intensity, order);
   gather<uint8_t, 1>(cloud.classification, order);
   gather<uint8_t, 1>(cloud.returnNumber, order);
+  gather<uint16_t, 1>(cloud.pointSourceId, order);
 }
 
 void reorder(PointCloud& cloud, Order kind, uint64_t seed) {

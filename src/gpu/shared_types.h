@@ -14,7 +14,10 @@ static_assert(offsetof(RasterPush, framebuffer) == 80);
 static_assert(offsetof(RasterPush, viewProjD) == 96);
 static_assert(offsetof(RasterPush, pointCount) == 104);
 static_assert(offsetof(RasterPush, groupsX) == 120);
-static_assert(sizeof(ResolvePush) == 48);
+static_assert(sizeof(ResolvePush) == 56);
+static_assert(offsetof(ResolvePush, int40Scale) == 48);
+static_assert(sizeof(PostPush) == 64);
+static_assert(offsetof(PostPush, width) == 24 && offsetof(PostPush, pointSize) == 48);
 static_assert(offsetof(ResolvePush, width) == 32);
 static_assert(sizeof(CopyPush) == 24);
 

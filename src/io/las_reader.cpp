@@ -30,9 +30,10 @@ struct BlockStats {
 struct Destination {
   int32_t* positions = nullptr;
   uint32_t* colors = nullptr;    // null: format has no color
-  uint16_t* intensity = nullptr; // these three are null unless attributes are kept
+  uint16_t* intensity = nullptr; // these four are null unless attributes are kept
   uint8_t* classification = nullptr;
   uint8_t* returnNumber = nullptr;
+  uint16_t* pointSourceId = nullptr;
 };
 
 // Calls fn(records, firstIndex, count) for consecutive chunks of point records (see forEachRecordChunk).
@@ -50,7 +51,8 @@ inline uint32_t packLasColor(const uint8_t* rgb, int shift) {
 
 // Record layout, R15 section 2.6: X, Y, Z int32 at 0, 4, 8; intensity uint16 at 12; byte 14 holds the
 // return number in bits 0-2 (formats 0-5) or bits 0-3 (formats 6-10); the classification is bits 0-4
-// of byte 15 (formats 0-5) or all of byte 16 (formats 6-10).
+// of byte 15 (formats 0-5) or all of byte 16 (formats 6-10); the point source id is a uint16 at 18
+// (formats 0-5) or 20 (formats 6-10).
 template <bool kExtended>
 void parseBlock(const uint8_t* src, uint64_t stride, uint64_t count, int rgbOffset, int colorShift,
                 const Destination& dst, BlockStats& stats) {
@@ -73,9 +75,11 @@ void parseBlock(const uint8_t* src, uint64_t stride, uint64_t count, int rgbOffs
       if constexpr (kExtended) {
         dst.returnNumber[i] = src[14] & 0x0F;
         dst.classification[i] = src[16];
+        dst.pointSourceId[i] = loadLE<uint16_t>(src + 20);
       } else {
         dst.returnNumber[i] = src[14] & 0x07;
         dst.classification[i] = src[15] & 0x1F;
+        dst.pointSourceId[i] = loadLE<uint16_t>(src + 18);
       }
     }
   }
@@ -90,6 +94,7 @@ Destination offsetBy(const Destination& d, uint64_t i) {
     o.intensity = d.intensity + i;
     o.classification = d.classification + i;
     o.returnNumber = d.returnNumber + i;
+    o.pointSourceId = d.pointSourceId + i;
   }
   return o;
 }
@@ -140,6 +145,7 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
     cloud.intensity.resize(n);
     cloud.classification.resize(n);
     cloud.returnNumber.resize(n);
+    cloud.pointSourceId.resize(n);
   }
   Destination all;
   all.positions = cloud.positions.data();
@@ -148,6 +154,7 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
     all.intensity = cloud.intensity.data();
     all.classification = cloud.classification.data();
     all.returnNumber = cloud.returnNumber.data();
+    all.pointSourceId = cloud.pointSourceId.data();
   }
 
   std::optional<Progress> progress;

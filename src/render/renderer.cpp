@@ -8,6 +8,7 @@
 #include "gpu/context.h"
 #include "gpu/timer.h"
 #include "render/method.h"
+#include "render/post/post_stage.h"
 
 namespace pointrast {
 
@@ -54,7 +55,10 @@ shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint
   shared::ResolvePush push{};
   push.framebuffer = framebuffer;
   push.image = targets.image.address();
-  push.words = frame.settings.captureWords ? targets.words.address() : 0;
+  const bool post = frame.settings.post.enabled();
+  push.words = frame.settings.captureWords || post ? targets.words.address() : 0;
+  // The resolve stage reads float depths: int40 words are converted for it.
+  if (post && frame.settings.depth == DepthMode::Int40) push.int40Scale = float(frame.settings.depthScale);
   push.width = targets.width;
   push.height = targets.height;
   push.background = frame.settings.background;
@@ -160,10 +164,19 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
                      " per frame (parts of up to 67,102,720 points: 4.29 billion points, the reach of a "
                      "32-bit visibility index)");
   if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
+  const bool post = settings.post.enabled();
+  if (post) {
+    validatePostSettings(settings.post);
+    if (info.output == MethodOutput::ColorOnly)
+      throw InputError(std::string("point size, dilation and eye-dome lighting work on the depth the "
+                                   "compute methods keep per pixel; ") +
+                       info.name + " keeps none");
+  }
   PointMethod& m = method(settings);
   Targets& t = *targets_;
-  // Canonical words are for equivalence tests only: allocated on first request (8 B a pixel).
-  if (settings.captureWords && !t.words)
+  // Canonical words are for equivalence tests and the resolve stage: allocated on first request (8 B a
+  // pixel).
+  if ((settings.captureWords || post) && !t.words)
     t.words =
         gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
   // Double-precision copies of each scene's matrix, for the int40 path.
@@ -181,18 +194,36 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
     effective.depthScale = int40Scale(scenes, camera);
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
+  PostView view;
+  std::optional<gpu::TimestampPool> postTimestamps;
+  if (post) {
+    if (!post_) post_ = std::make_unique<PostStage>(context_);
+    view = {t.words.address(),
+            t.image.address(),
+            t.width,
+            t.height,
+            t.width,
+            float(glm::length(camera.target - camera.eye)),
+            settings.background,
+            settings.captureWords};
+    postTimestamps.emplace(context_, frames * kPostPasses);
+  }
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
+    if (post) postTimestamps->reset(cmd);
     Frame frame{cmd, scenes, camera, effective};
-    for (uint32_t w = 0; w < settings.warmup; ++w)
+    for (uint32_t w = 0; w < settings.warmup; ++w) {
       m.recordFrame(frame, t);
+      if (post) post_->record(cmd, view, settings.post);
+    }
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);
       m.recordFrame(frame, t);
+      if (post) post_->record(cmd, view, settings.post, &*postTimestamps, f * kPostPasses);
       timestamps.end(cmd, f);
     }
   });
-  wordsCaptured_ = settings.captureWords && hasCanonicalWords(info);
+  wordsCaptured_ = settings.captureWords && (hasCanonicalWords(info) || post);
   std::vector<double> ms = timestamps.milliseconds();
   FrameStats stats;
   stats.frames = frames;
@@ -202,6 +233,7 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   for (const GpuScene* scene : scenes)
     stats.points += scene->pointCount();
   stats.batch = m.readStats();
+  if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), frames);
   return stats;
 }
 

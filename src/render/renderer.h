@@ -14,6 +14,7 @@
 
 #include "render/camera.h"
 #include "render/method_table.h"
+#include "render/post/post_settings.h"
 #include "render/scene.h"
 
 namespace pointrast {
@@ -44,6 +45,7 @@ struct RenderSettings {
   // the batch under half a pixel), 1..3 = forced (3 = full 30-bit precision).
   uint32_t precision = 0;
   bool batchCulling = true; // batch methods: frustum culling of batches (off only to test that it is exact)
+  PostSettings post;        // the resolve stage after the method: point size, dilation, eye-dome lighting
 };
 // "adaptive", "1", "2", "3" -> 0..3; throws InputError naming the choices.
 uint32_t parsePrecision(std::string_view text);
@@ -66,10 +68,12 @@ struct FrameStats {
   uint32_t frames = 0;
   uint64_t points = 0;             // points submitted per frame
   std::optional<BatchStats> batch; // batch methods only
+  std::optional<PostStats> post;   // when the resolve stage ran (its time is part of medianMs too)
 };
 
 struct Targets;
 class PointMethod;
+class PostStage;
 
 class Renderer {
 public:
@@ -78,8 +82,9 @@ public:
   ~Renderer();
 
   // Throws UnsupportedError if the device cannot run the method (missing extension or feature) and
-  // InputError for a combination that does not exist (hqs with int40 depth), for a scene uploaded in
-  // another layout than the method reads (MethodInfo::layout), and for more than 64 batched parts.
+  // InputError for a combination that does not exist (hqs with int40 depth, hw-points with the resolve
+  // stage), for a scene uploaded in another layout than the method reads (MethodInfo::layout), for more
+  // than 64 batched parts, and for resolve-stage settings out of range.
   FrameStats render(std::span<const GpuScene* const> scenes, const Camera& camera,
                     const RenderSettings& settings);
   FrameStats render(const GpuScene& scene, const Camera& camera, const RenderSettings& settings) {
@@ -90,7 +95,8 @@ public:
   // RGBA8 pixels of the last frame, row 0 at the top.
   std::vector<uint32_t> image();
   // Canonical words (depth << 32 | color, all ones where empty) of the last frame rendered with
-  // captureWords; for closest-point methods only.
+  // captureWords; for closest-point methods only, or for any method when the resolve stage ran (then the
+  // words it ended with, float depth also for int40).
   std::vector<uint64_t> framebufferWords();
   // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
   // reads to pick the point under the cursor.
@@ -110,7 +116,8 @@ private:
   gpu::Context& context_;
   std::unique_ptr<Targets> targets_;
   std::map<std::pair<Method, DepthMode>, std::unique_ptr<PointMethod>> methods_;
-  bool wordsCaptured_ = false; // the last frame wrote canonical words
+  std::unique_ptr<PostStage> post_; // made on the first frame that uses it
+  bool wordsCaptured_ = false;      // the last frame wrote canonical words
 };
 
 } // namespace pointrast

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "cloud/cloud.h"
@@ -51,6 +52,8 @@ struct UploadOptions {
   uint64_t maxPartPoints = 0;
   SceneLayout layout = SceneLayout::Float;
   bool progress = true;
+  // How points become colors (render --color); nullopt: displayColorMode(cloud), decided once per upload.
+  std::optional<DisplayColorMode> colors;
 };
 
 // Points per part of a layout: `requested` (0: as many as fit) bounded by the layout's maximum and by a
@@ -75,9 +78,15 @@ public:
   // Bytes of point data in GPU memory (sceneBytes()).
   uint64_t bytes() const { return sceneBytes(layout_, pointCount_); }
 
+  // Rewrites the colors of every part from `cloud` (the one uploaded, same subrange) in another mode:
+  // 4 B a point instead of a whole upload, so a viewer switches modes without uploading positions again.
+  void recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode);
+
 private:
-  void uploadFloat(gpu::Context& context, const PointCloud& cloud, bool progress);
-  void uploadBatched(gpu::Context& context, const PointCloud& cloud, bool progress);
+  void uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
+                   bool progress);
+  void uploadBatched(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
+                     bool progress);
   std::vector<ScenePart> parts_;
   SceneLayout layout_ = SceneLayout::Float;
   uint64_t pointCount_ = 0;

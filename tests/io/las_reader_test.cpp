@@ -175,6 +175,10 @@ TEST(LasReader, Pf7TwinEqualsPf3PointByPoint) {
   expectSamePoints(pf3, pf7);
   EXPECT_EQ(pf3.intensity, pf7.intensity);
   EXPECT_EQ(pf3.returnNumber, pf7.returnNumber);
+  // The point source id sits at byte 18 in PF3 and 20 in PF7; autzen_trim has one flight line.
+  ASSERT_EQ(pf3.pointSourceId.size(), pf3.size());
+  EXPECT_EQ(pf3.pointSourceId, pf7.pointSourceId);
+  EXPECT_EQ(pf3.pointSourceId.front(), 7326);
 }
 
 TEST(LasReader, ExtraBytesStepByRecordLength) {
@@ -260,6 +264,7 @@ TEST(LasReader, AttributesKeptOrDropped) {
   EXPECT_TRUE(without.intensity.empty());
   EXPECT_TRUE(without.classification.empty());
   EXPECT_TRUE(without.returnNumber.empty());
+  EXPECT_TRUE(without.pointSourceId.empty());
   EXPECT_EQ(with.positions, without.positions);
   EXPECT_EQ(with.colors, without.colors);
 }
