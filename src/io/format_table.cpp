@@ -9,6 +9,7 @@
 #include "io/formats.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
+#include "io/las_source.h"
 #include "io/point_source.h"
 #include "io/potree.h"
 
@@ -53,7 +54,7 @@ void refuseParticles(const std::filesystem::path& path) {
 // clang-format off
 constexpr FormatInfo kFormats[] = {
   // name    extensions               content                 detect       read     probe     openPoints openNodes refuse
-  {"LAS",   ".las",                   FormatContent::Points,    isLasFile,   readLas, probeLas, nullptr,   nullptr,  nullptr},
+  {"LAS",   ".las",                   FormatContent::Points,    isLasFile,   readLas, probeLas, openLasSource, nullptr, nullptr},
   {"LAZ",   ".laz",                   FormatContent::Points,    isLazFile,   nullptr, nullptr,  nullptr,   nullptr,  failCompressed},
   {"PLY",   ".ply",                   FormatContent::Points,    isPlyFile,   readPly, probePly, nullptr,   nullptr,  nullptr},
   {"XYZ",   ".xyz .txt .csv .pts",    FormatContent::Points,    nullptr,     readXyz, probeXyz, nullptr,   nullptr,  nullptr},
