@@ -5,6 +5,7 @@
 #include "io/formats.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
+#include "io/laz_reader.h"
 
 namespace pointrast::io {
 
@@ -47,7 +48,6 @@ Format detectFormat(const std::filesystem::path& path) {
 namespace {
 
 [[noreturn]] void failUnreadable(const std::filesystem::path& path, Format format) {
-  if (format == Format::Laz) failCompressed(path);
   if (format == Format::Mmpld)
     fail(path, "an MMPLD file holds particles (spheres), not a point cloud; `pointrast info` and the sphere "
                "renderers read it");
@@ -63,6 +63,8 @@ PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& optio
   switch (format) {
   case Format::Las:
     return readLas(path, options);
+  case Format::Laz:
+    return readLaz(path, options);
   case Format::Ply:
     return readPly(path, options);
   case Format::Xyz:
@@ -77,6 +79,8 @@ FileInfo probeFile(const std::filesystem::path& path) {
   switch (format) {
   case Format::Las:
     return probeLas(path);
+  case Format::Laz:
+    return probeLaz(path);
   case Format::Ply:
     return probePly(path);
   case Format::Xyz:

@@ -336,26 +336,21 @@ TEST(LasReader, LateSixteenBitValueRecolorsEarlierChunks) {
   }
 }
 
-TEST(LasReader, CompressedFilesAreRefusedWithAClearMessage) {
+TEST(LasReader, CompressedFilesGoToTheLazReader) {
   for (const char* file : {"laz/autzen_trim.laz", "laz/simple.laz", "laz/lone-star.copc.laz"}) {
     SCOPED_TRACE(file);
     EXPECT_EQ(detectFormat(data(file)), Format::Laz);
-    for (int probe = 0; probe < 2; ++probe) {
-      try {
-        if (probe)
-          probeFile(data(file));
-        else
-          readCloud(data(file), quiet());
-        ADD_FAILURE() << "expected InputError";
-      } catch (const InputError& e) {
-        std::string m = e.what();
-        EXPECT_NE(m.find("LAZ"), std::string::npos) << m;
-        EXPECT_NE(m.find("not supported"), std::string::npos) << m;
-        EXPECT_NE(m.find("pdal translate"), std::string::npos) << m;
-        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-      }
+    EXPECT_GT(readCloud(data(file), quiet()).size(), 0u);
+    EXPECT_EQ(probeFile(data(file)).format, Format::Laz);
+    // The plain LAS reader refuses them with one line.
+    try {
+      readLas(data(file), quiet());
+      ADD_FAILURE() << "expected InputError";
+    } catch (const InputError& e) {
+      std::string m = e.what();
+      EXPECT_NE(m.find("LAZ"), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     }
-    EXPECT_THROW(readLas(data(file), quiet()), InputError);
   }
 }
 
@@ -369,7 +364,7 @@ TEST(LasReader, ContentDecidesNotTheExtension) {
   bytes[104] |= 0x80;
   iotest::writeBytes(dir / "flag.las", bytes);
   EXPECT_EQ(detectFormat(dir / "flag.las"), Format::Laz);
-  EXPECT_THROW(readCloud(dir / "flag.las", quiet()), InputError);
+  EXPECT_THROW(readCloud(dir / "flag.las", quiet()), InputError); // no LASzip VLR says how
 }
 
 TEST(LasReader, LyingCountsAreRefusedBeforeAllocating) {
