@@ -87,7 +87,7 @@ public:
     value_ |= uint32_t(nextByte());
   }
 
-  uint32_t decodeBit(BitModel& m) {
+  [[gnu::always_inline]] uint32_t decodeBit(BitModel& m) {
     const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
     uint32_t bit;
     if (value_ < x) {
@@ -104,7 +104,7 @@ public:
     return bit;
   }
 
-  uint32_t decodeSymbol(SymbolModel& m) {
+  [[gnu::always_inline]] uint32_t decodeSymbol(SymbolModel& m) {
     uint32_t sym, x, y = length_;
     if (m.decoderTable_) {
       const uint32_t dv = value_ / (length_ >>= kLengthShift);
@@ -178,12 +178,12 @@ public:
   const uint8_t* position() const { return ptr_; }
 
 private:
-  uint8_t nextByte() {
+  [[gnu::always_inline]] uint8_t nextByte() {
     if (ptr_ < end_) return *ptr_++;
     ++pastEnd_;
     return 0;
   }
-  void renormalize() {
+  [[gnu::always_inline]] void renormalize() {
     do {
       value_ = (value_ << 8) | nextByte();
     } while ((length_ <<= 8) < kMinLength);

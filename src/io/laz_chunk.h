@@ -15,6 +15,9 @@
 
 namespace pointrast::io::laz {
 
+class PointwiseChunkDecoder;
+class LayeredChunkDecoder;
+
 class ChunkDecoder {
 public:
   explicit ChunkDecoder(const Layout& layout);
@@ -31,11 +34,9 @@ public:
   const Layout& layout() const { return layout_; }
 
 private:
-  struct Pointwise;
-  struct Layered;
   Layout layout_;
-  std::unique_ptr<Pointwise> pointwise_;
-  std::unique_ptr<Layered> layered_;
+  std::unique_ptr<PointwiseChunkDecoder> pointwise_;
+  std::unique_ptr<LayeredChunkDecoder> layered_;
 };
 
 // Reads chunk `index` of a LAZ file and decodes it into raw records; damaged data throws InputError

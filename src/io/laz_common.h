@@ -3,8 +3,10 @@
 // byte folding and clamping, and the error a corrupt chunk raises inside a decoder.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <stdexcept>
+#include <vector>
 
 namespace pointrast::io::laz {
 
@@ -16,6 +18,30 @@ public:
 };
 [[noreturn]] inline void corrupt(const char* what) {
   throw CorruptChunk(what);
+}
+
+// Bytes a decoder may read past the end of its stream: LASzip's encoders pad every stream so that a
+// decoder never needs to, older versions by fewer bytes. Anything beyond means the data is cut off or
+// the point count is larger than what the data codes.
+inline constexpr size_t kPastEndSlack = 4;
+
+// Output records are first allocated for this many points per compressed byte (real files hold
+// 0.1-0.5); the buffer doubles when the data turns out to code more. So a point count that lies costs
+// no more memory than the points the data really codes before the decoder runs out of bytes.
+inline constexpr uint64_t kInitialPointsPerByte = 4;
+
+inline uint64_t initialRecordCapacity(uint64_t count, size_t compressedBytes) {
+  return std::min<uint64_t>(count, std::max<uint64_t>(1024, compressedBytes * kInitialPointsPerByte));
+}
+
+// Makes room for record i (capacity counts records), doubling the buffer.
+inline uint8_t* recordSlot(std::vector<uint8_t>& out, uint64_t i, uint64_t& capacity, size_t recordLength,
+                           uint64_t count) {
+  if (i == capacity) {
+    capacity = std::min(count, capacity * 2);
+    out.resize(capacity * recordLength);
+  }
+  return out.data() + i * recordLength;
 }
 
 // Median of the last five values, maintained in a sorted window without sorting: LASzip's

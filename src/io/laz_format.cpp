@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "io/laz_arithmetic.h"
+#include "io/laz_common.h"
 #include "io/laz_integer.h"
 
 namespace pointrast::io::laz {
@@ -212,9 +213,6 @@ Layout parseLaszipVlr(const std::filesystem::path& path, const uint8_t* data, si
 // each predicted by the previous chunk's.
 
 namespace {
-// Bytes the coder may read past the end of a coded stream before the stream counts as truncated:
-// every LASzip encoder pads its streams so that a decoder reads nothing past them; older ones pad less.
-constexpr size_t kPastEndSlack = 4;
 // An upper bound of one chunk's coded entry: two values of at most 15 + 15 + 24 bits.
 constexpr uint64_t kMaxEntryBytes = 14;
 } // namespace

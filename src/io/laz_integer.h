@@ -23,7 +23,7 @@ public:
   // Start of a chunk: every model back to its start state (lazily, at first use).
   void reset();
 
-  int32_t decompress(ArithmeticDecoder& dec, int32_t pred, uint32_t context = 0) {
+  [[gnu::always_inline]] int32_t decompress(ArithmeticDecoder& dec, int32_t pred, uint32_t context = 0) {
     uint32_t real = uint32_t(pred) + uint32_t(readCorrector(dec, context));
     if (int32_t(real) < 0)
       real += corrRange_;
@@ -36,7 +36,7 @@ public:
   uint32_t getK() const { return k_; }
 
 private:
-  int32_t readCorrector(ArithmeticDecoder& dec, uint32_t context) {
+  [[gnu::always_inline]] int32_t readCorrector(ArithmeticDecoder& dec, uint32_t context) {
     SymbolModel& bitsModel = bitsModels_[context];
     bitsModel.ensureReady();
     k_ = dec.decodeSymbol(bitsModel);

@@ -408,4 +408,74 @@ void Byte14Decoder::read(uint8_t* item, uint32_t context) {
   }
 }
 
+// ---- the chunk ----------------------------------------------------------------------------------------
+
+LayeredChunkDecoder::LayeredChunkDecoder(const Layout& layout) : recordLength_(layout.recordLength) {
+  size_t offset = 0;
+  for (const Item& item : layout.items) {
+    // parseLaszipVlr admits these items in this order only.
+    if (item.type == ItemType::Rgb14 || item.type == ItemType::RgbNir14) {
+      rgb_ = std::make_unique<Rgb14Decoder>(item.type == ItemType::RgbNir14);
+      rgbOffset_ = offset;
+    } else if (item.type == ItemType::Byte14) {
+      bytes_ = std::make_unique<Byte14Decoder>(item.size);
+      bytesOffset_ = offset;
+    }
+    offset += item.size;
+  }
+  layers_.resize(Point14Decoder::kLayers + (rgb_ ? rgb_->layerCount() : 0) +
+                 (bytes_ ? bytes_->layerCount() : 0));
+}
+
+LayeredChunkDecoder::~LayeredChunkDecoder() = default;
+
+void LayeredChunkDecoder::readLayers(const uint8_t* data, size_t size, uint64_t count) {
+  const size_t header = recordLength_ + 4 + 4 * layers_.size();
+  if (size < header) corrupt("its data ends inside the layer table");
+  const uint32_t chunkCount = loadLE<uint32_t>(data + recordLength_);
+  if (chunkCount != count)
+    corrupt(detail::strFormat("it says it holds %u points, the chunk table %llu", chunkCount,
+                              static_cast<unsigned long long>(count))
+                .c_str());
+  size_t offset = header;
+  for (size_t i = 0; i < layers_.size(); ++i) {
+    const uint32_t bytesInLayer = loadLE<uint32_t>(data + recordLength_ + 4 + 4 * i);
+    if (bytesInLayer > size - offset) corrupt("its layers run past its end");
+    layers_[i] = {data + offset, bytesInLayer};
+    offset += bytesInLayer;
+  }
+}
+
+size_t LayeredChunkDecoder::pastEnd() const {
+  return std::max({point_.pastEnd(), rgb_ ? rgb_->pastEnd() : 0, bytes_ ? bytes_->pastEnd() : 0});
+}
+
+void LayeredChunkDecoder::decode(const uint8_t* data, size_t size, uint64_t count,
+                                 std::vector<uint8_t>& out) {
+  const size_t rl = recordLength_;
+  if (size < rl) corrupt("its data ends inside the first point");
+  readLayers(data, size, count);
+  if (count > 1 && layers_[0].size == 0) corrupt("its coordinate layer is empty");
+  uint64_t capacity = initialRecordCapacity(count, size);
+  out.resize(capacity * rl);
+  std::memcpy(out.data(), data, rl);
+  uint32_t context = 0;
+  point_.init(data, layers_.data(), context);
+  size_t next = Point14Decoder::kLayers;
+  if (rgb_) {
+    rgb_->init(data + rgbOffset_, layers_.data() + next, context);
+    next += size_t(rgb_->layerCount());
+  }
+  if (bytes_) bytes_->init(data + bytesOffset_, layers_.data() + next, context);
+  for (uint64_t i = 1; i < count; ++i) {
+    uint8_t* record = recordSlot(out, i, capacity, rl, count);
+    point_.read(record, context);
+    if (rgb_) rgb_->read(record + rgbOffset_, context);
+    if (bytes_) bytes_->read(record + bytesOffset_, context);
+    // The coordinate layer advances with every point; the others are checked once at the end.
+    if (point_.pastEnd() > kPastEndSlack) corrupt("its data ends before its last point");
+  }
+  if (count > 1 && pastEnd() > kPastEndSlack) corrupt("one of its layers ends before its last point");
+}
+
 } // namespace pointrast::io::laz

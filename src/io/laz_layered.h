@@ -16,6 +16,7 @@
 
 #include "io/laz_arithmetic.h"
 #include "io/laz_common.h"
+#include "io/laz_format.h"
 #include "io/laz_integer.h"
 #include "io/laz_pointwise.h"
 
@@ -108,6 +109,27 @@ private:
   uint32_t current_ = 0;
   std::vector<ArithmeticDecoder> dec_;
   std::vector<uint8_t> changed_;
+};
+
+// A layered chunk: the first point raw, the point count (u32), the byte size of every layer (u32 each:
+// POINT14's nine, then RGB and NIR, then one per extra byte), then the layers in that order.
+class LayeredChunkDecoder {
+public:
+  explicit LayeredChunkDecoder(const Layout& layout);
+  ~LayeredChunkDecoder();
+  // out: count raw records (see ChunkDecoder::decode). Throws CorruptChunk.
+  void decode(const uint8_t* data, size_t size, uint64_t count, std::vector<uint8_t>& out);
+
+private:
+  void readLayers(const uint8_t* data, size_t size, uint64_t count);
+  size_t pastEnd() const;
+
+  size_t recordLength_;
+  Point14Decoder point_;
+  std::unique_ptr<Rgb14Decoder> rgb_;
+  std::unique_ptr<Byte14Decoder> bytes_;
+  size_t rgbOffset_ = 0, bytesOffset_ = 0;
+  std::vector<Layer> layers_;
 };
 
 } // namespace pointrast::io::laz

@@ -40,7 +40,7 @@ void Point10Decoder::init(const uint8_t* item) {
   last_[12] = last_[13] = 0;
 }
 
-void Point10Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+[[gnu::always_inline]] inline void Point10Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
   // Bits of changedValues: 32 return byte, 16 intensity, 8 classification, 4 scan angle rank,
   // 2 user data, 1 point source id.
   const uint32_t changed = dec.decodeSymbol(changedValues_);
@@ -86,64 +86,6 @@ void Point10Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
   std::memcpy(item, last_, 20);
 }
 
-// ---- GPS time sequences ---------------------------------------------------------------------------
-// Multiplier symbols shared by both generations: 1..499 that multiple of the last difference, 500 a
-// large multiple, 501..510 the multiples -1..-10, 0 a difference unrelated to the last one. A multiplier
-// at an extreme (0, 500, -10) four times in a row replaces the sequence's difference.
-
-namespace {
-constexpr uint32_t kGpsMulti = 500;
-constexpr int32_t kGpsMultiMinus = -10;
-} // namespace
-
-void GpsSequences::readFirstDiff(ArithmeticDecoder& dec, IntegerCodec& ic) {
-  diff[last] = ic.decompress(dec, 0, 0);
-  time[last] += uint64_t(int64_t(diff[last]));
-  extremeCounter[last] = 0;
-}
-
-void GpsSequences::readFull(ArithmeticDecoder& dec, IntegerCodec& ic) {
-  next = (next + 1) & 3;
-  const uint32_t high = uint32_t(ic.decompress(dec, int32_t(uint32_t(time[last] >> 32)), 8));
-  time[next] = (uint64_t(high) << 32) | dec.readInt();
-  last = next;
-  diff[last] = 0;
-  extremeCounter[last] = 0;
-}
-
-void GpsSequences::readSameDiff(ArithmeticDecoder& dec, IntegerCodec& ic) {
-  time[last] += uint64_t(int64_t(ic.decompress(dec, diff[last], 1)));
-  extremeCounter[last] = 0;
-}
-
-void GpsSequences::readMultiple(ArithmeticDecoder& dec, IntegerCodec& ic, uint32_t multi) {
-  auto countExtreme = [&](int32_t d) {
-    if (++extremeCounter[last] > 3) {
-      diff[last] = d;
-      extremeCounter[last] = 0;
-    }
-  };
-  int32_t d;
-  if (multi == 0) {
-    d = ic.decompress(dec, 0, 7);
-    countExtreme(d);
-  } else if (multi < kGpsMulti) {
-    d = ic.decompress(dec, mulWrap(int32_t(multi), diff[last]), multi < 10 ? 2 : 3);
-  } else if (multi == kGpsMulti) {
-    d = ic.decompress(dec, mulWrap(int32_t(kGpsMulti), diff[last]), 4);
-    countExtreme(d);
-  } else {
-    const int32_t negative = int32_t(kGpsMulti) - int32_t(multi);
-    if (negative > kGpsMultiMinus) {
-      d = ic.decompress(dec, mulWrap(negative, diff[last]), 5);
-    } else {
-      d = ic.decompress(dec, mulWrap(kGpsMultiMinus, diff[last]), 6);
-      countExtreme(d);
-    }
-  }
-  time[last] += uint64_t(int64_t(d));
-}
-
 // ---- GPSTIME11 v2 -------------------------------------------------------------------------------------
 // After a zero difference (6 symbols): 0 unchanged, 1 a new difference, 2 a full time, 3..5 a switch to
 // sequence last + 1..3. Otherwise (516 symbols): the multipliers above, 511 unchanged, 512 a full time,
@@ -164,7 +106,7 @@ void GpsTime11Decoder::init(const uint8_t* item) {
   seq_.reset(loadLE<uint64_t>(item));
 }
 
-void GpsTime11Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+[[gnu::always_inline]] inline void GpsTime11Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
   for (int hop = 0;; ++hop) {
     if (hop > kMaxSequenceHops) corrupt("its GPS times switch sequences without end");
     if (seq_.diff[seq_.last] == 0) {
@@ -196,46 +138,6 @@ void GpsTime11Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
 }
 
 // ---- RGB12 v2 -----------------------------------------------------------------------------------------
-// byteUsed bits: 0/1 red low/high byte changed, 2/3 green, 4/5 blue, 6 the channels differ (else green
-// and blue equal red). Green is predicted by red's change, blue by the mean of red's and green's.
-
-void decodeRgb(ArithmeticDecoder& dec, SymbolModel& byteUsed, SymbolModel* diff, const uint16_t* last,
-               uint16_t* out) {
-  const uint32_t sym = dec.decodeSymbol(byteUsed);
-  auto low = [](uint32_t v) { return int32_t(v & 0xFF); };
-  auto high = [](uint32_t v) { return int32_t(v >> 8); };
-  uint32_t r = sym & 1 ? foldByte(int32_t(dec.decodeSymbol(diff[0])) + low(last[0])) : last[0] & 0xFFu;
-  r |= sym & 2 ? uint32_t(foldByte(int32_t(dec.decodeSymbol(diff[1])) + high(last[0]))) << 8
-               : last[0] & 0xFF00u;
-  uint32_t g, b;
-  if (sym & 64) {
-    int32_t d = low(r) - low(last[0]);
-    g = sym & 4 ? foldByte(int32_t(dec.decodeSymbol(diff[2])) + clampByte(d + low(last[1])))
-                : last[1] & 0xFFu;
-    if (sym & 16) {
-      const int32_t corr = int32_t(dec.decodeSymbol(diff[4]));
-      d = (d + (low(g) - low(last[1]))) / 2;
-      b = foldByte(corr + clampByte(d + low(last[2])));
-    } else {
-      b = last[2] & 0xFFu;
-    }
-    d = high(r) - high(last[0]);
-    g |= sym & 8 ? uint32_t(foldByte(int32_t(dec.decodeSymbol(diff[3])) + clampByte(d + high(last[1])))) << 8
-                 : last[1] & 0xFF00u;
-    if (sym & 32) {
-      const int32_t corr = int32_t(dec.decodeSymbol(diff[5]));
-      d = (d + (high(g) - high(last[1]))) / 2;
-      b |= uint32_t(foldByte(corr + clampByte(d + high(last[2])))) << 8;
-    } else {
-      b |= last[2] & 0xFF00u;
-    }
-  } else {
-    g = b = r;
-  }
-  out[0] = static_cast<uint16_t>(r);
-  out[1] = static_cast<uint16_t>(g);
-  out[2] = static_cast<uint16_t>(b);
-}
 
 Rgb12Decoder::Rgb12Decoder() = default;
 
@@ -247,7 +149,7 @@ void Rgb12Decoder::init(const uint8_t* item) {
     last_[c] = loadLE<uint16_t>(item + 2 * c);
 }
 
-void Rgb12Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+[[gnu::always_inline]] inline void Rgb12Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
   uint16_t rgb[3];
   decodeRgb(dec, byteUsed_, diff_, last_, rgb);
   for (int c = 0; c < 3; ++c) {
@@ -265,10 +167,81 @@ void Byte2Decoder::init(const uint8_t* item) {
   std::memcpy(last_.data(), item, last_.size());
 }
 
-void Byte2Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+[[gnu::always_inline]] inline void Byte2Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
   for (size_t i = 0; i < last_.size(); ++i) {
     last_[i] = foldByte(int32_t(last_[i]) + int32_t(dec.decodeSymbol(models_[i])));
     item[i] = last_[i];
+  }
+}
+
+// ---- the chunk ----------------------------------------------------------------------------------------
+
+PointwiseChunkDecoder::PointwiseChunkDecoder(const Layout& layout) : recordLength_(layout.recordLength) {
+  size_t offset = 0;
+  for (const Item& item : layout.items) {
+    // parseLaszipVlr admits these items in this order only.
+    if (item.type == ItemType::GpsTime11) {
+      gps_ = std::make_unique<GpsTime11Decoder>();
+      gpsOffset_ = offset;
+    } else if (item.type == ItemType::Rgb12) {
+      rgb_ = std::make_unique<Rgb12Decoder>();
+      rgbOffset_ = offset;
+    } else if (item.type == ItemType::Byte) {
+      bytes_ = std::make_unique<Byte2Decoder>(item.size);
+      bytesOffset_ = offset;
+    }
+    offset += item.size;
+  }
+}
+
+PointwiseChunkDecoder::~PointwiseChunkDecoder() = default;
+
+template <bool kGps, bool kRgb, bool kBytes>
+void PointwiseChunkDecoder::decodeLoop(const uint8_t* data, size_t size, uint64_t count,
+                                       std::vector<uint8_t>& out) {
+  const size_t rl = recordLength_;
+  uint64_t capacity = initialRecordCapacity(count, size);
+  out.resize(capacity * rl);
+  std::memcpy(out.data(), data, rl);
+  point_.init(data);
+  if constexpr (kGps) gps_->init(data + gpsOffset_);
+  if constexpr (kRgb) rgb_->init(data + rgbOffset_);
+  if constexpr (kBytes) bytes_->init(data + bytesOffset_);
+  // A local coder: its address never escapes the inlined item decoders, so its state stays in
+  // registers instead of round-tripping through memory between symbols.
+  ArithmeticDecoder dec;
+  dec.init(data + rl, data + size);
+  for (uint64_t i = 1; i < count; ++i) {
+    uint8_t* record = recordSlot(out, i, capacity, rl, count);
+    point_.read(dec, record);
+    if constexpr (kGps) gps_->read(dec, record + gpsOffset_);
+    if constexpr (kRgb) rgb_->read(dec, record + rgbOffset_);
+    if constexpr (kBytes) bytes_->read(dec, record + bytesOffset_);
+    if (dec.pastEnd() > kPastEndSlack) corrupt("its data ends before its last point");
+  }
+}
+
+void PointwiseChunkDecoder::decode(const uint8_t* data, size_t size, uint64_t count,
+                                   std::vector<uint8_t>& out) {
+  if (size < recordLength_) corrupt("its data ends inside the first point");
+  const int combination = (gps_ ? 4 : 0) | (rgb_ ? 2 : 0) | (bytes_ ? 1 : 0);
+  switch (combination) {
+  case 0:
+    return decodeLoop<false, false, false>(data, size, count, out);
+  case 1:
+    return decodeLoop<false, false, true>(data, size, count, out);
+  case 2:
+    return decodeLoop<false, true, false>(data, size, count, out);
+  case 3:
+    return decodeLoop<false, true, true>(data, size, count, out);
+  case 4:
+    return decodeLoop<true, false, false>(data, size, count, out);
+  case 5:
+    return decodeLoop<true, false, true>(data, size, count, out);
+  case 6:
+    return decodeLoop<true, true, false>(data, size, count, out);
+  default:
+    return decodeLoop<true, true, true>(data, size, count, out);
   }
 }
 
