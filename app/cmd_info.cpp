@@ -164,7 +164,7 @@ int runInfo(const InfoArgs& a) {
       j["bounds_max"] = {info.bounds.max.x, info.bounds.max.y, info.bounds.max.z};
     }
     j["bounds_from_header"] = info.boundsFromHeader;
-    if (info.format == io::Format::Las) {
+    if (info.format == io::Format::Las || info.format == io::Format::Laz) {
       j["scale"] = {info.scale.x, info.scale.y, info.scale.z};
       j["offset"] = {info.offset.x, info.offset.y, info.offset.z};
     }
@@ -183,7 +183,7 @@ int runInfo(const InfoArgs& a) {
                 info.bounds.min.z, info.bounds.max.x, info.bounds.max.y, info.bounds.max.z,
                 info.boundsFromHeader ? " (header)" : "");
   }
-  if (info.format == io::Format::Las) {
+  if (info.format == io::Format::Las || info.format == io::Format::Laz) {
     std::printf("scale:   %g, %g, %g\n", info.scale.x, info.scale.y, info.scale.z);
     std::printf("offset:  %.6f, %.6f, %.6f\n", info.offset.x, info.offset.y, info.offset.z);
   }
@@ -209,7 +209,7 @@ Command addInfo(CLI::App& app) {
       "usable, the bounds of their centers and the radius range.\n"
       "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n"
       "  pointrast info particles.mmpld --frame 3\n  pointrast info --devices");
-  cmd->add_option("FILE", a->input, "LAS/PLY/XYZ or MMPLD file");
+  cmd->add_option("FILE", a->input, "LAS/LAZ/PLY/XYZ or MMPLD file");
   cmd->add_option("--frame", a->frame, "MMPLD: the frame to describe")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");

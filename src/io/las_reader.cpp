@@ -149,14 +149,12 @@ uint64_t lasChunkBytes() {
   return gChunkBytes;
 }
 
-FileInfo probeLas(const std::filesystem::path& path) {
-  InputFile file(path);
-  const LasHeader hd = readLasHeader(file);
+FileInfo describeLasHeader(const LasHeader& hd, Format format, uint16_t colorLo, uint16_t colorHi) {
   FileInfo info;
-  info.format = Format::Las;
+  info.format = format;
   uint16_t formatSize = las::kRecordSize[static_cast<size_t>(hd.pointFormat)];
-  info.formatDetail = strFormat("LAS %d.%d, point format %d (%u B records", hd.versionMajor, hd.versionMinor,
-                                hd.pointFormat, hd.recordLength);
+  info.formatDetail = strFormat("%s %d.%d, point format %d (%u B records", formatName(format), hd.versionMajor,
+                                hd.versionMinor, hd.pointFormat, hd.recordLength);
   if (hd.recordLength > formatSize)
     info.formatDetail += strFormat(": %u + %u extra bytes", formatSize, hd.recordLength - formatSize);
   info.formatDetail += ")";
@@ -169,21 +167,9 @@ FileInfo probeLas(const std::filesystem::path& path) {
 
   auto& extra = info.extra;
   if (info.hasColor) {
-    // The bit depth is a property of the values, not the header: scan the color channels.
-    const int rgbOffset = hd.rgbOffset();
-    uint16_t lo = UINT16_MAX, hi = 0;
-    forEachChunk(file, hd, [&](const uint8_t* records, uint64_t, uint64_t count) {
-      for (uint64_t i = 0; i < count; ++i) {
-        const uint8_t* rgb = records + i * hd.recordLength + rgbOffset;
-        for (int c = 0; c < 3; ++c) {
-          uint16_t v = loadLE<uint16_t>(rgb + 2 * c);
-          lo = std::min(lo, v);
-          hi = std::max(hi, v);
-        }
-      }
-    });
-    info.colorBits = hi > 255 ? 16 : 8;
-    if (hd.pointCount > 0) extra.emplace_back("color values", strFormat("%u .. %u", lo, hi));
+    // The bit depth is a property of the values, not the header.
+    info.colorBits = colorHi > 255 ? 16 : 8;
+    if (hd.pointCount > 0) extra.emplace_back("color values", strFormat("%u .. %u", colorLo, colorHi));
   }
   extra.emplace_back("system identifier", hd.systemId.empty() ? "(empty)" : hd.systemId);
   extra.emplace_back("generating software", hd.software.empty() ? "(empty)" : hd.software);
@@ -210,6 +196,27 @@ FileInfo probeLas(const std::filesystem::path& path) {
     extra.emplace_back(
         "EVLRs", strFormat("%u at offset %llu", hd.evlrCount, static_cast<unsigned long long>(hd.evlrStart)));
   return info;
+}
+
+
+FileInfo probeLas(const std::filesystem::path& path) {
+  InputFile file(path);
+  const LasHeader hd = readLasHeader(file);
+  uint16_t lo = UINT16_MAX, hi = 0;
+  if (hd.hasColor()) {
+    const int rgbOffset = hd.rgbOffset();
+    forEachChunk(file, hd, [&](const uint8_t* records, uint64_t, uint64_t count) {
+      for (uint64_t i = 0; i < count; ++i) {
+        const uint8_t* rgb = records + i * hd.recordLength + rgbOffset;
+        for (int c = 0; c < 3; ++c) {
+          uint16_t v = loadLE<uint16_t>(rgb + 2 * c);
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+      }
+    });
+  }
+  return describeLasHeader(hd, Format::Las, lo, hi);
 }
 
 } // namespace detail

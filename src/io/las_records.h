@@ -10,6 +10,7 @@
 #include "cloud/point_record.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
+#include "io/reader.h"
 
 namespace pointrast::io::detail {
 
@@ -102,5 +103,9 @@ inline RecordFields lasRecordFields(bool hasColor) {
   f.intensity = f.returnNumber = f.classification = f.pointSourceId = true;
   return f;
 }
+
+// What `info` shows of a LAS or LAZ header; colorLo/colorHi: the lowest and highest color channel value
+// of the file's records (the bit depth is decided by the values).
+FileInfo describeLasHeader(const LasHeader& hd, Format format, uint16_t colorLo, uint16_t colorHi);
 
 } // namespace pointrast::io::detail

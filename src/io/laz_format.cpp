@@ -156,9 +156,8 @@ void checkItems(const std::filesystem::path& path, const Layout& layout, int poi
   // Item versions: 2 for pointwise chunks, 3 for layered chunks, as LASzip 2.x-3.x write them.
   for (const Item& item : layout.items) {
     if (item.version == 1 && !layout.layered())
-      fail(path, strFormat("%s was written by LASzip 1.x (item version 1), an encoding pointrast does not "
-                           "decode; LASzip 2 or later re-encodes it (laszip -i FILE -o NEW.laz)",
-                           path.filename().string().c_str()));
+      fail(path, "written by LASzip 1.x (item version 1), an encoding pointrast does not decode; LASzip 2 or "
+                 "later re-encodes it (laszip -i FILE -o NEW.laz)");
     const uint16_t want = layout.layered() ? 3 : 2;
     if (item.version != want)
       fail(path,
@@ -202,7 +201,8 @@ Layout parseLaszipVlr(const std::filesystem::path& path, const uint8_t* data, si
   if (point14 != layout.layered())
     fail(path, strFormat("LASzip %s compression cannot code %s items", layout.describeCompressor().c_str(),
                          itemName(layout.items[0].type)));
-  if (layout.chunkSize == 0) fail(path, "the LASzip VLR gives a chunk size of 0 points");
+  if (layout.chunkSize == 0 && layout.compressor != Compressor::Pointwise)
+    fail(path, "the LASzip VLR gives a chunk size of 0 points");
   checkItems(path, layout, pointFormat);
   return layout;
 }

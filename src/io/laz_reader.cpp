@@ -232,21 +232,101 @@ std::vector<uint8_t> readLazRecords(const std::filesystem::path& path, unsigned 
 
 namespace pointrast::io::detail {
 
+namespace {
+
+std::string describeChunks(const laz::LazFile& laz) {
+  const size_t n = laz.chunks.size();
+  if (!laz.layout.variableChunks()) return strFormat("%zu of %u points", n, laz.layout.chunkSize);
+  uint64_t lo = UINT64_MAX, hi = 0;
+  for (const laz::Chunk& c : laz.chunks) {
+    lo = std::min(lo, c.pointCount);
+    hi = std::max(hi, c.pointCount);
+  }
+  if (n == 0) return "0 (variable size)";
+  return strFormat("%zu of variable size (%llu .. %llu points)", n, static_cast<unsigned long long>(lo),
+                   static_cast<unsigned long long>(hi));
+}
+
+} // namespace
+
 FileInfo probeLaz(const std::filesystem::path& path) {
   InputFile file(path);
   const laz::LazFile laz = laz::openLaz(file);
   const LasHeader& hd = laz.header;
-  FileInfo info;
-  info.format = Format::Laz;
-  info.formatDetail = strFormat("LAZ %d.%d, point format %d (%u B records)", hd.versionMajor, hd.versionMinor,
-                                hd.pointFormat, hd.recordLength);
-  info.pointCount = hd.pointCount;
-  info.bounds = hd.bounds;
-  info.boundsFromHeader = true;
-  info.scale = hd.scale;
-  info.offset = hd.offset;
-  info.hasColor = hd.hasColor();
+  // The bit depth of colors is a property of the values, as for LAS: every chunk is decoded.
+  uint16_t lo = UINT16_MAX, hi = 0;
+  if (hd.hasColor()) {
+    const int rgbOffset = hd.rgbOffset();
+    decodeLazInWindows(file, laz, lazThreads(), [&](size_t, std::vector<std::vector<uint8_t>>& records) {
+      for (const std::vector<uint8_t>& r : records)
+        for (size_t i = 0; i + hd.recordLength <= r.size(); i += hd.recordLength)
+          for (int c = 0; c < 3; ++c) {
+            const uint16_t v = loadLE<uint16_t>(r.data() + i + rgbOffset + 2 * c);
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+          }
+    });
+  }
+  FileInfo info = describeLasHeader(hd, Format::Laz, lo, hi);
+  const laz::Layout& layout = laz.layout;
+  // After the header lines: how the points are compressed.
+  info.extra.emplace_back("compression",
+                          strFormat("LASzip %u.%ur%u, %s", layout.versionMajor, layout.versionMinor,
+                                    layout.versionRevision, layout.describeCompressor().c_str()));
+  info.extra.emplace_back("items", layout.describeItems());
+  info.extra.emplace_back("chunks", describeChunks(laz));
   return info;
 }
 
 } // namespace pointrast::io::detail
+
+namespace pointrast::io {
+
+namespace {
+
+class LazPointSource : public PointSource {
+public:
+  explicit LazPointSource(const std::filesystem::path& path)
+      : file_(path), laz_(laz::openLaz(file_)), pool_(laz_.layout) {
+    const LasHeader& hd = laz_.header;
+    info_.source = path.filename().string();
+    info_.pointCount = hd.pointCount;
+    info_.bounds = hd.bounds;
+    info_.scale = hd.scale;
+    info_.offset = hd.offset;
+    info_.fields = lasRecordFields(hd.hasColor());
+    for (const laz::Chunk& c : laz_.chunks)
+      pieces_.push_back({c.firstPoint, c.pointCount});
+  }
+
+  const PointSourceInfo& info() const override { return info_; }
+  const std::vector<PointPiece>& pieces() const override { return pieces_; }
+  uint64_t pieceBytes(size_t i) const override { return laz_.chunks[i].bytes; }
+
+  void readPiece(size_t i, std::vector<PointRecord>& out) const override {
+    const LasHeader& hd = laz_.header;
+    std::vector<uint8_t> records;
+    pool_.decode(file_, laz_.chunks[i], strFormat("LAZ chunk %zu of %zu", i + 1, laz_.chunks.size()),
+                 records);
+    const bool extended = las::isExtended(hd.pointFormat);
+    const int rgbOffset = hd.rgbOffset();
+    out.resize(laz_.chunks[i].pointCount);
+    for (size_t k = 0; k < out.size(); ++k)
+      out[k] = toPointRecord(records.data() + k * hd.recordLength, extended, rgbOffset);
+  }
+
+private:
+  InputFile file_;
+  laz::LazFile laz_;
+  mutable ChunkDecoderPool pool_;
+  PointSourceInfo info_;
+  std::vector<PointPiece> pieces_;
+};
+
+} // namespace
+
+std::unique_ptr<PointSource> openLazSource(const std::filesystem::path& path) {
+  return std::make_unique<LazPointSource>(path);
+}
+
+} // namespace pointrast::io
