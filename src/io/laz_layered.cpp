@@ -434,7 +434,7 @@ void LayeredChunkDecoder::readLayers(const uint8_t* data, size_t size, uint64_t 
   if (size < header) corrupt("its data ends inside the layer table");
   const uint32_t chunkCount = loadLE<uint32_t>(data + recordLength_);
   if (chunkCount != count)
-    corrupt(detail::strFormat("it says it holds %u points, the chunk table %llu", chunkCount,
+    corrupt(detail::strFormat("it counts %u points itself, the file's index %llu", chunkCount,
                               static_cast<unsigned long long>(count))
                 .c_str());
   size_t offset = header;

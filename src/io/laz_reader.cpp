@@ -9,6 +9,7 @@
 
 #include "base/parallel.h"
 #include "base/progress.h"
+#include "io/copc.h"
 #include "io/las_records.h"
 
 namespace pointrast::io {
@@ -275,6 +276,16 @@ FileInfo probeLaz(const std::filesystem::path& path) {
                                     layout.versionRevision, layout.describeCompressor().c_str()));
   info.extra.emplace_back("items", layout.describeItems());
   info.extra.emplace_back("chunks", describeChunks(laz));
+  if (const std::optional<CopcSummary> copc = summarizeCopc(path)) {
+    info.extra.emplace_back(
+        "COPC", strFormat("1.0, root cube center %.6f, %.6f, %.6f, half size %g, spacing %g", copc->center.x,
+                          copc->center.y, copc->center.z, copc->halfSize, copc->spacing));
+    info.extra.emplace_back("COPC hierarchy",
+                            strFormat("%llu nodes, depth %d, %llu points, %llu page%s",
+                                      (unsigned long long)copc->nodes, copc->depth,
+                                      (unsigned long long)copc->points, (unsigned long long)copc->pages,
+                                      copc->pages == 1 ? "" : "s"));
+  }
   return info;
 }
 

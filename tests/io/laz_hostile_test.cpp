@@ -123,7 +123,7 @@ TEST(LazHostile, CountsThatLie) {
   // grown its buffer with the points it really decoded, not the 4 billion claimed.
   expectRefused(withTable(f, {{0, 1438, 0, 4000000000u}, {0, 1733, 0, 318}}, 4000000318u), "damaged");
   // The chunk's own count (in its layer header) disagrees with the table.
-  expectRefused(withTable(f, {{0, 1438, 0, 213}, {0, 1733, 0, 318}}, 531), "says it holds 212 points");
+  expectRefused(withTable(f, {{0, 1438, 0, 213}, {0, 1733, 0, 318}}, 531), "it counts 212 points itself");
   // Table and header disagree.
   expectRefused(withTable(f, {{0, 1438, 0, 212}, {0, 1733, 0, 318}}, 600), "the header says 600");
   // Chunk sizes: larger than the space before the table, or summing past it.
