@@ -164,7 +164,7 @@ int runInfo(const InfoArgs& a) {
       j["bounds_max"] = {info.bounds.max.x, info.bounds.max.y, info.bounds.max.z};
     }
     j["bounds_from_header"] = info.boundsFromHeader;
-    if (info.format == io::Format::Las || info.format == io::Format::Laz) {
+    if (info.format == io::Format::Las || info.format == io::Format::Laz || info.format == io::Format::Ept) {
       j["scale"] = {info.scale.x, info.scale.y, info.scale.z};
       j["offset"] = {info.offset.x, info.offset.y, info.offset.z};
     }
@@ -183,7 +183,7 @@ int runInfo(const InfoArgs& a) {
                 info.bounds.min.z, info.bounds.max.x, info.bounds.max.y, info.bounds.max.z,
                 info.boundsFromHeader ? " (header)" : "");
   }
-  if (info.format == io::Format::Las || info.format == io::Format::Laz) {
+  if (info.format == io::Format::Las || info.format == io::Format::Laz || info.format == io::Format::Ept) {
     std::printf("scale:   %g, %g, %g\n", info.scale.x, info.scale.y, info.scale.z);
     std::printf("offset:  %.6f, %.6f, %.6f\n", info.offset.x, info.offset.y, info.offset.z);
   }

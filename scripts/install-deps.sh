@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libvulkan-dev glslc spirv-tools mesa-vulkan-drivers vulkan-validationlayers
-  libglm-dev libcli11-dev nlohmann-json3-dev libstb-dev libgtest-dev
+  libglm-dev libcli11-dev nlohmann-json3-dev libstb-dev libgtest-dev libzstd-dev
 )
 
 missing=()

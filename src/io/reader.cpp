@@ -2,6 +2,7 @@
 // formats, which have no magic.
 #include "io/reader.h"
 
+#include "io/ept.h"
 #include "io/formats.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
@@ -23,6 +24,8 @@ const char* formatName(Format format) {
     return "XYZ";
   case Format::Mmpld:
     return "MMPLD";
+  case Format::Ept:
+    return "EPT";
   case Format::Unknown:
     break;
   }
@@ -30,6 +33,7 @@ const char* formatName(Format format) {
 }
 
 Format detectFormat(const std::filesystem::path& path) {
+  if (looksLikeEpt(path)) return Format::Ept; // a folder, or its ept.json
   InputFile file(path);
   uint8_t magic[8] = {};
   size_t got = file.readSome(0, magic, sizeof magic);
@@ -53,7 +57,8 @@ namespace {
                "renderers read it");
   InputFile file(path); // a missing or unreadable file reports that instead
   if (file.size() == 0) fail(path, "the file is empty");
-  fail(path, "not a LAS, LAZ, PLY, XYZ/CSV/PTS or MMPLD file (unrecognised content and extension)");
+  fail(path, "not a LAS, LAZ, PLY, XYZ/CSV/PTS or MMPLD file or an EPT dataset (unrecognised content and "
+             "extension)");
 }
 
 } // namespace
@@ -65,6 +70,8 @@ PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& optio
     return readLas(path, options);
   case Format::Laz:
     return readLaz(path, options);
+  case Format::Ept:
+    return readEpt(path, options);
   case Format::Ply:
     return readPly(path, options);
   case Format::Xyz:
@@ -81,6 +88,8 @@ FileInfo probeFile(const std::filesystem::path& path) {
     return probeLas(path);
   case Format::Laz:
     return probeLaz(path);
+  case Format::Ept:
+    return probeEpt(path);
   case Format::Ply:
     return probePly(path);
   case Format::Xyz:

@@ -12,7 +12,7 @@
 
 namespace pointrast::io {
 
-enum class Format { Unknown, Las, Laz, Ply, Xyz, Mmpld };
+enum class Format { Unknown, Las, Laz, Ply, Xyz, Mmpld, Ept };
 const char* formatName(Format format);
 
 // Decides by content (magic bytes) first, by extension second. Throws InputError if the file cannot be
@@ -22,19 +22,19 @@ Format detectFormat(const std::filesystem::path& path);
 // Header-level facts for `pointrast info`, without reading every point where the format allows.
 struct FileInfo {
   Format format = Format::Unknown;
-  std::string formatDetail;        // "LAS 1.2, point format 3 (34 B records)", "PLY binary_little_endian"
-  uint64_t pointCount = 0;         // as stated by the header (LAS/PLY) or counted (XYZ)
-  Bounds bounds;                   // header bounds where the format has them, else computed
+  std::string formatDetail; // "LAS 1.2, point format 3 (34 B records)", "PLY binary_little_endian"
+  uint64_t pointCount = 0;  // as stated by the header (LAS/PLY) or counted (XYZ)
+  Bounds bounds;            // header bounds where the format has them, else computed
   bool boundsFromHeader = false;
-  glm::dvec3 scale{0}, offset{0};  // LAS only
+  glm::dvec3 scale{0}, offset{0}; // LAS only
   bool hasColor = false;
-  int colorBits = 0;               // 8 or 16 for LAS RGB (detected from the values), 8 for PLY uchar...
+  int colorBits = 0; // 8 or 16 for LAS RGB (detected from the values), 8 for PLY uchar...
   std::vector<std::pair<std::string, std::string>> extra; // ordered (key, value) lines for display
 };
 
 struct ReadOptions {
-  bool progress = true;            // progress line on stderr when it is a terminal
-  bool keepAttributes = true;      // intensity, classification, return number
+  bool progress = true;       // progress line on stderr when it is a terminal
+  bool keepAttributes = true; // intensity, classification, return number
 };
 
 // Reads the whole file into a PointCloud (bounds computed from the points). Throws InputError.
