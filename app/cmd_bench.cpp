@@ -312,10 +312,7 @@ int runBench(const BenchArgs& a) {
                      "spheres2023");
 
   bench::BenchConfig config;
-  std::vector<Method> allMethods;
-  for (const MethodInfo& m : methodTable())
-    allMethods.push_back(m.method);
-  config.methods = parseList(a.methods, "--methods", allMethods, parseMethod);
+  config.methods = parseList(a.methods, "--methods", allMethods(), parseMethod);
   config.orders = parseList(a.orders, "--orders", kAllOrders, parseOrder);
   std::vector<bench::View> allViews(bench::allViews().begin(), bench::allViews().end());
   config.views = parseList(a.views, "--views", allViews, bench::parseView);

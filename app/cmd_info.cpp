@@ -150,7 +150,7 @@ int mmpldInfo(const InfoArgs& a) {
 int runInfo(const InfoArgs& a) {
   if (a.devices) return listDevicesCommand(a.json);
   if (a.input.empty()) throw InputError("info needs a FILE (or --devices)");
-  if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file");
+  if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file or folder");
   if (io::detectFormat(a.input) == io::Format::Mmpld) return mmpldInfo(a);
   io::FileInfo info = io::probeFile(a.input);
   if (a.json) {
@@ -164,7 +164,8 @@ int runInfo(const InfoArgs& a) {
       j["bounds_max"] = {info.bounds.max.x, info.bounds.max.y, info.bounds.max.z};
     }
     j["bounds_from_header"] = info.boundsFromHeader;
-    if (info.format == io::Format::Las || info.format == io::Format::Laz || info.format == io::Format::Ept) {
+    if (info.format == io::Format::Las || info.format == io::Format::Laz || info.format == io::Format::Ept ||
+        info.format == io::Format::Potree) {
       j["scale"] = {info.scale.x, info.scale.y, info.scale.z};
       j["offset"] = {info.offset.x, info.offset.y, info.offset.z};
     }
@@ -183,7 +184,8 @@ int runInfo(const InfoArgs& a) {
                 info.bounds.min.z, info.bounds.max.x, info.bounds.max.y, info.bounds.max.z,
                 info.boundsFromHeader ? " (header)" : "");
   }
-  if (info.format == io::Format::Las || info.format == io::Format::Laz || info.format == io::Format::Ept) {
+  if (info.format == io::Format::Las || info.format == io::Format::Laz || info.format == io::Format::Ept ||
+      info.format == io::Format::Potree) {
     std::printf("scale:   %g, %g, %g\n", info.scale.x, info.scale.y, info.scale.z);
     std::printf("offset:  %.6f, %.6f, %.6f\n", info.offset.x, info.offset.y, info.offset.z);
   }
@@ -206,10 +208,13 @@ Command addInfo(CLI::App& app) {
       "\nReads the header (and for LAS the color values, to tell 8-bit from 16-bit color). For MMPLD\n"
       "particle files: the version, frames, each list of one frame (vertex and color type, count,\n"
       "global radius or color, intensity range), then from a pass over its particles how many are\n"
-      "usable, the bounds of their centers and the radius range.\n"
+      "usable, the bounds of their centers and the radius range. For a Potree 2.0 octree (its folder or\n"
+      "metadata.json): points, nodes, depth, spacing, attributes, encoding, bounds and its writer.\n"
       "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n"
-      "  pointrast info particles.mmpld --frame 3\n  pointrast info --devices");
-  cmd->add_option("FILE", a->input, "LAS/LAZ/PLY/XYZ or MMPLD file");
+      "  pointrast info particles.mmpld --frame 3\n  pointrast info octree/\n  pointrast info ept/\n  "
+      "pointrast info --devices");
+  cmd->add_option("FILE", a->input,
+                  "LAS/LAZ/PLY/XYZ or MMPLD file, a Potree 2.0 octree folder or an EPT dataset");
   cmd->add_option("--frame", a->frame, "MMPLD: the frame to describe")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");

@@ -183,7 +183,8 @@ int runRender(const RenderArgs& a) {
   settings.precision = parsePrecision(a.precision);
   const SceneLayout layout = methodInfo(settings.method).layout;
   if (settings.precision != 0 && layout != SceneLayout::Batched)
-    throw InputError("--precision applies to the batch methods (batch, batch-prefetch, batch-hqs)");
+    throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
+                     ")");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -302,9 +303,9 @@ int runRender(const RenderArgs& a) {
 // "  name  description" per point method, from the method table.
 std::string methodList() {
   std::string list;
-  for (const MethodInfo& m : methodTable()) {
-    std::string name = m.name;
-    list += "  " + name + std::string(name.size() < 16 ? 16 - name.size() : 1, ' ') + m.description + "\n";
+  for (Method m : allMethods()) {
+    std::string name = m.name();
+    list += "  " + name + std::string(name.size() < 16 ? 16 - name.size() : 1, ' ') + m.info().help + "\n";
   }
   return list;
 }

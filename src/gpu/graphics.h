@@ -6,7 +6,7 @@
 // so no render pass objects; viewport and scissor are dynamic state, set with setViewport.
 //
 //   GraphicsProgram points(ctx, "points_hw.vert", "points_hw.frag", {.depthCompare = VK_COMPARE_OP_GREATER});
-//   points.draw(cmd, count, push);  // asserts sizeof(push) == the shaders' push-constant block
+//   points.draw(cmd, count, push);  // checks sizeof(push) == the shaders' push-constant block
 #pragma once
 
 #include <cassert>
@@ -46,18 +46,12 @@ struct GraphicsOptions {
   std::string taskShader;
 };
 
-class GraphicsProgram {
+class GraphicsProgram : public Pipeline {
 public:
   GraphicsProgram() = default;
   GraphicsProgram(Context& context, const std::string& vertexShader, const std::string& fragmentShader,
                   const GraphicsOptions& options = {});
-  ~GraphicsProgram();
-  GraphicsProgram(GraphicsProgram&& other) noexcept;
-  GraphicsProgram& operator=(GraphicsProgram&& other) noexcept;
-  GraphicsProgram(const GraphicsProgram&) = delete;
-  GraphicsProgram& operator=(const GraphicsProgram&) = delete;
 
-  uint32_t pushConstantSize() const { return pushConstantSize_; }
   const GraphicsOptions& options() const { return options_; }
 
   // Binds the pipeline, pushes the constants and draws vertexCount vertices of each of instanceCount
@@ -65,7 +59,6 @@ public:
   // options() formats.
   template <class Push>
   void draw(VkCommandBuffer cmd, uint32_t vertexCount, const Push& push, uint32_t instanceCount = 1) const {
-    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
     drawRaw(cmd, vertexCount, instanceCount, &push, sizeof(Push));
   }
 
@@ -73,7 +66,6 @@ public:
   // workgroups without a task shader), between vkCmdBeginRendering and vkCmdEndRendering.
   template <class Push>
   void drawMeshTasks(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const Push& push) const {
-    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
     drawMeshTasksRaw(cmd, groupsX, groupsY, &push, sizeof(Push));
   }
 
@@ -82,12 +74,6 @@ private:
                         uint32_t size) const;
   void drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_t instanceCount, const void* push,
                uint32_t size) const;
-  void release();
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  uint32_t pushConstantSize_ = 0;
-  VkShaderStageFlags pushStages_ = 0;
   GraphicsOptions options_;
 };
 

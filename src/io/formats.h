@@ -11,6 +11,7 @@ namespace pointrast::io::detail {
 FileInfo probeLas(const std::filesystem::path& path);
 FileInfo probePly(const std::filesystem::path& path);
 FileInfo probeXyz(const std::filesystem::path& path);
+FileInfo probePotreeFolder(const std::filesystem::path& path);
 
 // Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to
 // cross chunk boundaries with small files; 0 restores the default.

@@ -7,6 +7,7 @@
 #include "io/io_util.h"
 #include "io/las_format.h"
 #include "io/laz_reader.h"
+#include "io/potree.h"
 
 namespace pointrast::io {
 
@@ -26,6 +27,8 @@ const char* formatName(Format format) {
     return "MMPLD";
   case Format::Ept:
     return "EPT";
+  case Format::Potree:
+    return "Potree 2.0";
   case Format::Unknown:
     break;
   }
@@ -34,6 +37,7 @@ const char* formatName(Format format) {
 
 Format detectFormat(const std::filesystem::path& path) {
   if (looksLikeEpt(path)) return Format::Ept; // a folder, or its ept.json
+  if (looksLikePotree(path)) return Format::Potree;
   InputFile file(path);
   uint8_t magic[8] = {};
   size_t got = file.readSome(0, magic, sizeof magic);
@@ -76,6 +80,8 @@ PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& optio
     return readPly(path, options);
   case Format::Xyz:
     return readXyz(path, options);
+  case Format::Potree:
+    return readPotree(path, options);
   default:
     failUnreadable(path, format);
   }
@@ -94,6 +100,8 @@ FileInfo probeFile(const std::filesystem::path& path) {
     return probePly(path);
   case Format::Xyz:
     return probeXyz(path);
+  case Format::Potree:
+    return probePotreeFolder(path);
   default:
     failUnreadable(path, format);
   }

@@ -12,11 +12,11 @@
 
 namespace pointrast::io {
 
-enum class Format { Unknown, Las, Laz, Ply, Xyz, Mmpld, Ept };
+enum class Format { Unknown, Las, Laz, Ply, Xyz, Mmpld, Potree, Ept };
 const char* formatName(Format format);
 
-// Decides by content (magic bytes) first, by extension second. Throws InputError if the file cannot be
-// opened.
+// Decides by content (magic bytes) first, by extension second; a Potree 2.0 octree by its folder (or its
+// metadata.json). Throws InputError if the file cannot be opened.
 Format detectFormat(const std::filesystem::path& path);
 
 // Header-level facts for `pointrast info`, without reading every point where the format allows.
@@ -45,5 +45,7 @@ FileInfo probeFile(const std::filesystem::path& path);
 PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options = {});
 PointCloud readPly(const std::filesystem::path& path, const ReadOptions& options = {});
 PointCloud readXyz(const std::filesystem::path& path, const ReadOptions& options = {});
+// Every point of a Potree 2.0 octree (its folder or metadata.json), nodes decoded on all cores.
+PointCloud readPotree(const std::filesystem::path& path, const ReadOptions& options = {});
 
 } // namespace pointrast::io
