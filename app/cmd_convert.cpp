@@ -10,8 +10,8 @@
 #include "base/progress.h"
 #include "commands.h"
 #include "input.h"
+#include "io/format_table.h"
 #include "io/potree.h"
-#include "io/reader.h"
 #include "io/writer.h"
 
 namespace pointrast::app {
@@ -68,7 +68,9 @@ Command addConvert(CLI::App& app) {
       "and 16-bit colors, node after node (LAS 1.4 format 7 when its classes or return numbers need it).\n\n"
       "Examples:\n  pointrast convert scan.ply scan_morton.las --order morton\n"
       "  pointrast convert octree/ all.las");
-  cmd->add_option("IN", a->input, "LAS/PLY/XYZ file or Potree 2.0 octree folder")->required();
+  cmd->add_option("IN", a->input,
+                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + ") or Potree 2.0 octree folder")
+      ->required();
   cmd->add_option("OUT", a->output, "LAS file to write")->required();
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the shuffled orders")->capture_default_str();
@@ -80,7 +82,8 @@ Command addConvert(CLI::App& app) {
       throw InputError("--las expects auto, 1.2 or 1.4");
     lasFlavorFor(a->output, 0);
     if (!std::filesystem::exists(a->input)) throw InputError(a->input + ": no such file or folder");
-    if (a->order == "original" && io::detectFormat(a->input) == io::Format::Potree) return convertOctree(*a);
+    const io::FormatInfo* format = io::detectFormat(a->input);
+    if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
     InputSpec spec;
     spec.source = a->input;
     spec.order = parseOrder(a->order);

@@ -6,6 +6,7 @@
 #include "base/error.h"
 #include "cloud/generate.h"
 #include "cloud/particles_generate.h"
+#include "io/format_table.h"
 #include "io/particles_io.h"
 #include "io/reader.h"
 
@@ -44,7 +45,8 @@ ParticleSet loadParticles(const ParticleInputSpec& spec) {
   };
   std::error_code ec;
   if (std::filesystem::exists(source, ec)) {
-    if (io::detectFormat(source) != io::Format::Mmpld) {
+    const io::FormatInfo* format = io::detectFormat(source);
+    if (!format || format->content != io::FormatContent::Particles) {
       io::ReadOptions options;
       options.progress = spec.progress;
       return pointsAsSpheres(io::readCloud(source, options));

@@ -246,10 +246,17 @@ std::unique_ptr<lod::NodeSource> openCopc(const std::filesystem::path& path) {
   return std::make_unique<CopcSource>(path);
 }
 
+bool hasCopcInfoVlr(const InputFile& file) {
+  try {
+    return findInfoVlr(readLasHeader(file, true)) != nullptr;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
 bool looksLikeCopc(const std::filesystem::path& path) {
   try {
-    InputFile file(path);
-    return findInfoVlr(readLasHeader(file, true)) != nullptr;
+    return hasCopcInfoVlr(InputFile(path));
   } catch (const InputError&) {
     return false;
   }

@@ -20,8 +20,14 @@ namespace pointrast::io {
 // that is not COPC.
 std::unique_ptr<lod::NodeSource> openCopc(const std::filesystem::path& path);
 
+namespace detail {
+class InputFile;
+}
+
 // Whether a LAS/LAZ file carries a COPC info VLR (by its VLR list, without reading the hierarchy).
+// Tolerant: a damaged header is just not COPC.
 bool looksLikeCopc(const std::filesystem::path& path);
+bool hasCopcInfoVlr(const detail::InputFile& file);
 
 // What `info` shows of a COPC file: the info VLR's cube and spacing, and the hierarchy walked in full
 // (node count, depth, points in nodes).

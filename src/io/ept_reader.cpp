@@ -81,7 +81,6 @@ FileInfo probeEpt(const std::filesystem::path& path) {
   const std::unique_ptr<lod::NodeSource> source = openEpt(path);
   const lod::OctreeMetadata& meta = source->metadata();
   FileInfo info;
-  info.format = Format::Ept;
   info.formatDetail = meta.format;
   info.pointCount = meta.pointCount;
   info.bounds = meta.bounds;

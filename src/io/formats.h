@@ -1,8 +1,9 @@
-// Per-format entry points that are private to src/io/ (reader.cpp dispatches to them).
+// Per-format entry points that are private to src/io/ (the rows of format_table.cpp name them).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include "io/reader.h"
 
@@ -12,6 +13,9 @@ FileInfo probeLas(const std::filesystem::path& path);
 FileInfo probePly(const std::filesystem::path& path);
 FileInfo probeXyz(const std::filesystem::path& path);
 FileInfo probePotreeFolder(const std::filesystem::path& path);
+
+// "not a LAS, LAZ, ... file (unrecognised content and extension)", naming every row.
+std::string unrecognisedFormatText();
 
 // Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to
 // cross chunk boundaries with small files; 0 restores the default.

@@ -149,11 +149,10 @@ uint64_t lasChunkBytes() {
   return gChunkBytes;
 }
 
-FileInfo describeLasHeader(const LasHeader& hd, Format format, uint16_t colorLo, uint16_t colorHi) {
+FileInfo describeLasHeader(const LasHeader& hd, const char* name, uint16_t colorLo, uint16_t colorHi) {
   FileInfo info;
-  info.format = format;
   uint16_t formatSize = las::kRecordSize[static_cast<size_t>(hd.pointFormat)];
-  info.formatDetail = strFormat("%s %d.%d, point format %d (%u B records", formatName(format), hd.versionMajor,
+  info.formatDetail = strFormat("%s %d.%d, point format %d (%u B records", name, hd.versionMajor,
                                 hd.versionMinor, hd.pointFormat, hd.recordLength);
   if (hd.recordLength > formatSize)
     info.formatDetail += strFormat(": %u + %u extra bytes", formatSize, hd.recordLength - formatSize);
@@ -198,7 +197,6 @@ FileInfo describeLasHeader(const LasHeader& hd, Format format, uint16_t colorLo,
   return info;
 }
 
-
 FileInfo probeLas(const std::filesystem::path& path) {
   InputFile file(path);
   const LasHeader hd = readLasHeader(file);
@@ -216,7 +214,7 @@ FileInfo probeLas(const std::filesystem::path& path) {
       }
     });
   }
-  return describeLasHeader(hd, Format::Las, lo, hi);
+  return describeLasHeader(hd, "LAS", lo, hi);
 }
 
 } // namespace detail

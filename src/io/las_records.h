@@ -104,8 +104,8 @@ inline RecordFields lasRecordFields(bool hasColor) {
   return f;
 }
 
-// What `info` shows of a LAS or LAZ header; colorLo/colorHi: the lowest and highest color channel value
-// of the file's records (the bit depth is decided by the values).
-FileInfo describeLasHeader(const LasHeader& hd, Format format, uint16_t colorLo, uint16_t colorHi);
+// What `info` shows of a LAS or LAZ header ("LAS 1.2, point format 3..." with name "LAS"); colorLo/colorHi:
+// the lowest and highest color channel value of the file's records (the bit depth is decided by them).
+FileInfo describeLasHeader(const LasHeader& hd, const char* name, uint16_t colorLo, uint16_t colorHi);
 
 } // namespace pointrast::io::detail

@@ -268,7 +268,7 @@ FileInfo probeLaz(const std::filesystem::path& path) {
           }
     });
   }
-  FileInfo info = describeLasHeader(hd, Format::Laz, lo, hi);
+  FileInfo info = describeLasHeader(hd, "LAZ", lo, hi);
   const laz::Layout& layout = laz.layout;
   // After the header lines: how the points are compressed.
   info.extra.emplace_back("compression",

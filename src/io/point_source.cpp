@@ -1,18 +1,15 @@
 #include "io/point_source.h"
 
+#include "io/format_table.h"
 #include "io/io_util.h"
-#include "io/laz_reader.h"
-#include "io/reader.h"
 
 namespace pointrast::io {
 
 std::unique_ptr<PointSource> openPointSource(const std::filesystem::path& path) {
-  switch (detectFormat(path)) {
-  case Format::Laz:
-    return openLazSource(path);
-  default:
-    detail::fail(path, "streaming reads are available for LAZ files only");
-  }
+  const FormatInfo* format = detectFormat(path);
+  if (format && format->openPoints) return format->openPoints(path);
+  detail::fail(path, std::string(format ? "a " + std::string(format->name) + " file" : "this input") +
+                         " cannot be read as a stream of pieces");
 }
 
 } // namespace pointrast::io

@@ -50,7 +50,6 @@ FileInfo probePotreeFolder(const std::filesystem::path& path) {
   });
 
   FileInfo info;
-  info.format = Format::Potree;
   info.formatDetail =
       "Potree 2.0 octree, " + folder.encoding + " encoding, written by " +
       (folder.fromPointrast ? std::string("pointrast") : "PotreeConverter (no \"generator\" field)");

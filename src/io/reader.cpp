@@ -1,110 +1,40 @@
-// Format detection and dispatch. Content decides first (magic bytes), the extension only for text
-// formats, which have no magic.
+// Reading whole clouds through the format table (io/format_table.h).
 #include "io/reader.h"
 
-#include "io/ept.h"
+#include "io/format_table.h"
 #include "io/formats.h"
 #include "io/io_util.h"
-#include "io/las_format.h"
-#include "io/laz_reader.h"
-#include "io/potree.h"
 
 namespace pointrast::io {
 
 using namespace detail;
 
-const char* formatName(Format format) {
-  switch (format) {
-  case Format::Las:
-    return "LAS";
-  case Format::Laz:
-    return "LAZ";
-  case Format::Ply:
-    return "PLY";
-  case Format::Xyz:
-    return "XYZ";
-  case Format::Mmpld:
-    return "MMPLD";
-  case Format::Ept:
-    return "EPT";
-  case Format::Potree:
-    return "Potree 2.0";
-  case Format::Unknown:
-    break;
-  }
-  return "unknown";
-}
-
-Format detectFormat(const std::filesystem::path& path) {
-  if (looksLikeEpt(path)) return Format::Ept; // a folder, or its ept.json
-  if (looksLikePotree(path)) return Format::Potree;
-  InputFile file(path);
-  uint8_t magic[8] = {};
-  size_t got = file.readSome(0, magic, sizeof magic);
-  if (got >= 4 && std::memcmp(magic, "LASF", 4) == 0)
-    return lasLooksCompressed(file) ? Format::Laz : Format::Las;
-  // "ply" ends its own line (PLY header, first line); trailing spaces and CR LF are tolerated.
-  if (got >= 4 && std::memcmp(magic, "ply", 3) == 0 &&
-      (magic[3] == '\n' || magic[3] == '\r' || magic[3] == ' ' || magic[3] == '\t'))
-    return Format::Ply;
-  if (got >= 6 && std::memcmp(magic, "MMPLD\0", 6) == 0) return Format::Mmpld;
-  std::string ext = lowerExtension(path);
-  if (ext == ".xyz" || ext == ".txt" || ext == ".csv" || ext == ".pts") return Format::Xyz;
-  return Format::Unknown;
-}
-
 namespace {
 
-[[noreturn]] void failUnreadable(const std::filesystem::path& path, Format format) {
-  if (format == Format::Mmpld)
-    fail(path, "an MMPLD file holds particles (spheres), not a point cloud; `pointrast info` and the sphere "
-               "renderers read it");
-  InputFile file(path); // a missing or unreadable file reports that instead
-  if (file.size() == 0) fail(path, "the file is empty");
-  fail(path, "not a LAS, LAZ, PLY, XYZ/CSV/PTS or MMPLD file or an EPT dataset (unrecognised content and "
-             "extension)");
+// The row that reads `path` as a whole cloud; InputError (from the row's refusal, or naming every
+// format) when there is none.
+const FormatInfo& cloudFormat(const std::filesystem::path& path) {
+  const FormatInfo* format = detectFormat(path);
+  if (format && format->read) return *format;
+  if (format && format->refuse) format->refuse(path);
+  if (format) fail(path, std::string("a ") + format->name + " file cannot be read as a point cloud");
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) fail(path, "a folder, not a point cloud file");
+  if (InputFile(path).size() == 0) fail(path, "the file is empty");
+  fail(path, unrecognisedFormatText());
 }
 
 } // namespace
 
 PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& options) {
-  Format format = detectFormat(path);
-  switch (format) {
-  case Format::Las:
-    return readLas(path, options);
-  case Format::Laz:
-    return readLaz(path, options);
-  case Format::Ept:
-    return readEpt(path, options);
-  case Format::Ply:
-    return readPly(path, options);
-  case Format::Xyz:
-    return readXyz(path, options);
-  case Format::Potree:
-    return readPotree(path, options);
-  default:
-    failUnreadable(path, format);
-  }
+  return cloudFormat(path).read(path, options);
 }
 
 FileInfo probeFile(const std::filesystem::path& path) {
-  Format format = detectFormat(path);
-  switch (format) {
-  case Format::Las:
-    return probeLas(path);
-  case Format::Laz:
-    return probeLaz(path);
-  case Format::Ept:
-    return probeEpt(path);
-  case Format::Ply:
-    return probePly(path);
-  case Format::Xyz:
-    return probeXyz(path);
-  case Format::Potree:
-    return probePotreeFolder(path);
-  default:
-    failUnreadable(path, format);
-  }
+  const FormatInfo& format = cloudFormat(path);
+  FileInfo info = format.probe(path);
+  info.format = &format;
+  return info;
 }
 
 } // namespace pointrast::io

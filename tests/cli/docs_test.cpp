@@ -1,5 +1,6 @@
 // The README's lists against the product's own: the lists in `--help` are generated from the method and
 // format tables, so a README row missing, extra or out of order fails here.
+#include <algorithm>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -62,12 +63,12 @@ std::vector<std::string> backticked(const std::vector<std::string>& cells) {
   return names;
 }
 
-// The names of an indented list in help text that follows the line `title`.
+// The first words of an indented list in help text that follows the line starting with `title`.
 std::vector<std::string> helpList(const std::string& help, const std::string& title) {
   std::vector<std::string> names;
   bool in = false;
   for (const std::string& line : lines(help)) {
-    if (line == title) {
+    if (!in && line.rfind(title, 0) == 0) {
       in = true;
       continue;
     }
@@ -91,6 +92,23 @@ TEST(Docs, ReadmeMethodsTableListsEveryPointMethodInTableOrder) {
   const std::vector<std::string> methods = helpList(help.out, "Point methods (--method):");
   ASSERT_GE(methods.size(), 10u) << help.out;
   EXPECT_EQ(backticked(tableFirstCells(text, "## Methods (`--method`)")), methods);
+}
+
+TEST(Docs, ReadmeFormatsTableListsEveryFormatInTableOrder) {
+  const std::string text = readme();
+  if (text.empty()) GTEST_SKIP() << "no README.md beside this build";
+  CliResult help = runPointrast("info --help");
+  ASSERT_EQ(help.exitCode, 0) << help.err;
+  const std::vector<std::string> formats = helpList(help.out, "Formats (");
+  ASSERT_GE(formats.size(), 4u) << help.out;
+  // The README's rows start with the format's name; rows of what is only written (PNG) have no row in
+  // the format table.
+  std::vector<std::string> rows;
+  for (const std::string& cell : tableFirstCells(text, "## Formats")) {
+    const std::string first = cell.substr(0, cell.find(' '));
+    if (std::find(formats.begin(), formats.end(), first) != formats.end()) rows.push_back(first);
+  }
+  EXPECT_EQ(rows, formats);
 }
 
 } // namespace pointrast::test

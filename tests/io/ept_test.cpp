@@ -80,8 +80,8 @@ TEST_P(EptEncodings, EveryNodeEqualsTheCopcNode) {
 TEST_P(EptEncodings, ReadCloudAndProbe) {
   iotest::TempDir dir;
   const fs::path json = iotest::writeEpt(data(kCopc), dir / "ept", GetParam());
-  EXPECT_EQ(detectFormat(json), Format::Ept);
-  EXPECT_EQ(detectFormat(json.parent_path()), Format::Ept);
+  EXPECT_EQ(iotest::formatOf(json), "EPT");
+  EXPECT_EQ(iotest::formatOf(json.parent_path()), "EPT");
   const PointCloud cloud = readCloud(json, quiet());
   const PointCloud copc = readCloud(data(kCopc), quiet());
   ASSERT_EQ(cloud.size(), copc.size());
@@ -97,7 +97,7 @@ TEST_P(EptEncodings, ReadCloudAndProbe) {
   std::sort(b.begin(), b.end());
   EXPECT_EQ(a, b);
   const FileInfo info = probeFile(json.parent_path());
-  EXPECT_EQ(info.format, Format::Ept);
+  EXPECT_STREQ(info.format->name, "EPT");
   EXPECT_EQ(info.pointCount, 518862u);
 }
 

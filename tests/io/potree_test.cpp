@@ -10,6 +10,7 @@
 #include <sys/resource.h>
 
 #include "cloud/octree_cloud.h"
+#include "io/format_table.h"
 #include "io/potree_format.h"
 #include "io/potree_test_util.h"
 #include "io/writer.h"
@@ -351,7 +352,7 @@ TEST(PotreeReader, FolderOrMetadataJson) {
   EXPECT_TRUE(looksLikePotree(dir / "o" / "metadata.json"));
   EXPECT_FALSE(looksLikePotree(dir / "o" / "octree.bin"));
   EXPECT_FALSE(looksLikePotree(dir.path()));
-  EXPECT_EQ(detectFormat(dir / "o"), Format::Potree);
+  EXPECT_STREQ(detectFormat(dir / "o")->name, "Potree 2.0");
   EXPECT_EQ(openPotree(dir / "o" / "metadata.json")->metadata().pointCount, 500u);
   EXPECT_THROW(openPotree(dir / "o" / "octree.bin"), InputError);
 }
@@ -546,7 +547,7 @@ TEST(PotreeCloud, ProbeDescribesTheOctree) {
   const Tree tree = makeTree({.points = 1200, .depth = 3});
   writeTree(tree, dir / "o", writeOptions(PotreeEncoding::Brotli, 2));
   const FileInfo info = probeFile(dir / "o");
-  EXPECT_EQ(info.format, Format::Potree);
+  EXPECT_STREQ(info.format->name, "Potree 2.0");
   EXPECT_EQ(info.pointCount, tree.points());
   EXPECT_TRUE(info.hasColor);
   EXPECT_EQ(info.colorBits, 8);
