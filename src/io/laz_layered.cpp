@@ -143,7 +143,7 @@ size_t Point14Decoder::pastEnd() const {
   return worst;
 }
 
-void Point14Decoder::read(uint8_t* item, uint32_t& context) {
+[[gnu::always_inline]] inline void Point14Decoder::read(uint8_t* item, uint32_t& context) {
   ArithmeticDecoder& xy = dec_[kXY];
   Point14* last = &contexts_[current_]->last;
 
@@ -244,7 +244,7 @@ void Point14Decoder::read(uint8_t* item, uint32_t& context) {
   last->gpsTimeChange = gpsTimeChange;
 }
 
-void Point14Decoder::readGpsTime(Context& c) {
+[[gnu::always_inline]] inline void Point14Decoder::readGpsTime(Context& c) {
   ArithmeticDecoder& dec = dec_[kGps];
   GpsSequences& seq = c.gps;
   for (int hop = 0;; ++hop) {
@@ -324,7 +324,7 @@ size_t Rgb14Decoder::pastEnd() const {
   return std::max(changedRgb_ ? rgb_.pastEnd() : 0, changedNir_ ? nirDec_.pastEnd() : 0);
 }
 
-void Rgb14Decoder::read(uint8_t* item, uint32_t context) {
+[[gnu::always_inline]] inline void Rgb14Decoder::read(uint8_t* item, uint32_t context) {
   uint16_t* last = contexts_[current_]->last;
   if (current_ != context) {
     current_ = context;
@@ -392,7 +392,7 @@ size_t Byte14Decoder::pastEnd() const {
   return worst;
 }
 
-void Byte14Decoder::read(uint8_t* item, uint32_t context) {
+[[gnu::always_inline]] inline void Byte14Decoder::read(uint8_t* item, uint32_t context) {
   uint8_t* last = contexts_[current_]->last.data();
   if (current_ != context) {
     current_ = context;
