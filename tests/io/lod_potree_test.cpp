@@ -6,6 +6,8 @@
 #include "io/io_test_util.h"
 #include "io/lod_potree.h"
 #include "io/point_source.h"
+#include "io/potree_format.h"
+#include "io/potree_test_util.h"
 #include "io/writer.h"
 
 namespace {
@@ -107,6 +109,34 @@ TEST_P(LodPotree, AutzenOnDiskHoldsEveryPointOnceAndRoundTrips) {
     for (size_t i = 0; i < read.size(); ++i)
       ASSERT_EQ(read[i], built.records[i]) << built.key.potreeName() << " record " << i;
   }
+  // hierarchy.bin itself: child masks, counts and byte ranges agree with the nodes built, and the nodes'
+  // byte ranges tile octree.bin exactly.
+  const uint64_t octreeBytes = std::filesystem::file_size(dir / "o" / "octree.bin");
+  std::vector<std::pair<uint64_t, uint64_t>> ranges;
+  std::map<NodeKey, uint8_t> masks;
+  for (const potreetest::DiskNode& n : potreetest::walkHierarchy(dir / "o")) {
+    if (n.record.type == io::potree::kProxy) continue;
+    ASSERT_TRUE(byKey.count(n.key)) << n.key.potreeName();
+    EXPECT_EQ(n.record.pointCount, byKey[n.key]->records.size()) << n.key.potreeName();
+    EXPECT_EQ(n.record.type, n.record.childMask ? io::potree::kNormal : io::potree::kLeaf);
+    if (GetParam() == io::PotreeEncoding::Default) {
+      EXPECT_EQ(uint64_t(n.record.byteSize), n.record.pointCount * 24u);
+    }
+    ranges.push_back({n.record.byteOffset, n.record.byteOffset + n.record.byteSize});
+    masks[n.key] = n.record.childMask;
+  }
+  EXPECT_EQ(masks.size(), nodes.size());
+  for (const auto& [key, mask] : masks)
+    for (int c = 0; c < 8; ++c)
+      EXPECT_EQ(bool(mask >> c & 1), byKey.count(key.child(c)) == 1) << key.potreeName() << " child " << c;
+  std::sort(ranges.begin(), ranges.end());
+  uint64_t at = 0;
+  for (const auto& [begin, end] : ranges) {
+    EXPECT_EQ(begin, at) << "a gap or an overlap in octree.bin";
+    at = end;
+  }
+  EXPECT_EQ(at, octreeBytes);
+
   const lod::OctreeMetadata meta = io::openPotree(dir / "o")->metadata();
   EXPECT_EQ(meta.pointCount, records.size());
   EXPECT_DOUBLE_EQ(meta.spacing, grid.spacing());
