@@ -94,6 +94,7 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
     q["points_per_second"] = perSecond(double(p.points), p.seconds);
     q["bytes"] = p.bytes;
     q["overlapped"] = p.overlapped;
+    if (p.overlapped) q["thread_seconds"] = p.threadSeconds;
     phases.push_back(q);
   }
   j["phases"] = phases;
@@ -111,7 +112,7 @@ void printSummary(const LodArgs& a, const io::PotreeBuildReport& r) {
     std::printf("  %-10s %8.3f s %10s points/s", p.name.c_str(), p.seconds,
                 humanCount(perSecond(double(p.points), p.seconds)).c_str());
     if (p.overlapped)
-      std::printf("   (during index)\n");
+      std::printf("   (during index; %.3f s over all threads)\n", p.threadSeconds);
     else
       std::printf("   cpu %7.3f s\n", p.cpuSeconds);
   }

@@ -9,10 +9,11 @@ std::unique_ptr<PreparedNode> NodeSink::prepare(const NodeKey&, const PointRecor
   return nullptr;
 }
 
-void NodeSink::writePrepared(const NodeKey& key, std::unique_ptr<PreparedNode>, const PointRecord* records,
-                             size_t count) {
+void NodeSink::writePrepared(const NodeKey& key, PreparedNode*, const PointRecord* records, size_t count) {
   writeNode(key, records, count);
 }
+
+void NodeSink::finishPrepared(std::unique_ptr<PreparedNode>) const {}
 
 void OctreeAssembler::prepare(ChunkNodes& chunk) const {
   chunk.prepared.clear();
@@ -70,10 +71,15 @@ void OctreeAssembler::add(ChunkNodes& chunk) {
   for (size_t i = 0; i < chunk.nodes.size(); ++i) {
     const ChunkNodes::Node& node = chunk.nodes[i];
     const PointRecord* records = chunk.records.data() + node.first;
-    sink_.writePrepared(node.key, i < chunk.prepared.size() ? std::move(chunk.prepared[i]) : nullptr, records,
+    sink_.writePrepared(node.key, i < chunk.prepared.size() ? chunk.prepared[i].get() : nullptr, records,
                         static_cast<size_t>(node.count));
     counted(node.key, node.count);
   }
+}
+
+void OctreeAssembler::finishChunk(ChunkNodes& chunk) const {
+  for (std::unique_ptr<PreparedNode>& prepared : chunk.prepared)
+    if (prepared) sink_.finishPrepared(std::move(prepared));
   chunk.prepared.clear();
 }
 

@@ -23,15 +23,19 @@ public:
   // time (not always the same one).
   virtual void writeNode(const NodeKey& key, const PointRecord* records, size_t count) = 0;
 
-  // Optional split of writeNode for sinks with work that needs no order (encoding a node): prepare()
-  // runs on any thread, several at once, as soon as a node's points are final; writePrepared() then
-  // takes its result in the builder's order instead of writeNode(). Nodes that span chunks go through
-  // writeNode().
-  // The default prepares nothing and writes through writeNode().
+  // Optional split of writeNode for sinks with work that needs no order (encoding a node, writing its
+  // bytes once their place is known): prepare() runs on any thread, several at once, as soon as a node's
+  // points are final; writePrepared() then takes its result in the builder's order instead of
+  // writeNode() (where only the order matters: the node's place in the output); finishPrepared() last
+  // does the rest on any thread, several at once (writing the bytes there). Every node given to
+  // writePrepared() reaches finishPrepared() before the build returns. Nodes that span chunks go
+  // through writeNode().
+  // The default prepares nothing, writes through writeNode() and has nothing to finish.
   virtual std::unique_ptr<PreparedNode> prepare(const NodeKey& key, const PointRecord* records,
                                                 size_t count) const;
-  virtual void writePrepared(const NodeKey& key, std::unique_ptr<PreparedNode> prepared,
-                             const PointRecord* records, size_t count);
+  virtual void writePrepared(const NodeKey& key, PreparedNode* prepared, const PointRecord* records,
+                             size_t count);
+  virtual void finishPrepared(std::unique_ptr<PreparedNode> prepared) const;
 };
 
 struct AssembleStats {
@@ -48,6 +52,8 @@ public:
   void prepare(ChunkNodes& chunk) const;
   // Chunks in Morton order (planChunks' order), each once.
   void add(ChunkNodes& chunk);
+  // The sink's finishPrepared() for a chunk after its add(), on the calling thread (any, several at once).
+  void finishChunk(ChunkNodes& chunk) const;
   // Writes the ancestors still open. Call once, after the last chunk.
   void finish();
   const AssembleStats& stats() const { return stats_; }

@@ -165,7 +165,9 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
   window = std::max<size_t>(window, threads);
   std::mutex mutex;
   std::condition_variable wake;
-  size_t nextClaim = 0, nextWrite = 0;
+  // Chunks claimed for indexing, handed to the assembler (in order), and finished (their buffers back
+  // in the pool): nextClaim >= nextWrite >= released.
+  size_t nextClaim = 0, nextWrite = 0, released = 0;
   bool writing = false, stop = false;
   std::exception_ptr error;
   std::vector<std::unique_ptr<ChunkNodes>> done(n);
@@ -176,7 +178,7 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
     std::vector<LodItem> storage;
     std::unique_lock lock(mutex);
     for (;;) {
-      wake.wait(lock, [&] { return stop || nextClaim >= n || nextClaim < nextWrite + window; });
+      wake.wait(lock, [&] { return stop || nextClaim >= n || nextClaim < released + window; });
       if (stop || nextClaim >= n) return;
       const size_t i = nextClaim++;
       std::unique_ptr<ChunkNodes> result;
@@ -199,21 +201,30 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
         if (progress) progress->advance(items.size());
         lock.lock();
         done[i] = std::move(result);
-        if (writing) continue;
-        writing = true;
-        while (!stop && nextWrite < n && done[nextWrite]) {
+        // Chunks go to the assembler in order, one thread at a time (only their places in the output
+        // are decided there); each is then finished (its bytes written) outside that order, on the
+        // thread that added it, while another thread may add the next.
+        while (!writing && !stop && nextWrite < n && done[nextWrite]) {
+          writing = true;
           std::unique_ptr<ChunkNodes> next = std::move(done[nextWrite]);
           lock.unlock();
-          const auto writeStart = Clock::now();
+          const auto addStart = Clock::now();
           assembler.add(*next);
-          const double seconds = since(writeStart);
+          const double addSeconds = since(addStart);
           lock.lock();
-          times.writeSeconds += seconds;
-          pool.push_back(std::move(next));
           ++nextWrite;
+          writing = false;
+          lock.unlock();
+          const auto finishStart = Clock::now();
+          assembler.finishChunk(*next);
+          const double finishSeconds = since(finishStart);
+          lock.lock();
+          times.writeSeconds += addSeconds + finishSeconds;
+          times.orderSeconds += addSeconds;
+          pool.push_back(std::move(next));
+          ++released;
           wake.notify_all();
         }
-        writing = false;
       } catch (...) {
         if (!lock.owns_lock()) lock.lock();
         if (!error) error = std::current_exception();
@@ -230,10 +241,12 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
   for (auto& t : pool_threads)
     t.join();
   if (error) std::rethrow_exception(error);
-  assert(nextWrite == n);
+  assert(nextWrite == n && released == n);
   const auto finishStart = Clock::now();
   assembler.finish();
-  times.writeSeconds += since(finishStart);
+  const double finishSeconds = since(finishStart);
+  times.writeSeconds += finishSeconds;
+  times.orderSeconds += finishSeconds;
   if (progress) progress->finish();
   times.index = clock.done("index", points);
   return times;
@@ -242,7 +255,8 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
 LodPhase writePhase(const IndexTimes& times, uint64_t points) {
   LodPhase p;
   p.name = "write";
-  p.seconds = times.writeSeconds;
+  p.seconds = times.orderSeconds;
+  p.threadSeconds = times.writeSeconds;
   p.points = points;
   p.overlapped = true;
   return p;

@@ -28,11 +28,12 @@ struct LodRunOptions {
 
 struct LodPhase {
   std::string name;
-  double seconds = 0;      // wall time
-  double cpuSeconds = 0;   // CPU time of the process (all threads) meanwhile
-  uint64_t points = 0;     // points the phase went through
-  uint64_t bytes = 0;      // bytes it read or wrote, where it touches files (0 otherwise)
-  bool overlapped = false; // ran during the phase before it (its time is part of that phase's)
+  double seconds = 0;       // wall time
+  double cpuSeconds = 0;    // CPU time of the process (all threads) meanwhile
+  uint64_t points = 0;      // points the phase went through
+  uint64_t bytes = 0;       // bytes it read or wrote, where it touches files (0 otherwise)
+  bool overlapped = false;  // ran during the phase before it (its time is part of that phase's)
+  double threadSeconds = 0; // an overlapped phase on several threads at once: its time summed over them
 };
 
 // Times a phase: wall and process CPU time from construction to done().
@@ -66,8 +67,11 @@ LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uin
 using ChunkLoader = std::function<std::span<LodItem>(size_t chunk, std::vector<LodItem>& storage)>;
 
 struct IndexTimes {
-  LodPhase index;          // indexing and writing together (they overlap)
-  double writeSeconds = 0; // time spent handing nodes to the sink, within index.seconds
+  LodPhase index; // indexing and writing together (they overlap)
+  // Time spent handing nodes to the sink, within index.seconds: all of it, summed over the threads
+  // (writing runs on several at once), and the part in the builder's order (one thread at a time).
+  double writeSeconds = 0;
+  double orderSeconds = 0;
 };
 
 // Phases "index" and "write": chunks indexed on all threads, each handed to the assembler in chunk order
@@ -78,7 +82,8 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
                        const ChunkLoader& load, const LodGrid& grid, const LodParams& params,
                        OctreeAssembler& assembler, size_t window, const LodRunOptions& options);
 
-// The "write" phase of indexChunks' times (overlapped with "index").
+// The "write" phase of indexChunks' times (overlapped with "index"): seconds is the part in the
+// builder's order (one thread at a time), threadSeconds all of it summed over the threads.
 LodPhase writePhase(const IndexTimes& times, uint64_t points);
 
 // Chunk size for points in memory: small enough for every thread to get several chunks, no smaller than

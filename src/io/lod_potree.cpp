@@ -6,6 +6,8 @@ namespace {
 
 struct EncodedNode final : lod::PreparedNode {
   PotreeEncodedNode node;
+  uint64_t offset = 0; // in octree.bin, from writePrepared()
+  bool placed = false;
 };
 
 uint64_t folderBytes(const std::filesystem::path& dir) {
@@ -29,11 +31,17 @@ std::unique_ptr<lod::PreparedNode> PotreeNodeSink::prepare(const lod::NodeKey&, 
   return encoded;
 }
 
-void PotreeNodeSink::writePrepared(const lod::NodeKey& key, std::unique_ptr<lod::PreparedNode> prepared,
+void PotreeNodeSink::writePrepared(const lod::NodeKey& key, lod::PreparedNode* prepared,
                                    const PointRecord* records, size_t count) {
-  auto* encoded = dynamic_cast<EncodedNode*>(prepared.get());
+  auto* encoded = dynamic_cast<EncodedNode*>(prepared);
   if (!encoded) return writeNode(key, records, count);
-  writer_.writeEncoded(key, std::move(encoded->node));
+  encoded->offset = writer_.place(key, encoded->node);
+  encoded->placed = true;
+}
+
+void PotreeNodeSink::finishPrepared(std::unique_ptr<lod::PreparedNode> prepared) const {
+  auto* encoded = dynamic_cast<EncodedNode*>(prepared.get());
+  if (encoded && encoded->placed) writer_.writeAt(encoded->offset, encoded->node);
 }
 
 PotreeBuildReport buildPotree(const std::vector<std::filesystem::path>& inputs,

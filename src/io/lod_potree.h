@@ -1,5 +1,6 @@
 // An octree build written as a Potree 2.0 folder: the builder (lod_builder.h) feeding a PotreeWriter
-// (potree.h), nodes encoded on the builder's threads and appended in its order. The folder appears only
+// (potree.h), nodes encoded on the builder's threads, placed in octree.bin in its order and written there
+// by the builder's threads again. The folder appears only
 // when everything is written; a failure or an interruption leaves nothing (the writer's temporary folder,
 // which also holds the build's temporary chunk files, is removed).
 #pragma once
@@ -18,8 +19,9 @@ public:
   void writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count) override;
   std::unique_ptr<lod::PreparedNode> prepare(const lod::NodeKey& key, const PointRecord* records,
                                              size_t count) const override;
-  void writePrepared(const lod::NodeKey& key, std::unique_ptr<lod::PreparedNode> prepared,
-                     const PointRecord* records, size_t count) override;
+  void writePrepared(const lod::NodeKey& key, lod::PreparedNode* prepared, const PointRecord* records,
+                     size_t count) override;
+  void finishPrepared(std::unique_ptr<lod::PreparedNode> prepared) const override;
 
 private:
   PotreeWriter& writer_;

@@ -30,6 +30,7 @@
 // wrongly there (not here).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -70,6 +71,26 @@ struct PotreeValueRanges {
 
   void add(const PointRecord* records, size_t n);
   void merge(const PotreeValueRanges& other);
+  // One record, without counting it (add() and the encoders count). Inline so that a loop over a local
+  // copy keeps every extreme in a register: on the members through a pointer, each store may alias the
+  // records read, and the loop costs 114 instructions a point instead of ~35.
+  void include(const PointRecord& r) {
+    const int32_t q[3] = {r.x, r.y, r.z};
+    for (int a = 0; a < 3; ++a) {
+      positionMin[a] = std::min(positionMin[a], q[a]);
+      positionMax[a] = std::max(positionMax[a], q[a]);
+      rgbMin[a] = std::min(rgbMin[a], r.rgb[a]);
+      rgbMax[a] = std::max(rgbMax[a], r.rgb[a]);
+    }
+    intensityMin = std::min(intensityMin, r.intensity);
+    intensityMax = std::max(intensityMax, r.intensity);
+    returnMin = std::min(returnMin, r.returnNumber);
+    returnMax = std::max(returnMax, r.returnNumber);
+    classMin = std::min(classMin, r.classification);
+    classMax = std::max(classMax, r.classification);
+    sourceMin = std::min(sourceMin, r.pointSourceId);
+    sourceMax = std::max(sourceMax, r.pointSourceId);
+  }
 };
 
 // One node's points in the octree's encoding, made by PotreeWriter::encodeNode().
@@ -105,13 +126,21 @@ public:
   // thread-safe (and the slow half with BROTLI); writeEncoded() appends in the caller's order, not
   // thread-safe. writeNode(key, r, n) == writeEncoded(key, encodeNode(r, n)).
   PotreeEncodedNode encodeNode(const PointRecord* records, size_t count) const;
-  void writeEncoded(const lod::NodeKey& key, PotreeEncodedNode&& node);
+  void writeEncoded(const lod::NodeKey& key, const PotreeEncodedNode& node);
+
+  // The two halves of writeEncoded() for callers that also write on several threads: place() gives the
+  // node its byte range in octree.bin, in the caller's order (not thread-safe; this order alone decides
+  // the bytes); writeAt() then writes its bytes there from any thread, several at once (pwrite).
+  // writeEncoded(key, node) == writeAt(place(key, node), node). Every placed node is written before
+  // commit().
+  uint64_t place(const lod::NodeKey& key, const PotreeEncodedNode& node);
+  void writeAt(uint64_t offset, const PotreeEncodedNode& node) const;
 
   // Writes hierarchy.bin and metadata.json and renames the folder into place. Throws InputError (with the
   // folder's name) when a write fails, e.g. a full disk.
   void commit();
 
-  uint64_t bytesWritten() const; // octree.bin so far
+  uint64_t bytesWritten() const; // octree.bin so far (placed)
 
 private:
   struct State;

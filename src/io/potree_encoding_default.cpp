@@ -12,7 +12,27 @@ namespace {
 // Byte offset of each record field within a point (-1: no such attribute).
 struct FieldOffsets {
   int position = -1, rgb = -1, intensity = -1, returnNumber = -1, classification = -1, pointSourceId = -1;
+  bool everyByte = true; // every byte of a point belongs to a record field (no zeros to write)
 };
+
+// Bytes a record field fills in a point (0: none).
+int fieldBytes(Field field) {
+  switch (field) {
+  case Field::Position:
+    return 12;
+  case Field::Rgb:
+    return 6;
+  case Field::Intensity:
+  case Field::PointSourceId:
+    return 2;
+  case Field::ReturnNumber:
+  case Field::Classification:
+    return 1;
+  case Field::Other:
+    break;
+  }
+  return 0;
+}
 
 FieldOffsets fieldOffsets(const Layout& layout) {
   FieldOffsets o;
@@ -40,6 +60,7 @@ FieldOffsets fieldOffsets(const Layout& layout) {
     case Field::Other:
       break;
     }
+    if (fieldBytes(a.field) != a.size) o.everyByte = false;
     at += a.size;
   }
   return o;
@@ -47,13 +68,16 @@ FieldOffsets fieldOffsets(const Layout& layout) {
 
 } // namespace
 
-void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, uint8_t* dst) {
+void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, uint8_t* dst,
+                   PotreeValueRanges& ranges) {
   if (n == 0) return; // dst may be null
   const FieldOffsets o = fieldOffsets(layout);
   const size_t stride = static_cast<size_t>(layout.defaultStride);
-  std::memset(dst, 0, n * stride); // attributes without a record field are written as zeros
+  if (!o.everyByte) std::memset(dst, 0, n * stride); // attributes without a record field are zeros
+  PotreeValueRanges local = ranges;                  // in registers (see PotreeValueRanges::include)
   for (size_t i = 0; i < n; ++i) {
     const PointRecord& r = records[i];
+    local.include(r);
     uint8_t* p = dst + i * stride;
     storeLE<int32_t>(p + o.position, r.x);
     storeLE<int32_t>(p + o.position + 4, r.y);
@@ -66,6 +90,8 @@ void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, u
     if (o.classification >= 0) p[o.classification] = r.classification;
     if (o.pointSourceId >= 0) storeLE<uint16_t>(p + o.pointSourceId, r.pointSourceId);
   }
+  local.count += n;
+  ranges = local;
 }
 
 void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointRecord* dst) {

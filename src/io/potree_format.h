@@ -121,8 +121,10 @@ const char* encodingName(PotreeEncoding encoding);
 
 // ---- node encodings --------------------------------------------------------------------------------
 
-// DEFAULT: dst holds n * layout.defaultStride bytes.
-void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, uint8_t* dst);
+// DEFAULT: dst holds n * layout.defaultStride bytes. Adds the records to `ranges` on the way (one pass
+// over them instead of two).
+void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, uint8_t* dst,
+                   PotreeValueRanges& ranges);
 // src holds n * layout.defaultStride bytes.
 void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointRecord* dst);
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "io/io_util.h"
@@ -15,25 +16,11 @@ namespace pointrast::io {
 using namespace detail;
 
 void PotreeValueRanges::add(const PointRecord* records, size_t n) {
-  for (size_t i = 0; i < n; ++i) {
-    const PointRecord& r = records[i];
-    const int32_t q[3] = {r.x, r.y, r.z};
-    for (int a = 0; a < 3; ++a) {
-      positionMin[a] = std::min(positionMin[a], q[a]);
-      positionMax[a] = std::max(positionMax[a], q[a]);
-      rgbMin[a] = std::min(rgbMin[a], r.rgb[a]);
-      rgbMax[a] = std::max(rgbMax[a], r.rgb[a]);
-    }
-    intensityMin = std::min(intensityMin, r.intensity);
-    intensityMax = std::max(intensityMax, r.intensity);
-    returnMin = std::min(returnMin, r.returnNumber);
-    returnMax = std::max(returnMax, r.returnNumber);
-    classMin = std::min(classMin, r.classification);
-    classMax = std::max(classMax, r.classification);
-    sourceMin = std::min(sourceMin, r.pointSourceId);
-    sourceMax = std::max(sourceMax, r.pointSourceId);
-  }
-  count += n;
+  PotreeValueRanges local = *this; // in registers (see include())
+  for (size_t i = 0; i < n; ++i)
+    local.include(records[i]);
+  local.count += n;
+  *this = local;
 }
 
 void PotreeValueRanges::merge(const PotreeValueRanges& o) {
@@ -59,8 +46,8 @@ struct PotreeWriter::State {
   lod::OctreeMetadata metadata;
   PotreeWriteOptions options;
   potree::Layout layout;
-  std::FILE* octree = nullptr;
-  uint64_t bytes = 0;
+  int octree = -1;    // octree.bin, written with pwrite at the offsets place() assigns
+  uint64_t bytes = 0; // placed
   std::vector<potree::WrittenNode> nodes;
   std::unordered_set<lod::NodeKey, lod::NodeKeyHash> written;
   PotreeValueRanges ranges;
@@ -184,8 +171,8 @@ PotreeWriter::PotreeWriter(std::filesystem::path dir, const lod::OctreeMetadata&
   std::filesystem::remove_all(s.work, ec);
   if (!std::filesystem::create_directory(s.work, ec))
     fail(s.dir, "cannot create: " + (ec ? ec.message() : std::string("a folder of that name exists")));
-  s.octree = std::fopen((s.work / "octree.bin").c_str(), "wb");
-  if (!s.octree) {
+  s.octree = ::open((s.work / "octree.bin").c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (s.octree < 0) {
     const int error = errno;
     std::filesystem::remove_all(s.work, ec);
     s.failWrite(error);
@@ -195,7 +182,7 @@ PotreeWriter::PotreeWriter(std::filesystem::path dir, const lod::OctreeMetadata&
 PotreeWriter::~PotreeWriter() {
   State& s = *state_;
   if (s.committed) return;
-  if (s.octree) std::fclose(s.octree);
+  if (s.octree >= 0) ::close(s.octree);
   std::error_code ignored;
   std::filesystem::remove_all(s.work, ignored);
 }
@@ -211,12 +198,12 @@ uint64_t PotreeWriter::bytesWritten() const {
 PotreeEncodedNode PotreeWriter::encodeNode(const PointRecord* records, size_t count) const {
   const State& s = *state_;
   PotreeEncodedNode node;
-  node.ranges.add(records, count);
   if (s.options.encoding == PotreeEncoding::Brotli) {
+    node.ranges.add(records, count);
     node.bytes = potree::encodeBrotli(s.layout, records, count);
   } else {
     node.bytes.resize(count * static_cast<size_t>(s.layout.defaultStride));
-    potree::encodeDefault(s.layout, records, count, node.bytes.data());
+    potree::encodeDefault(s.layout, records, count, node.bytes.data(), node.ranges);
   }
   return node;
 }
@@ -225,9 +212,13 @@ void PotreeWriter::writeNode(const lod::NodeKey& key, const PointRecord* records
   writeEncoded(key, encodeNode(records, count));
 }
 
-void PotreeWriter::writeEncoded(const lod::NodeKey& key, PotreeEncodedNode&& node) {
+void PotreeWriter::writeEncoded(const lod::NodeKey& key, const PotreeEncodedNode& node) {
+  writeAt(place(key, node), node);
+}
+
+uint64_t PotreeWriter::place(const lod::NodeKey& key, const PotreeEncodedNode& node) {
   State& s = *state_;
-  assert(!s.committed && s.octree);
+  assert(!s.committed && s.octree >= 0);
   const bool keyValid = key.level >= 0 && key.level <= potree::kMaxLevel && key.x >= 0 && key.y >= 0 &&
                         key.z >= 0 && int64_t(key.x) >> key.level == 0 && int64_t(key.y) >> key.level == 0 &&
                         int64_t(key.z) >> key.level == 0;
@@ -245,23 +236,32 @@ void PotreeWriter::writeEncoded(const lod::NodeKey& key, PotreeEncodedNode&& nod
     fail(s.dir, strFormat("node %s: its %llu points are so alike that Brotli compresses them more than "
                           "4096x, past what readers accept from a node; write the DEFAULT encoding",
                           key.potreeName().c_str(), static_cast<unsigned long long>(count)));
-  if (!node.bytes.empty() &&
-      std::fwrite(node.bytes.data(), 1, node.bytes.size(), s.octree) != node.bytes.size())
-    s.failWrite(errno ? errno : EIO);
-  s.nodes.push_back({key, uint32_t(count), s.bytes, node.bytes.size()});
+  const uint64_t offset = s.bytes;
+  s.nodes.push_back({key, uint32_t(count), offset, node.bytes.size()});
   s.bytes += node.bytes.size();
   s.ranges.merge(node.ranges);
+  return offset;
+}
+
+void PotreeWriter::writeAt(uint64_t offset, const PotreeEncodedNode& node) const {
+  const State& s = *state_;
+  assert(!s.committed && s.octree >= 0);
+  size_t done = 0;
+  while (done < node.bytes.size()) {
+    const ssize_t n = ::pwrite(s.octree, node.bytes.data() + done, node.bytes.size() - done,
+                               static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) s.failWrite(n < 0 ? errno : EIO);
+    done += static_cast<size_t>(n);
+  }
 }
 
 void PotreeWriter::commit() {
   State& s = *state_;
-  assert(!s.committed && s.octree);
-  errno = 0;
-  const bool flushed = std::fflush(s.octree) == 0;
-  const int error = errno;
-  const bool closed = std::fclose(s.octree) == 0;
-  s.octree = nullptr;
-  if (!flushed || !closed) s.failWrite(error ? error : (errno ? errno : EIO));
+  assert(!s.committed && s.octree >= 0);
+  const int closed = ::close(s.octree);
+  s.octree = -1;
+  if (closed != 0) s.failWrite(errno);
 
   if (s.nodes.empty()) s.nodes.push_back({lod::NodeKey{}, 0, 0, 0}); // an empty octree is an empty root
   const potree::HierarchyBytes hierarchy = potree::buildHierarchy(s.nodes, s.options.hierarchyStepSize);
