@@ -30,7 +30,6 @@
 // wrongly there (not here).
 #pragma once
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -71,26 +70,6 @@ struct PotreeValueRanges {
 
   void add(const PointRecord* records, size_t n);
   void merge(const PotreeValueRanges& other);
-  // One record, without counting it (add() and the encoders count). Inline so that a loop over a local
-  // copy keeps every extreme in a register: on the members through a pointer, each store may alias the
-  // records read, and the loop costs 114 instructions a point instead of ~35.
-  void include(const PointRecord& r) {
-    const int32_t q[3] = {r.x, r.y, r.z};
-    for (int a = 0; a < 3; ++a) {
-      positionMin[a] = std::min(positionMin[a], q[a]);
-      positionMax[a] = std::max(positionMax[a], q[a]);
-      rgbMin[a] = std::min(rgbMin[a], r.rgb[a]);
-      rgbMax[a] = std::max(rgbMax[a], r.rgb[a]);
-    }
-    intensityMin = std::min(intensityMin, r.intensity);
-    intensityMax = std::max(intensityMax, r.intensity);
-    returnMin = std::min(returnMin, r.returnNumber);
-    returnMax = std::max(returnMax, r.returnNumber);
-    classMin = std::min(classMin, r.classification);
-    classMax = std::max(classMax, r.classification);
-    sourceMin = std::min(sourceMin, r.pointSourceId);
-    sourceMax = std::max(sourceMax, r.pointSourceId);
-  }
 };
 
 // One node's points in the octree's encoding, made by PotreeWriter::encodeNode().

@@ -74,10 +74,10 @@ void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, u
   const FieldOffsets o = fieldOffsets(layout);
   const size_t stride = static_cast<size_t>(layout.defaultStride);
   if (!o.everyByte) std::memset(dst, 0, n * stride); // attributes without a record field are zeros
-  PotreeValueRanges local = ranges;                  // in registers (see PotreeValueRanges::include)
+  RecordExtremes extremes(ranges);
   for (size_t i = 0; i < n; ++i) {
     const PointRecord& r = records[i];
-    local.include(r);
+    extremes.include(r);
     uint8_t* p = dst + i * stride;
     storeLE<int32_t>(p + o.position, r.x);
     storeLE<int32_t>(p + o.position + 4, r.y);
@@ -90,8 +90,8 @@ void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, u
     if (o.classification >= 0) p[o.classification] = r.classification;
     if (o.pointSourceId >= 0) storeLE<uint16_t>(p + o.pointSourceId, r.pointSourceId);
   }
-  local.count += n;
-  ranges = local;
+  extremes.into(ranges);
+  ranges.count += n;
 }
 
 void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointRecord* dst) {

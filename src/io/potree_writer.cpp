@@ -16,12 +16,67 @@ namespace pointrast::io {
 using namespace detail;
 
 void PotreeValueRanges::add(const PointRecord* records, size_t n) {
-  PotreeValueRanges local = *this; // in registers (see include())
+  potree::RecordExtremes extremes(*this);
   for (size_t i = 0; i < n; ++i)
-    local.include(records[i]);
-  local.count += n;
-  *this = local;
+    extremes.include(records[i]);
+  extremes.into(*this);
+  count += n;
 }
+
+namespace potree {
+
+namespace {
+
+PointRecord recordOf(const std::array<int32_t, 3>& position, const std::array<uint16_t, 3>& rgb,
+                     uint16_t intensity, uint8_t returnNumber, uint8_t classification, uint16_t source) {
+  PointRecord r;
+  r.x = position[0];
+  r.y = position[1];
+  r.z = position[2];
+  for (int c = 0; c < 3; ++c)
+    r.rgb[c] = rgb[c];
+  r.intensity = intensity;
+  r.returnNumber = returnNumber;
+  r.classification = classification;
+  r.pointSourceId = source;
+  return r;
+}
+
+} // namespace
+
+RecordExtremes::RecordExtremes(const PotreeValueRanges& s) {
+  const PointRecord lo =
+      recordOf(s.positionMin, s.rgbMin, s.intensityMin, s.returnMin, s.classMin, s.sourceMin);
+  const PointRecord hi =
+      recordOf(s.positionMax, s.rgbMax, s.intensityMax, s.returnMax, s.classMax, s.sourceMax);
+  const auto* l = reinterpret_cast<const uint8_t*>(&lo);
+  const auto* h = reinterpret_cast<const uint8_t*>(&hi);
+  std::memcpy(&posMin_, l, 16);
+  std::memcpy(&posMax_, h, 16);
+  std::memcpy(&u16Min_, l + 8, 16);
+  std::memcpy(&u16Max_, h + 8, 16);
+  std::memcpy(&u8Min_, l + 8, 16);
+  std::memcpy(&u8Max_, h + 8, 16);
+}
+
+void RecordExtremes::into(PotreeValueRanges& s) const {
+  for (int a = 0; a < 3; ++a) {
+    s.positionMin[a] = posMin_[a];
+    s.positionMax[a] = posMax_[a];
+    s.rgbMin[a] = u16Min_[2 + a];
+    s.rgbMax[a] = u16Max_[2 + a];
+  }
+  s.intensityMin = u16Min_[5];
+  s.intensityMax = u16Max_[5];
+  s.sourceMin = u16Min_[7];
+  s.sourceMax = u16Max_[7];
+  s.returnMin = u8Min_[12];
+  s.returnMax = u8Max_[12];
+  s.classMin = u8Min_[13];
+  s.classMax = u8Max_[13];
+}
+
+} // namespace potree
 
 void PotreeValueRanges::merge(const PotreeValueRanges& o) {
   for (int a = 0; a < 3; ++a) {
