@@ -55,9 +55,9 @@ for what in "$@"; do
     .gpu/bin/bench_tests --gtest_brief=1 || status=1
     ;;
   lod)
-    echo "== octree build: pointrast lod on generated terrain (scripts/bench-lod.sh), ${LOD_SIZES:-100M 1G} points"
+    echo "== octree build: pointrast lod on generated terrain (scripts/bench-lod.sh), ${LOD_SIZES:-10M/2 100M 1G} points"
     # shellcheck disable=SC2086
-    { POINTRAST_BIN=$pr OUT=$OUT scripts/bench-lod.sh run ${LOD_SIZES:-100M 1G} && OUT=$OUT scripts/bench-lod.sh report; } || status=1
+    { POINTRAST_BIN=$pr OUT=$OUT scripts/bench-lod.sh run ${LOD_SIZES:-10M/2 100M 1G} && OUT=$OUT scripts/bench-lod.sh report; } || status=1
     ;;
   autzen)
     echo "== autzen_trim.las"
