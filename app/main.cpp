@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   app::Command generate = app::addGenerate(app);
   app::Command bench = app::addBench(app);
   app::Command view = app::addView(app);
+  app::Command serve = app::addServe(app);
 
   try {
     app.parse(argc, argv);
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
       if (sub->get_name() == "generate") return generate();
       if (sub->get_name() == "bench") return bench();
       if (sub->get_name() == "view") return view();
+      if (sub->get_name() == "serve") return serve();
     }
     return 1;
   } catch (const InputError& e) {
