@@ -56,6 +56,7 @@ int runServe(const ServeArgs& a) {
   o.events = a.events;
   o.quiet = a.quiet;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  view::web::checkServerOptions(o);
 
   InputSpec spec;
   spec.source = a.input;

@@ -76,10 +76,13 @@ HttpResponse httpRequest(const std::string& host, uint16_t port, const std::stri
   HttpResponse r;
   int fd = connectTcp(host, port);
   if (fd < 0) return r;
-  std::string request = method + " " + target + " HTTP/1.1\r\nHost: " + host + ":" + std::to_string(port) +
-                        "\r\nConnection: close\r\n";
-  for (const std::string& h : headers)
+  std::string request = method + " " + target + " HTTP/1.1\r\nConnection: close\r\n";
+  bool hostGiven = false;
+  for (const std::string& h : headers) {
     request += h + "\r\n";
+    hostGiven = hostGiven || h.rfind("Host:", 0) == 0;
+  }
+  if (!hostGiven) request += "Host: " + host + ":" + std::to_string(port) + "\r\n";
   request += "\r\n";
   double deadline = clockSeconds() + timeoutSeconds;
   std::string all;

@@ -17,8 +17,8 @@ struct HttpResponse {
   std::string head, body;
 };
 
-// One HTTP/1.1 GET (or another method) with extra header lines ("Name: value"); reads until the server
-// closes or Content-Length bytes arrived.
+// One HTTP/1.1 GET (or another method) with extra header lines ("Name: value"; a Host line replaces the
+// default one); reads until the server closes or Content-Length bytes arrived.
 HttpResponse httpRequest(const std::string& host, uint16_t port, const std::string& target,
                          const std::vector<std::string>& headers = {}, const std::string& method = "GET",
                          double timeoutSeconds = 10);

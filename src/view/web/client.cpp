@@ -259,7 +259,8 @@ std::string WebClient::stateJson(const FrameHeader* frame) const {
             {"keyframes",
              {{"count", session_->path().keyframes().size()}, {"duration", session_->path().duration()}}},
             {"stats", stats}};
-  if (frame) j["frame"] = frame->frame;
+  // The frame this state goes with: the one it precedes, else the last one sent.
+  j["frame"] = frame ? frame->frame : nextFrame_ - 1;
   return j.dump();
 }
 

@@ -250,6 +250,9 @@ const char* keyName(Key key) {
 std::variant<ClientMessage, std::string> parseClientMessage(std::string_view text,
                                                             std::span<const Method> methods) {
   if (text.size() > kMaxMessageBytes) return std::string("message too long");
+  // The JSON parser stops at a NUL byte as at the end of the text: what follows it would pass unread. JSON
+  // has no raw NUL anywhere (inside a string it is escaped).
+  if (text.find('\0') != std::string_view::npos) return std::string("a NUL byte");
   // Invalid UTF-8 and nesting deeper than the 1 KiB allow fail the parse like any other malformed text.
   Json j = Json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) return std::string("not JSON");

@@ -44,6 +44,8 @@ constexpr uint16_t kCloseUnsupported = 1003;
 constexpr uint16_t kClosePolicy = 1008;
 constexpr uint16_t kCloseTooBig = 1009;
 constexpr uint16_t kCloseTryAgain = 1013;
+// How long a shutdown waits for the clients' close frames to be written.
+constexpr double kCloseGraceSeconds = 2.0;
 
 // The headers of every answer: nothing cached, nothing framed, no referrer (the token may be in the URL),
 // and scripts, styles and connections only from this server.
@@ -139,6 +141,7 @@ private:
   void renderLoop();
   std::optional<double> renderPass();
   void wakeRenderer();
+  void waitForCloses(double deadline);
   void emit(const Json& event);
   std::string url() const;
 
@@ -320,7 +323,7 @@ int Server::wsConnect(const mg_connection* conn, void* selfPointer) {
   std::lock_guard lock(self.connectionsMutex_);
   size_t open = 0;
   for (const auto& [id, other] : self.connections_)
-    open += other->closed ? 0 : 1;
+    open += other->closed || other->refused ? 0 : 1; // a refused one is on its way out
   c->refused = open >= self.options_.maxClients;
   c->id = self.nextId_++;
   cw::mg_set_user_connection_data(conn, c.get());
@@ -467,6 +470,21 @@ void Server::renderLoop() {
   clients_.clear();
 }
 
+// The senders put their close frames on the wire before mg_stop ends the connections under them; one that
+// a stalled client blocks is given up at the deadline.
+void Server::waitForCloses(double deadline) {
+  while (now() < deadline) {
+    bool sent = true;
+    {
+      std::lock_guard lock(connectionsMutex_);
+      for (const auto& [id, c] : connections_)
+        sent = sent && (!c->stream || c->stream->stopped());
+    }
+    if (sent) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
 std::string Server::url() const {
   std::string host = options_.bind;
   if (host == "0.0.0.0" || host == "::") {
@@ -545,6 +563,7 @@ int Server::run() {
   }
   wakeRenderer();
   renderThread_.join();
+  waitForCloses(now() + kCloseGraceSeconds);
   cw::mg_stop(civet_); // waits for civetweb's threads; the close handlers stop the remaining senders
   civet_ = nullptr;
   connections_.clear();
@@ -558,7 +577,9 @@ int Server::run() {
   return 0;
 }
 
-void checkOptions(const ServerOptions& o) {
+} // namespace
+
+void checkServerOptions(const ServerOptions& o) {
   in6_addr v6{};
   in_addr v4{};
   if (o.bind != "localhost" && inet_pton(AF_INET, o.bind.c_str(), &v4) != 1 &&
@@ -577,10 +598,8 @@ void checkOptions(const ServerOptions& o) {
     throw InputError("--token takes 16 to 100 letters, digits, '-' or '_'");
 }
 
-} // namespace
-
 int runServer(const PointCloud& cloud, ServerOptions options) {
-  checkOptions(options);
+  checkServerOptions(options);
   if (cloud.size() == 0) throw InputError(cloud.source + ": no points to view");
   cw::load();
   if (options.token.empty() && !isLocalBind(options.bind)) options.token = generateToken();

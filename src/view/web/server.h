@@ -35,6 +35,10 @@ struct ServerOptions {
   bool quiet = false;
 };
 
+// InputError with one sentence for options that cannot work; runServer checks them too. Callers check before
+// loading a large cloud.
+void checkServerOptions(const ServerOptions& options);
+
 // Checks the options (InputError with one sentence), generates the token a non-local bind needs, and
 // serves until a signal. Returns the exit code: 1 when the validation layer reported errors.
 int runServer(const PointCloud& cloud, ServerOptions options);

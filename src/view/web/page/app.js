@@ -27,7 +27,7 @@ const $ = (id) => document.getElementById(id);
 // What tests and scripts read: the server's last info and state, and the frames drawn.
 const pointrast = window.pointrast = {
   info: null, state: null, frames: 0, fullFrames: 0, lastFrame: null, lastPick: null, cameraText: null,
-  errors: [], closed: null,
+  errors: [], closed: null, sentSeq: 0,
 };
 
 let socket = null;
@@ -38,7 +38,7 @@ const heldKeys = new Set();
 
 function send(message) {
   if (!socket || socket.readyState !== WebSocket.OPEN) return;
-  if (message.t !== 'ack' && message.t !== 'resize') message.seq = ++seq;
+  if (message.t !== 'ack' && message.t !== 'resize') message.seq = pointrast.sentSeq = ++seq;
   socket.send(JSON.stringify(message));
 }
 
