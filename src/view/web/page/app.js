@@ -111,6 +111,7 @@ async function drawFrame(header, jpeg) {
     pointrast.frames++;
     if (header.full) pointrast.fullFrames++;
     pointrast.lastFrame = header;
+    showStream(header, jpeg.byteLength);
   } catch (error) {
     pointrast.errors.push('frame ' + header.frame + ': ' + error);
   }
@@ -159,6 +160,28 @@ function buildPanel(info) {
   $('panel').hidden = false;
 }
 
+// What the stream delivers, measured here from the frames drawn: the server's state message goes before
+// its frame, so its figures would always lag one frame behind.
+const stream = { drawn: [], motionBytes: [], fullBytes: 0 };
+
+function showStream(header, bytes) {
+  const now = performance.now();
+  stream.drawn.push(now);
+  while (stream.drawn.length && now - stream.drawn[0] > 1000) stream.drawn.shift();
+  if (header.full) {
+    stream.fullBytes = bytes;
+  } else {
+    stream.motionBytes.push(bytes);
+    if (stream.motionBytes.length > 60) stream.motionBytes.shift();
+  }
+  const motion = stream.motionBytes.length ? stream.motionBytes.reduce((a, b) => a + b, 0) / stream.motionBytes.length : 0;
+  $('streamStats').textContent = [
+    `JPEG encode ${fmt(header.encodeMs, 3).padStart(8)} ms  (sender thread)`,
+    `stream ${header.width}x${header.height} q${header.quality}, ${stream.drawn.length} frames/s`,
+    `JPEG ${fmt(motion / 1024, 0)} KiB moving, ${fmt(stream.fullBytes / 1024, 0)} KiB at rest`,
+  ].join('\n');
+}
+
 function showState(s) {
   const info = pointrast.info || { device: '', input: '', points: 0 };
   const st = s.stats;
@@ -172,13 +195,11 @@ function showState(s) {
     info.device,
     `${info.input}: ${human(info.points)} points`,
     `GPU render  ${fmt(st.renderMs, 3).padStart(8)} ms  (clear + draw + resolve)`,
-    `JPEG encode ${fmt(st.encodeMs, 3).padStart(8)} ms  (sender thread)`,
     `frame (host) ${fmt(st.hostMs, 2).padStart(7)} ms, ${st.frames} frames`,
     `points drawn ${human(st.points)}, ${human(st.pointsPerSecond)} points/s`,
   ];
   if (st.batch) lines.push(`batches ${human(st.batch.batchesRendered)} of ${human(st.batch.batchesProcessed)} rendered, ${human(st.batch.pointsRendered)} points passed early-z`);
   lines.push(`GPU memory ${fmt(st.gpuBytes / 1048576, 1)} MiB (scene + targets)`);
-  lines.push(`stream ${s.viewport[0]}x${s.viewport[1]}, ${st.framesPerSecond} fps, ${fmt(st.motionBytes / 1024, 0)} KiB moving, ${fmt(st.fullBytes / 1024, 0)} KiB at rest`);
   $('stats').textContent = lines.join('\n');
   $('camera').textContent = `eye    ${vec(s.camera.eye)}\ntarget ${vec(s.camera.target)}\npivot  ${vec(s.pivot)}`;
   $('keyframes').textContent = `${s.keyframes.count} keyframes, ${fmt(s.keyframes.duration, 1)} s`;
