@@ -112,8 +112,15 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 $pr render terrain --points 4G --method "${BIG4G_METHOD:-batch}" --width 2560 \
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
+  serve)
+    # The browser viewer: `serve` on 1 G generated points (SERVE_POINTS, SERVE_METHOD), one loopback client
+    # at 1920x1080 (serve_load); writes serve.json and serve.md.
+    echo "== serve: ${SERVE_POINTS:-1G} points, one client at 1920x1080"
+    POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT \
+      timeout 590 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, serve)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

@@ -6,7 +6,7 @@
 // draws it before acknowledging, unless --no-decode.
 //
 //   serve_load --port 8080 [--host 127.0.0.1] [--token T] [--width 1920] [--height 1080] [--seconds 10]
-//              [--rate 120] [--isolated 30] [--no-decode] [-o result.json]
+//              [--rate 120] [--isolated 30] [--no-decode] [-o result.json] [--markdown result.md]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,7 +35,7 @@ double clockSeconds() {
 }
 
 struct Args {
-  std::string host = "127.0.0.1", token, output;
+  std::string host = "127.0.0.1", token, output, markdown;
   uint16_t port = 8080;
   uint32_t width = 1920, height = 1080, isolated = 30;
   double seconds = 10, rate = 120;
@@ -219,6 +219,62 @@ Json Load::isolatedLatency() {
   return summary(ms);
 }
 
+// The targets a browser user needs: a smooth drag, and a frame soon after each input.
+constexpr double kTargetFramesPerSecond = 30;
+constexpr double kTargetLatencyMs = 50;
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0) {
+  char text[160];
+  std::snprintf(text, sizeof text, pattern, a, b, c);
+  return text;
+}
+
+// The result as a Markdown table: one row per motion phase, the isolated inputs below.
+std::string markdown(const Json& r) {
+  std::string md = "# pointrast serve: one client at " + std::to_string(r["width"].get<uint32_t>()) + "x" +
+                   std::to_string(r["height"].get<uint32_t>()) + "\n\n";
+  md += "Device " + r["device"].get<std::string>() + ", " + r["input"].get<std::string>() + " (" +
+        std::to_string(r["points"].get<uint64_t>()) + " points), method " + r["method"].get<std::string>() +
+        "; the load client `serve_load` over loopback, a continuous drag at " +
+        format("%.0f", r["input_rate_hz"].get<double>()) + " pointer moves/s, each frame decoded before " +
+        "its acknowledgement. Targets: >= " + format("%.0f", kTargetFramesPerSecond) +
+        " frames/s, <= " + format("%.0f", kTargetLatencyMs) + " ms from input to frame.\n\n";
+  md += "| motion scale | frame while moving | frames/s | input to frame p50 (ms) | p95 (ms) | KiB/frame "
+        "moving "
+        "| KiB/frame at rest | server render (ms) | server encode (ms) |\n";
+  md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const Json& p : r["phases"]) {
+    const Json& size = p["motion_frame_size"];
+    md += "| " + format("%.2f", p["motion_scale"].get<double>()) + " | " +
+          (size.is_array()
+               ? std::to_string(size[0].get<uint32_t>()) + "x" + std::to_string(size[1].get<uint32_t>())
+               : std::string("-")) +
+          " | " + format("%.1f", p["frames_per_second"].get<double>()) + " | " +
+          format("%.1f | %.1f", p["input_to_frame_ms"]["p50"].get<double>(),
+                 p["input_to_frame_ms"]["p95"].get<double>()) +
+          " | " + format("%.0f", p["bytes_per_frame_moving"].get<double>() / 1024) + " | " +
+          format("%.0f", p.value("bytes_per_frame_at_rest", 0.0) / 1024) + " | " +
+          format("%.2f | %.2f", p["server_render_ms"].get<double>(), p["server_encode_ms"].get<double>()) +
+          " |\n";
+  }
+  const Json& iso = r["isolated_input_to_frame_ms"];
+  md += "\nOne input after a pause (" + std::to_string(iso["inputs"].get<size_t>()) +
+        " inputs), to its frame: " +
+        format("p50 %.1f ms, p95 %.1f ms, max %.1f ms", iso["p50"].get<double>(), iso["p95"].get<double>(),
+               iso["max"].get<double>()) +
+        ".\n";
+  return md;
+}
+
+bool writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (out) return true;
+  std::fprintf(stderr, "serve_load: cannot write %s\n", path.c_str());
+  return false;
+}
+
 int Load::run() {
   if (!connect()) return 1;
   std::optional<Frame> first = waitFrame(300.0, 0, true);
@@ -252,14 +308,8 @@ int Load::run() {
         p["motion_scale"].get<double>(), p["frames_per_second"].get<double>(), args_.width, args_.height,
         p["input_to_frame_ms"]["p50"].get<double>(), p["input_to_frame_ms"]["p95"].get<double>(),
         p["bytes_per_frame_moving"].get<double>() / 1024, p.value("bytes_per_frame_at_rest", 0.0) / 1024);
-  if (!args_.output.empty()) {
-    std::ofstream out(args_.output);
-    out << text << "\n";
-    if (!out) {
-      std::fprintf(stderr, "serve_load: cannot write %s\n", args_.output.c_str());
-      return 1;
-    }
-  }
+  if (!args_.output.empty() && !writeFile(args_.output, text + "\n")) return 1;
+  if (!args_.markdown.empty() && !writeFile(args_.markdown, markdown(result))) return 1;
   return 0;
 }
 
@@ -287,6 +337,8 @@ bool parse(int argc, char** argv, Args& a) {
       a.decode = false;
     else if (k == "-o" || k == "--output")
       a.output = value();
+    else if (k == "--markdown")
+      a.markdown = value();
     else
       return false;
   }
@@ -301,7 +353,7 @@ int main(int argc, char** argv) {
     if (!parse(argc, argv, args)) {
       std::fprintf(stderr,
                    "usage: serve_load --port P [--host H] [--token T] [--width W] [--height H] [--seconds S] "
-                   "[--rate HZ] [--isolated N] [--no-decode] [-o result.json]\n");
+                   "[--rate HZ] [--isolated N] [--no-decode] [-o result.json] [--markdown result.md]\n");
       return 1;
     }
   } catch (const std::exception&) {
