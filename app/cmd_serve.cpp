@@ -47,6 +47,8 @@ int runServe(const ServeArgs& a) {
   o.maxSize = parseSize(a.maxSize);
   o.fovY = a.fov;
   o.settings.method = parseMethod(a.method);
+  if (methodInfo(o.settings.method).layout == SceneLayout::Octree)
+    throw InputError("serve draws a loaded cloud; " + a.method + " draws octrees, with `pointrast render`");
   o.settings.background = parseRgb(a.background, "--background");
   if (!(a.motionScale >= 0.25 && a.motionScale <= 1)) throw InputError("--motion-scale takes 0.25 to 1");
   if (a.quality < 10 || a.quality > 100 || a.motionQuality < 10 || a.motionQuality > 100)

@@ -1,5 +1,6 @@
 // `pointrast serve` as a process on lavapipe, reached over loopback by the load tool's WebSocket client:
 // what it serves and refuses, its frames against `render`, hostile clients, and a clean stop.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -75,6 +76,20 @@ TEST(Serve, ServesItsPageAndHealthAndNothingElse) {
     EXPECT_EQ(httpRequest("127.0.0.1", server.port(), path).status, 404) << path;
   EXPECT_EQ(httpRequest("127.0.0.1", server.port(), "/", {}, "POST").status, 405);
   EXPECT_EQ(httpRequest("127.0.0.1", server.port(), "/", {}, "HEAD").status, 200);
+  // The page offers the methods that draw the loaded cloud: not the octree ones, which stream from disk.
+  Client ws;
+  ASSERT_TRUE(ws.connect("127.0.0.1", server.port(), "/ws"));
+  auto info = ws.receive(30);
+  ASSERT_TRUE(info);
+  Json j = Json::parse(info->text(), nullptr, false);
+  ASSERT_TRUE(j.is_object()) << info->text();
+  std::vector<std::string> methods;
+  for (const Json& m : j["methods"])
+    methods.push_back(m["name"]);
+  EXPECT_NE(std::find(methods.begin(), methods.end(), "atomicmin"), methods.end());
+  EXPECT_NE(std::find(methods.begin(), methods.end(), "batch-prefetch"), methods.end());
+  EXPECT_EQ(std::find(methods.begin(), methods.end(), "lod"), methods.end());
+  EXPECT_EQ(std::find(methods.begin(), methods.end(), "lod-hqs"), methods.end());
   EXPECT_EQ(server.stop(), 0) << server.stderrText();
 }
 
@@ -343,6 +358,7 @@ TEST(Serve, RefusesBadOptionsBeforeLoading) {
   EXPECT_NE(run("--max-size 100").find("--max-size 100: give WIDTHxHEIGHT"), std::string::npos);
   EXPECT_NE(run("--token short").find("--token takes 16 to 100"), std::string::npos);
   EXPECT_NE(run("--motion-scale 2").find("--motion-scale takes"), std::string::npos);
+  EXPECT_NE(run("--method lod").find("serve draws a loaded cloud; lod draws octrees"), std::string::npos);
   EXPECT_NE(run("--max-clients 0").find("exit 1"), std::string::npos);
 }
 

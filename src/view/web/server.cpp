@@ -183,8 +183,9 @@ Server::Server(const PointCloud& cloud, const ServerOptions& options)
     : cloud_(cloud), options_(options), context_(makeContext(options)),
       gpuCloud_(context_, cloud, !options.quiet) {
   access_.token = options.token;
+  // The octree methods stream nodes from disk; a client's page offers what draws the loaded cloud.
   for (Method m : allMethods())
-    if (Renderer::supports(context_, m)) methods_.push_back(m);
+    if (m.info().layout != SceneLayout::Octree && Renderer::supports(context_, m)) methods_.push_back(m);
   if (std::find(methods_.begin(), methods_.end(), options.settings.method) == methods_.end())
     throw UnsupportedError(std::string("this device cannot run ") + methodName(options.settings.method));
   // The first client should not wait for the upload of the starting method's scene.
