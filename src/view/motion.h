@@ -2,8 +2,11 @@
 // pixel they send (the browser viewer streams JPEG): while the camera moves, frames may be cheaper (fewer
 // pixels, lower JPEG quality); once it has rested for kRestSeconds, one full frame replaces the last
 // cheap one. A single discrete change (a view key, one wheel step after a pause, a settings change) gets a
-// full frame at once: only a camera that keeps changing is "moving". Times are seconds on any monotonic
-// clock, passed in, so the policy is tested without waiting.
+// full frame at once: only a camera that keeps changing is "moving", judged by its frames and, where frames
+// are slower than kRestSeconds (a large canvas on a slow device, a client slow to take frames), by the
+// inputs that move it: without that, every frame of a slow drag would look like one after a rest and be
+// the costliest kind. Times are seconds on any monotonic clock, passed in, so the policy is tested without
+// waiting.
 #pragma once
 
 #include <optional>
@@ -17,10 +20,16 @@ constexpr double kRestSeconds = 0.2;
 
 enum class FrameQuality { Motion, Full };
 
+// Whether two cameras give the same image of the same scene.
+bool sameCamera(const Camera& a, const Camera& b);
+
 class MotionQuality {
 public:
+  // An input that moved the camera (a drag's pointer move, a wheel step) arrived at `time`.
+  void input(double time);
   // The quality of the frame about to be rendered at `now` with `camera`: Motion when the camera differs
-  // from the last frame's and the previous change was less than kRestSeconds ago.
+  // from the last frame's and either the previous change was less than kRestSeconds ago, or the latest
+  // input followed the one before within kRestSeconds and is itself less than kRestSeconds old.
   FrameQuality next(const Camera& camera, double now) const;
   // Records a rendered frame.
   void rendered(const Camera& camera, FrameQuality quality, double now);
@@ -34,6 +43,8 @@ private:
   std::optional<Camera> last_;
   FrameQuality lastQuality_ = FrameQuality::Full;
   double lastChange_ = -1e300;
+  double lastInput_ = -1e300;
+  bool inputsContinue_ = false; // the last input came within kRestSeconds of the one before
 };
 
 } // namespace pointrast::view

@@ -104,9 +104,13 @@ void WebClient::receive(const ClientMessage& m) {
   case MessageType::Move:
   case MessageType::Up:
   case MessageType::DoubleClick:
-  case MessageType::Wheel:
+  case MessageType::Wheel: {
+    Camera before = session_->camera();
     pointer(m);
+    // The wheel's steps are applied at the next frame; a drag's moves now.
+    if (m.type == MessageType::Wheel || !sameCamera(before, session_->camera())) quality_.input(m.received);
     break;
+  }
   case MessageType::Key:
     if (m.down)
       session_->keyDown(m.key, m.shift);

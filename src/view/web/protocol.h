@@ -66,6 +66,7 @@ struct ClientMessage {
   std::optional<int> quality, motionQuality;
   ClientAction action = ClientAction::ClearKeyframes;
   uint32_t frame = 0;
+  double received = 0; // seconds on the steady clock: when the server read it (not from the wire)
 };
 
 // One text message parsed and validated against the methods this device runs. Returns the message, or

@@ -384,6 +384,7 @@ int Server::receive(Connection& c, int bits, const char* data, size_t length) {
       return refuseMessage(c, kClosePolicy, "acknowledged a frame not sent");
     return 1;
   }
+  m.received = now();
   {
     std::lock_guard lock(c.inboxMutex);
     // The budget bounds this: at most a burst of messages waits for the render thread.
