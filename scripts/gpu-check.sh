@@ -5,6 +5,7 @@
 # combination starts; the process is killed 90 s later if it still runs), SUITE_FRAMES,
 # SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS;
 # BIG4G_METHOD (default batch).
+# OCTREE_CACHE: the octree cache of lodsuite and lod2022 (default /tmp/octrees: on the machine's disk).
 #   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -112,8 +113,27 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 $pr render terrain --points 4G --method "${BIG4G_METHOD:-batch}" --width 2560 \
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
+  lodsuite)
+    # The lod suite on the 1,000 M stand-in's octree: sweeps of point budget and --min-node-px, then streaming
+    # with 1/8 of the octree in GPU memory (a flight and jumps). The octree is built into OCTREE_CACHE on the
+    # machine's disk (24 GB; generation + build about 1-2 min on 16 cores) unless a run before built it;
+    # lod2022 reuses it. df says which filesystem it is on (the page cache drop needs a real disk).
+    mkdir -p "${OCTREE_CACHE:-/tmp/octrees}" && df -hT "${OCTREE_CACHE:-/tmp/octrees}"
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite lod \
+      --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" ${SUITE_FRAMES:+--frames "$SUITE_FRAMES"} ${SUITE_ARGS:-} --out "$OUT" --name lod \
+      --json > "$OUT/lod.jsonl" || status=1
+    ls -l "${OCTREE_CACHE:-/tmp/octrees}"
+    ;;
+  lod2022)
+    # paper2022's LOD columns on the 1,000 M stand-in only: batch-prefetch against lod and lod-hqs at
+    # 2560x1140, the octree from OCTREE_CACHE (built there first when lodsuite did not run before).
+    mkdir -p "${OCTREE_CACHE:-/tmp/octrees}" && df -hT "${OCTREE_CACHE:-/tmp/octrees}"
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite paper2022 \
+      --datasets aerial1g --methods batch-prefetch,lod,lod-hqs --frames "${SUITE_FRAMES:-15}" --budget "${SUITE_BUDGET:-2}" \
+      --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" --out "$OUT" --name lod2022 --json > "$OUT/lod2022.jsonl" || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
