@@ -530,7 +530,7 @@ Command addBench(CLI::App& app) {
       "default ~/.cache/pointrast/octrees) and reused by later runs and by the other suite: KEY/ is the\n"
       "octree of the data set, size and seed KEY names, KEY.json its build's time and phases, which the\n"
       "reports give whether the octree was built or reused. A damaged entry is built again. The 1,000 M\n"
-      "stand-in's octree takes about 24 GB of disk, and its build about 56 GB of memory beside the "
+      "stand-in's octree takes about 18 GB of disk, and its build about 56 GB of memory beside the "
       "points.\n\n"
       "--suite lod measures the method lod on the octree of aerial1g (the 1,000 M stand-in of paper2022,\n"
       "the same octree) at 2560x1140: the full-detail frame time against the point budget (1 M .. 300 M,\n"

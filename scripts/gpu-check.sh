@@ -116,7 +116,7 @@ for what in "$@"; do
   lodsuite)
     # The lod suite on the 1,000 M stand-in's octree: sweeps of point budget and --min-node-px, then streaming
     # with 1/8 of the octree in GPU memory (a flight and jumps). The octree is built into OCTREE_CACHE on the
-    # machine's disk (24 GB; generation + build about 1-2 min on 16 cores) unless a run before built it;
+    # machine's disk (about 18 GB; generation + build about 1-2 min on 16 cores) unless a run before built it;
     # lod2022 reuses it. df says which filesystem it is on (the page cache drop needs a real disk).
     mkdir -p "${OCTREE_CACHE:-/tmp/octrees}" && df -hT "${OCTREE_CACHE:-/tmp/octrees}"
     POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite lod \
