@@ -64,6 +64,24 @@ for what in "$@"; do
     echo "== autzen_trim.las"
     $pr render .gpu/data/las/autzen_trim.las -o "$OUT/autzen.png" --json --frames 50 | tee "$OUT/autzen.json" || status=1
     ;;
+  lazio)
+    # LAZ decoding on 1 and all cores: autzen_trim.laz (point format 3) and lone-star.copc.laz (point format 7),
+    # each replicated from its own chunks to IO_POINTS points.
+    echo "== LAZ decoding (bench-io), ${IO_POINTS:-50M} points per file"
+    $pr bench-io .gpu/data/laz/autzen_trim.laz .gpu/data/laz/lone-star.copc.laz --points "${IO_POINTS:-50M}" \
+      --threads "1,$(nproc)" --repeats 5 --out "$OUT" --name laz-decode --quiet || status=1
+    ;;
+  post)
+    # GPU time of each pass of the resolve stage at 1920x1080 and one VR eye (2478x2740).
+    scripts/time-post.sh "$pr" "$OUT/post-passes.jsonl" 20M 50 || status=1
+    ;;
+  viewpath)
+    # The 5 s orbit at 60 fps (300 frames) over a 1 G-point cloud into MP4 (PNG frames where no ffmpeg).
+    echo "== render --path, 1 G points, 300 frames at 1920x1080"
+    if command -v ffmpeg >/dev/null || [ -n "${POINTRAST_FFMPEG:-}" ]; then dst=(--video /tmp/orbit-1g.mp4); else dst=(--frames-dir /tmp/orbit-1g); fi
+    POINTRAST_VALIDATION=0 $pr render terrain --points 1G --order morton --method batch-prefetch --path orbit \
+      --fps 60 --width 1920 --height 1080 "${dst[@]}" --json | tee "$OUT/view-path-1g.json" || status=1
+    ;;
   big)
     # 1.2 billion generated points (float32 xyz alone: 14.4 GB) drawn as one upload and as 12 separately
     # uploaded scenes of 100 M points; the two images must be identical.
@@ -133,7 +151,7 @@ for what in "$@"; do
       --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" --out "$OUT" --name lod2022 --json > "$OUT/lod2022.jsonl" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
