@@ -350,6 +350,33 @@ TEST(Serve, StopsCleanlyOnSigintWithClientsConnected) {
   EXPECT_TRUE(told);
 }
 
+// The load client that measures serve on the GPU machine, here briefly on lavapipe: it drags, gets motion
+// frames and a full one at rest, and writes its JSON and Markdown.
+TEST(Serve, TheLoadClientMeasuresADrag) {
+  ServeProcess server(autzen());
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  auto dir = scratchDir("load");
+  std::string json = (dir / "serve.json").string(), md = (dir / "serve.md").string();
+  std::string out = commandOutput("'" SERVE_LOAD_BINARY "' --port " + std::to_string(server.port()) +
+                                  " --width 160 --height 120 --seconds 1 --isolated 3 -o '" + json +
+                                  "' --markdown '" + md + "' 2>&1; echo \"exit $?\"");
+  EXPECT_NE(out.find("exit 0"), std::string::npos) << out;
+  Json r = Json::parse(commandOutput("cat '" + json + "'"), nullptr, false);
+  ASSERT_TRUE(r.is_object()) << out;
+  EXPECT_EQ(r["points"], 110000);
+  ASSERT_EQ(r["phases"].size(), 2u);
+  for (const Json& p : r["phases"]) {
+    EXPECT_GT(p["frames"].get<int>(), 0) << p.dump();
+    EXPECT_GT(p["input_to_frame_ms"]["inputs"].get<int>(), 0) << p.dump();
+    EXPECT_GT(p["input_to_frame_ms"]["p50"].get<double>(), 0) << p.dump();
+    EXPECT_GT(p.value("bytes_per_frame_at_rest", 0.0), 0) << p.dump();
+  }
+  EXPECT_GT(r["phases"][0]["motion_frames"].get<int>(), 0) << "no motion frames while dragging";
+  EXPECT_EQ(r["isolated_input_to_frame_ms"]["inputs"], 3);
+  EXPECT_NE(commandOutput("cat '" + md + "'").find("| motion scale |"), std::string::npos);
+  EXPECT_EQ(server.stop(), 0) << server.stderrText();
+}
+
 TEST(Serve, RefusesBadOptionsBeforeLoading) {
   std::string bin = "'" + pointrastBinary() + "' serve ";
   auto run = [&](const std::string& args) { return commandOutput(bin + args + " 2>&1; echo \"exit $?\""); };
