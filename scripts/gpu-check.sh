@@ -157,7 +157,7 @@ for what in "$@"; do
     # at 1920x1080 (serve_load); writes serve.json and serve.md.
     echo "== serve: ${SERVE_POINTS:-1G} points, one client at 1920x1080"
     POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT \
-      timeout 590 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
+      timeout 540 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
     ;;
   *)
     echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve)"; status=1 ;;
