@@ -4,7 +4,12 @@
 // part (node chunks live there, at file offsets from kChunksStart); the rest is the root page (32-byte
 // entries: level, x, y, z int32, offset u64, byte size int32, point count int32). The whole hierarchy is
 // walked and every node with at most 2^16 points decoded.
-// Seeds: laz
+//
+// Seeds: with COPC_FUZZ_SEEDS=DIR set, the target first writes into DIR inputs whose nodes are real
+// POINT14 chunks of the shared LAZ files (laz_seeds.h): a root alone, a root and a child sharing its chunk,
+// and a root page that references itself as a child page (a cycle).
+//   COPC_FUZZ_SEEDS=seeds ./copc_fuzz -runs=0 seeds && ./copc_fuzz -max_total_time=300 corpus seeds
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -12,6 +17,7 @@
 #include "cloud/octree.h"
 #include "fuzz_input.h"
 #include "io/copc.h"
+#include "laz_seeds.h"
 
 namespace {
 
@@ -19,7 +25,8 @@ template <class T> void put(std::vector<uint8_t>& b, size_t at, T v) {
   std::memcpy(b.data() + at, &v, sizeof v);
 }
 
-void putVlr(std::vector<uint8_t>& file, const char* user, uint16_t record, const std::vector<uint8_t>& payload) {
+void putVlr(std::vector<uint8_t>& file, const char* user, uint16_t record,
+            const std::vector<uint8_t>& payload) {
   std::vector<uint8_t> h(54, 0);
   std::memcpy(h.data() + 2, user, std::strlen(user));
   put<uint16_t>(h, 18, record);
@@ -88,10 +95,45 @@ std::vector<uint8_t> copcFile(const uint8_t* data, size_t size) {
   return f;
 }
 
+void putEntry(std::vector<uint8_t>& page, int32_t level, int32_t x, int32_t y, int32_t z, uint64_t offset,
+              int32_t bytes, int32_t points) {
+  const size_t at = page.size();
+  page.resize(at + 32);
+  put(page, at, level), put(page, at + 4, x), put(page, at + 8, y), put(page, at + 12, z);
+  put(page, at + 16, offset), put(page, at + 24, bytes), put(page, at + 28, points);
+}
+
+void writeSeeds(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  int n = 0;
+  for (const fuzz::SeedChunk& chunk : fuzz::seedChunks(60000, 2)) {
+    const auto& items = chunk.layout.items;
+    if (items.size() != 1 || items[0].type != pointrast::io::laz::ItemType::Point14) continue;
+    const uint64_t split = chunk.bytes.size();
+    const int32_t bytes = int32_t(split), points = int32_t(chunk.count);
+    const uint64_t pageOffset = kChunksStart + split + 8 + 60;
+    for (int variant = 0; variant < 3; ++variant) {
+      std::vector<uint8_t> page;
+      putEntry(page, 0, 0, 0, 0, kChunksStart, bytes, points);
+      if (variant == 1) putEntry(page, 1, 1, 0, 1, kChunksStart, bytes, points);
+      if (variant == 2) putEntry(page, 1, 0, 1, 1, pageOffset, 2 * 32, -1);
+      std::vector<uint8_t> input{uint8_t(split & 0xFF), uint8_t(split >> 8)};
+      input.insert(input.end(), chunk.bytes.begin(), chunk.bytes.end());
+      input.insert(input.end(), page.begin(), page.end());
+      fuzz::writeSeed(dir / ("copc" + std::to_string(n++)), input);
+    }
+  }
+}
+
 } // namespace
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
   pointrast::Progress::setEnabled(false);
+  if (const char* seeds = std::getenv("COPC_FUZZ_SEEDS"); seeds && *seeds) writeSeeds(seeds);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::vector<uint8_t> file = copcFile(data, size);
   fuzz::MemFile mem(file.data(), file.size());
   try {

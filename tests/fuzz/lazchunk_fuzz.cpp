@@ -2,13 +2,19 @@
 // (pointwise point formats 0-3, layered 6-8, with or without extra bytes), the next two the claimed point
 // count, the rest is the chunk's bytes (raw first point, layer table, arithmetic-coded streams). Every
 // input decodes or throws CorruptChunk; the decoded buffer must hold exactly the claimed records.
-// Seeds: laz
+//
+// Seeds: with LAZCHUNK_FUZZ_SEEDS=DIR set, the target first writes into DIR the chunks of the shared LAZ
+// files whose items match one of its layouts (laz_seeds.h):
+//   LAZCHUNK_FUZZ_SEEDS=seeds ./lazchunk_fuzz -runs=0 seeds && ./lazchunk_fuzz -max_total_time=300 corpus
+//   seeds
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "io/laz_chunk.h"
 #include "io/laz_common.h"
 #include "io/laz_format.h"
+#include "laz_seeds.h"
 
 namespace {
 
@@ -40,7 +46,36 @@ Layout layoutFor(uint8_t selector) {
   return layout;
 }
 
+bool sameItems(const Layout& a, const Layout& b) {
+  if (a.compressor != b.compressor || a.recordLength != b.recordLength || a.items.size() != b.items.size())
+    return false;
+  for (size_t i = 0; i < a.items.size(); ++i)
+    if (a.items[i].type != b.items[i].type || a.items[i].size != b.items[i].size ||
+        a.items[i].version != b.items[i].version)
+      return false;
+  return true;
+}
+
+void writeSeeds(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  int n = 0;
+  for (const fuzz::SeedChunk& chunk : fuzz::seedChunks(65536 - 3, 4))
+    for (unsigned selector = 0; selector < 256; ++selector)
+      if (sameItems(layoutFor(uint8_t(selector)), chunk.layout)) {
+        std::vector<uint8_t> input{uint8_t(selector), uint8_t((chunk.count - 1) & 0xFF),
+                                   uint8_t((chunk.count - 1) >> 8)};
+        input.insert(input.end(), chunk.bytes.begin(), chunk.bytes.end());
+        fuzz::writeSeed(dir / ("chunk" + std::to_string(n++)), input);
+        break;
+      }
+}
+
 } // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  if (const char* seeds = std::getenv("LAZCHUNK_FUZZ_SEEDS"); seeds && *seeds) writeSeeds(seeds);
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 3) return 0;
