@@ -6,6 +6,7 @@
 # SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS;
 # BIG4G_METHOD (default batch).
 #   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
+#   scripts/gpu-check.sh io           # LAZ decoding throughput (bench-io) on 1, 8 and all cores
 set -uo pipefail
 cd "$(dirname "$0")/.."
 OUT=${OUT:-$PWD/gpu-out}
@@ -58,6 +59,16 @@ for what in "$@"; do
     echo "== octree build: pointrast lod on generated terrain (scripts/bench-lod.sh), ${LOD_SIZES:-100M 1G} points"
     # shellcheck disable=SC2086
     { POINTRAST_BIN=$pr OUT=$OUT scripts/bench-lod.sh run ${LOD_SIZES:-100M 1G} && OUT=$OUT scripts/bench-lod.sh report; } || status=1
+    ;;
+  io)
+    # LAZ decoding on 1, 8 and all cores (CPU only): PF3, PF8 and COPC files replicated from their own
+    # chunks to IO_POINTS (default 48M: about 1 s a file at the 40 M points/s target). Run from $OUT so
+    # that the report lands in $OUT/bench/results/cpu-<model>-<threads>t/io-laz.{json,md}, the path it
+    # has in the repository.
+    echo "== LAZ decoding: bench-io, ${IO_POINTS:-48M} points a file"
+    (cd "$OUT" && $pr bench-io "$POINTRAST_DATA_DIR"/laz/autzen_trim.laz \
+      "$POINTRAST_DATA_DIR"/laz/las_with_several_extra_byte_bloc.laz "$POINTRAST_DATA_DIR"/laz/lone-star.copc.laz \
+      --points "${IO_POINTS:-48M}" --threads 1,8,all --repeats "${IO_REPEATS:-3}") || status=1
     ;;
   autzen)
     echo "== autzen_trim.las"
@@ -113,7 +124,7 @@ for what in "$@"; do
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
+    echo "unknown check '$what' (tests, lod, io, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
