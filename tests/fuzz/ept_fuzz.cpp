@@ -3,7 +3,12 @@
 // ept.json, ept-hierarchy/0-0-0-0.json (and the same text as 1-0-0-0.json, so subtree references
 // resolve) and ept-data/0-0-0-0.{bin,zst,laz}. The dataset is opened, its hierarchy walked and every node
 // with at most 2^16 points read, then read whole and probed.
-// Seeds: ept
+//
+// Seeds: with EPT_FUZZ_SEEDS=DIR set, the target first writes into DIR small valid datasets in this layout:
+// binary and zstandard nodes, and a laszip node that is the shared simple.laz (laz_seeds.h):
+//   EPT_FUZZ_SEEDS=seeds ./ept_fuzz -runs=0 seeds && ./ept_fuzz -dict=ept.dict -max_total_time=300 corpus
+//   seeds
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +19,9 @@
 #include "cloud/octree.h"
 #include "fuzz_input.h"
 #include "io/ept.h"
+#include "laz_seeds.h"
+
+#include <zstd.h>
 
 namespace {
 
@@ -36,7 +44,56 @@ void write(const fs::path& path, const uint8_t* data, size_t size) {
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
 }
 
+std::vector<uint8_t> seedInput(const std::string& json, const std::string& hierarchy,
+                               const std::vector<uint8_t>& node) {
+  std::vector<uint8_t> input{uint8_t(json.size() & 0xFF), uint8_t(json.size() >> 8),
+                             uint8_t(hierarchy.size() & 0xFF), uint8_t(hierarchy.size() >> 8)};
+  input.insert(input.end(), json.begin(), json.end());
+  input.insert(input.end(), hierarchy.begin(), hierarchy.end());
+  input.insert(input.end(), node.begin(), node.end());
+  return input;
+}
+
+std::string eptJson(const char* dataType, int points, const char* extraFields) {
+  std::string json =
+      std::string(R"({"bounds": [0, 0, 0, 10, 10, 10], "boundsConforming": [0, 0, 0, 10, 10, 10], )") +
+      R"("dataType": ")" + dataType + R"(", "hierarchyType": "json", "points": )" + std::to_string(points) +
+      R"(, "schema": [)";
+  for (const char* axis : {"X", "Y", "Z"})
+    json += std::string(*axis == 'X' ? "" : ", ") + R"({"name": ")" + axis +
+            R"(", "type": "signed", "size": 4, "scale": 0.01, "offset": 0})";
+  if (*extraFields) json += std::string(", ") + extraFields;
+  return json + R"(], "span": 128, "version": "1.0.0"})";
+}
+
+void writeSeeds(const fs::path& dir) {
+  fs::create_directories(dir);
+  const char* colors = R"({"name": "Intensity", "type": "unsigned", "size": 2}, {"name": "Red", "type": )"
+                       R"("unsigned", "size": 2}, {"name": "Green", "type": "unsigned", "size": 2}, )"
+                       R"({"name": "Blue", "type": "unsigned", "size": 2})";
+  // Three points of 20 bytes (X, Y, Z in hundredths inside the bounds, then four 16-bit fields).
+  std::vector<uint8_t> points(60);
+  for (size_t i = 0; i < points.size(); ++i)
+    points[i] = uint8_t(i % 4 == 3 ? 0 : (i * 37) % 200);
+  fuzz::writeSeed(dir / "binary", seedInput(eptJson("binary", 3, colors), R"({"0-0-0-0": 3})", points));
+  // Two points of X, Y, Z alone, zstd-compressed.
+  std::vector<uint8_t> zst(ZSTD_compressBound(24));
+  zst.resize(ZSTD_compress(zst.data(), zst.size(), points.data(), 24, 3));
+  fuzz::writeSeed(dir / "zstandard", seedInput(eptJson("zstandard", 2, ""), R"({"0-0-0-0": 2})", zst));
+  // A laszip node: the shared simple.laz (LAS 1.2 point format 3, 1,065 points) when it is there.
+  std::ifstream in(fuzz::sharedLazDir() / "simple.laz", std::ios::binary);
+  const std::vector<uint8_t> laz{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (!laz.empty())
+    fuzz::writeSeed(dir / "laszip", seedInput(eptJson("laszip", 1065, colors), R"({"0-0-0-0": 1065})", laz));
+}
+
 } // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  pointrast::Progress::setEnabled(false);
+  if (const char* seeds = std::getenv("EPT_FUZZ_SEEDS"); seeds && *seeds) writeSeeds(seeds);
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pointrast::Progress::setEnabled(false);

@@ -26,12 +26,16 @@ struct SeedChunk {
   uint64_t count = 0; // points the bytes decode to
 };
 
+inline std::filesystem::path sharedLazDir() {
+  const char* env = std::getenv("POINTRAST_DATA_DIR");
+  return std::filesystem::path(env && *env ? env : "../shared/data") / "laz";
+}
+
 // Chunks of at most maxBytes from every LAZ file of the shared data, each checked to decode.
 inline std::vector<SeedChunk> seedChunks(size_t maxBytes, size_t perFile) {
   namespace fs = std::filesystem;
   using namespace pointrast::io;
-  const char* env = std::getenv("POINTRAST_DATA_DIR");
-  const fs::path dir = fs::path(env && *env ? env : "../shared/data") / "laz";
+  const fs::path dir = sharedLazDir();
   std::vector<SeedChunk> seeds;
   std::error_code ec;
   for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
