@@ -27,16 +27,25 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The dataset's folder, in memory, removed when the fuzzer exits normally (a crash leaves it for a look).
 const fs::path& folder() {
-  static const fs::path dir = [] {
-    std::error_code ec;
-    fs::path base = fs::is_directory("/dev/shm", ec) ? fs::path("/dev/shm") : fs::temp_directory_path();
-    fs::path d = base / ("pointrast-ept-fuzz-" + std::to_string(::getpid()));
-    fs::create_directories(d / "ept-hierarchy");
-    fs::create_directories(d / "ept-data");
-    return d;
-  }();
-  return dir;
+  struct Folder {
+    fs::path dir;
+    Folder() {
+      std::error_code ec;
+      const fs::path base =
+          fs::is_directory("/dev/shm", ec) ? fs::path("/dev/shm") : fs::temp_directory_path();
+      dir = base / ("pointrast-ept-fuzz-" + std::to_string(::getpid()));
+      fs::create_directories(dir / "ept-hierarchy");
+      fs::create_directories(dir / "ept-data");
+    }
+    ~Folder() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  static const Folder instance;
+  return instance.dir;
 }
 
 void write(const fs::path& path, const uint8_t* data, size_t size) {
