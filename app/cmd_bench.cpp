@@ -19,7 +19,10 @@
 #include "bench/report.h"
 #include "bench/runner.h"
 #include "bench/sphere_runner.h"
+#include "bench/octree_folder.h"
 #include "bench/suites.h"
+#include "bench/vr_report.h"
+#include "bench/vr_suite.h"
 #include "cli_util.h"
 #include "cloud/generate.h"
 #include "commands.h"
@@ -39,6 +42,7 @@ struct BenchArgs {
   std::vector<std::string> inputs;
   std::string suite, methods = "all", orders = "all", views = "all", points = "1M", copySize = "1G";
   std::string out, name;
+  std::string octreeCache; // vr2022: folder of the stand-ins' octrees (built there when missing)
   // Sphere suites: the layouts, billboards, conservative settings and orbits measured, cameras per orbit.
   std::string layouts = "all", billboards = "all", conservative = "all", orbits = "all";
   uint32_t cameras = 10;
@@ -297,6 +301,59 @@ int runSphereSuite(const BenchArgs& a) {
   return 0;
 }
 
+// --suite vr2022: the VR frame on the 529 M stand-in's octree, stereo against two mono renders.
+int runVrSuite(const BenchArgs& a) {
+  if (!a.inputs.empty())
+    throw InputError("--suite " + a.suite + " generates its data set; it takes no INPUT (" + a.inputs.front() +
+                     ")");
+  if (a.ordersGiven || a.methodsGiven)
+    throw InputError("--suite vr2022 measures its own configurations; --orders and --methods do not apply");
+  bench::VrSuiteConfig config;
+  config.datasets = bench::suiteDatasets(a.suite, a.scale, a.seed);
+  if (a.viewsGiven) {
+    std::vector<bench::View> allViews(bench::allViews().begin(), bench::allViews().end());
+    config.views = parseList(a.views, "--views", allViews, bench::parseView);
+  }
+  if (a.widthGiven) config.width = a.width;
+  if (a.heightGiven) config.height = a.height;
+  if (a.framesGiven) config.frames = a.frames;
+  config.timeLimitSeconds = timeLimitSeconds(a);
+  config.copyBytes = parseCount(a.copySize, "--copy-size");
+  if (config.copyBytes == 0) throw InputError("--copy-size must be at least 1");
+  config.progress = !a.quiet;
+  const std::filesystem::path cache =
+      a.octreeCache.empty() ? bench::defaultOctreeFolder() : std::filesystem::path(a.octreeCache);
+  config.octrees = bench::octreeFolder(cache, !a.quiet);
+  const bench::ReportInfo info = suiteReportInfo(a);
+
+  gpu::Context context(contextOptions(a));
+  ProgressLines lines(a.quiet);
+  bench::VrSuiteCallbacks callbacks;
+  callbacks.onNote = [&](const std::string& line) { lines.note(line); };
+  size_t done = 0;
+  callbacks.onResult = [&](const bench::VrSuiteRun& run, const bench::VrResult& r) {
+    if (a.json) {
+      nlohmann::json j = {{"suite", a.suite},      {"dataset", r.dataset},
+                          {"view", bench::viewName(r.view)}, {"case", r.caseName},
+                          {"pass", r.stereo ? "stereo" : "mono"}, {"status", r.status}};
+      if (r.ok()) j["median_ms"] = r.medianMs;
+      if (!r.reason.empty()) j["reason"] = r.reason;
+      printJsonLine(j, context);
+    }
+    const size_t total = run.config.datasets.size() * run.config.views.size() * (2 * bench::vrCases().size() - 1);
+    lines.result(++done, total,
+                 r.dataset + " / " + bench::viewName(r.view) + " / " + r.caseName + " / " +
+                     (r.stereo ? "stereo" : "two mono") + ": " +
+                     (r.ok() ? bench::formatMs(r.medianMs) + " ms" : std::string("n/a")));
+  };
+  bench::VrSuiteRun run = bench::runVrSuite(context, config, callbacks);
+  lines.end();
+  checkRun(context, run.datasets);
+  bench::WrittenFiles files = bench::writeVrSuiteReports(run, info, reportDir(a, context));
+  printWritten(a, run.results.size(), run.seconds, files);
+  return 0;
+}
+
 int runBench(const BenchArgs& a) {
   Progress::setEnabled(!a.quiet);
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -308,6 +365,9 @@ int runBench(const BenchArgs& a) {
   if (!a.name.empty() && (a.name.find('/') != std::string::npos || a.name == "." || a.name == ".."))
     throw InputError("--name '" + a.name + "': give a plain file name without '/'");
   if (bench::isSphereSuite(a.suite)) return runSphereSuite(a);
+  if (!a.octreeCache.empty() && !bench::isVrSuite(a.suite))
+    throw InputError("--octree-cache applies to --suite vr2022");
+  if (bench::isVrSuite(a.suite)) return runVrSuite(a);
   if (a.sphereOptionsGiven)
     throw InputError("--layouts, --billboards, --conservative, --orbits and --cameras apply to --suite "
                      "spheres2023");
@@ -421,6 +481,10 @@ Command addBench(CLI::App& app) {
       "(default 5 here); a result is the median over the orbit's cameras of each camera's median. Its\n"
       "report adds sphere-compute against the fastest other method. --methods, --layouts, --billboards,\n"
       "--conservative off,on and --orbits short,long pick parts of the matrix.\n\n"
+      "--suite vr2022 measures the VR frame of the 2022 paper on the octree of scan529m (tls, 529 M, built\n"
+      "into --octree-cache when missing): both eyes at 2478x2740 each, lod-hqs, foveated LOD (100 px in the\n"
+      "fovea, 300 px at the corners), dilation, parallel eyes 6.4 cm apart, from the closeup and overview\n"
+      "views; each configuration as one stereo pass and as two mono renders of the same eyes.\n\n"
       "Examples:\n"
       "  pointrast bench terrain --points 10M --methods atomicmin,earlyz --orders original,morton\n"
       "  pointrast bench autzen.las --views overview --frames 100 --json\n"
@@ -493,6 +557,9 @@ Command addBench(CLI::App& app) {
                   "Bytes per copy of the bandwidth measurement (clamped to the device)")
       ->capture_default_str();
   cmd->add_option("--out", a->out, "Folder for the reports (default: bench/results/<device>/)");
+  cmd->add_option("--octree-cache", a->octreeCache,
+                  "--suite vr2022: folder of the stand-ins' octrees, built there when missing (default: "
+                  "~/.cache/pointrast/octrees)");
   cmd->add_option("--name", a->name,
                   "File name of the reports without extension (default: suite or data sets)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");

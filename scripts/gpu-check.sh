@@ -97,6 +97,14 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite spheres2023 --scale "${SUITE_SCALE:-1}" \
       --budget "${SUITE_BUDGET:-2}" ${SUITE_ARGS:-} --out "$OUT" --name spheres2023 --json > "$OUT/spheres2023.jsonl" || status=1
     ;;
+  vr2022)
+    # The 2022 VR frame (2 x 2478x2740, lod-hqs, foveated, dilation) on the 529 M tls stand-in's octree, stereo
+    # pass against two mono renders. The octree is built into OCTREE_CACHE on the first run (generate, 14 GB of
+    # LAS, `pointrast lod` on all cores; 13 GB of octree kept) and reused after.
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite vr2022 \
+      --octree-cache "${OCTREE_CACHE:-/tmp/pointrast-octrees}" ${SUITE_FRAMES:+--frames "$SUITE_FRAMES"} ${SUITE_SCALE:+--scale "$SUITE_SCALE"} \
+      --out "$OUT" --name vr2022 --json > "$OUT/vr2022.jsonl" || status=1
+    ;;
   batch1g)
     # The batch methods against dedup on the 1,000 M terrain overview of paper2022 (Morton, 2560x1140), in
     # one process so that their ratios are sound; SUITE_METHODS picks the methods.
@@ -113,7 +121,7 @@ for what in "$@"; do
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, vr2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
