@@ -1,5 +1,5 @@
-// The vr2022 suite on lavapipe at a tiny scale, with its octree built by the command line's provider (a LAS
-// file written from the stand-in, `pointrast lod`'s builder) into a folder and reused by a second run:
+// The vr2022 suite on lavapipe at a tiny scale, with its octree built by the command line's octree cache (the
+// octree builder of `pointrast lod`) into a folder and reused by a second run:
 // every configuration measured as a stereo pass and as mono renders, the stereo pass drawing at least what
 // each eye draws alone, and the three reports written with the targets.
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-#include "bench/octree_folder.h"
+#include "bench/octree_cache.h"
 #include "bench/suites.h"
 #include "bench/vr_report.h"
 #include "bench/vr_suite.h"
@@ -51,7 +51,11 @@ TEST_F(VrBench, TinySuiteMeasuresStereoAgainstMonoAndWritesItsReports) {
   config.copyRepeats = 1;
   config.progress = false;
   const std::filesystem::path octrees = scratch("octrees");
-  config.octrees = octreeFolder(octrees, false);
+  OctreeCacheOptions cache;
+  cache.dir = octrees;
+  cache.threads = 2;
+  cache.progress = false;
+  config.octrees = octreeCache(cache);
   const VrSuiteRun run = runVrSuite(*context, config);
   ASSERT_EQ(run.datasets.size(), 1u);
   ASSERT_FALSE(run.datasets[0].skipped) << run.datasets[0].reason;
