@@ -24,6 +24,8 @@
 #include "bench/runner.h"
 #include "bench/sphere_runner.h"
 #include "bench/suites.h"
+#include "bench/vr_report.h"
+#include "bench/vr_suite.h"
 #include "cli_util.h"
 #include "cloud/generate.h"
 #include "commands.h"
@@ -405,6 +407,57 @@ int runLodSuite(const BenchArgs& a) {
   return 0;
 }
 
+// --suite vr2022: the VR frame on the 529 M stand-in's octree, a stereo pass against two mono renders.
+int runVrSuite(const BenchArgs& a) {
+  if (a.ordersGiven || a.methodsGiven)
+    throw InputError("--suite vr2022 measures its own configurations; --orders and --methods do not apply");
+  bench::VrSuiteConfig config;
+  config.datasets = pickDatasets(a, bench::suiteDatasets(a.suite, a.scale, a.seed, a.inputs));
+  if (a.viewsGiven) {
+    std::vector<bench::View> all(bench::allViews().begin(), bench::allViews().end());
+    config.views = parseList(a.views, "--views", all, bench::parseView);
+  }
+  if (a.widthGiven) config.width = a.width;
+  if (a.heightGiven) config.height = a.height;
+  if (a.framesGiven) config.frames = a.frames;
+  config.timeLimitSeconds = timeLimitSeconds(a);
+  config.copyBytes = parseCount(a.copySize, "--copy-size");
+  if (config.copyBytes == 0) throw InputError("--copy-size must be at least 1");
+  config.progress = !a.quiet;
+  const bench::ReportInfo info = suiteReportInfo(a);
+
+  gpu::Context context(contextOptions(a));
+  ProgressLines lines(a.quiet);
+  config.octrees = octreeProvider(a, lines);
+  bench::VrSuiteCallbacks callbacks;
+  callbacks.onNote = [&](const std::string& line) { lines.note(line); };
+  size_t done = 0;
+  const size_t total = config.datasets.size() * config.views.size() * (2 * bench::vrCases().size() - 1);
+  callbacks.onResult = [&](const bench::VrSuiteRun&, const bench::VrResult& r) {
+    if (a.json) {
+      nlohmann::json j = {{"suite", a.suite},
+                          {"dataset", r.dataset},
+                          {"view", bench::viewName(r.view)},
+                          {"case", r.caseName},
+                          {"pass", r.stereo ? "stereo" : "mono"},
+                          {"status", r.status}};
+      if (r.ok()) j["median_ms"] = r.medianMs;
+      if (!r.reason.empty()) j["reason"] = r.reason;
+      printJsonLine(j, context);
+    }
+    lines.result(++done, total,
+                 r.dataset + " / " + bench::viewName(r.view) + " / " + r.caseName + " / " +
+                     (r.stereo ? "stereo" : "two mono") + ": " +
+                     (r.ok() ? bench::formatMs(r.medianMs) + " ms" : std::string("n/a")));
+  };
+  bench::VrSuiteRun run = bench::runVrSuite(context, config, callbacks);
+  lines.end();
+  checkRun(context, run.datasets);
+  bench::WrittenFiles files = bench::writeVrSuiteReports(run, info, reportDir(a, context));
+  printWritten(a, run.results.size(), run.seconds, files);
+  return 0;
+}
+
 int runBench(const BenchArgs& a) {
   Progress::setEnabled(!a.quiet);
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -424,6 +477,7 @@ int runBench(const BenchArgs& a) {
     throw InputError("--layouts, --billboards, --conservative, --orbits and --cameras apply to --suite "
                      "spheres2023");
   if (bench::isLodSuite(a.suite)) return runLodSuite(a);
+  if (bench::isVrSuite(a.suite)) return runVrSuite(a);
 
   bench::BenchConfig config;
   config.methods = parseList(a.methods, "--methods", allMethods(), parseMethod);
@@ -541,6 +595,11 @@ Command addBench(CLI::App& app) {
       "allows. It reports each frame's GPU and wall time against 60 fps, the frames until each jump\n"
       "converges (target: 30) and the rate nodes stream from disk. --views, --frames, --width and --height\n"
       "override the suite's.\n\n"
+      "--suite vr2022 measures the VR frame of the 2022 paper on the octree of scan529m (tls, 529 M, the\n"
+      "octree cache's, shared with paper2022): both eyes at 2478x2740 each, lod-hqs, foveated LOD (100 px in\n"
+      "the fovea, 300 px at the corners), dilation, parallel eyes 6.4 cm apart, from the closeup and\n"
+      "overview views; each configuration as one stereo pass and as two mono renders of the same eyes.\n"
+      "--views, --frames, --width and --height (each eye's) override the suite's.\n\n"
       "--suite spheres2023 stands in for the particle data sets of \"Efficient Sphere Rendering Revisited\"\n"
       "(2023) with generated particle scenes at the sizes issue 5 gives them: laser (particles-laser, 306 "
       "M:\n"
@@ -567,13 +626,14 @@ Command addBench(CLI::App& app) {
       "  pointrast bench --suite paper2022 --datasets aerial1g --methods batch-prefetch,lod,lod-hqs\n"
       "  pointrast bench --suite lod --octree-cache /scratch/octrees\n"
       "  pointrast bench --suite lod --scale 0.001 --frames 2 --flight-frames 60 --jumps 2 --out /tmp/smoke\n"
+      "  pointrast bench --suite vr2022 --octree-cache /scratch/octrees\n"
       "  pointrast bench --suite spheres2023\n"
       "  pointrast bench --suite spheres2023 --scale 0.0001 --cameras 2 --frames 1 --out /tmp/smoke\n"
       "  pointrast bench --suite spheres2023 --methods sphere-compute,sphere-points --orbits long");
   cmd->add_option("INPUT", a->inputs,
                   "Point cloud files (" + io::formatList(io::FormatUse::Cloud) +
                       ") or scene names (terrain, tls); with --suite, NAME=PATH");
-  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022, lod or spheres2023");
+  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022, lod, vr2022 or spheres2023");
   cmd->add_option("--datasets", a->datasets,
                   "With --suite: its data sets to measure, comma-separated, or all")
       ->capture_default_str()

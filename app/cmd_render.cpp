@@ -1,5 +1,6 @@
 // pointrast render [FILE|SCENE] -o OUT.png ...
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -62,7 +63,77 @@ struct RenderArgs {
   uint32_t dilate = 0;
   bool edl = false;
   std::optional<float> edlStrength, edlRadius;
+  // Stereo (batch and LOD methods) and foveated LOD.
+  bool stereo = false;
+  std::optional<double> ipd;
+  std::string convergence, stereoLayout = "side-by-side";
+  bool foveated = false;
+  std::optional<double> foveaRadius, foveaPeriphery;
 };
+
+// --stereo and its options; throws InputError for stereo options without --stereo and bad values.
+StereoSettings stereoSettings(const RenderArgs& a) {
+  if (!a.stereo && (a.ipd || !a.convergence.empty() || a.stereoLayout != "side-by-side"))
+    throw InputError("--ipd, --convergence and --stereo-layout need --stereo");
+  StereoSettings s;
+  if (!a.stereo) return s;
+  if (a.stereoLayout != "side-by-side" && a.stereoLayout != "cross-eyed" && a.stereoLayout != "separate")
+    throw InputError("unknown --stereo-layout '" + a.stereoLayout + "'; choose side-by-side, cross-eyed or separate");
+  if (a.ipd) {
+    if (!(*a.ipd > 0) || !std::isfinite(*a.ipd))
+      throw InputError("--ipd must be a distance > 0 in scene units");
+    s.separation = *a.ipd;
+  }
+  if (!a.convergence.empty()) s.convergence = parseConvergence(a.convergence);
+  s.crossed = a.stereoLayout == "cross-eyed";
+  validateStereo(s);
+  return s;
+}
+
+// --foveated and its options (LOD methods).
+lod::Foveation foveation(const RenderArgs& a) {
+  if (!a.foveated && (a.foveaRadius || a.foveaPeriphery))
+    throw InputError("--fovea-radius and --fovea-periphery need --foveated");
+  lod::Foveation f;
+  f.enabled = a.foveated;
+  if (a.foveaRadius) f.radius = *a.foveaRadius;
+  if (a.foveaPeriphery) f.periphery = *a.foveaPeriphery;
+  if (!(f.radius >= 0 && f.radius <= 1)) throw InputError("--fovea-radius must be between 0 and 1");
+  if (!(f.periphery >= 1) || !std::isfinite(f.periphery))
+    throw InputError("--fovea-periphery must be a factor >= 1");
+  return f;
+}
+
+// The PNG(s) of a frame: -o, or with --stereo-layout separate the two eyes as OUT-left.png and OUT-right.png.
+std::vector<std::string> writeOutput(const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  const uint32_t eyes = a.stereo ? 2 : 1;
+  if (!a.stereo || a.stereoLayout != "separate") {
+    io::writePng(a.output, a.width * eyes, a.height, pixels.data());
+    return {a.output};
+  }
+  const std::filesystem::path out(a.output);
+  std::vector<std::string> files;
+  for (uint32_t e = 0; e < 2; ++e) {
+    std::vector<uint32_t> eye(uint64_t(a.width) * a.height);
+    for (uint32_t y = 0; y < a.height; ++y)
+      std::copy_n(pixels.begin() + (uint64_t(y) * 2 * a.width + uint64_t(e) * a.width), a.width,
+                  eye.begin() + uint64_t(y) * a.width);
+    std::filesystem::path file = out;
+    file.replace_filename(out.stem().string() + (e == 0 ? "-left" : "-right") + out.extension().string());
+    io::writePng(file.string(), a.width, a.height, eye.data());
+    files.push_back(file.string());
+  }
+  return files;
+}
+
+nlohmann::json stereoJson(const RenderArgs& a, const StereoSettings& s, const Camera& camera) {
+  nlohmann::json j;
+  j["ipd"] = eyeSeparation(camera, s);
+  const double convergence = convergenceDistance(camera, s);
+  j["convergence"] = std::isinf(convergence) ? nlohmann::json("inf") : nlohmann::json(convergence);
+  j["layout"] = a.stereoLayout;
+  return j;
+}
 
 // Whether any option of the resolve stage or of coloring was given (the sphere methods take none).
 bool postOrColorGiven(const RenderArgs& a) {
@@ -88,21 +159,34 @@ PostSettings postSettings(const RenderArgs& a) {
   return post;
 }
 
-// --color and --color-range: nullopt for auto (displayColorMode's choice).
-std::optional<DisplayColorMode> colorMode(const RenderArgs& a, const PointCloud& cloud) {
+// --color and --color-range as given: no source for auto (displayColorMode's choice).
+struct ColorChoice {
+  std::optional<DisplayColorMode::Source> source;
+  std::optional<ColorRange> range;
+};
+
+ColorChoice colorChoice(const RenderArgs& a) {
+  ColorChoice choice;
   if (a.color == "auto") {
     if (!a.colorRange.empty()) throw InputError("--color-range applies to --color intensity and elevation");
-    return std::nullopt;
+    return choice;
   }
-  DisplayColorMode::Source source = parseColorSource(a.color);
-  std::optional<ColorRange> range;
+  choice.source = parseColorSource(a.color);
   if (!a.colorRange.empty()) {
-    if (source != DisplayColorMode::Source::Intensity && source != DisplayColorMode::Source::Elevation)
+    if (choice.source != DisplayColorMode::Source::Intensity &&
+        choice.source != DisplayColorMode::Source::Elevation)
       throw InputError("--color-range applies to --color intensity and elevation, not " + a.color);
     auto [lo, hi] = parseRange(a.colorRange, "--color-range");
-    range = ColorRange{lo, hi};
+    choice.range = ColorRange{lo, hi};
   }
-  return displayColorMode(cloud, source, range);
+  return choice;
+}
+
+// The color mode of a loaded cloud: nullopt for auto.
+std::optional<DisplayColorMode> colorMode(const RenderArgs& a, const PointCloud& cloud) {
+  const ColorChoice choice = colorChoice(a);
+  if (!choice.source) return std::nullopt;
+  return displayColorMode(cloud, *choice.source, choice.range);
 }
 
 // The resolve stage's settings and per-pass GPU times.
@@ -119,6 +203,11 @@ nlohmann::json postJson(const PostSettings& post, const PostStats& stats) {
   j["dilate_ms"] = stats.dilateMs;
   j["compose_ms"] = stats.composeMs;
   return j;
+}
+
+void printPostStats(const PostSettings& post, const PostStats& stats) {
+  std::printf("  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
+              stats.splatMs, stats.dilateMs, post.edlStrength > 0 ? " + EDL" : "", stats.composeMs);
 }
 
 // The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
@@ -276,6 +365,10 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   settings.minNodePx = a.minNodePx;
   settings.pointBudget = parseCount(a.pointBudget, "--point-budget");
   settings.background = parseRgb(a.background, "--background");
+  settings.post = postSettings(a);
+  settings.stereo = stereoSettings(a);
+  settings.foveation = foveation(a);
+  const ColorChoice colors = colorChoice(a);
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (std::filesystem::path(a.output).extension() != ".png")
@@ -287,6 +380,8 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
                      "): build one with `pointrast lod FILE -o DIR`");
   lod::LodOptions options;
   if (!a.gpuMemory.empty()) options.gpuBytes = parseBytes(a.gpuMemory, "--gpu-memory");
+  options.colorSource = colors.source;
+  options.colorRange = colors.range;
   std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
   const Camera camera =
       cameraFor(a, source->metadata().bounds.empty() ? source->metadata().cube : source->metadata().bounds);
@@ -297,14 +392,14 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   gpu::Context context(contextOptions);
   std::string why;
   if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
-  Renderer renderer(context, a.width, a.height);
+  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
   lod::LodScene octree(context, *source, options);
   FrameStats stats = renderer.render(octree, camera, settings);
   std::vector<uint32_t> pixels = renderer.image();
   if (context.validationErrors() > 0)
     throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
                      " error(s)");
-  io::writePng(a.output, a.width, a.height, pixels.data());
+  const std::vector<std::string> files = writeOutput(a, pixels);
   const double perSecond = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
   if (a.json) {
     nlohmann::json j;
@@ -327,12 +422,17 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
     j["point_budget"] = settings.pointBudget;
     j["batch_stats"] = bench::batchStatsJson(*stats.batch);
     j["lod_stats"] = bench::lodStatsJson(*stats.lod);
+    if (settings.foveation.enabled)
+      j["foveation"] = {{"radius", settings.foveation.radius}, {"periphery", settings.foveation.periphery}};
+    if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
+    if (colors.source) j["color"] = colorSourceName(*colors.source);
+    if (stats.post) j["post"] = postJson(settings.post, *stats.post);
     j["camera"] = describeCamera(camera);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx",
                   static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
     j["image_hash"] = hex;
-    j["output"] = a.output;
+    j["output"] = files.size() == 1 ? nlohmann::json(files[0]) : nlohmann::json(files);
     std::printf("%s\n", j.dump().c_str());
   } else if (!a.quiet) {
     std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
@@ -342,6 +442,7 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
                 methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
                 humanCount(perSecond).c_str());
     printLodStats(*stats.lod, *stats.batch);
+    if (stats.post) printPostStats(settings.post, *stats.post);
   }
   return 0;
 }
@@ -380,12 +481,21 @@ int runRender(const RenderArgs& a) {
     throw InputError("--precision applies to the batch and LOD methods (" +
                      methodNamesReading(SceneLayout::Batched) + ", " +
                      methodNamesReading(SceneLayout::Octree) + ")");
+  if (a.stereo && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
+    throw InputError("--stereo draws both eyes in one pass with the batch and LOD methods (" +
+                     methodNamesReading(SceneLayout::Batched) + ", " + methodNamesReading(SceneLayout::Octree) +
+                     "), not " + a.method);
+  if (a.stereo && pathMode) throw InputError("--stereo renders one frame with -o, not a camera path");
   if (layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  if (a.foveated || a.foveaRadius || a.foveaPeriphery)
+    throw InputError("--foveated applies to the LOD methods (" + methodNamesReading(SceneLayout::Octree) +
+                     "), which choose octree nodes by their size on screen");
   if (a.lodOptionsGiven)
     throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
                      methodNamesReading(SceneLayout::Octree) + ")");
   settings.background = parseRgb(a.background, "--background");
   settings.post = postSettings(a);
+  settings.stereo = stereoSettings(a);
   if (settings.post.enabled() && methodInfo(settings.method).output == MethodOutput::ColorOnly)
     throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
                      " keeps no depth per pixel to work on");
@@ -423,7 +533,7 @@ int runRender(const RenderArgs& a) {
   contextOptions.deviceIndex = a.device;
   contextOptions.announce = !a.quiet;
   gpu::Context context(contextOptions);
-  Renderer renderer(context, a.width, a.height);
+  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
 
   // --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image
   // as one upload (the atomic min does not care which dispatch a point came from).
@@ -457,7 +567,7 @@ int runRender(const RenderArgs& a) {
     return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
   FrameStats stats = renderer.render(drawn, camera, settings);
   std::vector<uint32_t> pixels = renderer.image();
-  io::writePng(a.output, a.width, a.height, pixels.data());
+  const std::vector<std::string> files = writeOutput(a, pixels);
   uint64_t hash = imageHash(pixels.data(), pixels.size());
 
   if (context.validationErrors() > 0)
@@ -485,12 +595,13 @@ int runRender(const RenderArgs& a) {
       j["batch_stats"] = bench::batchStatsJson(*stats.batch);
     }
     if (colors) j["color"] = colorSourceName(colors->source);
+    if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
     if (stats.post) j["post"] = postJson(settings.post, *stats.post);
     j["camera"] = describeCamera(camera);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
     j["image_hash"] = hex;
-    j["output"] = a.output;
+    j["output"] = files.size() == 1 ? nlohmann::json(files[0]) : nlohmann::json(files);
     std::printf("%s\n", j.dump().c_str());
   } else if (!a.quiet) {
     std::printf(
@@ -508,11 +619,7 @@ int runRender(const RenderArgs& a) {
           humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
           humanCount(double(b.pointsRendered)).c_str());
     }
-    if (stats.post)
-      std::printf(
-          "  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
-          stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
-          stats.post->composeMs);
+    if (stats.post) printPostStats(settings.post, *stats.post);
   }
   return 0;
 }
@@ -560,6 +667,12 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --color classification --point-size 3 --edl\n"
       "  pointrast render autzen.las -o a.png --color elevation --dilate 2\n"
       "  pointrast render autzen.las --path path.json --video fly.mp4 --fps 60 --width 3840 --height 2160\n"
+      "Stereo (--stereo, batch and LOD methods): the eyes sit --ipd apart around --eye, look in parallel\n"
+      "and their frusta are shifted so that the plane at --convergence lies at the same pixels in both\n"
+      "images (nearer points stand out of the screen). --width and --height are each eye's.\n"
+      "  pointrast render autzen.las --method batch-prefetch --stereo -o sbs.png\n"
+      "  pointrast render cloud_lod --method lod-hqs --stereo --ipd 0.064 --convergence inf --foveated \\\n"
+      "      --dilate 1 --width 2478 --height 2740 -o vr.png\n"
       "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
       std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
       sphereMethodList() + "The pipelines that rasterize billboards (" + billboardMethodNames() +
@@ -669,6 +782,28 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--edl-strength", a->edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
   cmd->add_option("--edl-radius", a->edlRadius,
                   "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
+  cmd->add_flag("--stereo", a->stereo,
+                "Batch and LOD methods: render both eyes in one pass, each --width x --height, into one "
+                "side-by-side image (left eye on the left); each point is read once and drawn into both eyes");
+  cmd->add_option("--ipd", a->ipd,
+                  "Stereo: distance between the eyes in scene units (default: the convergence distance / 30, "
+                  "comfortable whatever the units; 0.064 is life-size for a cloud in metres)");
+  cmd->add_option("--convergence", a->convergence,
+                  "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
+                  "the target's distance), or inf for parallel eyes as a VR headset renders");
+  cmd->add_option("--stereo-layout", a->stereoLayout,
+                  "Stereo output: side-by-side (one PNG, left eye left), cross-eyed (right eye left, for "
+                  "cross-eyed viewing) or separate (OUT-left.png and OUT-right.png)")
+      ->capture_default_str();
+  cmd->add_flag("--foveated", a->foveated,
+                "LOD methods: foveated level of detail, nodes must look larger away from the image's centre "
+                "(each eye's centre in stereo) to be drawn");
+  cmd->add_option("--fovea-radius", a->foveaRadius,
+                  "Foveated LOD: radius of the fovea in half-diagonals of the image (0..1, default 0.3); "
+                  "inside it --min-node-px holds");
+  cmd->add_option("--fovea-periphery", a->foveaPeriphery,
+                  "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
+                  "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

@@ -42,6 +42,12 @@ constexpr SuiteEntry kLod[] = {
     {"aerial1g", Scene::Terrain, 1'000'000'000, "a 1,000 M point aerial survey, as an octree"},
 };
 
+// The vr2022 suite's data set: the 529 M point laser-scan stand-in of paper2022 (same name, size and seed, so
+// both suites share its octree), as in the 2022 paper's VR section (a 529 M point octree in a headset).
+constexpr SuiteEntry kVr2022[] = {
+    {"scan529m", Scene::Tls, 529'000'000, "a 529 M point laser scan, as an octree seen in a headset"},
+};
+
 // The four particle data sets of the 2023 sphere study, at the sizes the issue gives for them (306 M, 4 M,
 // 30 M, 200 M particles, in this order), each drawn by the particle scene closest to what it shows:
 // laser ablation of a metal (a crystal slab with a molten crater and ejected clusters), a Riemann shock tube
@@ -60,9 +66,11 @@ std::span<const SuiteEntry> entriesOf(std::string_view suite) {
   if (suite == "paper2021") return kPaper2021;
   if (suite == "paper2022") return kPaper2022;
   if (suite == "lod") return kLod;
+  if (suite == "vr2022") return kVr2022;
   if (suite == "spheres2023")
     throw InputError("spheres2023 is a particle suite: it has no point data sets or methods");
-  throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021, paper2022, lod or spheres2023");
+  throw InputError("unknown suite '" + std::string(suite) +
+                   "'; choose paper2021, paper2022, lod, vr2022 or spheres2023");
 }
 
 uint64_t scaled(uint64_t size, double scale) {
@@ -88,7 +96,7 @@ std::span<const SuiteEntry> paper2022Suite() {
 }
 
 std::vector<std::string> suiteNames() {
-  return {"paper2021", "paper2022", "lod", "spheres2023"};
+  return {"paper2021", "paper2022", "lod", "vr2022", "spheres2023"};
 }
 
 std::span<const SphereSuiteEntry> spheres2023Suite() {
@@ -97,6 +105,10 @@ std::span<const SphereSuiteEntry> spheres2023Suite() {
 
 bool isLodSuite(std::string_view suite) {
   return suite == "lod";
+}
+
+bool isVrSuite(std::string_view suite) {
+  return suite == "vr2022";
 }
 
 bool isSphereSuite(std::string_view suite) {
@@ -127,6 +139,12 @@ SuiteDefaults suiteDefaults(std::string_view suite) {
     // methods are the 2022 suite's (they can still be asked for with --methods).
     for (Method m : allMethods())
       if (m.info().layout == SceneLayout::Float) d.methods.push_back(m);
+  }
+  if (suite == "vr2022") {
+    d.methods = {pointMethod("lod-hqs"), pointMethod("lod")};
+    d.views = {View::Closeup, View::Overview};
+    d.width = 2478; // each eye's
+    d.height = 2740;
   }
   if (suite == "lod") {
     d.methods = {pointMethod("lod")};

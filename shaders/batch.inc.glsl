@@ -12,6 +12,9 @@
 #include "project.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
+// 1: the pass draws a stereo frame, every box's points into both eyes' halves of the framebuffer (BatchFrame,
+// LodFrame: eyes); the drawing loops read each point's words once and project them twice.
+layout(constant_id = 2) const uint STEREO = 0;
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
 
@@ -46,12 +49,16 @@ struct BatchView {
   vec3 lo, step; // the batch's min corner (relative to the scene origin) and 2^30 quantization steps
 };
 
-// The camera of a batch pass: view-projection relative to the scene origin, near plane, image size.
+// The camera of a batch pass: view-projection relative to the scene origin, near plane, image size, and
+// where the image lies in the framebuffer: pixel (x, y) is element offset + y * pitch + x (a stereo eye is
+// one half of a framebuffer twice as wide; a mono image has pitch = width, offset 0).
 struct BatchCamera {
   mat4 viewProj; // only rows x, y, w are used
   float nearW;   // points with c.w <= nearW are dropped
   uint width;
   uint height;
+  uint pitch;
+  uint offset;
 };
 
 // The decision for the box [lo, hi] (relative to the scene origin): forcedWords 1..3 overrides the
@@ -159,9 +166,10 @@ uint pixelCoordinate(float s) {
 
 // The pixel and depth bits of a point of an `inside` batch: no test can fail. The clamp only keeps a
 // rounding surprise inside the framebuffer (whatever the coordinates, the index stays in it).
-void projectInside(vec3 s, uint width, uint height, out uint pixel, out uint depthBits) {
+void projectInside(vec3 s, BatchCamera cam, out uint pixel, out uint depthBits) {
   float r = 1.0 / s.z;
-  pixel = min(pixelCoordinate(s.y * r) * width + pixelCoordinate(s.x * r), width * height - 1u);
+  pixel = cam.offset + min(pixelCoordinate(s.y * r) * cam.pitch + pixelCoordinate(s.x * r),
+                           cam.pitch * (cam.height - 1u) + cam.width - 1u);
   depthBits = floatBitsToUint(s.z);
 }
 
@@ -176,7 +184,7 @@ bool projectChecked(vec3 s, BatchCamera cam, out uint pixel, out uint depthBits)
   // Compare as floats before rounding (x, y are the pixel's coordinates less 1/2): a huge or NaN
   // coordinate must not wrap into the image.
   if (!(x >= -0.5 && x < float(width) - 0.5 && y >= -0.5 && y < float(height) - 0.5)) return false;
-  projectInside(s, width, height, pixel, depthBits);
+  projectInside(s, cam, pixel, depthBits);
   return true;
 }
 
@@ -193,11 +201,11 @@ vec3 fullPrecisionPosition(BatchView v, uint high, uint medium, uint low) {
 bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint medium, uint low, BatchCamera cam,
                        out uint pixel, out uint depthBits) {
   if (words == 3u)
-    return projectPoint(cam.viewProj, fullPrecisionPosition(v, high, medium, low), cam.width, cam.height,
-                        cam.nearW, pixel, depthBits);
+    return projectPointInto(cam.viewProj, fullPrecisionPosition(v, high, medium, low), cam.width, cam.height,
+                            cam.pitch, cam.offset, cam.nearW, pixel, depthBits);
   vec3 s = screenOf(v, pointFields(words, high, medium, low));
   if (checked) return projectChecked(s, cam, pixel, depthBits);
-  projectInside(s, cam.width, cam.height, pixel, depthBits);
+  projectInside(s, cam, pixel, depthBits);
   return true;
 }
 

@@ -10,12 +10,16 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Bo
 };
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer FrameRef { BatchFrame f; };
 
-BatchCamera batchCamera(BatchFrame f) {
+// The camera of eye `eye` (0: the left, or the only one; 1: the right of a stereo frame), read field by field
+// (the frame holds the table of colors and matrices besides).
+BatchCamera batchCamera(FrameRef frame, uint eye) {
   BatchCamera cam;
-  cam.viewProj = pc.viewProj;
+  cam.viewProj = eye == 0u ? pc.viewProj : frame.f.rightViewProj[pc.part];
   cam.nearW = pc.nearW;
-  cam.width = f.width;
-  cam.height = f.height;
+  cam.width = frame.f.width;
+  cam.height = frame.f.height;
+  cam.pitch = frame.f.pitch;
+  cam.offset = eye * frame.f.width;
   return cam;
 }
 

@@ -7,12 +7,15 @@ layout(push_constant) uniform Push { LodPush pc; };
 
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer LodViews { LodNodeView v[]; };
 
-BatchCamera lodCamera(LodFrame f) {
+// The camera of eye `eye` (0: the left, or the only one; 1: the right of a stereo frame).
+BatchCamera lodCamera(LodFrame f, uint eye) {
   BatchCamera cam;
-  cam.viewProj = pc.viewProj;
+  cam.viewProj = eye == 0u ? pc.viewProj : f.rightViewProj;
   cam.nearW = pc.nearW;
   cam.width = f.width;
   cam.height = f.height;
+  cam.pitch = f.pitch;
+  cam.offset = eye * f.width;
   return cam;
 }
 

@@ -4,27 +4,28 @@
 // only on the point's pixel u (and, attenuated, its depth), so that is the smallest word over pixels u
 // with p in shape(u) of the points that landed on u; and of those only u's closest point matters: a
 // farther point on u has a shape no larger (sizes never grow with depth) and shapes of smaller size lie
-// inside larger ones, so whatever it covers the closest one covers with a smaller word. Hence a gather
-// over the 1-pixel framebuffer equals the rasterization of shapes exactly (tests/gpu/post_test.cpp checks
-// it against a CPU rasterizer), with one difference GL_POINTS shares: a point whose center is outside the
+// inside larger ones, so whatever it covers the closest one covers with a smaller word. Hence working on
+// the 1-pixel framebuffer equals the rasterization of shapes exactly (tests/gpu/post_test.cpp checks it
+// against a CPU rasterizer), with one difference GL_POINTS shares: a point whose center is outside the
 // image draws nothing.
 //   SHAPE       kPointShapeSquare or kPointShapeDisc (shared.h gives the pixels of each)
-//   ATTENUATED  0: every point has size pc.pointSize; 1: pc.pointSize / depth, clamped to [1, max]
-//   AXIS        0: the whole window; fixed squares, whose window is a product of two ranges, are cut into
-//               a pass along rows (1) and one along columns (2): 2n words read a pixel instead of n^2
-//   SCATTER     1: the same image pushed instead of gathered: each pixel's word goes with atomicMin to the
-//               pixels its shape covers (the target filled with kEmptyPixel first). Attenuated sizes use it:
-//               a gather reads the largest shape's window at every pixel, a scatter only what the shapes
-//               cover, mostly small ones.
+//   ATTENUATED  0: every point has size pc.pointSize, gathered: each pixel takes the smallest word of the
+//               window of pixels whose shape covers it.
+//               1: pc.pointSize / depth, clamped to [1, max], scattered: each pixel's word goes with
+//               atomicMin to the pixels its shape covers (the target filled with kEmptyPixel first), so the
+//               cost follows the sizes drawn, mostly small ones, where a gather would read the largest
+//               shape's window everywhere.
+//   AXIS        gathers: 0 the whole window (discs); fixed squares, whose window is a product of two ranges,
+//               are cut into a pass along rows (1) and one along columns (2): 2n words read a pixel instead
+//               of n^2
 #include "post.inc.glsl"
 
 layout(constant_id = 0) const uint SHAPE = kPointShapeSquare;
 layout(constant_id = 1) const uint ATTENUATED = 0;
 layout(constant_id = 2) const uint AXIS = 0;
-layout(constant_id = 3) const uint SCATTER = 0;
 
+// The attenuated size of a point.
 float sizeOf(uint64_t word) {
-  if (ATTENUATED == 0u) return pc.pointSize;
   return clamp(pc.pointSize / wordDepth(word), 1.0, pc.maxPointSize);
 }
 
@@ -72,7 +73,7 @@ void scatter(ivec2 p) {
 void main() {
   ivec2 p;
   if (!postPixel(p)) return;
-  if (SCATTER != 0u) {
+  if (ATTENUATED != 0u) {
     scatter(p);
     return;
   }
@@ -87,7 +88,7 @@ void main() {
       ivec2 u = p - ivec2(dx, dy); // the point's pixel; p = u + d
       if (!insideImage(u)) continue;
       uint64_t w = sourceWord(u);
-      if (w < best && covers(sizeOf(w), ivec2(dx, dy))) best = w; // empty words are never < best
+      if (w < best && covers(pc.pointSize, ivec2(dx, dy))) best = w; // empty words are never < best
     }
   }
   Words(pc.target).v[uint(p.y) * pc.targetPitch + uint(p.x)] = best;

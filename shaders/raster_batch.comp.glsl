@@ -12,12 +12,21 @@ layout(constant_id = 1) const uint DEPTH_ONLY = 0;
 void main() {
   beginStats();
   FrameRef frame = FrameRef(pc.frame);
-  BatchCamera cam = batchCamera(frame.f);
+  BatchCamera cam = batchCamera(frame, 0u);
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
   BatchView v = viewBatch(gl_WorkGroupID.x, cam, frame.f.forcedWords, frame.f.culling != 0u);
   uint payloadBase = (pc.part << kVisibilityPartShift) | first;
-  uint rendered = drawBoxAs(v, batchWords(first), payloadBase, count, kBatchPoints,
-                            kBatchPointsPerThread / GROUP, cam, frame.f.framebuffer);
-  endStats(frame.f.stats, kStatPointsRendered, rendered, true, v.words, count);
+  uint rendered = 0u, words = v.words;
+  if (STEREO != 0u) {
+    BatchCamera right = batchCamera(frame, 1u);
+    BatchView v1 = viewBatch(gl_WorkGroupID.x, right, frame.f.forcedWords, frame.f.culling != 0u);
+    rendered = drawBoxAsStereo(v, v1, batchWords(first), payloadBase, count, kBatchPoints,
+                               kBatchPointsPerThread / GROUP, cam, right, frame.f.framebuffer);
+    words = max(v.words, v1.words); // the words loaded
+  } else {
+    rendered = drawBoxAs(v, batchWords(first), payloadBase, count, kBatchPoints, kBatchPointsPerThread / GROUP,
+                         cam, frame.f.framebuffer);
+  }
+  endStats(frame.f.stats, kStatPointsRendered, rendered, true, words, count);
 }

@@ -20,8 +20,14 @@ void main() {
     LodNode node = LodNodes(f.nodes).v[page.node];
     BatchView v = loadView(LodViews(f.views).v[page.node]);
     uint count = min(kLodPagePoints, node.pointCount - page.first);
-    rendered = drawBoxAs(v, pageWords(page.address), node.firstIndex + page.first, count, kLodPagePoints,
-                         kLodPageSteps, lodCamera(f), f.framebuffer);
+    if (STEREO != 0u) {
+      BatchView right = loadView(LodViews(f.views).v[f.nodeCount + page.node]);
+      rendered = drawBoxAsStereo(v, right, pageWords(page.address), node.firstIndex + page.first, count,
+                                 kLodPagePoints, kLodPageSteps, lodCamera(f, 0u), lodCamera(f, 1u), f.framebuffer);
+    } else {
+      rendered = drawBoxAs(v, pageWords(page.address), node.firstIndex + page.first, count, kLodPagePoints,
+                           kLodPageSteps, lodCamera(f, 0u), f.framebuffer);
+    }
   }
   endStats(f.stats, kStatPointsRendered, rendered, false, 0u, 0u);
 }

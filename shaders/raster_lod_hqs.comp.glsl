@@ -22,8 +22,14 @@ void main() {
     LodNode node = LodNodes(f.nodes).v[page.node];
     BatchView v = loadView(LodViews(f.views).v[page.node]);
     uint count = min(kLodPagePoints, node.pointCount - page.first);
-    blended = blendBox(v, pageWords(page.address), count, kLodPageSteps, lodCamera(f), f.framebuffer,
-                       f.accumulators);
+    if (STEREO != 0u) {
+      BatchView right = loadView(LodViews(f.views).v[f.nodeCount + page.node]);
+      blended = blendBoxStereo(v, right, pageWords(page.address), count, kLodPageSteps, lodCamera(f, 0u),
+                               lodCamera(f, 1u), f.framebuffer, f.accumulators);
+    } else {
+      blended = blendBox(v, pageWords(page.address), count, kLodPageSteps, lodCamera(f, 0u), f.framebuffer,
+                         f.accumulators);
+    }
   }
   endStats(f.stats, kStatPointsBlended, blended, false, 0u, 0u);
 }

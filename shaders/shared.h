@@ -201,7 +201,11 @@ struct BatchFrame {
   uint height;
   uint forcedWords; // 0: adaptive precision; 1..3: every batch decodes from this many words
   uint culling;     // 1: frustum culling; 0 (a debug setting): every batch is drawn
+  uint pitch;       // pixels per framebuffer row: width, or 2 x width for a stereo frame (eyes side by side)
+  uint eyes;        // 1, or 2: every point is drawn into the left half with BatchPush::viewProj and into the
+                    // right half with rightViewProj[part] (specialization constant STEREO of the passes)
   uint64_t partColors[kMaxVisibilityParts]; // RGBA8 colors of visibility part p (the resolve's table)
+  mat4 rightViewProj[kMaxVisibilityParts];  // stereo: the right half's view-projection of part p
 };
 
 // Push constants of the batch passes: one dispatch draws one part, one workgroup per batch.
@@ -287,7 +291,11 @@ struct LodFrame {
   uint nodeCount;
   uint pageCount;
   uint nodeStats; // 1: the node pass counts nodes and points (0 when a pass's nodes are viewed again)
+  uint pitch;     // pixels per framebuffer row: width, or 2 x width for a stereo frame (eyes side by side)
+  uint eyes;      // 1, or 2: views holds the right half's node decisions after the left's (views[nodeCount
+                  // + i]), made with rightViewProj (specialization constant STEREO of the passes)
   uint reserved;
+  mat4 rightViewProj; // stereo: the right half's view-projection (LodPush::viewProj is the left's)
 };
 
 // Push constants of the LOD passes (a frame's matrix and near plane; the rest is in LodFrame).

@@ -31,8 +31,10 @@ static_assert(offsetof(BatchPush, part) == 120);
 static_assert(sizeof(BatchBounds) == 32);
 static_assert(offsetof(BatchFrame, width) == 24);
 static_assert(offsetof(BatchFrame, culling) == 36);
-static_assert(offsetof(BatchFrame, partColors) == 40);
-static_assert(sizeof(BatchFrame) == 40 + 8 * kMaxVisibilityParts);
+static_assert(offsetof(BatchFrame, eyes) == 44);
+static_assert(offsetof(BatchFrame, partColors) == 48);
+static_assert(offsetof(BatchFrame, rightViewProj) == 48 + 8 * kMaxVisibilityParts); // 16-aligned for std430
+static_assert(sizeof(BatchFrame) == 48 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
 static_assert(kBatchPoints == 10240 && kBatchPrefetchSteps * 4 == kBatchPointsPerThread);
 static_assert(uint64_t(kMaxPartBatches) * kBatchPoints <= kVisibilityLocalMask + 1ull);
 static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 32);
@@ -42,8 +44,9 @@ static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 3
 static_assert(sizeof(LodNode) == 48 && offsetof(LodNode, firstIndex) == 32 && offsetof(LodNode, rank) == 44);
 static_assert(sizeof(LodPage) == 16 && offsetof(LodPage, node) == 8);
 static_assert(sizeof(LodNodeView) == 96);
-static_assert(sizeof(LodFrame) == 88 && offsetof(LodFrame, width) == 56 &&
-              offsetof(LodFrame, pageCount) == 76);
+static_assert(sizeof(LodFrame) == 160 && offsetof(LodFrame, width) == 56 &&
+              offsetof(LodFrame, pageCount) == 76 && offsetof(LodFrame, eyes) == 88 &&
+              offsetof(LodFrame, rightViewProj) == 96);
 static_assert(sizeof(LodPush) == 80 && offsetof(LodPush, frame) == 64 && offsetof(LodPush, groupsX) == 76);
 static_assert(kLodPageSteps * 4 * kPointGroupSize == kLodPagePoints && kLodPagePoints % 4 == 0);
 

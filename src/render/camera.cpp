@@ -61,6 +61,7 @@ void validateCamera(const Camera& camera) {
   if (!(camera.fovY > 0 && camera.fovY < 180))
     throw InputError("camera: --fov must be between 0 and 180 degrees");
   if (!(camera.nearW >= 0) || !std::isfinite(camera.nearW)) throw InputError("camera: --near must be >= 0");
+  if (!std::isfinite(camera.shiftX)) throw InputError("camera: the stereo image shift must be finite");
 }
 
 glm::dmat4 viewProjection(const Camera& camera, const glm::dvec3& origin, double aspect) {
@@ -68,6 +69,8 @@ glm::dmat4 viewProjection(const Camera& camera, const glm::dvec3& origin, double
   // glm::perspectiveRH_NO puts the linear view depth (-z_view) in clip w; its z row is unused here.
   double nearW = camera.nearW > 0 ? camera.nearW : 1e-6;
   glm::dmat4 proj = glm::perspectiveRH_NO(glm::radians(camera.fovY), aspect, nearW, nearW * 1e9);
+  // The off-axis shift adds shiftX times row w to row x (w = -z_view; a zero shift leaves proj as is).
+  if (camera.shiftX != 0.0) proj[2][0] -= camera.shiftX;
   return proj * view;
 }
 

@@ -17,6 +17,9 @@ struct Camera {
   glm::dvec3 up{0, 0, 1};
   double fovY = 60.0; // degrees
   double nearW = 0.0; // 0: automatic, defaultNear(bounds)
+  // Horizontal shift of the image in normalized device coordinates (clip x += shiftX * clip w): an
+  // off-axis frustum, as a stereo eye's (render/stereo.h). 0 for every mono camera.
+  double shiftX = 0.0;
 };
 
 // The overview used when no --eye is given: looking at the center of the bounds from the south-west

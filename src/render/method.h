@@ -21,7 +21,9 @@ class Context;
 }
 
 struct Targets {
-  uint32_t width = 0, height = 0;
+  uint32_t width = 0, height = 0; // of the whole framebuffer and image: both eyes of a stereo renderer
+  uint32_t eyes = 1;              // 2: two images of width / 2 side by side, left eye first
+  uint32_t eyeWidth() const { return width / eyes; }
   gpu::Buffer framebuffer; // 8 B per pixel; methods choose the layout
   gpu::Buffer image;       // RGBA8 per pixel
   gpu::Buffer words;       // canonical depth << 32 | color per pixel, filled when non-empty
@@ -34,6 +36,8 @@ struct Frame {
   std::span<const GpuScene* const> scenes;
   const Camera& camera;
   const RenderSettings& settings;
+  // The camera of each half of the image (one for mono: `camera`; left half first for stereo).
+  std::span<const Camera> views;
 };
 
 class PointMethod {
@@ -88,7 +92,8 @@ std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, const Method
                                              uint32_t height);
 std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, const MethodInfo& method,
                                                   uint32_t width, uint32_t height);
+// eyes = 2: the stereo passes (one read of each point, both halves of the framebuffer).
 std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, const MethodInfo& method,
-                                               uint32_t width, uint32_t height);
+                                               uint32_t width, uint32_t height, uint32_t eyes);
 
 } // namespace pointrast

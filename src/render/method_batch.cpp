@@ -16,13 +16,14 @@ namespace {
 // the part's visibility part (shared.h), and the index of its colors in BatchFrame::partColors.
 template <class Draw>
 void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frameAddress, Draw&& draw) {
-  const double aspect = double(targets.width) / double(targets.height);
+  const double aspect = double(targets.eyeWidth()) / double(targets.height);
   shared::BatchPush push{};
   push.frame = frameAddress;
   uint32_t number = 0;
   for (const GpuScene* scene : frame.scenes) {
-    // The matrix and near plane of forEachPart(): the same projection as the 2021 methods.
-    push.viewProj = glm::mat4(viewProjection(frame.camera, scene->origin(), aspect));
+    // The matrix and near plane of forEachPart(): the same projection as the 2021 methods (the left eye's
+    // for stereo; the right eye's is in the frame).
+    push.viewProj = glm::mat4(viewProjection(frame.views[0], scene->origin(), aspect));
     push.nearW = float(frame.camera.nearW > 0 ? frame.camera.nearW : defaultNear(scene->bounds()));
     for (const ScenePart& part : scene->parts()) {
       push.high = part.high.address();
@@ -39,13 +40,14 @@ void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frame
 
 class BatchMethod : public PointMethod {
 public:
-  BatchMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
-      : context_(context), hqs_(method.output == MethodOutput::Blend) {
+  BatchMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height, uint32_t eyes)
+      : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
     // The row's constants: PREFETCH (one 128-bit load of 4 consecutive points) and, for the blending
-    // rows, DEPTH_ONLY (the depth pass before the accumulation).
-    raster_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
+    // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes.
+    const gpu::SpecConstant stereo{/* STEREO= */ 2, eyes == 2 ? 1u : 0u};
+    raster_ = gpu::ComputeProgram(context, method.shader, method.spec.with({stereo}));
     if (hqs_) {
-      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp");
+      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo});
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
       // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
       accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
@@ -71,14 +73,22 @@ public:
     f.framebuffer = targets.framebuffer.address();
     f.stats = stats_.address();
     f.accumulators = hqs_ ? accumulators_.address() : 0;
-    f.width = targets.width;
+    f.width = targets.eyeWidth();
     f.height = targets.height;
     f.forcedWords = frame.settings.precision;
     f.culling = frame.settings.batchCulling ? 1 : 0;
+    f.pitch = targets.width;
+    f.eyes = eyes_;
+    const double aspect = double(targets.eyeWidth()) / double(targets.height);
     uint32_t part = 0;
-    for (const GpuScene* scene : frame.scenes)
-      for (const ScenePart& p : scene->parts())
+    for (const GpuScene* scene : frame.scenes) {
+      const glm::mat4 right =
+          eyes_ == 2 ? glm::mat4(viewProjection(frame.views[1], scene->origin(), aspect)) : glm::mat4(1.0f);
+      for (const ScenePart& p : scene->parts()) {
+        f.rightViewProj[part] = right;
         f.partColors[part++] = p.colors.address(); // Renderer::render checked part <= 64
+      }
+    }
     std::memcpy(frameUpload_.mapped(), &f, sizeof f);
     VkBufferCopy copy{0, 0, sizeof f};
     gpu::vkCmdCopyBuffer(cmd, frameUpload_.handle(), frame_.handle(), 1, &copy);
@@ -134,6 +144,7 @@ private:
   static constexpr uint64_t kStatsBytes = uint64_t(shared::kBatchStatSlots) * shared::kBatchStatCount * 8;
   gpu::Context& context_;
   bool hqs_;
+  uint32_t eyes_;
   gpu::ComputeProgram raster_;     // batch / batch-prefetch, or batch-hqs's depth pass
   gpu::ComputeProgram accumulate_; // batch-hqs
   gpu::ComputeProgram resolve_;
@@ -146,8 +157,8 @@ private:
 } // namespace
 
 std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, const MethodInfo& method,
-                                               uint32_t width, uint32_t height) {
-  return std::make_unique<BatchMethod>(context, method, width, height);
+                                               uint32_t width, uint32_t height, uint32_t eyes) {
+  return std::make_unique<BatchMethod>(context, method, width, height, eyes);
 }
 
 } // namespace pointrast

@@ -93,14 +93,16 @@ bool Renderer::supports(gpu::Context& context, Method method, std::string* why) 
   return missing.empty();
 }
 
-Renderer::Renderer(gpu::Context& context, uint32_t width, uint32_t height)
+Renderer::Renderer(gpu::Context& context, uint32_t width, uint32_t height, uint32_t eyes)
     : context_(context), targets_(std::make_unique<Targets>()) {
-  if (width == 0 || height == 0 || width > kMaxSide || height > kMaxSide)
-    throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
+  assert((eyes == 1 || eyes == 2) && "mono or stereo");
+  if (width == 0 || height == 0 || width * eyes > kMaxSide || height > kMaxSide)
+    throw InputError("image size " + std::to_string(width * eyes) + "x" + std::to_string(height) +
                      " is out of range (1.." + std::to_string(kMaxSide) + " per side)");
   Targets& t = *targets_;
-  t.width = width;
+  t.width = width * eyes;
   t.height = height;
+  t.eyes = eyes;
   t.framebuffer =
       gpu::Buffer(context, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "framebuffer");
   t.image = gpu::Buffer(context, t.pixels() * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "image");
@@ -114,6 +116,20 @@ uint32_t Renderer::width() const {
 uint32_t Renderer::height() const {
   return targets_->height;
 }
+uint32_t Renderer::eyes() const {
+  return targets_->eyes;
+}
+
+std::vector<Camera> Renderer::views(const Camera& camera, const RenderSettings& settings) const {
+  const Targets& t = *targets_;
+  if (t.eyes == 1) return {camera};
+  validateStereo(settings.stereo);
+  const double aspect = double(t.eyeWidth()) / double(t.height);
+  std::vector<Camera> eyes;
+  for (uint32_t half = 0; half < 2; ++half)
+    eyes.push_back(eyeCamera(camera, settings.stereo, eyeOfHalf(settings.stereo, half), aspect));
+  return eyes;
+}
 
 PointMethod& Renderer::method(const RenderSettings& settings) {
   const MethodInfo& info = methodInfo(settings.method);
@@ -125,6 +141,10 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
                            context_.info().name + "' lacks");
   std::string why;
   if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
+  if (targets_->eyes == 2 && info.family != MethodFamily::Batch)
+    throw InputError(std::string("stereo frames draw both eyes in one pass with the batch and LOD methods (") +
+                     methodNamesReading(SceneLayout::Batched) + ", " + methodNamesReading(SceneLayout::Octree) +
+                     "), not " + info.name);
   auto key = std::make_pair(settings.method, settings.depth);
   auto found = methods_.find(key);
   if (found != methods_.end()) return *found->second;
@@ -141,7 +161,7 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
     created = createHwPointsMethod(context_, info, targets_->width, targets_->height);
     break;
   case MethodFamily::Batch:
-    created = createBatchMethod(context_, info, targets_->width, targets_->height);
+    created = createBatchMethod(context_, info, targets_->width, targets_->height, targets_->eyes);
     break;
   case MethodFamily::Lod:
     throw InputError(std::string(info.name) +
@@ -168,29 +188,19 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
                      " per frame (parts of up to 67,102,720 points: 4.29 billion points, the reach of a "
                      "32-bit visibility index)");
   if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
-  const bool post = settings.post.enabled();
-  if (post) {
-    validatePostSettings(settings.post);
-    if (info.output == MethodOutput::ColorOnly)
-      throw InputError(std::string("point size, dilation and eye-dome lighting work on the depth the "
-                                   "compute methods keep per pixel; ") +
-                       info.name + " keeps none");
-  }
+  const bool post = preparePost(settings);
   PointMethod& m = method(settings);
   Targets& t = *targets_;
-  // Canonical words are for equivalence tests and the resolve stage: allocated on first request (8 B a
-  // pixel).
-  if ((settings.captureWords || post) && !t.words)
-    t.words =
-        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
+  if (settings.captureWords) allocateWords();
   // Double-precision copies of each scene's matrix, for the int40 path.
   uint64_t matrixBytes = std::max<size_t>(1, scenes.size()) * sizeof(glm::dmat4);
   if (!t.matrices || t.matrices.size() < matrixBytes)
     t.matrices =
         gpu::Buffer(context_, matrixBytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "double matrices");
-  double aspect = double(t.width) / double(t.height);
+  const std::vector<Camera> eyes = views(camera, settings);
+  double aspect = double(t.eyeWidth()) / double(t.height);
   for (size_t s = 0; s < scenes.size(); ++s) {
-    glm::dmat4 vp = viewProjection(camera, scenes[s]->origin(), aspect);
+    glm::dmat4 vp = viewProjection(eyes[0], scenes[s]->origin(), aspect);
     std::memcpy(static_cast<char*>(t.matrices.mapped()) + s * sizeof(glm::dmat4), &vp, sizeof vp);
   }
   RenderSettings effective = settings;
@@ -198,32 +208,21 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
     effective.depthScale = int40Scale(scenes, camera);
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
-  PostView view;
+  const std::vector<PostView> eyeViews = postViews(camera, settings);
   std::optional<gpu::TimestampPool> postTimestamps;
-  if (post) {
-    if (!post_) post_ = std::make_unique<PostStage>(context_);
-    view = {t.words.address(),
-            t.image.address(),
-            t.width,
-            t.height,
-            t.width,
-            float(glm::length(camera.target - camera.eye)),
-            settings.background,
-            settings.captureWords};
-    postTimestamps.emplace(context_, frames * kPostPasses);
-  }
+  if (post) postTimestamps.emplace(context_, frames * kPostPasses);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
     if (post) postTimestamps->reset(cmd);
-    Frame frame{cmd, scenes, camera, effective};
+    Frame frame{cmd, scenes, camera, effective, eyes};
     for (uint32_t w = 0; w < settings.warmup; ++w) {
       m.recordFrame(frame, t);
-      if (post) post_->record(cmd, view, settings.post);
+      if (post) post_->record(cmd, eyeViews, settings.post);
     }
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);
       m.recordFrame(frame, t);
-      if (post) post_->record(cmd, view, settings.post, &*postTimestamps, f * kPostPasses);
+      if (post) post_->record(cmd, eyeViews, settings.post, &*postTimestamps, f * kPostPasses);
       timestamps.end(cmd, f);
     }
   });
@@ -253,33 +252,86 @@ lod::LodPasses& Renderer::lodPasses(const RenderSettings& settings) {
   if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
   auto found = lodPasses_.find(settings.method);
   if (found != lodPasses_.end()) return *found->second;
-  auto created = std::make_unique<lod::LodPasses>(context_, info, targets_->width, targets_->height);
+  auto created =
+      std::make_unique<lod::LodPasses>(context_, info, targets_->width, targets_->height, targets_->eyes);
   return *lodPasses_.emplace(settings.method, std::move(created)).first->second;
 }
 
-FrameStats Renderer::render(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings) {
-  validateCamera(camera);
-  lod::LodPasses& passes = lodPasses(settings);
+bool Renderer::preparePost(const RenderSettings& settings) {
+  if (!settings.post.enabled()) return false;
+  validatePostSettings(settings.post);
+  const MethodInfo& info = methodInfo(settings.method);
+  if (info.output == MethodOutput::ColorOnly)
+    throw InputError(std::string("point size, dilation and eye-dome lighting work on the depth the "
+                                 "compute methods keep per pixel; ") +
+                     info.name + " keeps none");
+  allocateWords(); // what the method's resolve hands the stage
+  if (!post_) post_ = std::make_unique<PostStage>(context_);
+  return true;
+}
+
+void Renderer::allocateWords() {
+  // Canonical words are for equivalence tests and the resolve stage: allocated on first request (8 B a
+  // pixel).
   Targets& t = *targets_;
-  if (settings.captureWords && !t.words)
+  if (!t.words)
     t.words =
         gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
-  FrameStats stats = lod::renderOctree(context_, octree, passes, t, camera, settings);
-  wordsCaptured_ = settings.captureWords && hasCanonicalWords(methodInfo(settings.method));
+}
+
+std::vector<PostView> Renderer::postViews(const Camera& camera, const RenderSettings& settings) const {
+  if (!settings.post.enabled()) return {};
+  const Targets& t = *targets_;
+  std::vector<PostView> views;
+  // Each eye is a window of the side-by-side buffers.
+  for (uint32_t e = 0; e < t.eyes; ++e)
+    views.push_back({t.words.address() + uint64_t(e) * t.eyeWidth() * 8,
+                     t.image.address() + uint64_t(e) * t.eyeWidth() * 4, t.eyeWidth(), t.height, t.width,
+                     float(glm::length(camera.target - camera.eye)), settings.background,
+                     settings.captureWords});
+  return views;
+}
+
+FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings,
+                               bool resident) {
+  validateCamera(camera);
+  lod::LodPasses& passes = lodPasses(settings);
+  const bool post = preparePost(settings);
+  Targets& t = *targets_;
+  if (settings.captureWords) allocateWords();
+  // The resolve stage after the passes of each frame, timed per pass as in render().
+  const std::vector<PostView> eyeViews = postViews(camera, settings);
+  std::optional<gpu::TimestampPool> postTimestamps;
+  uint32_t postFrames = 0;
+  lod::FrameEpilogue epilogue;
+  if (post) {
+    epilogue.begin = [&](VkCommandBuffer cmd, uint32_t timedFrames) {
+      postFrames = timedFrames;
+      postTimestamps.emplace(context_, timedFrames * kPostPasses);
+      postTimestamps->reset(cmd);
+    };
+    epilogue.record = [&](VkCommandBuffer cmd, uint32_t frame) {
+      if (frame == lod::FrameEpilogue::kUntimed)
+        post_->record(cmd, eyeViews, settings.post);
+      else
+        post_->record(cmd, eyeViews, settings.post, &*postTimestamps, frame * kPostPasses);
+    };
+  }
+  const std::vector<Camera> eyes = views(camera, settings);
+  FrameStats stats = resident ? lod::renderResidentFrame(context_, octree, passes, t, eyes, settings, epilogue)
+                              : lod::renderOctree(context_, octree, passes, t, eyes, settings, epilogue);
+  if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), postFrames);
+  wordsCaptured_ = settings.captureWords && (hasCanonicalWords(methodInfo(settings.method)) || post);
   return stats;
+}
+
+FrameStats Renderer::render(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings) {
+  return renderLod(octree, camera, settings, false);
 }
 
 FrameStats Renderer::renderFrame(lod::LodScene& octree, const Camera& camera,
                                  const RenderSettings& settings) {
-  validateCamera(camera);
-  lod::LodPasses& passes = lodPasses(settings);
-  Targets& t = *targets_;
-  if (settings.captureWords && !t.words)
-    t.words =
-        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
-  FrameStats stats = lod::renderResidentFrame(context_, octree, passes, t, camera, settings);
-  wordsCaptured_ = settings.captureWords && hasCanonicalWords(methodInfo(settings.method));
-  return stats;
+  return renderLod(octree, camera, settings, true);
 }
 
 std::vector<uint32_t> Renderer::image() {

@@ -13,10 +13,12 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/lod/foveation.h"
 #include "render/lod/lod_stats.h"
 #include "render/method_table.h"
 #include "render/post/post_settings.h"
 #include "render/scene.h"
+#include "render/stereo.h"
 
 namespace pointrast {
 
@@ -51,6 +53,8 @@ struct RenderSettings {
   // is under minNodePx are not drawn, nor their subtrees; at most pointBudget points a frame (0: no limit).
   double minNodePx = 100;
   uint64_t pointBudget = 0;
+  lod::Foveation foveation; // LOD methods: larger nodes needed away from the image's centre (off by default)
+  StereoSettings stereo;    // a stereo Renderer's eyes (render/stereo.h); ignored by a mono one
 };
 // "adaptive", "1", "2", "3" -> 0..3; throws InputError naming the choices.
 uint32_t parsePrecision(std::string_view text);
@@ -78,6 +82,7 @@ struct FrameStats {
 };
 
 struct Targets;
+struct PostView;
 class PointMethod;
 class PostStage;
 namespace lod {
@@ -87,8 +92,10 @@ class LodPasses;
 
 class Renderer {
 public:
-  // Throws InputError for a zero or oversized image.
-  Renderer(gpu::Context& context, uint32_t width, uint32_t height);
+  // Throws InputError for a zero or oversized image. eyes = 2: a stereo renderer, whose frames draw two
+  // images of width x height side by side (the left eye's first unless StereoSettings::crossed), both in one
+  // pass with the batch and LOD methods; its image is 2 width x height.
+  Renderer(gpu::Context& context, uint32_t width, uint32_t height, uint32_t eyes = 1);
   ~Renderer();
 
   // Throws UnsupportedError if the device cannot run the method (missing extension or feature) and
@@ -113,7 +120,7 @@ public:
   // warmup are ignored); FrameStats::lod says whether it changed and whether it converged.
   FrameStats renderFrame(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings);
 
-  // RGBA8 pixels of the last frame, row 0 at the top.
+  // RGBA8 pixels of the last frame, row 0 at the top (width() x height(): both eyes of a stereo frame).
   std::vector<uint32_t> image();
   // Canonical words (depth << 32 | color, all ones where empty) of the last frame rendered with
   // captureWords; for closest-point methods only, or for any method when the resolve stage ran (then the
@@ -126,14 +133,23 @@ public:
   // front ends that show it without a copy to the host. Valid until the Renderer is destroyed.
   uint64_t imageAddress() const;
 
-  uint32_t width() const;
+  uint32_t width() const; // of the image: eyes() x an eye's width
   uint32_t height() const;
+  uint32_t eyes() const;
 
   // Whether the device can run a method (and why not, in one sentence, when it cannot).
   static bool supports(gpu::Context& context, Method method, std::string* why = nullptr);
 
 private:
   PointMethod& method(const RenderSettings& settings);
+  // Validates the resolve stage's settings for the method and makes what it needs; false when off.
+  bool preparePost(const RenderSettings& settings);
+  void allocateWords();
+  std::vector<PostView> postViews(const Camera& camera, const RenderSettings& settings) const;
+  // The camera of each half of the image: the given one, or the two eyes in image order.
+  std::vector<Camera> views(const Camera& camera, const RenderSettings& settings) const;
+  FrameStats renderLod(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings,
+                       bool resident);
   lod::LodPasses& lodPasses(const RenderSettings& settings);
   gpu::Context& context_;
   std::unique_ptr<Targets> targets_;

@@ -21,26 +21,29 @@ struct TableLayout {
   uint64_t uploadPages, uploadEnd;
 };
 
-TableLayout layoutOf(uint64_t nodes, uint64_t pages) {
+// Stereo frames keep two views a node (shared.h, LodFrame::eyes).
+TableLayout layoutOf(uint64_t nodes, uint64_t pages, uint32_t eyes) {
   TableLayout l;
   l.nodes = kFrameBytes;
   l.views = l.nodes + align256(nodes * sizeof(shared::LodNode));
-  l.pages = l.views + align256(nodes * sizeof(shared::LodNodeView));
+  l.pages = l.views + align256(eyes * nodes * sizeof(shared::LodNodeView));
   l.end = l.pages + align256(pages * sizeof(shared::LodPage));
-  l.uploadPages = l.views;
+  l.uploadPages = l.views; // the upload has no views
   l.uploadEnd = l.uploadPages + align256(pages * sizeof(shared::LodPage));
   return l;
 }
 
 } // namespace
 
-LodPasses::LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
-    : context_(context), hqs_(method.output == MethodOutput::Blend) {
-  nodes_ = gpu::ComputeProgram(context, "lod_nodes.comp");
+LodPasses::LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height,
+                     uint32_t eyes)
+    : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
+  const gpu::SpecConstant stereo{/* STEREO= */ 2, eyes == 2 ? 1u : 0u};
+  nodes_ = gpu::ComputeProgram(context, "lod_nodes.comp", {stereo});
   // The row's constants: PREFETCH and, for lod-hqs, DEPTH_ONLY (the depth pass before the accumulation).
-  raster_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
+  raster_ = gpu::ComputeProgram(context, method.shader, method.spec.with({stereo}));
   if (hqs_) {
-    accumulate_ = gpu::ComputeProgram(context, "raster_lod_hqs.comp");
+    accumulate_ = gpu::ComputeProgram(context, "raster_lod_hqs.comp", {stereo});
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
     // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
     accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
@@ -63,19 +66,20 @@ void LodPasses::setList(const LodDrawList& list) {
     // Room for the list and some growth: interactive frames draw lists of slowly changing length.
     capacityNodes_ = std::max<uint64_t>(1024, list.nodes.size() + list.nodes.size() / 2);
     capacityPages_ = std::max<uint64_t>(4096, list.pages.size() + list.pages.size() / 2);
-    const TableLayout l = layoutOf(capacityNodes_, capacityPages_);
+    const TableLayout l = layoutOf(capacityNodes_, capacityPages_, eyes_);
     upload_ = gpu::Buffer(context_, l.uploadEnd, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload,
                           "lod tables upload");
     tables_ = gpu::Buffer(context_, l.end, gpu::kBufferUsage, gpu::MemoryKind::Device, "lod tables");
   }
-  const TableLayout l = layoutOf(capacityNodes_, capacityPages_);
+  const TableLayout l = layoutOf(capacityNodes_, capacityPages_, eyes_);
   auto* base = static_cast<char*>(upload_.mapped());
   std::memcpy(base + l.nodes, list.nodes.data(), list.nodes.size() * sizeof(shared::LodNode));
   std::memcpy(base + l.uploadPages, list.pages.data(), list.pages.size() * sizeof(shared::LodPage));
 }
 
-void LodPasses::writeFrame(const Targets& targets, const RenderSettings& settings, bool nodeStats) {
-  const TableLayout l = layoutOf(capacityNodes_, capacityPages_);
+void LodPasses::writeFrame(const Targets& targets, const LodCamera& camera, const RenderSettings& settings,
+                           bool nodeStats) {
+  const TableLayout l = layoutOf(capacityNodes_, capacityPages_, eyes_);
   shared::LodFrame f{};
   f.framebuffer = targets.framebuffer.address();
   f.stats = stats_.address();
@@ -84,8 +88,11 @@ void LodPasses::writeFrame(const Targets& targets, const RenderSettings& setting
   f.views = tables_.address() + l.views;
   f.pages = tables_.address() + l.pages;
   f.composite = composite_ ? composite_.address() : 0;
-  f.width = targets.width;
+  f.width = targets.eyeWidth();
   f.height = targets.height;
+  f.pitch = targets.width;
+  f.eyes = eyes_;
+  f.rightViewProj = camera.rightViewProj;
   f.forcedWords = settings.precision;
   f.culling = settings.batchCulling ? 1 : 0;
   f.nodeCount = nodeCount_;
@@ -95,7 +102,7 @@ void LodPasses::writeFrame(const Targets& targets, const RenderSettings& setting
 }
 
 void LodPasses::recordTables(VkCommandBuffer cmd) {
-  const TableLayout l = layoutOf(capacityNodes_, capacityPages_);
+  const TableLayout l = layoutOf(capacityNodes_, capacityPages_, eyes_);
   VkBufferCopy regions[3] = {
       {0, 0, sizeof(shared::LodFrame)},
       {l.nodes, l.nodes, std::max<uint64_t>(1, nodeCount_) * sizeof(shared::LodNode)},
@@ -133,12 +140,15 @@ void LodPasses::recordPages(VkCommandBuffer cmd, const gpu::ComputeProgram& prog
 }
 
 void LodPasses::recordResolve(VkCommandBuffer cmd, const gpu::ComputeProgram& program, const Targets& targets,
-                              const RenderSettings& settings, uint64_t aux, bool words) {
+                              const RenderSettings& settings, uint64_t aux, bool canonical) {
   shared::ResolvePush push{};
   push.framebuffer = targets.framebuffer.address();
   push.image = targets.image.address();
   push.aux = aux;
-  push.words = words && settings.captureWords ? targets.words.address() : 0;
+  // The resolve stage reads the words (lod-hqs's: the closest depth with the average color); tests read
+  // lod's canonical ones.
+  const bool words = settings.post.enabled() || (canonical && settings.captureWords);
+  push.words = words ? targets.words.address() : 0;
   push.width = targets.width;
   push.height = targets.height;
   push.background = settings.background;
@@ -149,7 +159,7 @@ void LodPasses::recordResolve(VkCommandBuffer cmd, const gpu::ComputeProgram& pr
 
 void LodPasses::recordFrame(VkCommandBuffer cmd, const LodCamera& camera, Targets& targets,
                             const RenderSettings& settings) {
-  writeFrame(targets, settings, true);
+  writeFrame(targets, camera, settings, true);
   recordTables(cmd);
   gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, targets.pixels() * 8,
                        0xFFFFFFFFu); // kEmptyPixel
@@ -187,7 +197,7 @@ void LodPasses::recordBegin(VkCommandBuffer cmd, Targets& targets) {
 
 void LodPasses::recordPass(VkCommandBuffer cmd, const LodCamera& camera, Targets& targets,
                            const RenderSettings& settings, LodPhase phase) {
-  writeFrame(targets, settings, phase != LodPhase::Blend);
+  writeFrame(targets, camera, settings, phase != LodPhase::Blend);
   recordTables(cmd);
   if (phase == LodPhase::Closest)
     gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, targets.pixels() * 8, 0xFFFFFFFFu);

@@ -19,9 +19,11 @@
 
 namespace pointrast::lod {
 
-// The frame's camera for the passes: view-projection relative to the scene origin, near plane.
+// The frame's camera for the passes: view-projection relative to the scene origin, near plane; a stereo
+// frame's right eye in rightViewProj (viewProj is the left's).
 struct LodCamera {
   glm::mat4 viewProj{1.0f};
+  glm::mat4 rightViewProj{1.0f};
   float nearW = 0;
 };
 
@@ -35,8 +37,9 @@ enum class LodPhase {
 class LodPasses {
 public:
   // The passes of a LOD row of the method table: its shader and specialization constants draw the pages;
-  // Blend output (lod-hqs) adds the accumulation pass.
-  LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height);
+  // Blend output (lod-hqs) adds the accumulation pass. width x height is the whole framebuffer; eyes = 2:
+  // the stereo passes, each eye in one half.
+  LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height, uint32_t eyes);
   bool hqs() const { return hqs_; }
 
   // The list the next recorded commands draw (host-written tables, copied to the GPU by each pass). One list
@@ -56,16 +59,18 @@ public:
   BatchStats readStats() const;
 
 private:
-  void writeFrame(const Targets& targets, const RenderSettings& settings, bool nodeStats);
+  void writeFrame(const Targets& targets, const LodCamera& camera, const RenderSettings& settings,
+                  bool nodeStats);
   void recordTables(VkCommandBuffer cmd);
   void recordStatsCopy(VkCommandBuffer cmd);
   void recordNodes(VkCommandBuffer cmd, const LodCamera& camera);
   void recordPages(VkCommandBuffer cmd, const gpu::ComputeProgram& program, const LodCamera& camera);
   void recordResolve(VkCommandBuffer cmd, const gpu::ComputeProgram& program, const Targets& targets,
-                     const RenderSettings& settings, uint64_t aux, bool words);
+                     const RenderSettings& settings, uint64_t aux, bool canonical);
 
   gpu::Context& context_;
   bool hqs_;
+  uint32_t eyes_;
   gpu::ComputeProgram nodes_;
   gpu::ComputeProgram raster_;     // lod, or lod-hqs's depth pass
   gpu::ComputeProgram accumulate_; // lod-hqs

@@ -10,22 +10,35 @@ namespace pointrast::lod {
 
 namespace {
 
+void beginEpilogue(const FrameEpilogue& epilogue, VkCommandBuffer cmd, uint32_t timedFrames) {
+  if (epilogue.begin) epilogue.begin(cmd, timedFrames);
+}
+
+void recordEpilogue(const FrameEpilogue& epilogue, VkCommandBuffer cmd, uint32_t frame) {
+  if (epilogue.record) epilogue.record(cmd, frame);
+}
+
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void timeOnePass(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
-                 const LodCamera& cam, const RenderSettings& settings, FrameStats& result) {
+                 const LodCamera& cam, const RenderSettings& settings, const FrameEpilogue& epilogue,
+                 FrameStats& result) {
   passes.setList(scene.drawList());
   const uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context, frames);
   context.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
-    for (uint32_t w = 0; w < settings.warmup; ++w)
+    beginEpilogue(epilogue, cmd, frames);
+    for (uint32_t w = 0; w < settings.warmup; ++w) {
       passes.recordFrame(cmd, cam, targets, settings);
+      recordEpilogue(epilogue, cmd, FrameEpilogue::kUntimed);
+    }
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);
       passes.recordFrame(cmd, cam, targets, settings);
+      recordEpilogue(epilogue, cmd, f);
       timestamps.end(cmd, f);
     }
   });
@@ -39,7 +52,7 @@ void timeOnePass(gpu::Context& context, LodScene& scene, LodPasses& passes, Targ
 // Each pass streamed in, then drawn in its own submission (lod-hqs: every pass's depths, then every pass's
 // blending, streaming the passes twice). One frame, its time the sum of the submissions'.
 void timePasses(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
-                const LodCamera& cam, const RenderSettings& settings,
+                const LodCamera& cam, const RenderSettings& settings, const FrameEpilogue& epilogue,
                 const std::vector<std::vector<uint32_t>>& split, FrameStats& result, double& streamSeconds) {
   std::vector<LodPhase> phases = passes.hqs() ? std::vector<LodPhase>{LodPhase::Depth, LodPhase::Blend}
                                               : std::vector<LodPhase>{LodPhase::Closest};
@@ -57,10 +70,14 @@ void timePasses(gpu::Context& context, LodScene& scene, LodPasses& passes, Targe
       const bool first = span == 0, last = span + 1 == spans;
       context.submitAndWait([&](VkCommandBuffer cmd) {
         if (first) timestamps.reset(cmd);
+        if (last) beginEpilogue(epilogue, cmd, 1);
         timestamps.begin(cmd, span);
         if (first) passes.recordBegin(cmd, targets);
         passes.recordPass(cmd, cam, targets, settings, phase);
-        if (last) passes.recordFinish(cmd, targets, settings);
+        if (last) {
+          passes.recordFinish(cmd, targets, settings);
+          recordEpilogue(epilogue, cmd, 0);
+        }
         timestamps.end(cmd, span);
       });
       ++span;
@@ -76,35 +93,38 @@ void timePasses(gpu::Context& context, LodScene& scene, LodPasses& passes, Targe
 
 } // namespace
 
-LodCamera lodCamera(const LodScene& scene, const Camera& camera, uint32_t width, uint32_t height) {
+LodCamera lodCamera(const LodScene& scene, std::span<const Camera> views, uint32_t width, uint32_t height) {
+  const double aspect = double(width) / double(height);
   LodCamera cam;
-  cam.viewProj = glm::mat4(viewProjection(camera, scene.origin(), double(width) / double(height)));
-  cam.nearW = float(scene.nearW(camera));
+  cam.viewProj = glm::mat4(viewProjection(views[0], scene.origin(), aspect));
+  if (views.size() > 1) cam.rightViewProj = glm::mat4(viewProjection(views[1], scene.origin(), aspect));
+  cam.nearW = float(scene.nearW(views[0]));
   return cam;
 }
 
 LodView lodView(const RenderSettings& settings) {
-  return {settings.minNodePx, settings.pointBudget};
+  return {settings.minNodePx, settings.pointBudget, settings.foveation};
 }
 
 FrameStats renderOctree(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
-                        const Camera& camera, const RenderSettings& settings) {
+                        std::span<const Camera> views, const RenderSettings& settings,
+                        const FrameEpilogue& epilogue) {
   FrameStats result;
   const auto start = std::chrono::steady_clock::now();
-  const Selection selection = scene.selectAll(camera, targets.width, targets.height, lodView(settings));
+  const Selection selection = scene.selectAll(views, targets.eyeWidth(), targets.height, lodView(settings));
   const std::vector<std::vector<uint32_t>> split = scene.splitPasses(selection);
-  const LodCamera cam = lodCamera(scene, camera, targets.width, targets.height);
+  const LodCamera cam = lodCamera(scene, views, targets.eyeWidth(), targets.height);
   double streamSeconds = 0;
   uint64_t nodes = 0, points = 0, pages = 0;
   if (split.size() <= 1) {
     scene.makeResident(split.empty() ? std::vector<uint32_t>{} : split[0], 0);
     streamSeconds = secondsSince(start);
-    timeOnePass(context, scene, passes, targets, cam, settings, result);
+    timeOnePass(context, scene, passes, targets, cam, settings, epilogue, result);
     nodes = scene.stats().nodesDrawn;
     points = scene.stats().pointsDrawn;
     pages = scene.stats().pagesDrawn;
   } else {
-    timePasses(context, scene, passes, targets, cam, settings, split, result, streamSeconds);
+    timePasses(context, scene, passes, targets, cam, settings, epilogue, split, result, streamSeconds);
     for (const std::vector<uint32_t>& pass : split) {
       nodes += pass.size();
       for (uint32_t id : pass) {
@@ -129,17 +149,20 @@ FrameStats renderOctree(gpu::Context& context, LodScene& scene, LodPasses& passe
 }
 
 FrameStats renderResidentFrame(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
-                               const Camera& camera, const RenderSettings& settings) {
+                               std::span<const Camera> views, const RenderSettings& settings,
+                               const FrameEpilogue& epilogue) {
   FrameStats result;
-  const bool changed = scene.update(camera, targets.width, targets.height, lodView(settings));
+  const bool changed = scene.update(views, targets.eyeWidth(), targets.height, lodView(settings));
   passes.setList(scene.drawList());
-  const LodCamera cam = lodCamera(scene, camera, targets.width, targets.height);
+  const LodCamera cam = lodCamera(scene, views, targets.eyeWidth(), targets.height);
   gpu::TimestampPool timestamps(context, 1);
   context.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
+    beginEpilogue(epilogue, cmd, 1);
     timestamps.begin(cmd, 0);
     scene.recordUploads(cmd);
     passes.recordFrame(cmd, cam, targets, settings);
+    recordEpilogue(epilogue, cmd, 0);
     timestamps.end(cmd, 0);
   });
   scene.uploadsFinished();

@@ -32,7 +32,15 @@ bool finite(const Bounds& b) {
 }
 
 bool sameCamera(const Camera& a, const Camera& b) {
-  return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fovY == b.fovY && a.nearW == b.nearW;
+  return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fovY == b.fovY && a.nearW == b.nearW &&
+         a.shiftX == b.shiftX;
+}
+
+bool sameViews(std::span<const Camera> a, const std::vector<Camera>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (!sameCamera(a[i], b[i])) return false;
+  return true;
 }
 
 } // namespace
@@ -56,7 +64,7 @@ LodScene::LodScene(gpu::Context& context, NodeSource& source, const LodOptions& 
   if (sample.size() != root.pointCount)
     throw InputError(hierarchy_->describe(0) + " holds " + std::to_string(sample.size()) +
                      " points where its hierarchy says " + std::to_string(root.pointCount));
-  encoder_ = std::make_unique<NodeEncoder>(meta, sample);
+  encoder_ = std::make_unique<NodeEncoder>(meta, sample, options.colorSource, options.colorRange);
   pool_ = std::make_unique<PagePool>(context, options.gpuBytes ? options.gpuBytes : defaultGpuBytes(context));
   const uint64_t stagingBytes = options.stagingBytes ? options.stagingBytes : kDefaultStagingBytes;
   staging_ = std::make_unique<StagingBlocks>(
@@ -230,14 +238,15 @@ void LodScene::buildDrawList(const std::vector<uint32_t>& nodes, uint32_t rankBa
   stats_.residentBytes = pool_->used() * shared::kLodPageBytes;
 }
 
-bool LodScene::update(const Camera& camera, uint32_t width, uint32_t height, const LodView& view) {
+bool LodScene::update(std::span<const Camera> views, uint32_t width, uint32_t height, const LodView& view) {
   collect();
   ++frame_;
   SelectionLimits limits;
   limits.minNodePx = view.minNodePx;
+  limits.foveation = view.foveation;
   limits.pointBudget = std::min(view.pointBudget ? view.pointBudget : kMaxPassPoints, kMaxPassPoints);
   limits.pageBudget = pool_->capacity(); // a frame draws one pass: its selection fits the cache
-  const Selection sel = selectNodes(*hierarchy_, camera, width, height, origin_, nearW(camera), limits);
+  const Selection sel = selectNodes(*hierarchy_, views, width, height, origin_, nearW(views[0]), limits);
   stats_.nodesSelected = sel.nodes.size();
   stats_.pointsSelected = sel.points;
   stats_.budgetReached = sel.limited;
@@ -257,9 +266,9 @@ bool LodScene::update(const Camera& camera, uint32_t width, uint32_t height, con
   std::sort(draw.begin(), draw.end(), [&](uint32_t a, uint32_t b) {
     return hierarchy_->node(a).info.key < hierarchy_->node(b).info.key;
   });
-  const bool changed = draw != drawn_ || !sameCamera(camera, lastCamera_) || frame_ == 1;
+  const bool changed = draw != drawn_ || !sameViews(views, lastViews_) || frame_ == 1;
   buildDrawList(draw, 0);
-  lastCamera_ = camera;
+  lastViews_.assign(views.begin(), views.end());
   converged_ = drawn.size() == sel.nodes.size() && sel.unexpanded.empty();
   return changed;
 }
@@ -288,13 +297,15 @@ void LodScene::uploadsFinished() {
   copies_.clear();
 }
 
-Selection LodScene::selectAll(const Camera& camera, uint32_t width, uint32_t height, const LodView& view) {
+Selection LodScene::selectAll(std::span<const Camera> views, uint32_t width, uint32_t height,
+                              const LodView& view) {
   SelectionLimits limits;
   limits.minNodePx = view.minNodePx;
   limits.pointBudget = view.pointBudget;
+  limits.foveation = view.foveation;
   for (;;) {
     collect();
-    Selection sel = selectNodes(*hierarchy_, camera, width, height, origin_, nearW(camera), limits);
+    Selection sel = selectNodes(*hierarchy_, views, width, height, origin_, nearW(views[0]), limits);
     stats_.nodesSelected = sel.nodes.size();
     stats_.pointsSelected = sel.points;
     stats_.budgetReached = sel.limited;

@@ -24,9 +24,11 @@
 #include <list>
 #include <memory>
 #include <optional>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
+#include "cloud/cloud.h"
 #include "gpu/shared_types.h"
 #include "gpu/vulkan_api.h"
 #include "render/camera.h"
@@ -51,6 +53,10 @@ struct LodOptions {
   uint32_t readers = 0;             // reader threads; 0: one per hardware thread
   uint64_t stagingBytes = 0;        // host staging for nodes read and not yet uploaded; 0: 256 MiB
   uint64_t uploadBytesPerFrame = 0; // node bytes one interactive frame copies at most; 0: 256 MiB
+  // How points become colors (render --color), decided once from the root's points; nullopt: the automatic
+  // choice (node_encoding.h). Colors are computed as nodes are encoded, so every LOD method draws them.
+  std::optional<DisplayColorMode::Source> colorSource;
+  std::optional<ColorRange> colorRange; // intensity and elevation: the values at the ramp's ends
 };
 
 // Half the device-local memory: the rest stays for framebuffers, the other methods and the driver.
@@ -60,6 +66,7 @@ uint64_t defaultGpuBytes(const gpu::Context& context);
 struct LodView {
   double minNodePx = 100;   // LOD culling: smallest projected radius drawn, in pixels (selection.h)
   uint64_t pointBudget = 0; // most points a frame selects; 0: no limit
+  Foveation foveation;      // larger nodes needed away from the image's centre (foveation.h)
 };
 
 // A frame's nodes for the GPU (shared.h): nodes in key order with their pages.
@@ -87,7 +94,12 @@ public:
 
   // --- Frame by frame ---
   // Returns whether the draw list or the camera changed since the last update. Rethrows a reader's error.
-  bool update(const Camera& camera, uint32_t width, uint32_t height, const LodView& view);
+  // `views`: the frame's camera, or a stereo frame's two eyes (one selection for both, selection.h); width x
+  // height is one view's image.
+  bool update(std::span<const Camera> views, uint32_t width, uint32_t height, const LodView& view);
+  bool update(const Camera& camera, uint32_t width, uint32_t height, const LodView& view) {
+    return update(std::span<const Camera>(&camera, 1), width, height, view);
+  }
   bool converged() const { return converged_; }
   void recordUploads(VkCommandBuffer cmd) const; // the copies of this update's nodes, then a barrier
   void uploadsFinished();                        // their staging blocks are free again
@@ -97,7 +109,10 @@ public:
 
   // --- Offline ---
   // The whole selection for a camera (no cache limit), after reading every hierarchy part it reaches.
-  Selection selectAll(const Camera& camera, uint32_t width, uint32_t height, const LodView& view);
+  Selection selectAll(std::span<const Camera> views, uint32_t width, uint32_t height, const LodView& view);
+  Selection selectAll(const Camera& camera, uint32_t width, uint32_t height, const LodView& view) {
+    return selectAll(std::span<const Camera>(&camera, 1), width, height, view);
+  }
   // The selection's nodes with points in key order, cut into passes that each fit the cache and hold fewer
   // than 2^32 points. Throws UnsupportedError for a node larger than the cache or the staging blocks.
   std::vector<std::vector<uint32_t>> splitPasses(const Selection& selection) const;
@@ -145,7 +160,7 @@ private:
   uint64_t frame_ = 0;
   LodDrawList drawList_;
   std::vector<uint32_t> drawn_; // ids of drawList_'s nodes, in its order
-  Camera lastCamera_;
+  std::vector<Camera> lastViews_;
   bool converged_ = false;
   LodStats stats_;
 };

@@ -10,7 +10,8 @@
 
 namespace pointrast::lod {
 
-NodeEncoder::NodeEncoder(const OctreeMetadata& metadata, const std::vector<PointRecord>& sample)
+NodeEncoder::NodeEncoder(const OctreeMetadata& metadata, const std::vector<PointRecord>& sample,
+                         std::optional<DisplayColorMode::Source> source, std::optional<ColorRange> range)
     : metadata_(metadata) {
   uint16_t colorMax = metadata.fields.colorMax;
   if (metadata.fields.color && colorMax == 0)
@@ -19,7 +20,7 @@ NodeEncoder::NodeEncoder(const OctreeMetadata& metadata, const std::vector<Point
   colorShift_ = colorMax > 255 ? 8 : 0;
   PointCloud cloud = cloudOf(sample);
   computeBounds(cloud);
-  mode_ = displayColorMode(cloud);
+  mode_ = source ? displayColorMode(cloud, *source, range) : displayColorMode(cloud);
 }
 
 PointCloud NodeEncoder::cloudOf(const std::vector<PointRecord>& records) const {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -17,8 +18,11 @@ class NodeEncoder {
 public:
   // Decides the display colors from a sample of the octree (its root's points, a subsample of the whole):
   // RGB where the source has a usable one (16-bit when its values pass 255), else a ramp over intensity or
-  // elevation with the sample's percentiles.
-  NodeEncoder(const OctreeMetadata& metadata, const std::vector<PointRecord>& sample);
+  // elevation with the sample's percentiles; or the given source (cloud/attribute_colors.h), its ramp over
+  // `range` when given. Throws InputError naming the source when the octree lacks that attribute.
+  NodeEncoder(const OctreeMetadata& metadata, const std::vector<PointRecord>& sample,
+              std::optional<DisplayColorMode::Source> source = std::nullopt,
+              std::optional<ColorRange> range = std::nullopt);
 
   // Encodes one node's records into pages: pages[k] receives points [k * 4096, (k + 1) * 4096) in the four
   // sections of a page (kLodPageBytes each, pagesOf(records.size()) of them). Returns the tight world bounds

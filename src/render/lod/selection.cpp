@@ -1,5 +1,7 @@
 #include "render/lod/selection.h"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -38,6 +40,25 @@ double projectedRadiusPx(const Bounds& cube, const Camera& camera, uint32_t heig
   return radius * double(height) / (2.0 * distance * std::tan(glm::radians(camera.fovY) / 2.0));
 }
 
+double foveationFactor(const Foveation& foveation, double distance) {
+  if (!foveation.enabled || distance <= foveation.radius) return 1.0;
+  const double t = std::min(1.0, (distance - foveation.radius) / std::max(1e-9, 1.0 - foveation.radius));
+  return 1.0 + (foveation.periphery - 1.0) * t;
+}
+
+double foveatedSizePx(const Bounds& cube, const Camera& camera, const glm::dmat4& viewProj,
+                      const glm::dvec3& origin, uint32_t width, uint32_t height, const Foveation& foveation) {
+  const double size = projectedRadiusPx(cube, camera, height);
+  if (!foveation.enabled || std::isinf(size)) return size;
+  const glm::dvec4 c = viewProj * glm::dvec4(cube.center() - origin, 1.0);
+  if (!(c.w > 0)) return size; // behind the eye yet visible: the eye is near, keep the fovea's threshold
+  const glm::dvec2 pixel{(c.x / c.w + 1.0) * 0.5 * width, (1.0 - c.y / c.w) * 0.5 * height};
+  const glm::dvec2 centre{0.5 * width, 0.5 * height};
+  const double halfDiagonal = 0.5 * std::sqrt(double(width) * width + double(height) * height);
+  const double distance = std::max(0.0, glm::length(pixel - centre) - size) / halfDiagonal;
+  return size / foveationFactor(foveation, distance);
+}
+
 bool boxMayBeVisible(const Bounds& box, const glm::dmat4& viewProj, const glm::dvec3& origin, double nearW) {
   bool left = true, right = true, below = true, above = true, behind = true;
   for (int i = 0; i < 8; ++i) {
@@ -53,10 +74,13 @@ bool boxMayBeVisible(const Bounds& box, const glm::dmat4& viewProj, const glm::d
   return !(left || right || below || above || behind);
 }
 
-Selection selectNodes(const Hierarchy& hierarchy, const Camera& camera, uint32_t width, uint32_t height,
-                      const glm::dvec3& origin, double nearW, const SelectionLimits& limits) {
+Selection selectNodes(const Hierarchy& hierarchy, std::span<const Camera> cameras, uint32_t width,
+                      uint32_t height, const glm::dvec3& origin, double nearW, const SelectionLimits& limits) {
+  assert(!cameras.empty() && cameras.size() <= 2);
   const OctreeMetadata& meta = hierarchy.metadata();
-  const glm::dmat4 viewProj = viewProjection(camera, origin, double(width) / double(height));
+  glm::dmat4 viewProj[2];
+  for (size_t k = 0; k < cameras.size(); ++k)
+    viewProj[k] = viewProjection(cameras[k], origin, double(width) / double(height));
   auto grown = [&](const NodeKey& key) {
     Bounds cube = meta.nodeCube(key);
     glm::dvec3 margin(kCubeMargin * (cube.max.x - cube.min.x));
@@ -65,11 +89,27 @@ Selection selectNodes(const Hierarchy& hierarchy, const Camera& camera, uint32_t
     cube.max += margin;
     return cube;
   };
+  auto visible = [&](const Bounds& box) {
+    for (size_t k = 0; k < cameras.size(); ++k)
+      if (boxMayBeVisible(box, viewProj[k], origin, nearW)) return true;
+    return false;
+  };
+  // The node's size in the eyes that may see it (-1: none): each eye's selection taken alone is then a
+  // subset of the stereo one, and without budgets or foveation the stereo selection is exactly their union
+  // (a child is then never visible, nor larger, where its parent is not).
+  auto weigh = [&](const NodeKey& key) {
+    const Bounds box = grown(key), cube = meta.nodeCube(key);
+    double size = -1;
+    for (size_t k = 0; k < cameras.size(); ++k)
+      if (boxMayBeVisible(box, viewProj[k], origin, nearW))
+        size = std::max(
+            size, foveatedSizePx(cube, cameras[k], viewProj[k], origin, width, height, limits.foveation));
+    return size;
+  };
   Selection s;
   std::priority_queue<Candidate> queue;
   const NodeKey root = hierarchy.node(0).info.key;
-  if (boxMayBeVisible(grown(root), viewProj, origin, nearW))
-    queue.push({std::numeric_limits<double>::infinity(), root, 0});
+  if (visible(grown(root))) queue.push({std::numeric_limits<double>::infinity(), root, 0});
   while (!queue.empty()) {
     const Candidate c = queue.top();
     queue.pop();
@@ -90,9 +130,8 @@ Selection selectNodes(const Hierarchy& hierarchy, const Camera& camera, uint32_t
     for (uint32_t k = 0; k < node.childCount; ++k) {
       const uint32_t child = node.firstChild + k;
       const NodeKey key = hierarchy.node(child).info.key;
-      if (!boxMayBeVisible(grown(key), viewProj, origin, nearW)) continue;
-      const double size = projectedRadiusPx(meta.nodeCube(key), camera, height);
-      if (size < limits.minNodePx) continue;
+      const double size = weigh(key);
+      if (size < 0 || size < limits.minNodePx) continue; // outside every frustum, or too small
       queue.push({size, key, child});
     }
   }

@@ -1,6 +1,7 @@
 #include "render/post/post_stage.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <string>
 
@@ -58,8 +59,8 @@ void validatePostSettings(const PostSettings& s) {
     throw InputError("largest point size " + std::to_string(s.maxPointSize) + " is out of range (1.." +
                      std::to_string(shared::kMaxPointSize) + " pixels)");
   if (s.sizeMode == PointSizeMode::Adaptive)
-    throw InputError("adaptive point sizes come from the spacing of LOD levels, which the brute-force "
-                     "methods do not have; use fixed or attenuated");
+    throw InputError("adaptive point sizes (from the spacing of each point's LOD level) are not available; "
+                     "use fixed or attenuated");
   if (s.dilate > shared::kMaxDilateRadius)
     throw InputError("dilation radius " + std::to_string(s.dilate) + " is out of range (0.." +
                      std::to_string(shared::kMaxDilateRadius) + " pixels)");
@@ -82,36 +83,56 @@ gpu::Buffer& PostStage::scratch(int index, uint64_t pixels) {
   return b;
 }
 
-const gpu::ComputeProgram& PostStage::splat(bool disc, bool attenuated, uint32_t axis) {
-  gpu::ComputeProgram& program = splat_[disc][attenuated][axis];
-  if (program.name().empty())
-    program =
-        gpu::ComputeProgram(context_, "post_splat.comp",
-                            {{/* SHAPE= */ 0, disc ? shared::kPointShapeDisc : shared::kPointShapeSquare},
-                             {/* ATTENUATED= */ 1, uint32_t(attenuated)},
-                             {/* AXIS= */ 2, axis < 3 ? axis : 0},
-                             {/* SCATTER= */ 3, uint32_t(axis == 3)}});
+const gpu::ComputeProgram& PostStage::splat(Splat variant) {
+  gpu::ComputeProgram& program = splat_[size_t(variant)];
+  if (!program.name().empty()) return program;
+  const bool disc = variant == Splat::DiscWindow || variant == Splat::DiscScatter;
+  const bool attenuated = variant == Splat::SquareScatter || variant == Splat::DiscScatter; // scattered
+  const uint32_t axis = variant == Splat::SquareRows ? 1 : variant == Splat::SquareColumns ? 2 : 0;
+  program = gpu::ComputeProgram(context_, "post_splat.comp",
+                                {{/* SHAPE= */ 0, disc ? shared::kPointShapeDisc : shared::kPointShapeSquare},
+                                 {/* ATTENUATED= */ 1, uint32_t(attenuated)},
+                                 {/* AXIS= */ 2, axis}});
   return program;
 }
 
 void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSettings& settings,
                        gpu::TimestampPool* timestamps, uint32_t firstSpan) {
-  const uint64_t pixels = uint64_t(view.width) * view.height;
+  record(cmd, std::span<const PostView>(&view, 1), settings, timestamps, firstSpan);
+}
+
+void PostStage::record(VkCommandBuffer cmd, std::span<const PostView> views, const PostSettings& settings,
+                       gpu::TimestampPool* timestamps, uint32_t firstSpan) {
+  assert(!views.empty() && views.size() <= kMaxPostViews);
+  const PostView& first = views[0];
+  for (const PostView& v : views)
+    assert(v.width == first.width && v.height == first.height && "the views of one run share a size");
+  const uint64_t pixels = uint64_t(first.width) * first.height;
+  // Each view ping-pongs between its own window of the two scratch buffers.
+  const uint64_t scratchPixels = pixels * views.size();
   shared::PostPush push{};
-  push.width = view.width;
-  push.height = view.height;
-  push.source = view.words;
-  push.sourcePitch = view.pitch;
+  push.width = first.width;
+  push.height = first.height;
+  uint64_t source[kMaxPostViews];
+  uint32_t sourcePitch[kMaxPostViews];
+  for (size_t v = 0; v < views.size(); ++v) {
+    source[v] = views[v].words;
+    sourcePitch[v] = views[v].pitch;
+  }
   int next = 0; // scratch buffer the next filter pass writes
-  // One filter pass from the current source into a scratch buffer, which becomes the source.
+  // One filter pass over every view from its current source into scratch, which becomes its source.
   auto pass = [&](const gpu::ComputeProgram& program) {
-    gpu::Buffer& target = scratch(next, pixels);
-    push.target = target.address();
-    push.targetPitch = view.width;
-    program.dispatch(cmd, tiles(view.width), tiles(view.height), push);
+    gpu::Buffer& target = scratch(next, scratchPixels);
+    for (size_t v = 0; v < views.size(); ++v) {
+      push.source = source[v];
+      push.sourcePitch = sourcePitch[v];
+      push.target = target.address() + v * pixels * 8;
+      push.targetPitch = first.width;
+      program.dispatch(cmd, tiles(first.width), tiles(first.height), push);
+      source[v] = push.target;
+      sourcePitch[v] = push.targetPitch;
+    }
     gpu::fullBarrier(cmd);
-    push.source = push.target;
-    push.sourcePitch = push.targetPitch;
     next ^= 1;
   };
   auto begin = [&](uint32_t span) {
@@ -125,19 +146,21 @@ void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSett
   if (settings.splats()) {
     const bool disc = settings.shape == PointShape::Disc;
     const bool attenuated = settings.sizeMode == PointSizeMode::Attenuated;
-    push.pointSize = attenuated ? settings.pointSize * view.referenceDepth : settings.pointSize;
+    // Attenuated sizes are the same at each view's reference depth (every eye sees the target alike).
+    push.pointSize = attenuated ? settings.pointSize * first.referenceDepth : settings.pointSize;
     push.maxPointSize = settings.maxPointSize;
     if (!disc && !attenuated) {
-      pass(splat(false, false, 1)); // rows, then columns
-      pass(splat(false, false, 2));
+      pass(splat(Splat::SquareRows)); // rows, then columns
+      pass(splat(Splat::SquareColumns));
     } else if (attenuated) {
       // Scattered into a cleared buffer: the cost follows the sizes drawn, not the largest allowed.
-      gpu::vkCmdFillBuffer(cmd, scratch(next, pixels).handle(), 0, pixels * 8, 0xFFFFFFFFu); // kEmptyPixel
+      gpu::vkCmdFillBuffer(cmd, scratch(next, scratchPixels).handle(), 0, scratchPixels * 8,
+                           0xFFFFFFFFu); // kEmptyPixel
       gpu::fullBarrier(cmd);
-      pass(splat(disc, true, 3));
+      pass(splat(disc ? Splat::DiscScatter : Splat::SquareScatter));
     } else {
       push.radius = uint32_t(settings.pointSize / 2); // a disc of diameter s reaches floor(s / 2) pixels
-      pass(splat(true, false, 0));
+      pass(splat(Splat::DiscWindow));
     }
   }
   end(0);
@@ -148,14 +171,18 @@ void PostStage::record(VkCommandBuffer cmd, const PostView& view, const PostSett
   end(1);
 
   begin(2);
-  push.target = view.image;
-  push.targetPitch = view.pitch;
-  // The final words go back where the method left its own, unless they are still those.
-  push.words = view.captureWords && push.source != view.words ? view.words : 0;
-  push.background = view.background;
+  push.background = first.background;
   push.edlStrength = settings.edlStrength;
   push.edlRadius = settings.edlRadius;
-  compose_.dispatch(cmd, tiles(view.width), tiles(view.height), push);
+  for (size_t v = 0; v < views.size(); ++v) {
+    push.source = source[v];
+    push.sourcePitch = sourcePitch[v];
+    push.target = views[v].image;
+    push.targetPitch = views[v].pitch;
+    // The final words go back where the method left its own, unless they are still those.
+    push.words = views[v].captureWords && source[v] != views[v].words ? views[v].words : 0;
+    compose_.dispatch(cmd, tiles(first.width), tiles(first.height), push);
+  }
   gpu::fullBarrier(cmd);
   end(2);
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "gpu/buffer.h"
@@ -30,6 +31,8 @@ struct PostView {
 
 // Passes timed per frame, in order: splat, dilate, compose (PostStats).
 constexpr uint32_t kPostPasses = 3;
+// Views one run works on: the two eyes of a stereo frame.
+constexpr size_t kMaxPostViews = 2;
 
 class PostStage {
 public:
@@ -41,16 +44,21 @@ public:
   // passed validatePostSettings().
   void record(VkCommandBuffer cmd, const PostView& view, const PostSettings& settings,
               gpu::TimestampPool* timestamps = nullptr, uint32_t firstSpan = 0);
+  // The same for several views of one size (the eyes of a stereo frame), each pass over all of them in
+  // one span: the spans time the stage for the whole frame.
+  void record(VkCommandBuffer cmd, std::span<const PostView> views, const PostSettings& settings,
+              gpu::TimestampPool* timestamps = nullptr, uint32_t firstSpan = 0);
 
   // Medians per pass of spans written by record() for `frames` frames, frame f at firstSpan f * kPostPasses.
   static PostStats stats(const std::vector<double>& spanMs, uint32_t frames);
 
 private:
   gpu::Buffer& scratch(int index, uint64_t pixels);
-  // AXIS 0..2 gather (post_splat.comp), 3 scatters.
-  const gpu::ComputeProgram& splat(bool disc, bool attenuated, uint32_t axis);
+  // The variants of post_splat.comp: fixed sizes gathered, attenuated ones scattered.
+  enum class Splat { SquareRows, SquareColumns, DiscWindow, SquareScatter, DiscScatter, Count };
+  const gpu::ComputeProgram& splat(Splat variant);
   gpu::Context& context_;
-  gpu::ComputeProgram splat_[2][2][4]; // [disc][attenuated][axis or scatter], made on first use
+  gpu::ComputeProgram splat_[size_t(Splat::Count)]; // made on first use
   gpu::ComputeProgram dilate_;
   gpu::ComputeProgram compose_;
   gpu::Buffer scratch_[2]; // ping-pong words, width x height each
