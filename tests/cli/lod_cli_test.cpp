@@ -10,6 +10,7 @@
 
 #include "cli_harness.h"
 #include "io/potree_test_util.h"
+#include "test_data.h"
 
 namespace {
 
@@ -89,7 +90,7 @@ TEST(LodCli, WrongInputsAndOptionsFailWithOneLine) {
   const fs::path png = pointrast::test::cliTempDir() / "wrong.png";
   const std::string out = " -o " + png.string() + " -q";
   const std::string octree = dirOf("wrong").string();
-  const std::string las = (fs::path(POINTRAST_DATA_DIR) / "las" / "autzen_trim.las").string();
+  const std::string las = (pointrast::test::dataDir() / "las" / "autzen_trim.las").string();
   const std::pair<std::string, std::string> cases[] = {
       {"render terrain --method lod" + out, "is a generated scene; lod draws octrees"},
       {"render " + las + " --method lod" + out, "is no level-of-detail octree"},
