@@ -188,8 +188,8 @@ std::filesystem::path reportDir(const BenchArgs& a, const gpu::Context& context)
 // What every run checks at its end: validation errors, and that something was measured at all.
 void checkRun(const gpu::Context& context, const std::vector<bench::DatasetOutcome>& datasets) {
   if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
+    throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                        " error(s), above; no report was written");
   bool measured = false;
   std::string skipped;
   for (const bench::DatasetOutcome& d : datasets) {
@@ -199,11 +199,16 @@ void checkRun(const gpu::Context& context, const std::vector<bench::DatasetOutco
   if (!measured) throw InputError("nothing was measured: " + skipped);
 }
 
-void printWritten(const BenchArgs& a, size_t results, double seconds, const bench::WrittenFiles& files) {
-  if (a.quiet && a.json) return;
-  std::FILE* to = a.json ? stderr : stdout;
-  std::fprintf(to, "%zu results in %.1f s; wrote %s, %s, %s\n", results, seconds, files.json.string().c_str(),
-               files.markdown.string().c_str(), files.svg.string().c_str());
+// The run's last words: the files written, and for a run a device fault ended, the fault as the one
+// error line (exit 1) after the reports that keep what was measured before it.
+template <class Run>
+void printWritten(const BenchArgs& a, const Run& run, const bench::WrittenFiles& files) {
+  if (!(a.quiet && a.json))
+    std::fprintf(a.json ? stderr : stdout, "%zu results in %.1f s; wrote %s, %s, %s\n", run.results.size(),
+                 run.seconds, files.json.string().c_str(), files.markdown.string().c_str(),
+                 files.svg.string().c_str());
+  if (run.faulted)
+    throw DeviceFault(run.stopped + "; " + files.json.string() + " holds what was measured before it");
 }
 
 gpu::ContextOptions contextOptions(const BenchArgs& a) {
@@ -293,7 +298,7 @@ int runSphereSuite(const BenchArgs& a) {
   lines.end();
   checkRun(context, run.datasets);
   bench::WrittenFiles files = bench::writeSphereReports(run, info, reportDir(a, context));
-  printWritten(a, run.results.size(), run.seconds, files);
+  printWritten(a, run, files);
   return 0;
 }
 
@@ -368,7 +373,7 @@ int runBench(const BenchArgs& a) {
   lines.end();
   checkRun(context, run.datasets);
   bench::WrittenFiles files = bench::writeReports(run, info, reportDir(a, context));
-  printWritten(a, run.results.size(), run.seconds, files);
+  printWritten(a, run, files);
   return 0;
 }
 

@@ -26,4 +26,12 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+// A defect of pointrast or of the driver, caught by a check that runs in every build: the Vulkan
+// validation layer reported an error, a shader is missing from the build, a push-constant block does not
+// match its shader. Neither the input's fault nor a missing device feature; one clear line all the same.
+class InternalError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
 } // namespace pointrast

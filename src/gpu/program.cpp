@@ -1,8 +1,8 @@
 #include "gpu/program.h"
 
 #include <algorithm>
-#include <stdexcept>
 
+#include "base/error.h"
 #include "gpu/context.h"
 #include "gpu/pipeline_parts.h"
 #include "gpu/shader_registry.h"
@@ -68,7 +68,7 @@ void ComputeProgram::dispatchRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t
 
 void checkPushSize(const std::string& program, uint32_t given, uint32_t declared) {
   if (given != declared)
-    throw std::logic_error("internal error: " + std::to_string(given) + " bytes of push constants for '" +
+    throw InternalError("internal error: " + std::to_string(given) + " bytes of push constants for '" +
                            program + "', whose shaders declare " + std::to_string(declared));
 }
 

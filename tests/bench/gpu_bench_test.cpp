@@ -114,29 +114,6 @@ TEST_F(BenchGpu, RunSkipsWhatDoesNotFitAndSaysSo) {
   }
 }
 
-TEST(BenchCloud, ReorderedCopyIsAPermutationWithTheSameBounds) {
-  GenerateOptions options;
-  options.points = 30'000;
-  options.progress = false;
-  PointCloud cloud = generateScene(Scene::Tls, options);
-  for (Order order : {Order::Morton, Order::Shuffled, Order::ShuffledMorton}) {
-    PointCloud copy = bench::reorderedCopy(cloud, order, 7);
-    ASSERT_EQ(copy.size(), cloud.size());
-    EXPECT_EQ(copy.bounds.min, cloud.bounds.min);
-    EXPECT_EQ(copy.bounds.max, cloud.bounds.max);
-    // Same multiset of (position, color): compare sorted keys.
-    auto keys = [](const PointCloud& c) {
-      std::vector<std::tuple<int32_t, int32_t, int32_t, uint32_t>> k(c.size());
-      for (uint64_t i = 0; i < c.size(); ++i)
-        k[i] = {c.positions[3 * i], c.positions[3 * i + 1], c.positions[3 * i + 2], c.colors[i]};
-      std::sort(k.begin(), k.end());
-      return k;
-    };
-    EXPECT_EQ(keys(copy), keys(cloud)) << orderName(order);
-    EXPECT_NE(copy.positions, cloud.positions) << orderName(order) << " changed nothing";
-  }
-}
-
 TEST(BenchBudget, SlowMethodsGetFewerFramesFastOnesAll) {
   // 10 frames after 2 warm-up: 12 probe-lengths must fit the budget.
   EXPECT_EQ(bench::budgetedFrames(10, 2, 0.1, 1.2), 10u);

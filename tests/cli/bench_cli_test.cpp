@@ -152,3 +152,59 @@ TEST(BenchCli, AGpuThatStopsMakingProgressIsOneClearErrorNotAHang) {
     for (const auto& entry : fs::directory_iterator(out))
       ADD_FAILURE() << "nothing should be written, found " << entry.path();
 }
+
+namespace {
+
+// Lines of stderr that are pointrast's own error lines.
+int errorLines(const std::string& err) {
+  int lines = 0;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    lines += line.rfind("pointrast:", 0) == 0;
+  return lines;
+}
+
+} // namespace
+
+TEST(BenchCli, ALostDeviceKeepsWhatWasMeasuredAndIsOneErrorLine) {
+  // POINTRAST_INJECT_DEVICE_LOST=6: the sixth submission (after the copy bandwidth, the upload and the
+  // first combinations) and every later one fail with VK_ERROR_DEVICE_LOST, as a driver reset would.
+  fs::path out = tempDir() / "lost";
+  fs::remove_all(out);
+  setenv("POINTRAST_INJECT_DEVICE_LOST", "6", 1);
+  Result r = run("bench terrain --points 20k --methods atomicmin,earlyz,reduce,reduce-earlyz,dedup-ballot,"
+                 "busyloop,justset --orders original --views overview --frames 2 --width 160 --height 100 "
+                 "--copy-size 16M --budget 0 -q --out " +
+                 out.string());
+  unsetenv("POINTRAST_INJECT_DEVICE_LOST");
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("device was lost (VK_ERROR_DEVICE_LOST from vkQueueSubmit)"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find(".cpp"), std::string::npos) << "no source locations in a device fault: " << r.err;
+  ASSERT_TRUE(fs::exists(out / "terrain-20k.json")) << r.err;
+  nlohmann::json report = nlohmann::json::parse(slurp(out / "terrain-20k.json"));
+  int ok = 0, faulted = 0;
+  for (const auto& result : report["results"]) {
+    ok += result["status"] == "ok";
+    faulted += result["status"] == "device-fault";
+  }
+  EXPECT_GE(ok, 1) << "what was measured before the fault is kept";
+  EXPECT_EQ(faulted, 1);
+  EXPECT_LT(report["results"].size(), 7u) << "nothing runs after the fault";
+  EXPECT_NE(slurp(out / "terrain-20k.md").find("Stopped early"), std::string::npos);
+}
+
+TEST(BenchCli, ALostDeviceInRenderIsOneLineAndNoImage) {
+  fs::path png = tempDir() / "lost.png";
+  fs::remove(png);
+  setenv("POINTRAST_INJECT_DEVICE_LOST", "1", 1);
+  Result r = run("render terrain --points 20k --width 160 --height 100 -q -o " + png.string());
+  unsetenv("POINTRAST_INJECT_DEVICE_LOST");
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("device was lost"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
+}

@@ -64,7 +64,7 @@ TEST(MethodTable, NameListsComeFromTheRows) {
 }
 
 TEST(ShaderRegistry, AMissingShaderIsAnErrorInEveryBuild) {
-  EXPECT_THROW(gpu::findShader("raster_no_such_thing.comp"), std::logic_error);
+  EXPECT_THROW(gpu::findShader("raster_no_such_thing.comp"), InternalError);
 }
 
 } // namespace pointrast::test
