@@ -79,6 +79,10 @@ uint64_t parseCount(std::string_view text, std::string_view option) {
   return uint64_t(n);
 }
 
+std::string jsonText(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 uint64_t imageHash(const uint32_t* pixels, uint64_t count) {
   uint64_t h = 0xcbf29ce484222325ull;
   auto bytes = reinterpret_cast<const unsigned char*>(pixels);

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 namespace pointrast::app {
 
@@ -15,6 +16,10 @@ glm::dvec3 parseVec3(std::string_view text, std::string_view option);
 uint32_t parseRgb(std::string_view text, std::string_view option);
 // "1000000", "1e6", "2.5M", "1.2G", "800k" -> count; throws InputError if not a non-negative integer.
 uint64_t parseCount(std::string_view text, std::string_view option);
+
+// One JSON line. Text that is not UTF-8 (a file name in another encoding) is replaced, not refused: the
+// result of a finished run is never lost to how a path was spelt.
+std::string jsonText(const nlohmann::json& j);
 
 // 64-bit FNV-1a of the image bytes: lets two renders be compared without keeping both images.
 uint64_t imageHash(const uint32_t* pixels, uint64_t count);

@@ -176,7 +176,7 @@ private:
 void printJsonLine(nlohmann::json j, const gpu::Context& context) {
   j["device"] = context.info().name;
   j["device_type"] = context.info().typeName;
-  std::printf("%s\n", j.dump().c_str());
+  std::printf("%s\n", jsonText(j).c_str());
   std::fflush(stdout);
 }
 
@@ -201,8 +201,7 @@ void checkRun(const gpu::Context& context, const std::vector<bench::DatasetOutco
 
 // The run's last words: the files written, and for a run a device fault ended, the fault as the one
 // error line (exit 1) after the reports that keep what was measured before it.
-template <class Run>
-void printWritten(const BenchArgs& a, const Run& run, const bench::WrittenFiles& files) {
+template <class Run> void printWritten(const BenchArgs& a, const Run& run, const bench::WrittenFiles& files) {
   if (!(a.quiet && a.json))
     std::fprintf(a.json ? stderr : stdout, "%zu results in %.1f s; wrote %s, %s, %s\n", run.results.size(),
                  run.seconds, files.json.string().c_str(), files.markdown.string().c_str(),

@@ -1,7 +1,9 @@
 // pointrast render [FILE|SCENE] -o OUT.png ...
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,14 +48,97 @@ struct RenderArgs {
   bool json = false, quiet = false;
 };
 
-// The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
-// as spheres of --radius, through the SphereRenderer.
-int runRenderSpheres(const RenderArgs& a) {
+// What every render checks before reading anything: the output, the image size, the frames, and the camera
+// options a user gave, each named.
+void checkCommonArgs(const RenderArgs& a) {
+  if (std::filesystem::path(a.output).extension() != ".png")
+    throw InputError("-o " + a.output + ": the output must be a .png file");
+  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (!(a.fov > 0 && a.fov < 180)) throw InputError("--fov must be between 0 and 180 degrees");
+  if (!(a.nearW >= 0) || !std::isfinite(a.nearW)) throw InputError("--near must be a number >= 0");
+  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  if (!a.eye.empty()) {
+    parseVec3(a.eye, "--eye");
+    parseVec3(a.up, "--up");
+    if (!a.target.empty()) parseVec3(a.target, "--target");
+  }
+}
+
+// What a camera problem means in terms of the options that set the camera.
+std::string cameraOptionText(CameraProblem problem) {
+  switch (problem) {
+  case CameraProblem::EyeIsTarget:
+    return "--eye and --target must differ (--target defaults to the center of the bounds)";
+  case CameraProblem::UpIsZero:
+    return "--up must not be zero";
+  case CameraProblem::UpAlongView:
+    return "--up is parallel to the view direction; give another --up";
+  default:
+    return describeCameraProblem(problem); // the rest was checked with its option's name already
+  }
+}
+
+// The camera of --eye/--target/--up, or the overview of `bounds`. The data is checked first (coordinates
+// pointrast can place a camera among), so what fails afterwards is an option the user gave.
+Camera renderCamera(const RenderArgs& a, const Bounds& bounds, const std::string& source) {
+  checkCoordinateRange(bounds, source);
+  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
+  if (!a.eye.empty()) {
+    camera.eye = parseVec3(a.eye, "--eye");
+    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
+    camera.up = parseVec3(a.up, "--up");
+  }
+  camera.nearW = a.nearW;
+  if (auto problem = findCameraProblem(camera))
+    throw InputError(a.eye.empty() ? source + ": no overview camera: " + describeCameraProblem(*problem)
+                                   : cameraOptionText(*problem));
+  return camera;
+}
+
+// Writes the image only once the frame can be trusted and its JSON line is made: a validation error, or a
+// result that cannot be printed, leaves no PNG behind. Then prints the JSON line, or calls `summary`.
+void finishImage(const RenderArgs& a, const gpu::Context& context, const std::vector<uint32_t>& pixels,
+                 const std::function<nlohmann::json()>& json, const std::function<void()>& summary) {
+  if (context.validationErrors() > 0)
+    throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                        " error(s), above; no image was written");
+  const std::string line = a.json ? jsonText(json()) : std::string();
+  io::writePng(a.output, a.width, a.height, pixels.data());
+  if (a.json)
+    std::printf("%s\n", line.c_str());
+  else if (!a.quiet)
+    summary();
+}
+
+double perSecond(uint64_t items, double medianMs) {
+  return medianMs > 0 ? double(items) / (medianMs * 1e-3) : 0.0;
+}
+
+bool isMeshMethod(SphereMethod method) {
+  return method == SphereMethod::MeshPoints || method == SphereMethod::MeshTriangles;
+}
+
+gpu::ContextOptions contextOptions(const RenderArgs& a) {
+  gpu::ContextOptions options;
+  options.deviceIndex = a.device;
+  options.announce = !a.quiet;
+  return options;
+}
+
+std::string hashText(const std::vector<uint32_t>& pixels) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
+  return hex;
+}
+
+// The sphere options of the command line, checked before anything is read.
+SphereSettings sphereSettings(const RenderArgs& a) {
   SphereSettings settings;
   settings.method = parseSphereMethod(a.method);
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
-  if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
     throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
                      a.method);
@@ -63,7 +148,7 @@ int runRenderSpheres(const RenderArgs& a) {
     throw InputError(
         "--billboard and --conservative apply to the sphere methods that rasterize billboards (" +
         billboardMethodNames() + "), not to " + a.method);
-  bool mesh = settings.method == SphereMethod::MeshPoints || settings.method == SphereMethod::MeshTriangles;
+  const bool mesh = isMeshMethod(settings.method);
   if ((a.meshlet || a.taskCull) && !mesh)
     throw InputError("--meshlet and --task-cull apply to sphere-mesh-points and sphere-mesh-tris, not to " +
                      a.method);
@@ -73,12 +158,51 @@ int runRenderSpheres(const RenderArgs& a) {
     throw InputError("--meshlet takes " + std::to_string(shared::kSphereMeshletLarge) + " or " +
                      std::to_string(shared::kSphereMeshletSmall) + " (spheres per mesh workgroup), not " +
                      std::to_string(settings.meshlet));
-  if (std::filesystem::path(a.output).extension() != ".png")
-    throw InputError("-o " + a.output + ": the output must be a .png file");
+  return settings;
+}
+
+nlohmann::json sphereJson(const gpu::Context& context, const SphereSettings& settings, const ParticleSet& set,
+                          const GpuParticles& particles, const SphereStats& stats, const Camera& camera,
+                          const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  nlohmann::json j;
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  j["method"] = sphereMethodName(settings.method);
+  j["layout"] = particleLayoutName(particles.layout());
+  if (sphereMethodTakesBillboards(settings.method)) {
+    j["billboard"] = sphereBillboardName(settings.billboard);
+    j["conservative"] = settings.conservative;
+  }
+  if (isMeshMethod(settings.method)) {
+    j["meshlet"] = settings.meshlet;
+    j["task_cull"] = settings.taskCull;
+  }
+  if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
+  j["input"] = set.source;
+  j["particles"] = stats.particles;
+  j["width"] = a.width;
+  j["height"] = a.height;
+  j["frames"] = stats.frames;
+  j["median_ms"] = stats.medianMs;
+  j["min_ms"] = stats.minMs;
+  j["max_ms"] = stats.maxMs;
+  j["particles_per_second"] = perSecond(stats.particles, stats.medianMs);
+  j["large_chunks"] = stats.largeChunks;
+  j["spilled_spheres"] = stats.spilledSpheres;
+  j["clamped_spheres"] = stats.clampedSpheres;
+  j["camera"] = describeCamera(camera);
+  j["image_hash"] = hashText(pixels);
+  j["output"] = a.output;
+  return j;
+}
+
+// The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
+// as spheres of --radius, through the SphereRenderer.
+int runRenderSpheres(const RenderArgs& a) {
+  const SphereSettings settings = sphereSettings(a);
   ParticleUploadOptions upload;
   upload.progress = !a.quiet;
   if (a.layout != "auto") upload.layout = parseParticleLayout(a.layout);
-  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
 
   ParticleInputSpec spec;
   spec.source = a.input;
@@ -87,83 +211,37 @@ int runRenderSpheres(const RenderArgs& a) {
   spec.particles = parseCount(a.points, "--points");
   spec.seed = a.seed;
   spec.progress = !a.quiet;
-  ParticleSet set = loadParticles(spec);
+  const ParticleSet set = loadParticles(spec);
   std::string why;
   if (upload.layout && !layoutHolds(*upload.layout, set, &why)) throw InputError(why);
-  Bounds bounds = sphereBounds(set);
-  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
-  if (!a.eye.empty()) {
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
-    camera.up = parseVec3(a.up, "--up");
-  }
-  camera.nearW = a.nearW;
-  validateCamera(camera);
+  const Camera camera = renderCamera(a, sphereBounds(set), set.source);
 
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
+  gpu::Context context(contextOptions(a));
   if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the upload
   SphereRenderer renderer(context, a.width, a.height);
   GpuParticles particles(context, set, upload);
-  SphereStats stats = renderer.render(particles, camera, settings);
-  std::vector<uint32_t> pixels = renderer.image();
-  if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
-  io::writePng(a.output, a.width, a.height, pixels.data());
-  double perSecond = stats.medianMs > 0 ? double(stats.particles) / (stats.medianMs * 1e-3) : 0.0;
-  if (a.json) {
-    nlohmann::json j;
-    j["device"] = context.info().name;
-    j["device_type"] = context.info().typeName;
-    j["method"] = sphereMethodName(settings.method);
-    j["layout"] = particleLayoutName(particles.layout());
-    if (sphereMethodTakesBillboards(settings.method)) {
-      j["billboard"] = sphereBillboardName(settings.billboard);
-      j["conservative"] = settings.conservative;
-    }
-    if (mesh) {
-      j["meshlet"] = settings.meshlet;
-      j["task_cull"] = settings.taskCull;
-    }
-    if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
-    j["input"] = set.source;
-    j["particles"] = stats.particles;
-    j["width"] = a.width;
-    j["height"] = a.height;
-    j["frames"] = stats.frames;
-    j["median_ms"] = stats.medianMs;
-    j["min_ms"] = stats.minMs;
-    j["max_ms"] = stats.maxMs;
-    j["particles_per_second"] = perSecond;
-    j["large_chunks"] = stats.largeChunks;
-    j["spilled_spheres"] = stats.spilledSpheres;
-    j["clamped_spheres"] = stats.clampedSpheres;
-    j["camera"] = describeCamera(camera);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx",
-                  static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
-    j["image_hash"] = hex;
-    j["output"] = a.output;
-    std::printf("%s\n", j.dump().c_str());
-  } else if (!a.quiet) {
-    std::printf("%s: %s particles (%s), %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
-                "particles/s\n",
-                a.output.c_str(), humanCount(double(stats.particles)).c_str(),
-                particleLayoutName(particles.layout()), a.width, a.height, sphereMethodName(settings.method),
-                stats.medianMs, stats.frames, stats.minMs, stats.maxMs, humanCount(perSecond).c_str());
-    if (settings.method == SphereMethod::RayTracing)
-      std::printf("  acceleration structures built in %.3f ms of GPU time (not in the frame times)\n",
-                  stats.buildMs);
-  }
+  const SphereStats stats = renderer.render(particles, camera, settings);
+  const std::vector<uint32_t> pixels = renderer.image();
+  finishImage(
+      a, context, pixels,
+      [&] { return sphereJson(context, settings, set, particles, stats, camera, a, pixels); },
+      [&] {
+        std::printf(
+            "%s: %s particles (%s), %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
+            "particles/s\n",
+            a.output.c_str(), humanCount(double(stats.particles)).c_str(),
+            particleLayoutName(particles.layout()), a.width, a.height, sphereMethodName(settings.method),
+            stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+            humanCount(perSecond(stats.particles, stats.medianMs)).c_str());
+        if (settings.method == SphereMethod::RayTracing)
+          std::printf("  acceleration structures built in %.3f ms of GPU time (not in the frame times)\n",
+                      stats.buildMs);
+      });
   return 0;
 }
 
-int runRender(const RenderArgs& a) {
-  Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
-  if (isSphereMethodName(a.method)) return runRenderSpheres(a);
+// The point-method options of the command line, checked before anything is read.
+RenderSettings pointSettings(const RenderArgs& a) {
   if (!a.billboard.empty() || a.conservative)
     throw InputError("--billboard and --conservative apply to the sphere methods (" + billboardMethodNames() +
                      ")");
@@ -172,69 +250,35 @@ int runRender(const RenderArgs& a) {
   if (a.method.rfind("sphere-", 0) == 0) parseSphereMethod(a.method); // throws, naming the sphere methods
   if (isParticleSceneName(a.input) || std::filesystem::path(a.input).extension() == ".mmpld")
     throw InputError(a.input + " holds particles: draw them with a sphere method (--method sphere-compute)");
-  InputSpec spec;
-  spec.source = a.input;
-  spec.points = parseCount(a.points, "--points");
-  spec.seed = a.seed;
-  spec.order = parseOrder(a.order);
-  spec.progress = !a.quiet;
   RenderSettings settings;
   settings.method = parseMethod(a.method);
   settings.depth = parseDepthMode(a.depth);
   settings.precision = parsePrecision(a.precision);
-  const SceneLayout layout = methodInfo(settings.method).layout;
-  if (settings.precision != 0 && layout != SceneLayout::Batched)
+  if (settings.precision != 0 && settings.method.info().layout != SceneLayout::Batched)
     throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
                      ")");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
-  if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.parts == 0) throw InputError("--parts must be at least 1");
-  if (std::filesystem::path(a.output).extension() != ".png")
-    throw InputError("-o " + a.output + ": the output must be a .png file");
-  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  return settings;
+}
 
-  Camera camera;
-  bool explicitCamera = !a.eye.empty();
-  if (!a.target.empty() && !explicitCamera) throw InputError("--target needs --eye");
-  if (explicitCamera) {
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.up = parseVec3(a.up, "--up");
-    camera.fovY = a.fov;
-    camera.nearW = a.nearW;
-  }
-
-  PointCloud cloud = loadInput(spec);
-  double aspect = double(a.width) / double(a.height);
-  if (explicitCamera) {
-    camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
-  } else {
-    camera = overviewCamera(cloud.bounds, aspect, a.fov);
-    camera.nearW = a.nearW;
-  }
-  validateCamera(camera);
-
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
-  Renderer renderer(context, a.width, a.height);
-
-  // --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image
-  // as one upload (the atomic min does not care which dispatch a point came from).
-  std::vector<std::unique_ptr<GpuScene>> scenes;
-  uint64_t perPart = (cloud.size() + a.parts - 1) / a.parts;
+// --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image as one
+// upload (the atomic min does not care which dispatch a point came from).
+std::vector<std::unique_ptr<GpuScene>> uploadParts(gpu::Context& context, const PointCloud& cloud,
+                                                   SceneLayout layout, const RenderArgs& a) {
+  const uint64_t perPart = (cloud.size() + a.parts - 1) / a.parts;
   if (layout == SceneLayout::Batched && perPart > 0) {
     // Said before uploading: the batch methods address 64 parts of a frame (4.29 billion points).
-    uint64_t capacity =
+    const uint64_t capacity =
         partCapacity(layout, 0, std::min(context.maxAllocationSize(), context.maxBufferSize()));
-    uint64_t parts = capacity ? uint64_t(a.parts) * ((perPart + capacity - 1) / capacity) : 0;
+    const uint64_t parts = capacity ? uint64_t(a.parts) * ((perPart + capacity - 1) / capacity) : 0;
     if (parts > shared::kMaxVisibilityParts)
       throw InputError(cloud.source + " needs " + std::to_string(parts) +
-                       " parts on this device; the batch methods "
-                       "draw at most " +
+                       " parts on this device; the batch methods draw at most " +
                        std::to_string(shared::kMaxVisibilityParts) + " (4.29 billion points) per frame");
   }
+  std::vector<std::unique_ptr<GpuScene>> scenes;
   for (uint32_t p = 0; p < a.parts; ++p) {
     UploadOptions upload;
     upload.first = uint64_t(p) * perPart;
@@ -243,61 +287,79 @@ int runRender(const RenderArgs& a) {
     upload.progress = !a.quiet;
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
-  std::vector<const GpuScene*> drawn;
-  for (auto& s : scenes)
-    drawn.push_back(s.get());
-  FrameStats stats = renderer.render(drawn, camera, settings);
-  std::vector<uint32_t> pixels = renderer.image();
-  io::writePng(a.output, a.width, a.height, pixels.data());
-  uint64_t hash = imageHash(pixels.data(), pixels.size());
+  return scenes;
+}
 
-  if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
-  if (a.json) {
-    nlohmann::json j;
-    j["device"] = context.info().name;
-    j["device_type"] = context.info().typeName;
-    j["method"] = methodName(settings.method);
-    j["depth"] = depthModeName(settings.depth);
-    j["input"] = cloud.source;
-    j["points"] = stats.points;
-    j["order"] = orderName(spec.order);
-    j["width"] = a.width;
-    j["height"] = a.height;
-    j["frames"] = stats.frames;
-    j["median_ms"] = stats.medianMs;
-    j["min_ms"] = stats.minMs;
-    j["max_ms"] = stats.maxMs;
-    j["points_per_second"] = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
-    j["parts"] = a.parts;
-    if (stats.batch) {
-      j["precision"] = a.precision;
-      j["batch_stats"] = bench::batchStatsJson(*stats.batch);
-    }
-    j["camera"] = describeCamera(camera);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-    j["image_hash"] = hex;
-    j["output"] = a.output;
-    std::printf("%s\n", j.dump().c_str());
-  } else if (!a.quiet) {
-    std::printf(
-        "%s: %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s points/s\n",
-        a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
-        methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
-        humanCount(stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0).c_str());
-    if (stats.batch) {
-      const BatchStats& b = *stats.batch;
-      std::printf(
-          "  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), %s "
-          "rendered\n",
-          (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
-          humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
-          humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
-          humanCount(double(b.pointsRendered)).c_str());
-    }
+nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& settings, const PointCloud& cloud,
+                         Order order, const FrameStats& stats, const Camera& camera, const RenderArgs& a,
+                         const std::vector<uint32_t>& pixels) {
+  nlohmann::json j;
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  j["method"] = methodName(settings.method);
+  j["depth"] = depthModeName(settings.depth);
+  j["input"] = cloud.source;
+  j["points"] = stats.points;
+  j["order"] = orderName(order);
+  j["width"] = a.width;
+  j["height"] = a.height;
+  j["frames"] = stats.frames;
+  j["median_ms"] = stats.medianMs;
+  j["min_ms"] = stats.minMs;
+  j["max_ms"] = stats.maxMs;
+  j["points_per_second"] = perSecond(stats.points, stats.medianMs);
+  j["parts"] = a.parts;
+  if (stats.batch) {
+    j["precision"] = a.precision;
+    j["batch_stats"] = bench::batchStatsJson(*stats.batch);
   }
+  j["camera"] = describeCamera(camera);
+  j["image_hash"] = hashText(pixels);
+  j["output"] = a.output;
+  return j;
+}
+
+void printPointSummary(const RenderArgs& a, const RenderSettings& settings, const FrameStats& stats) {
+  std::printf("%s: %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s points/s\n",
+              a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
+              methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+              humanCount(perSecond(stats.points, stats.medianMs)).c_str());
+  if (!stats.batch) return;
+  const BatchStats& b = *stats.batch;
+  std::printf("  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), %s "
+              "rendered\n",
+              (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
+              humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
+              humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
+              humanCount(double(b.pointsRendered)).c_str());
+}
+
+int runRender(const RenderArgs& a) {
+  Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
+  checkCommonArgs(a);
+  if (isSphereMethodName(a.method)) return runRenderSpheres(a);
+  const RenderSettings settings = pointSettings(a);
+  InputSpec spec;
+  spec.source = a.input;
+  spec.points = parseCount(a.points, "--points");
+  spec.seed = a.seed;
+  spec.order = parseOrder(a.order);
+  spec.progress = !a.quiet;
+
+  const PointCloud cloud = loadInput(spec);
+  const Camera camera = renderCamera(a, cloud.bounds, cloud.source);
+  gpu::Context context(contextOptions(a));
+  Renderer renderer(context, a.width, a.height);
+  const auto scenes = uploadParts(context, cloud, settings.method.info().layout, a);
+  std::vector<const GpuScene*> drawn;
+  for (const auto& scene : scenes)
+    drawn.push_back(scene.get());
+  const FrameStats stats = renderer.render(drawn, camera, settings);
+  const std::vector<uint32_t> pixels = renderer.image();
+  finishImage(
+      a, context, pixels,
+      [&] { return pointJson(context, settings, cloud, spec.order, stats, camera, a, pixels); },
+      [&] { printPointSummary(a, settings, stats); });
   return 0;
 }
 

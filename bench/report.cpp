@@ -316,6 +316,12 @@ std::string svgBars(const BarChart& chart) {
   return s.str();
 }
 
+// A report's JSON, indented; text that is not UTF-8 (a file name in another encoding) is replaced rather
+// than failing the report of a finished run.
+std::string jsonFileText(const nlohmann::json& j) {
+  return j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
 // Writes the three files of a report through ".partial" files renamed into place; everything is rendered
 // by the caller before the first file is written, so a failure leaves no mixed set.
 WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::string& name,
@@ -585,7 +591,7 @@ std::string svgChart(const BenchRun& run, const ReportInfo& info) {
 }
 
 WrittenFiles writeReports(const BenchRun& run, const ReportInfo& info, const std::filesystem::path& dir) {
-  return writeReportFiles(dir, info.name, runJson(run, info).dump(1) + "\n", markdownReport(run, info),
+  return writeReportFiles(dir, info.name, jsonFileText(runJson(run, info)), markdownReport(run, info),
                           svgChart(run, info));
 }
 
@@ -928,7 +934,7 @@ std::string sphereSvgChart(const SphereBenchRun& run, const ReportInfo& info) {
 
 WrittenFiles writeSphereReports(const SphereBenchRun& run, const ReportInfo& info,
                                 const std::filesystem::path& dir) {
-  return writeReportFiles(dir, info.name, sphereRunJson(run, info).dump(1) + "\n",
+  return writeReportFiles(dir, info.name, jsonFileText(sphereRunJson(run, info)),
                           sphereMarkdownReport(run, info), sphereSvgChart(run, info));
 }
 

@@ -177,6 +177,7 @@ Context::Context(const ContextOptions& options) {
       info.pfnUserCallback = &Context::debugCallback;
       info.pUserData = this;
       VK_CHECK(vkCreateDebugUtilsMessengerEXT(instance_, &info, nullptr, &messenger_));
+      if (envFlag("POINTRAST_INJECT_VALIDATION_ERROR")) injectValidationError();
     }
     chooseDevice(options);
     createDevice();
@@ -210,6 +211,15 @@ void Context::destroy() {
   messenger_ = VK_NULL_HANDLE;
   if (instance_) vkDestroyInstance(instance_, nullptr);
   instance_ = VK_NULL_HANDLE;
+}
+
+void Context::injectValidationError() {
+  VkDebugUtilsMessengerCallbackDataEXT data{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CALLBACK_DATA_EXT};
+  data.pMessageIdName = "pointrast-injected";
+  data.pMessage = "an error injected by POINTRAST_INJECT_VALIDATION_ERROR (a test of what follows one)";
+  if (vkSubmitDebugUtilsMessageEXT)
+    vkSubmitDebugUtilsMessageEXT(instance_, VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+                                 VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT, &data);
 }
 
 VkBool32 VKAPI_PTR Context::debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,

@@ -22,7 +22,8 @@
 
 // From VK_EXT_debug_utils: may be null when the extension is missing.
 #define PR_VK_DEBUG_FUNCTIONS(X) \
-  X(vkCreateDebugUtilsMessengerEXT) X(vkDestroyDebugUtilsMessengerEXT) X(vkSetDebugUtilsObjectNameEXT)
+  X(vkCreateDebugUtilsMessengerEXT) X(vkDestroyDebugUtilsMessengerEXT) X(vkSetDebugUtilsObjectNameEXT) \
+  X(vkSubmitDebugUtilsMessageEXT)
 
 #define PR_VK_DEVICE_FUNCTIONS(X) \
   X(vkDestroyDevice) X(vkGetDeviceQueue) X(vkDeviceWaitIdle) X(vkQueueSubmit) X(vkQueueWaitIdle) \
