@@ -126,6 +126,17 @@ gpu::ContextOptions contextOptions(const RenderArgs& a) {
   return options;
 }
 
+// The image size, the frames and their GPU times, as both kinds of render report them.
+void addTimes(nlohmann::json& j, const RenderArgs& a, uint32_t frames, double medianMs, double minMs,
+              double maxMs) {
+  j["width"] = a.width;
+  j["height"] = a.height;
+  j["frames"] = frames;
+  j["median_ms"] = medianMs;
+  j["min_ms"] = minMs;
+  j["max_ms"] = maxMs;
+}
+
 std::string hashText(const std::vector<uint32_t>& pixels) {
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
@@ -180,12 +191,7 @@ nlohmann::json sphereJson(const gpu::Context& context, const SphereSettings& set
   if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
   j["input"] = set.source;
   j["particles"] = stats.particles;
-  j["width"] = a.width;
-  j["height"] = a.height;
-  j["frames"] = stats.frames;
-  j["median_ms"] = stats.medianMs;
-  j["min_ms"] = stats.minMs;
-  j["max_ms"] = stats.maxMs;
+  addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
   j["particles_per_second"] = perSecond(stats.particles, stats.medianMs);
   j["large_chunks"] = stats.largeChunks;
   j["spilled_spheres"] = stats.spilledSpheres;
@@ -301,12 +307,7 @@ nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& sett
   j["input"] = cloud.source;
   j["points"] = stats.points;
   j["order"] = orderName(order);
-  j["width"] = a.width;
-  j["height"] = a.height;
-  j["frames"] = stats.frames;
-  j["median_ms"] = stats.medianMs;
-  j["min_ms"] = stats.minMs;
-  j["max_ms"] = stats.maxMs;
+  addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
   j["points_per_second"] = perSecond(stats.points, stats.medianMs);
   j["parts"] = a.parts;
   if (stats.batch) {
