@@ -152,7 +152,7 @@ int mmpldInfo(const InfoArgs& a, const io::FormatInfo& format) {
 int runInfo(const InfoArgs& a) {
   if (a.devices) return listDevicesCommand(a.json);
   if (a.input.empty()) throw InputError("info needs a FILE (or --devices)");
-  if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file");
+  if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file or folder");
   const io::FormatInfo* format = io::detectFormat(a.input);
   if (format && format->content == io::FormatContent::Particles) return mmpldInfo(a, *format);
   io::FileInfo info = io::probeFile(a.input);
@@ -210,7 +210,7 @@ std::string formatHelp() {
     if (f.openNodes) what += std::string(what.empty() ? "" : ", ") + "level-of-detail octree";
     if (what.empty()) what = "recognised, not read (says why)";
     char line[160];
-    std::snprintf(line, sizeof line, "  %-7s %-22s %s\n", f.name, *f.extensions ? f.extensions : "(folder)",
+    std::snprintf(line, sizeof line, "  %-11s %-20s %s\n", f.name, *f.extensions ? f.extensions : "(folder)",
                   what.c_str());
     help += line;
   }
@@ -227,14 +227,16 @@ Command addInfo(CLI::App& app) {
       "\nReads the header (and for LAS the color values, to tell 8-bit from 16-bit color). For MMPLD\n"
       "particle files: the version, frames, each list of one frame (vertex and color type, count,\n"
       "global radius or color, intensity range), then from a pass over its particles how many are\n"
-      "usable, the bounds of their centers and the radius range.\n"
+      "usable, the bounds of their centers and the radius range. For a level-of-detail octree: points,\n"
+      "nodes, depth, spacing, attributes, encoding, bounds and its writer.\n"
       "\nFormats (recognised by their content; text formats, which have no signature, by extension):\n" +
       formatHelp() +
       "\nExamples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n"
-      "  pointrast info particles.mmpld --frame 3\n  pointrast info --devices");
+      "  pointrast info particles.mmpld --frame 3\n  pointrast info octree/\n  pointrast info --devices");
   cmd->add_option("FILE", a->input,
                   "A point cloud (" + io::formatList(io::FormatUse::Cloud) + ") or particle (" +
-                      io::formatList(io::FormatUse::Particles) + ") file");
+                      io::formatList(io::FormatUse::Particles) + ") file, or an octree folder (" +
+                      io::formatList(io::FormatUse::Octree) + ")");
   cmd->add_option("--frame", a->frame, "MMPLD: the frame to describe")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");

@@ -25,6 +25,7 @@
 #include "io/writer.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
+#include "render_path.h"
 
 namespace pointrast::app {
 
@@ -46,12 +47,21 @@ struct RenderArgs {
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
+  PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
 };
 
 // What every render checks before reading anything: the output, the image size, the frames, and the camera
 // options a user gave, each named.
 void checkCommonArgs(const RenderArgs& a) {
-  if (std::filesystem::path(a.output).extension() != ".png")
+  // -o is the single image; --path renders a camera path into --video or --frames-dir instead.
+  const bool pathMode = !a.path.path.empty();
+  if (!pathMode && (!a.path.video.empty() || !a.path.framesDir.empty()))
+    throw InputError("--video and --frames-dir need --path (a camera path)");
+  if (pathMode == !a.output.empty())
+    throw InputError(pathMode ? "--path replaces -o: give one of them" : "-o is required");
+  if (pathMode && isSphereMethodName(a.method))
+    throw InputError("--path renders the point methods, not " + a.method);
+  if (!pathMode && std::filesystem::path(a.output).extension() != ".png")
     throw InputError("-o " + a.output + ": the output must be a .png file");
   if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -340,6 +350,8 @@ int runRender(const RenderArgs& a) {
   checkCommonArgs(a);
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
   const RenderSettings settings = pointSettings(a);
+  view::CameraPath cameraPath;
+  if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
   InputSpec spec;
   spec.source = a.input;
   spec.points = parseCount(a.points, "--points");
@@ -355,6 +367,10 @@ int runRender(const RenderArgs& a) {
   std::vector<const GpuScene*> drawn;
   for (const auto& scene : scenes)
     drawn.push_back(scene.get());
+  if (!a.path.path.empty()) {
+    if (cameraPath.empty()) cameraPath = view::orbitPath(camera);
+    return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
+  }
   const FrameStats stats = renderer.render(drawn, camera, settings);
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(
@@ -404,6 +420,7 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
       "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
       "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
+      "  pointrast render autzen.las --path path.json --video fly.mp4 --fps 60 --width 3840 --height 2160\n"
       "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
       std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
       sphereMethodList() + "The pipelines that rasterize billboards (" + billboardMethodNames() +
@@ -416,7 +433,7 @@ Command addRender(CLI::App& app) {
   cmd->add_option("FILE", a->input,
                   "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + "), particle file (" +
                       io::formatList(io::FormatUse::Particles) + ") or a scene name (terrain, tls)");
-  cmd->add_option("-o,--output", a->output, "PNG to write")->required();
+  cmd->add_option("-o,--output", a->output, "PNG to write (required unless --path)");
   cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
   cmd->add_option("--height", a->height, "Image height in pixels")->capture_default_str();
   cmd->add_option("--eye", a->eye, "Camera position x,y,z (default: overview)");
@@ -469,6 +486,7 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");
+  addPathOptions(*cmd, a->path);
   return [a] { return runRender(*a); };
 }
 

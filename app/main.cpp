@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   app::Command convert = app::addConvert(app);
   app::Command generate = app::addGenerate(app);
   app::Command bench = app::addBench(app);
+  app::Command view = app::addView(app);
 
   try {
     app.parse(argc, argv);
@@ -53,6 +54,7 @@ int main(int argc, char** argv) {
       if (sub->get_name() == "convert") return convert();
       if (sub->get_name() == "generate") return generate();
       if (sub->get_name() == "bench") return bench();
+      if (sub->get_name() == "view") return view();
     }
     return 1;
   } catch (const InputError& e) {

@@ -93,8 +93,8 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
   VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
   multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
   VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-  depth.depthTestEnable = VK_TRUE;
-  depth.depthWriteEnable = VK_TRUE;
+  depth.depthTestEnable = options.depthFormat != VK_FORMAT_UNDEFINED;
+  depth.depthWriteEnable = depth.depthTestEnable;
   depth.depthCompareOp = options.depthCompare;
   VkFormat colorFormats[2] = {options.colorFormat, options.secondColorFormat};
   uint32_t colorCount = options.secondColorFormat == VK_FORMAT_UNDEFINED ? 1 : 2;
@@ -102,6 +102,16 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
   for (VkPipelineColorBlendAttachmentState& b : blendAttachments)
     b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
                        VK_COLOR_COMPONENT_A_BIT;
+  if (options.blend) {
+    VkPipelineColorBlendAttachmentState& b = blendAttachments[0];
+    b.blendEnable = VK_TRUE;
+    b.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+    b.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.colorBlendOp = VK_BLEND_OP_ADD;
+    b.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.alphaBlendOp = VK_BLEND_OP_ADD;
+  }
   VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   blend.attachmentCount = colorCount;
   blend.pAttachments = blendAttachments;

@@ -25,7 +25,7 @@ class Context;
 struct GraphicsOptions {
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_POINT_LIST;
   VkFormat colorFormat = VK_FORMAT_R8G8B8A8_UNORM;
-  VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
+  VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;   // UNDEFINED: no depth attachment, no depth test
   VkCompareOp depthCompare = VK_COMPARE_OP_LESS; // with depth writes; GREATER for reverse-Z
   // A geometry shader between vertex and fragment shader; empty for none (needs the geometryShader
   // feature, DeviceFeatures::geometryShader).
@@ -38,6 +38,8 @@ struct GraphicsOptions {
   // primitive touches gets a fragment, not only those whose center it covers. Needs
   // DeviceFeatures::conservativeRasterization, and conservativePoints for a point list drawn as points.
   bool conservative = false;
+  // Alpha blending of the (first) color attachment: SRC_ALPHA, ONE_MINUS_SRC_ALPHA (overlays, the panel).
+  bool blend = false;
   // A mesh pipeline (VK_EXT_mesh_shader, DeviceFeatures::meshShader): the first shader named is a mesh
   // shader instead of a vertex shader, preceded by taskShader unless empty (DeviceFeatures::taskShader).
   // No vertex input or input assembly; draw with drawMeshTasks. `topology` then names the list of the

@@ -10,6 +10,7 @@
 #include "io/io_util.h"
 #include "io/las_format.h"
 #include "io/point_source.h"
+#include "io/potree.h"
 
 namespace pointrast::io {
 
@@ -39,6 +40,11 @@ bool isMmpldFile(const FormatProbe& input) {
   return startsWith(input, std::string_view("MMPLD\0", 6));
 }
 
+// A Potree 2.0 octree: its folder, or the metadata.json in it.
+bool isPotree(const FormatProbe& input) {
+  return looksLikePotree(input.path);
+}
+
 void refuseParticles(const std::filesystem::path& path) {
   fail(path, "an MMPLD file holds particles (spheres), not a point cloud; `pointrast info` and the sphere "
              "renderers read it");
@@ -51,6 +57,7 @@ constexpr FormatInfo kFormats[] = {
   {"LAZ",   ".laz",                   FormatContent::Points,    isLazFile,   nullptr, nullptr,  nullptr,   nullptr,  failCompressed},
   {"PLY",   ".ply",                   FormatContent::Points,    isPlyFile,   readPly, probePly, nullptr,   nullptr,  nullptr},
   {"XYZ",   ".xyz .txt .csv .pts",    FormatContent::Points,    nullptr,     readXyz, probeXyz, nullptr,   nullptr,  nullptr},
+  {"Potree 2.0", "",                  FormatContent::Points,    isPotree,    readPotree, probePotreeFolder, nullptr, openPotree, nullptr},
   {"MMPLD", ".mmpld",                 FormatContent::Particles, isMmpldFile, nullptr, nullptr,  nullptr,   nullptr,  refuseParticles},
 };
 // clang-format on

@@ -12,6 +12,7 @@ namespace pointrast::io::detail {
 FileInfo probeLas(const std::filesystem::path& path);
 FileInfo probePly(const std::filesystem::path& path);
 FileInfo probeXyz(const std::filesystem::path& path);
+FileInfo probePotreeFolder(const std::filesystem::path& path);
 
 // "not a LAS, LAZ, ... file (unrecognised content and extension)", naming every row.
 std::string unrecognisedFormatText();

@@ -41,5 +41,7 @@ FileInfo probeFile(const std::filesystem::path& path);
 PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options = {});
 PointCloud readPly(const std::filesystem::path& path, const ReadOptions& options = {});
 PointCloud readXyz(const std::filesystem::path& path, const ReadOptions& options = {});
+// Every point of a Potree 2.0 octree (its folder or metadata.json), nodes decoded on all cores.
+PointCloud readPotree(const std::filesystem::path& path, const ReadOptions& options = {});
 
 } // namespace pointrast::io

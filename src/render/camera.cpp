@@ -15,11 +15,15 @@ double defaultNear(const Bounds& bounds) {
 }
 
 Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
+  return framingCamera(bounds, aspect, fovY, glm::normalize(glm::dvec3(-1, -1, 1)), {0, 0, 1});
+}
+
+Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm::dvec3& back,
+                     const glm::dvec3& up) {
   Camera camera;
   camera.fovY = fovY;
-  camera.up = {0, 0, 1};
-  glm::dvec3 back = glm::normalize(glm::dvec3(-1, -1, 1)); // from the target towards the eye
-  if (bounds.empty()) {
+  camera.up = up;
+  if (bounds.empty()) { // a cloud without points: the same view of the origin
     camera.target = glm::dvec3(0);
     camera.eye = back;
     return camera;
@@ -40,8 +44,9 @@ Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
     distance = std::max(
         {distance, std::abs(glm::dot(v, right)) / tanX + along, std::abs(glm::dot(v, upv)) / tanY + along});
   }
-  // Keep every corner in front of the eye even for degenerate (flat or single-point) bounds, and the eye a
-  // billion steps of double precision away from the center however far that lies from the origin.
+  // Keep every corner in front of the eye even for degenerate (flat or single-point) bounds, and the eye
+  // 1e-7 of the coordinates' magnitude (some 10^8 steps of double precision) away from the center however
+  // far that lies from the origin.
   const double magnitude = std::max(glm::length(bounds.min), glm::length(bounds.max));
   distance = std::max(distance * 1.05, deepest + 1e-3 * bounds.diagonal() + std::max(1e-6, 1e-7 * magnitude));
   camera.target = center;

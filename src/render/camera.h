@@ -34,6 +34,12 @@ constexpr double kMaxCoordinate = 1e15;
 // bounds pass.
 void checkCoordinateRange(const Bounds& bounds, const std::string& source);
 
+// The same framing from any direction: looking at the center of the bounds along -back (unit vector from
+// the target towards the eye) with the given up (not parallel to back), at the smallest distance that
+// keeps all eight corners in the image, plus 5 %. Views from the axes and "frame all" in the viewer.
+Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm::dvec3& back,
+                     const glm::dvec3& up);
+
 // 1e-5 of the bounds' diagonal (at least 1e-9): far below any visible point, so it only drops points
 // at or behind the eye.
 double defaultNear(const Bounds& bounds);

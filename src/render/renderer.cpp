@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
 #include "base/error.h"
@@ -217,6 +218,22 @@ std::vector<uint64_t> Renderer::framebufferWords() {
   std::vector<uint64_t> words(targets_->pixels());
   gpu::readBuffer(context_, targets_->words, 0, words.data(), words.size() * 8);
   return words;
+}
+
+std::vector<uint64_t> Renderer::framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h) {
+  assert(uint64_t(x) + w <= targets_->width && uint64_t(y) + h <= targets_->height && "outside the image");
+  if (!wordsCaptured_)
+    throw InputError("no canonical framebuffer words: the last frame was not rendered with captureWords by a "
+                     "closest-point method");
+  std::vector<uint64_t> words(uint64_t(w) * h);
+  for (uint32_t row = 0; row < h; ++row)
+    gpu::readBuffer(context_, targets_->words, ((uint64_t(y) + row) * targets_->width + x) * 8,
+                    words.data() + uint64_t(row) * w, uint64_t(w) * 8);
+  return words;
+}
+
+uint64_t Renderer::imageAddress() const {
+  return targets_->image.address();
 }
 
 } // namespace pointrast

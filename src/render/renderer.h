@@ -92,6 +92,12 @@ public:
   // Canonical words (depth << 32 | color, all ones where empty) of the last frame rendered with
   // captureWords; for closest-point methods only.
   std::vector<uint64_t> framebufferWords();
+  // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
+  // reads to pick the point under the cursor.
+  std::vector<uint64_t> framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h);
+  // Device address of the RGBA8 image of the last frame (width() x height() words, row 0 at the top), for
+  // front ends that show it without a copy to the host. Valid until the Renderer is destroyed.
+  uint64_t imageAddress() const;
 
   uint32_t width() const;
   uint32_t height() const;
