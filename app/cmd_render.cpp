@@ -14,8 +14,12 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "base/text.h"
+#include "bench/lod_report.h"
 #include "bench/report.h"
 #include "cli_util.h"
+#include "cloud/attribute_colors.h"
+#include "cloud/generate.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
 #include "gpu/context.h"
@@ -23,6 +27,7 @@
 #include "input.h"
 #include "io/format_table.h"
 #include "io/writer.h"
+#include "render/lod/lod_scene.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
 #include "render_path.h"
@@ -35,6 +40,10 @@ struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
   std::string precision = "adaptive"; // batch methods
+  double minNodePx = 100;             // LOD methods
+  std::string pointBudget = "0";      // LOD methods; 0: no limit
+  std::string gpuMemory;              // LOD methods: node cache budget; empty: half the device
+  bool lodOptionsGiven = false;       // one of the three above was given
   std::string layout = "auto";        // sphere methods
   std::string billboard;              // sphere methods that rasterize billboards; empty: screen
   bool conservative = false;          // the same: VK_EXT_conservative_rasterization
@@ -48,6 +57,13 @@ struct RenderArgs {
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
   PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
+  // Point methods: coloring and the resolve stage.
+  std::string color = "auto", colorRange;
+  float pointSize = 1, pointSizeMax = 16;
+  std::string pointShape = "square", pointSizeMode = "fixed";
+  uint32_t dilate = 0;
+  bool edl = false;
+  std::optional<float> edlStrength, edlRadius;
 };
 
 // What every render checks before reading anything: the output, the image size, the frames, and the camera
@@ -154,6 +170,63 @@ std::string hashText(const std::vector<uint32_t>& pixels) {
   return hex;
 }
 
+// Whether any option of the resolve stage or of coloring was given (the sphere methods take none).
+bool postOrColorGiven(const RenderArgs& a) {
+  return a.color != "auto" || !a.colorRange.empty() || a.pointSize != 1 || a.pointSizeMax != 16 ||
+         a.pointShape != "square" || a.pointSizeMode != "fixed" || a.dilate != 0 || a.edl || a.edlStrength ||
+         a.edlRadius;
+}
+
+// --point-size, --point-shape, --point-size-mode, --point-size-max, --dilate, --edl*.
+PostSettings postSettings(const RenderArgs& a) {
+  PostSettings post;
+  post.pointSize = a.pointSize;
+  post.shape = parsePointShape(a.pointShape);
+  post.sizeMode = parsePointSizeMode(a.pointSizeMode);
+  post.maxPointSize = a.pointSizeMax;
+  post.dilate = a.dilate;
+  // --edl-strength or --edl-radius alone turn eye-dome lighting on, with Potree's defaults for the other.
+  if (a.edl || a.edlStrength || a.edlRadius) {
+    post.edlStrength = a.edlStrength.value_or(1.0f);
+    post.edlRadius = a.edlRadius.value_or(post.edlRadius);
+  }
+  validatePostSettings(post);
+  return post;
+}
+
+// --color and --color-range: nullopt for auto (displayColorMode's choice).
+std::optional<DisplayColorMode> colorMode(const RenderArgs& a, const PointCloud& cloud) {
+  if (a.color == "auto") {
+    if (!a.colorRange.empty()) throw InputError("--color-range applies to --color intensity and elevation");
+    return std::nullopt;
+  }
+  DisplayColorMode::Source source = parseColorSource(a.color);
+  std::optional<ColorRange> range;
+  if (!a.colorRange.empty()) {
+    if (source != DisplayColorMode::Source::Intensity && source != DisplayColorMode::Source::Elevation)
+      throw InputError("--color-range applies to --color intensity and elevation, not " + a.color);
+    auto [lo, hi] = parseRange(a.colorRange, "--color-range");
+    range = ColorRange{lo, hi};
+  }
+  return displayColorMode(cloud, source, range);
+}
+
+// The resolve stage's settings and per-pass GPU times.
+nlohmann::json postJson(const PostSettings& post, const PostStats& stats) {
+  nlohmann::json j;
+  j["point_size"] = post.pointSize;
+  j["point_shape"] = pointShapeName(post.shape);
+  j["point_size_mode"] = pointSizeModeName(post.sizeMode);
+  if (post.sizeMode == PointSizeMode::Attenuated) j["point_size_max"] = post.maxPointSize;
+  j["dilate"] = post.dilate;
+  j["edl_strength"] = post.edlStrength;
+  if (post.edlStrength > 0) j["edl_radius"] = post.edlRadius;
+  j["splat_ms"] = stats.splatMs;
+  j["dilate_ms"] = stats.dilateMs;
+  j["compose_ms"] = stats.composeMs;
+  return j;
+}
+
 // The sphere options of the command line, checked before anything is read.
 SphereSettings sphereSettings(const RenderArgs& a) {
   SphereSettings settings;
@@ -162,6 +235,9 @@ SphereSettings sphereSettings(const RenderArgs& a) {
   settings.frames = a.frames;
   if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
     throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
+                     a.method);
+  if (postOrColorGiven(a))
+    throw InputError("--color, --point-size, --dilate and --edl apply to the point methods, not to " +
                      a.method);
   if (!a.billboard.empty()) settings.billboard = parseSphereBillboard(a.billboard);
   settings.conservative = a.conservative;
@@ -256,6 +332,84 @@ int runRenderSpheres(const RenderArgs& a) {
   return 0;
 }
 
+void printLodStats(const lod::LodStats& s, const BatchStats& b) {
+  std::printf("  nodes: %llu selected (%s points%s), %llu drawn in %u pass%s, %llu rendered; points: %s "
+              "processed, %s rendered\n",
+              (unsigned long long)s.nodesSelected, humanCount(double(s.pointsSelected)).c_str(),
+              s.budgetReached ? ", point budget reached" : "", (unsigned long long)s.nodesDrawn, s.passes,
+              s.passes == 1 ? "" : "es", (unsigned long long)b.batchesRendered,
+              humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsRendered)).c_str());
+  std::printf("  streamed %s of %llu nodes in %.2f s (%s uploaded, node cache %s)\n",
+              bytesText(s.bytesStreamed).c_str(), (unsigned long long)s.nodesLoaded, s.streamSeconds,
+              bytesText(s.bytesUploaded).c_str(), bytesText(s.cacheBytes).c_str());
+}
+
+// The JSON line of an octree render.
+nlohmann::json octreeJson(const gpu::Context& context, const RenderSettings& settings,
+                          const lod::OctreeMetadata& octree, const FrameStats& stats, const Camera& camera,
+                          const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  nlohmann::json j;
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  j["method"] = methodName(settings.method);
+  j["input"] = octree.source;
+  j["format"] = octree.format;
+  j["octree_points"] = octree.pointCount;
+  j["points"] = stats.points;
+  addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
+  j["points_per_second"] = perSecond(stats.points, stats.medianMs);
+  j["precision"] = a.precision;
+  j["min_node_px"] = settings.minNodePx;
+  j["point_budget"] = settings.pointBudget;
+  j["batch_stats"] = bench::batchStatsJson(*stats.batch);
+  j["lod_stats"] = bench::lodStatsJson(*stats.lod);
+  j["camera"] = describeCamera(camera);
+  j["image_hash"] = hashText(pixels);
+  j["output"] = a.output;
+  return j;
+}
+
+// The LOD methods (--method lod, lod-hqs): an octree streamed through the node cache.
+int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
+  if (!a.path.path.empty())
+    throw InputError("--path renders the methods that draw a loaded cloud, not " + a.method + " (an octree)");
+  if (a.order != "original" || a.parts != 1 || a.depth != "float")
+    throw InputError("--order, --parts and --depth do not apply to " + a.method +
+                     ", which draws an octree's nodes in their stored order");
+  if (!(a.minNodePx >= 0)) throw InputError("--min-node-px must be 0 or more");
+  settings.minNodePx = a.minNodePx;
+  settings.pointBudget = parseCount(a.pointBudget, "--point-budget");
+  if (a.input.empty() || isSceneName(a.input))
+    throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
+                     a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
+                     "): build one with `pointrast lod FILE -o DIR`");
+  lod::LodOptions options;
+  if (!a.gpuMemory.empty()) options.gpuBytes = parseBytes(a.gpuMemory, "--gpu-memory");
+  std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
+  const lod::OctreeMetadata& octree = source->metadata();
+  const Camera camera = renderCamera(a, octree.bounds.empty() ? octree.cube : octree.bounds, octree.source);
+
+  gpu::Context context(contextOptions(a));
+  std::string why;
+  if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
+  Renderer renderer(context, a.width, a.height);
+  lod::LodScene scene(context, *source, options);
+  const FrameStats stats = renderer.render(scene, camera, settings);
+  const std::vector<uint32_t> pixels = renderer.image();
+  finishImage(
+      a, context, pixels, [&] { return octreeJson(context, settings, octree, stats, camera, a, pixels); },
+      [&] {
+        std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), "
+                    "%s points/s\n",
+                    a.output.c_str(), humanCount(double(stats.points)).c_str(),
+                    humanCount(double(octree.pointCount)).c_str(), a.width, a.height,
+                    methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+                    humanCount(perSecond(stats.points, stats.medianMs)).c_str());
+        printLodStats(*stats.lod, *stats.batch);
+      });
+  return 0;
+}
+
 // The point-method options of the command line, checked before anything is read.
 RenderSettings pointSettings(const RenderArgs& a) {
   if (!a.billboard.empty() || a.conservative)
@@ -270,11 +424,21 @@ RenderSettings pointSettings(const RenderArgs& a) {
   settings.method = parseMethod(a.method);
   settings.depth = parseDepthMode(a.depth);
   settings.precision = parsePrecision(a.precision);
-  if (settings.precision != 0 && settings.method.info().layout != SceneLayout::Batched)
-    throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
-                     ")");
+  const SceneLayout layout = settings.method.info().layout;
+  if (settings.precision != 0 && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
+    throw InputError("--precision applies to the batch and LOD methods (" +
+                     methodNamesReading(SceneLayout::Batched) + ", " +
+                     methodNamesReading(SceneLayout::Octree) + ")");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
+  if (layout == SceneLayout::Octree) return settings; // runRenderOctree checks the octree's own options
+  if (a.lodOptionsGiven)
+    throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
+                     methodNamesReading(SceneLayout::Octree) + ")");
+  settings.post = postSettings(a);
+  if (settings.post.enabled() && settings.method.info().output == MethodOutput::ColorOnly)
+    throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
+                     " keeps no depth per pixel to work on");
   if (a.parts == 0) throw InputError("--parts must be at least 1");
   return settings;
 }
@@ -282,7 +446,9 @@ RenderSettings pointSettings(const RenderArgs& a) {
 // --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image as one
 // upload (the atomic min does not care which dispatch a point came from).
 std::vector<std::unique_ptr<GpuScene>> uploadParts(gpu::Context& context, const PointCloud& cloud,
-                                                   SceneLayout layout, const RenderArgs& a) {
+                                                   SceneLayout layout,
+                                                   const std::optional<DisplayColorMode>& colors,
+                                                   const RenderArgs& a) {
   const uint64_t perPart = (cloud.size() + a.parts - 1) / a.parts;
   if (layout == SceneLayout::Batched && perPart > 0) {
     // Said before uploading: the batch methods address 64 parts of a frame (4.29 billion points).
@@ -301,14 +467,15 @@ std::vector<std::unique_ptr<GpuScene>> uploadParts(gpu::Context& context, const 
     upload.count = perPart;
     upload.layout = layout;
     upload.progress = !a.quiet;
+    upload.colors = colors;
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
   return scenes;
 }
 
 nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& settings, const PointCloud& cloud,
-                         Order order, const FrameStats& stats, const Camera& camera, const RenderArgs& a,
-                         const std::vector<uint32_t>& pixels) {
+                         Order order, const std::optional<DisplayColorMode>& colors, const FrameStats& stats,
+                         const Camera& camera, const RenderArgs& a, const std::vector<uint32_t>& pixels) {
   nlohmann::json j;
   j["device"] = context.info().name;
   j["device_type"] = context.info().typeName;
@@ -324,6 +491,8 @@ nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& sett
     j["precision"] = a.precision;
     j["batch_stats"] = bench::batchStatsJson(*stats.batch);
   }
+  if (colors) j["color"] = colorSourceName(colors->source);
+  if (stats.post) j["post"] = postJson(settings.post, *stats.post);
   j["camera"] = describeCamera(camera);
   j["image_hash"] = hashText(pixels);
   j["output"] = a.output;
@@ -335,14 +504,19 @@ void printPointSummary(const RenderArgs& a, const RenderSettings& settings, cons
               a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
               methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
               humanCount(perSecond(stats.points, stats.medianMs)).c_str());
-  if (!stats.batch) return;
-  const BatchStats& b = *stats.batch;
-  std::printf("  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), %s "
-              "rendered\n",
-              (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
-              humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
-              humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
-              humanCount(double(b.pointsRendered)).c_str());
+  if (stats.batch) {
+    const BatchStats& b = *stats.batch;
+    std::printf("  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), "
+                "%s rendered\n",
+                (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
+                humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
+                humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
+                humanCount(double(b.pointsRendered)).c_str());
+  }
+  if (stats.post)
+    std::printf("  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
+                stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
+                stats.post->composeMs);
 }
 
 int runRender(const RenderArgs& a) {
@@ -350,6 +524,7 @@ int runRender(const RenderArgs& a) {
   checkCommonArgs(a);
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
   const RenderSettings settings = pointSettings(a);
+  if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
   InputSpec spec;
@@ -360,10 +535,11 @@ int runRender(const RenderArgs& a) {
   spec.progress = !a.quiet;
 
   const PointCloud cloud = loadInput(spec);
+  const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
   const Camera camera = renderCamera(a, cloud.bounds, cloud.source);
   gpu::Context context(contextOptions(a));
   Renderer renderer(context, a.width, a.height);
-  const auto scenes = uploadParts(context, cloud, settings.method.info().layout, a);
+  const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
   std::vector<const GpuScene*> drawn;
   for (const auto& scene : scenes)
     drawn.push_back(scene.get());
@@ -375,7 +551,7 @@ int runRender(const RenderArgs& a) {
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(
       a, context, pixels,
-      [&] { return pointJson(context, settings, cloud, spec.order, stats, camera, a, pixels); },
+      [&] { return pointJson(context, settings, cloud, spec.order, colors, stats, camera, a, pixels); },
       [&] { printPointSummary(a, settings, stats); });
   return 0;
 }
@@ -420,6 +596,8 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
       "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
       "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
+      "  pointrast render autzen.las -o a.png --color classification --point-size 3 --edl\n"
+      "  pointrast render autzen.las -o a.png --color elevation --dilate 2\n"
       "  pointrast render autzen.las --path path.json --video fly.mp4 --fps 60 --width 3840 --height 2160\n"
       "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
       std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
@@ -458,6 +636,22 @@ Command addRender(CLI::App& app) {
                   "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
                   "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
       ->capture_default_str();
+  auto lodOption = [a](const std::string&) { a->lodOptionsGiven = true; };
+  cmd->add_option(
+         "--min-node-px", a->minNodePx,
+         "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
+         "sphere) is smaller, with their subtrees; 0 draws every point")
+      ->capture_default_str()
+      ->each(lodOption);
+  cmd->add_option("--point-budget", a->pointBudget,
+                  "LOD methods: most points drawn, largest nodes first (e.g. 100M; 0: no limit)")
+      ->capture_default_str()
+      ->each(lodOption);
+  cmd->add_option(
+         "--gpu-memory", a->gpuMemory,
+         "LOD methods: GPU memory for the node cache (e.g. 8G; default: half the device's); a larger "
+         "selection is drawn in several passes")
+      ->each(lodOption);
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
       ->capture_default_str();
@@ -483,6 +677,37 @@ Command addRender(CLI::App& app) {
   cmd->add_flag("--task-cull", a->taskCull,
                 "sphere-mesh-points, sphere-mesh-tris: a task shader culls spheres outside the view first "
                 "and launches mesh workgroups only for the rest");
+  cmd->add_option("--color", a->color,
+                  "Point colors: auto (RGB if the file has it, else intensity, else elevation), rgb, "
+                  "intensity, classification (ASPRS classes), elevation, return (return number), source "
+                  "(point source id)")
+      ->capture_default_str();
+  cmd->add_option(
+      "--color-range", a->colorRange,
+      "lo,hi mapped to the ends of the intensity or elevation ramp (default: the 0.5 % and 99.5 % "
+      "percentiles)");
+  cmd->add_option("--point-size", a->pointSize,
+                  "Point size in pixels (1..32); the closest point still wins every pixel")
+      ->capture_default_str();
+  cmd->add_option("--point-shape", a->pointShape, "Shape of points larger than a pixel: square or disc")
+      ->capture_default_str();
+  cmd->add_option(
+         "--point-size-mode", a->pointSizeMode,
+         "fixed (every point --point-size pixels) or attenuated (--point-size pixels at the target's "
+         "distance, larger nearer and smaller farther, at most --point-size-max)")
+      ->capture_default_str();
+  cmd->add_option("--point-size-max", a->pointSizeMax, "Attenuated point sizes: the largest, pixels (1..32)")
+      ->capture_default_str();
+  cmd->add_option("--dilate", a->dilate,
+                  "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
+                  "point never covers a near one, and convex outlines do not grow")
+      ->capture_default_str();
+  cmd->add_flag("--edl", a->edl,
+                "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
+                "its neighbours");
+  cmd->add_option("--edl-strength", a->edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
+  cmd->add_option("--edl-radius", a->edlRadius,
+                  "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

@@ -11,6 +11,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "bench/lod_runner.h"
 #include "cloud/generate.h"
 #include "io/reader.h"
 #include "render/scene.h"
@@ -33,17 +34,6 @@ const std::vector<View>& viewsOf(const Dataset& d, const BenchConfig& c) {
 }
 
 } // namespace
-
-std::string bytesText(uint64_t bytes) {
-  char text[32];
-  if (bytes >= (uint64_t(1) << 30))
-    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t(1) << 30));
-  else if (bytes >= (uint64_t(1) << 20))
-    std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(uint64_t(1) << 20));
-  else
-    std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / 1024.0);
-  return text;
-}
 
 std::string printf1(const char* format, double value) {
   char text[64];
@@ -156,6 +146,7 @@ PointCloud loadDataset(const Dataset& dataset, bool progress) {
   cloud.intensity = {};
   cloud.classification = {};
   cloud.returnNumber = {};
+  cloud.pointSourceId = {};
   return cloud;
 }
 
@@ -165,6 +156,9 @@ namespace {
 // number of combinations the run will measure.
 size_t sizeDatasets(const gpu::Context& context, const BenchConfig& config, BenchRun& run, const Note& note) {
   size_t total = 0;
+  const size_t octrees = size_t(std::count_if(config.methods.begin(), config.methods.end(), [](Method m) {
+    return methodInfo(m).layout == SceneLayout::Octree;
+  }));
   for (const Dataset& d : config.datasets) {
     DatasetOutcome outcome;
     outcome.dataset = d;
@@ -178,8 +172,9 @@ size_t sizeDatasets(const gpu::Context& context, const BenchConfig& config, Benc
       outcome.reason = "it does not fit: " + outcome.memory.describe();
     }
     note(d.label + ": " + (outcome.skipped ? "skipped, " + outcome.reason : outcome.memory.describe()));
-    if (!outcome.skipped)
-      total += ordersOf(d, config).size() * viewsOf(d, config).size() * config.methods.size();
+    if (!outcome.skipped) // the LOD methods draw the data set's octree, once whatever the orders
+      total += viewsOf(d, config).size() *
+               (ordersOf(d, config).size() * (config.methods.size() - octrees) + octrees);
     run.datasets.push_back(std::move(outcome));
   }
   return total;
@@ -263,8 +258,9 @@ void timeCombination(Renderer& renderer, const GpuScene& scene, const BenchRun& 
   r.stats = renderer.render(scene, camera, settings);
 }
 
-// The rates of a measured result against the run's copy bandwidth.
-void deriveRates(Result& r, const gpu::CopyBandwidth& copy) {
+} // namespace
+
+void completeRates(Result& r, const gpu::CopyBandwidth& copy) {
   if (!r.ok() || !(r.stats.medianMs > 0)) return;
   const double seconds = r.stats.medianMs * 1e-3;
   r.pointsPerSecond = double(r.stats.points) / seconds;
@@ -273,8 +269,6 @@ void deriveRates(Result& r, const gpu::CopyBandwidth& copy) {
   r.effectiveBytesPerSecond = bytes / seconds;
   r.copyFraction = copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / copy.bytesPerSecond : 0;
 }
-
-} // namespace
 
 double secondsSince(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -323,6 +317,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
         for (View view : viewsOf(d, config)) {
           const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
           for (Method method : config.methods) {
+            if (methodInfo(method).layout == SceneLayout::Octree) continue; // after the orders, on the octree
             checkTimeLimit(start, config.timeLimitSeconds, done, total);
             Result r;
             r.dataset = d.name;
@@ -344,11 +339,14 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
               measureGuarded(
                   r, [&] { timeCombination(renderer, *scene, run, camera, r); }, record);
             }
-            deriveRates(r, run.copy);
+            completeRates(r, run.copy);
             record(r);
           }
         }
       }
+      checkTimeLimit(start, config.timeLimitSeconds, done, total);
+      measureOctreeMethods(context, renderer, config, d, cloud, ordersOf(d, config).front(),
+                           viewsOf(d, config), run, record);
     }
   });
   return run;

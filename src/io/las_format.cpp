@@ -46,6 +46,7 @@ std::vector<LasVlr> walkVlrs(const InputFile& file, uint64_t start, uint32_t cou
     vlr.length = loadLE<uint16_t>(h + 20);
     vlr.description = fixedString(h + 22, 32);
     pos += las::kVlrHeaderSize;
+    vlr.dataOffset = pos;
     if (vlr.length > limit - pos) {
       truncated = true;
       vlrs.push_back(std::move(vlr));
@@ -60,12 +61,7 @@ std::vector<LasVlr> walkVlrs(const InputFile& file, uint64_t start, uint32_t cou
 } // namespace
 
 void failCompressed(const std::filesystem::path& path) {
-  std::filesystem::path las = path;
-  las.replace_extension(".las");
-  fail(path,
-       strFormat("LAZ/COPC compressed files are not supported yet; decompress with "
-                 "`pdal translate %s %s` or `laszip -i %s -o %s`",
-                 path.string().c_str(), las.string().c_str(), path.string().c_str(), las.string().c_str()));
+  fail(path, "the points are LAZ-compressed; the plain LAS reader reads uncompressed files only");
 }
 
 bool lasLooksCompressed(const InputFile& file) {
@@ -83,7 +79,7 @@ bool lasLooksCompressed(const InputFile& file) {
   return false;
 }
 
-LasHeader readLasHeader(const InputFile& file) {
+LasHeader readLasHeader(const InputFile& file, bool allowCompressed) {
   const std::filesystem::path& path = file.path();
   const uint64_t fileSize = file.size();
   if (fileSize < las::kHeaderSize12)
@@ -148,7 +144,7 @@ LasHeader readLasHeader(const InputFile& file) {
   hd.compressed = (hd.pointFormatByte & las::kCompressionBits) != 0;
   for (const LasVlr& vlr : hd.vlrs)
     hd.compressed = hd.compressed || isCompressionVlr(vlr);
-  if (hd.compressed) failCompressed(path);
+  if (hd.compressed && !allowCompressed) failCompressed(path);
 
   if (hd.pointFormat > las::kMaxPointFormat)
     fail(path, strFormat("point format %d is not a LAS point format (0 to 10)", hd.pointFormat));
@@ -164,7 +160,7 @@ LasHeader readLasHeader(const InputFile& file) {
       fail(path, strFormat("%c offset %g is not a finite number", kAxis[a], hd.offset[a]));
   }
   uint64_t available = fileSize - hd.pointOffset;
-  if (hd.pointCount > available / hd.recordLength)
+  if (!hd.compressed && hd.pointCount > available / hd.recordLength)
     fail(path, strFormat("header claims %llu points of %u bytes but the file holds %llu bytes of point data",
                          static_cast<unsigned long long>(hd.pointCount), hd.recordLength,
                          static_cast<unsigned long long>(available)));

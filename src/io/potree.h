@@ -19,7 +19,8 @@
 //     coordinate whose division lands just below an integer sits one quantum low, in both encodings. The
 //     original value is lost; the reader cannot correct it (`info` says so).
 //   - Some inner nodes claim points but occupy 0 bytes (its sampler moved every point up); read as empty,
-//     as the Potree viewer does.
+//     as the Potree viewer does. Such a node behind a proxy was listed with the proxy record's count
+//     before its chunk was read, so readNode() then returns fewer points than that NodeInfo said.
 //   - Its out-of-core hierarchy may give a proxy record a child mask of 0; such a proxy's chunk is read
 //     as soon as the proxy is listed, to learn its children.
 // pointrast's writer rounds (the builder hands it exact integers), writes absolute integers in BROTLI

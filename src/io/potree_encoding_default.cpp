@@ -48,6 +48,7 @@ FieldOffsets fieldOffsets(const Layout& layout) {
 } // namespace
 
 void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, uint8_t* dst) {
+  if (n == 0) return; // dst may be null
   const FieldOffsets o = fieldOffsets(layout);
   const size_t stride = static_cast<size_t>(layout.defaultStride);
   std::memset(dst, 0, n * stride); // attributes without a record field are written as zeros

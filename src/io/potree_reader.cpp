@@ -73,6 +73,7 @@ private:
     uint8_t mask = 0;
     bool proxy = false; // offset/size locate the node's hierarchy chunk, not yet read
     uint64_t offset = 0, size = 0;
+    std::string damage; // why its chunk could not be read (said again on every later request)
   };
 
   // All below: mutex_ held.
@@ -128,7 +129,16 @@ PotreeSource::Node& PotreeSource::find(const lod::NodeKey& key) {
 
 PotreeSource::Node& PotreeSource::resolved(const lod::NodeKey& key) {
   Node& node = find(key);
-  if (node.proxy) loadChunk(key, int64_t(node.offset), int64_t(node.size));
+  if (!node.damage.empty()) throw InputError(node.damage);
+  if (!node.proxy) return node;
+  try {
+    loadChunk(key, int64_t(node.offset), int64_t(node.size));
+  } catch (const InputError& e) {
+    // Part of the chunk may have been taken in; the proxy stays unresolved and keeps the reason, so a
+    // later request gets the same sentence rather than a confusing one about the half-read chunk.
+    find(key).damage = e.what();
+    throw;
+  }
   return find(key); // the map may have rehashed
 }
 
@@ -141,9 +151,8 @@ PotreeSource::Node PotreeSource::checkedNode(const lod::NodeKey& key, const potr
   if (record.byteOffset < 0 || record.byteSize < 0 || uint64_t(record.byteSize) > fileSize ||
       uint64_t(record.byteOffset) > fileSize - uint64_t(record.byteSize))
     failNode(key,
-             strFormat("claims bytes %lld..%lld of octree.bin, which holds %llu",
-                       static_cast<long long>(record.byteOffset),
-                       static_cast<long long>(record.byteOffset) + static_cast<long long>(record.byteSize),
+             strFormat("claims %lld bytes at byte %lld of octree.bin, which holds %llu",
+                       static_cast<long long>(record.byteSize), static_cast<long long>(record.byteOffset),
                        static_cast<unsigned long long>(fileSize)));
   node.offset = uint64_t(record.byteOffset);
   node.size = uint64_t(record.byteSize);
@@ -176,17 +185,16 @@ PotreeSource::Node PotreeSource::checkedNode(const lod::NodeKey& key, const potr
 void PotreeSource::loadChunk(const lod::NodeKey& root, int64_t offset, int64_t size) {
   const uint64_t fileSize = hierarchy_.size();
   if (offset < 0 || size <= 0 || uint64_t(size) > fileSize || uint64_t(offset) > fileSize - uint64_t(size))
-    failNode(root, strFormat("points to a hierarchy chunk at bytes %lld..%lld, outside the %llu bytes of "
-                             "hierarchy.bin",
-                             static_cast<long long>(offset),
-                             static_cast<long long>(offset) + static_cast<long long>(size),
+    failNode(root, strFormat("points to a hierarchy chunk of %lld bytes at byte %lld, outside the %llu bytes "
+                             "of hierarchy.bin",
+                             static_cast<long long>(size), static_cast<long long>(offset),
                              static_cast<unsigned long long>(fileSize)));
   if (!chunkRanges_.claim(uint64_t(offset), uint64_t(size)))
-    failNode(root,
-             strFormat("points to a hierarchy chunk at bytes %lld..%lld, which overlaps a chunk already "
-                       "read (a proxy leading back into the hierarchy: a cycle)",
-                       static_cast<long long>(offset),
-                       static_cast<long long>(offset) + static_cast<long long>(size)));
+    failNode(
+        root,
+        strFormat("points to a hierarchy chunk of %lld bytes at byte %lld, which overlaps a chunk already "
+                  "read (a proxy leading back into the hierarchy: a cycle)",
+                  static_cast<long long>(size), static_cast<long long>(offset)));
   std::vector<uint8_t> bytes(static_cast<size_t>(size));
   hierarchy_.readAt(uint64_t(offset), bytes.data(), bytes.size());
   const std::vector<potree::ChunkNode> records =

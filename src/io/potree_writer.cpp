@@ -98,6 +98,13 @@ void checkMetadata(const std::filesystem::path& dir, const lod::OctreeMetadata& 
       fail(dir, "the octree's cube is not finite");
   }
   if (!std::isfinite(m.spacing) || m.spacing < 0) fail(dir, "the octree's spacing is not a finite number");
+  // Readers (the Potree viewer among them) halve this box into children: it must be the cube
+  // OctreeMetadata promises, or nodes would not be where the hierarchy says.
+  const glm::dvec3 edges = m.cube.max - m.cube.min;
+  const double edge = std::max({edges.x, edges.y, edges.z});
+  assert(edge - std::min({edges.x, edges.y, edges.z}) <= 1e-9 * edge && "the octree's cube has equal edges");
+  if (edge - std::min({edges.x, edges.y, edges.z}) > 1e-9 * edge)
+    fail(dir, "the octree's bounding box is not a cube");
 }
 
 } // namespace

@@ -29,7 +29,7 @@ struct FileInfo {
 
 struct ReadOptions {
   bool progress = true;       // progress line on stderr when it is a terminal
-  bool keepAttributes = true; // intensity, classification, return number
+  bool keepAttributes = true; // intensity, classification, return number, point source id
 };
 
 // Reads the whole file into a PointCloud (bounds computed from the points), through the format's row of

@@ -4,15 +4,19 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "cloud/octree.h"
 #include "io/io_test_util.h"
 #include "io/potree.h"
+#include "io/potree_format.h"
 
 namespace potreetest {
 
@@ -104,6 +108,52 @@ inline ReadBack readTree(pointrast::lod::NodeSource& source) {
     return true;
   });
   return out;
+}
+
+// Every record of a hierarchy.bin with its byte position, chunk by chunk from the first, following
+// proxies.
+struct DiskNode {
+  NodeKey key;
+  pointrast::io::potree::Record record;
+  uint64_t at = 0;    // byte position of the record in hierarchy.bin
+  uint64_t chunk = 0; // byte position of the chunk holding it
+};
+inline std::vector<DiskNode> walkHierarchy(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "metadata.json");
+  const uint64_t first = nlohmann::json::parse(in)["hierarchy"]["firstChunkSize"];
+  const std::vector<uint8_t> bytes = iotest::readBytes(dir / "hierarchy.bin");
+  namespace potree = pointrast::io::potree;
+  std::vector<DiskNode> out;
+  std::vector<std::pair<NodeKey, std::pair<uint64_t, uint64_t>>> chunks{{NodeKey{}, {0, first}}};
+  for (size_t c = 0; c < chunks.size(); ++c) {
+    const auto [root, range] = chunks[c];
+    if (range.first > bytes.size() || range.second > bytes.size() - range.first)
+      throw std::runtime_error("walkHierarchy: a chunk outside hierarchy.bin");
+    const auto records = potree::parseChunk(bytes.data() + range.first, range.second, root, "test");
+    for (size_t i = 0; i < records.size(); ++i) {
+      out.push_back({records[i].key, records[i].record, range.first + i * potree::kRecordBytes, range.first});
+      if (records[i].record.type == potree::kProxy)
+        chunks.push_back(
+            {records[i].key, {uint64_t(records[i].record.byteOffset), uint64_t(records[i].record.byteSize)}});
+    }
+  }
+  return out;
+}
+
+// Rewrites the record of `key` (its proxy record when proxy is true, else its real one) through edit.
+template <class Edit>
+void patchRecord(const std::filesystem::path& dir, const NodeKey& key, bool proxy, Edit edit) {
+  namespace potree = pointrast::io::potree;
+  std::vector<uint8_t> bytes = iotest::readBytes(dir / "hierarchy.bin");
+  for (const DiskNode& n : walkHierarchy(dir)) {
+    if (n.key != key || (n.record.type == potree::kProxy) != proxy) continue;
+    potree::Record r = n.record;
+    edit(r);
+    potree::storeRecord(bytes.data() + n.at, r);
+    iotest::writeBytes(dir / "hierarchy.bin", bytes);
+    return;
+  }
+  ADD_FAILURE() << "no " << (proxy ? "proxy" : "real") << " record of " << key.potreeName();
 }
 
 } // namespace potreetest
