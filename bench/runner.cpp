@@ -67,11 +67,12 @@ void checkTimeLimit(std::chrono::steady_clock::time_point start, double limitSec
                            " combinations; the rest were not run");
 }
 
-double settleClocks(const std::function<double(uint32_t frames)>& renderMs) {
-  const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
+double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
+                    const std::function<double()>& clock) {
+  const auto steadyStart = std::chrono::steady_clock::now();
+  const std::function<double()> now = clock ? clock : [&] { return secondsSince(steadyStart); };
+  const double start = now();
+  auto elapsed = [&] { return now() - start; };
   uint32_t frames = 1;
   double last = 0;
   for (int round = 0; elapsed() < 3.0; ++round) {

@@ -74,8 +74,10 @@ std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 // after such a pause ran 5.7x slow in all 17 frames of its one submission (bench/NOTES.md). So before the
 // first combination of each scene, renderMs(frames) (which renders that many frames in one submission and
 // returns their median ms) is called in rounds of about 30 ms of GPU work until two rounds agree within 3 %
-// after at least 0.2 s, or 3 s have passed. Returns the wall seconds it took.
-double settleClocks(const std::function<double(uint32_t frames)>& renderMs);
+// after at least 0.2 s, or 3 s have passed. Returns the wall seconds it took. `clock` (seconds, monotonic)
+// is the steady clock unless a test passes its own, so that its rounds do not depend on the machine's load.
+double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
+                    const std::function<double()>& clock = {});
 
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);
