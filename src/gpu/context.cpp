@@ -258,7 +258,7 @@ void Context::chooseDevice(const ContextOptions& options) {
   if (index) {
     if (*index >= devices.size())
       throw InputError("device " + std::to_string(*index) + " does not exist; this machine has " +
-                       std::to_string(devices.size()) + " Vulkan device(s) (see `pointrast info --devices`)");
+                       std::to_string(devices.size()) + " Vulkan device(s), numbered from 0");
     physical_ = devices[*index];
   } else {
     physical_ = *std::max_element(devices.begin(), devices.end(), [](VkPhysicalDevice a, VkPhysicalDevice b) {
