@@ -398,20 +398,24 @@ Command addBench(CLI::App& app) {
       "bench/results/<device>/. Without INPUT, the demo scene (terrain, 1 M points).\n\n"
       "--suite paper2021 generates stand-ins for the 2021 paper's data sets at its sizes (banyunibo 4 M "
       "tls,\n"
-      "eclepens 47 M terrain, retz 145 M terrain, endeavor 796 M tls), runs all methods x orders x views at\n"
-      "1920x1080, states the memory each needs and skips what does not fit. --scale 0.001 shrinks every "
+      "eclepens 47 M terrain, retz 145 M terrain, endeavor 796 M tls) and times, at 1920x1080, every order\n"
+      "and view with the methods that draw uploaded points one by one:\n  " +
+      methodNameList(bench::suiteDefaults("paper2021").methods) +
+      ".\nIt states the memory each data set needs and skips what does not fit. --scale 0.001 shrinks every "
       "size\n"
       "(4 k .. 796 k points) for a quick smoke run; NAME=PATH arguments replace a stand-in by a file.\n"
       "--suite paper2022 stands in for the 2022 paper (Software Rasterization of 2 Billion Points): scan69m\n"
       "(tls, 69 M), aerial279m (terrain, 279 M), scan529m (tls, 529 M, overview and closeup) and aerial1g\n"
       "(terrain, 1,000 M) in Morton order, plus tls-order (tls, 100 M) in scan (original) and Morton order,\n"
-      "overview and closeup; methods hw-points, batch, batch-prefetch, batch-hqs, dedup, hqs at 2560x1140.\n"
+      "overview and closeup, at 2560x1140, with the methods\n  " +
+      methodNameList(bench::suiteDefaults("paper2022").methods) +
+      ".\n"
       "Its report adds the batch statistics of the paper's Table 2 (batches and points processed/rendered,\n"
       "points per coordinate precision). Each data set is uploaded once per scene layout its methods read\n"
       "(float and batched, 16 B/point each); the memory estimate counts both. --methods, --orders, --views,\n"
       "--width and --height override the suite's.\n\n"
       "--suite spheres2023 stands in for the particle data sets of \"Efficient Sphere Rendering Revisited\"\n"
-      "(2023) with generated particle scenes at the sizes issue 5 gives them: laser (particles-laser, 306 "
+      "(2023) with generated particle scenes at the sizes of its data sets: laser (particles-laser, 306 "
       "M:\n"
       "laser ablation, a crystal slab with a crater and ejected clusters), riemann (particles-block, 4 M: a\n"
       "shock tube, dense block between vapor regions), drop (particles-drops, 30 M) and fluid\n"

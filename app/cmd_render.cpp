@@ -510,13 +510,14 @@ void printPointSummary(const RenderArgs& a, const RenderSettings& settings, cons
                 "%s rendered\n",
                 (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
                 humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
-                humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
-                humanCount(double(b.pointsRendered)).c_str());
+                humanCount(double(b.pointsByWords[1])).c_str(),
+                humanCount(double(b.pointsByWords[2])).c_str(), humanCount(double(b.pointsRendered)).c_str());
   }
   if (stats.post)
-    std::printf("  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
-                stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
-                stats.post->composeMs);
+    std::printf(
+        "  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
+        stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
+        stats.post->composeMs);
 }
 
 int runRender(const RenderArgs& a) {

@@ -42,8 +42,8 @@ constexpr SuiteEntry kLod[] = {
     {"aerial1g", Scene::Terrain, 1'000'000'000, "a 1,000 M point aerial survey, as an octree"},
 };
 
-// The four particle data sets of the 2023 sphere study, at the sizes the issue gives for them (306 M, 4 M,
-// 30 M, 200 M particles, in this order), each drawn by the particle scene closest to what it shows:
+// The four particle data sets of the 2023 sphere study, at their sizes (306 M, 4 M, 30 M, 200 M particles,
+// in this order), each drawn by the particle scene closest to what it shows:
 // laser ablation of a metal (a crystal slab with a molten crater and ejected clusters), a Riemann shock tube
 // (a dense block between two vapor regions), a drop and a fluid simulation (liquid droplets and filaments in
 // a vapor; particles-drops for both, at their two sizes).
