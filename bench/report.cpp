@@ -12,6 +12,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "base/build_info.h"
 #include "base/error.h"
 #include "bench/lod_report.h"
 #include "bench/report_parts.h"
@@ -129,6 +130,7 @@ nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& devi
   j["title"] = info.title;
   j["command_line"] = info.commandLine;
   j["date"] = info.date;
+  j["commit"] = buildCommit();
   j["wall_seconds"] = seconds;
   j["device"] = {{"name", device.name},          {"type", device.typeName},
                  {"driver", device.driver},      {"vulkan", apiVersion(device.apiVersion)},
@@ -140,9 +142,10 @@ nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& devi
       {"gb_per_s", copy.bytesPerSecond * 1e-9},
       {"transfer_gb_per_s", copy.transferBytesPerSecond * 1e-9},
       {"shader_gb_per_s", copy.shaderBytesPerSecond * 1e-9},
-      {"note", "the faster of vkCmdCopyBuffer (transfer_gb_per_s) and a compute-shader copy of 16 B per "
-               "invocation (shader_gb_per_s) between two device buffers; counts bytes read + bytes written per "
-               "second, since a copy moves every byte through memory twice"}};
+      {"note",
+       "the faster of vkCmdCopyBuffer (transfer_gb_per_s) and a compute-shader copy of 16 B per "
+       "invocation (shader_gb_per_s) between two device buffers; counts bytes read + bytes written per "
+       "second, since a copy moves every byte through memory twice"}};
   return j;
 }
 
@@ -181,7 +184,8 @@ void markdownHeader(std::ostringstream& md, const ReportInfo& info, const gpu::D
 void markdownFooter(std::ostringstream& md, const ReportInfo& info, double seconds) {
   md << "- Ratios between methods of one run are the figures that count; absolute times depend on clocks "
         "and drivers.\n";
-  md << "- Date: " << info.date << "; the run took " << printf1("%.0f", seconds) << " s (wall clock).\n";
+  md << "- Date: " << info.date << "; the run took " << printf1("%.0f", seconds)
+     << " s (wall clock); pointrast " << buildCommit() << ".\n";
   md << "- Command: `" << info.commandLine << "`\n\n";
 }
 
