@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   app::Command benchIo = app::addBenchIo(app, argc, argv);
   app::Command view = app::addView(app);
   app::Command lod = app::addLod(app);
+  app::Command serve = app::addServe(app);
 
   try {
     app.parse(argc, argv);
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
       if (sub->get_name() == "bench-io") return benchIo();
       if (sub->get_name() == "view") return view();
       if (sub->get_name() == "lod") return lod();
+      if (sub->get_name() == "serve") return serve();
     }
     return 1;
   } catch (const InputError& e) {

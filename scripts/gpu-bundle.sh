@@ -9,9 +9,12 @@ cd "$(dirname "$0")/.."
 mkdir -p .git/info; grep -qx '/.gpu/' .git/info/exclude 2>/dev/null || echo '/.gpu/' >> .git/info/exclude
 mkdir -p .git/info; grep -qx '/.vkrt/' .git/info/exclude 2>/dev/null || echo '/.vkrt/' >> .git/info/exclude
 cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O2" -DPOINTRAST_STATIC_RUNTIME=ON
-cmake --build build-gpu -j"$(nproc)" --target pointrast gpu_tests cli_tests bench_tests
+cmake --build build-gpu -j"$(nproc)" --target pointrast gpu_tests cli_tests bench_tests serve_load
 rm -rf .gpu && mkdir -p .gpu/bin .gpu/data/las .gpu/data/laz .gpu/data/las/permutations .gpu/data/mmpld
 cp build-gpu/pointrast build-gpu/tests/gpu_tests build-gpu/tests/cli_tests build-gpu/tests/bench_tests .gpu/bin/
+cp build-gpu/serve_load .gpu/bin/
+# `serve` loads civetweb at run time, from beside the binary where the system has none.
+cp -L /usr/lib/x86_64-linux-gnu/libcivetweb.so.1 .gpu/bin/
 strip .gpu/bin/*
 data=../shared/data
 cp $data/las/autzen_trim.las .gpu/data/las/

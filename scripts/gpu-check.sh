@@ -152,8 +152,15 @@ for what in "$@"; do
       --datasets aerial1g --methods batch-prefetch,lod,lod-hqs --frames "${SUITE_FRAMES:-15}" --budget "${SUITE_BUDGET:-2}" \
       --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" --out "$OUT" --name lod2022 --json > "$OUT/lod2022.jsonl" || status=1
     ;;
+  serve)
+    # The browser viewer: `serve` on 1 G generated points (SERVE_POINTS, SERVE_METHOD), one loopback client
+    # at 1920x1080 (serve_load); writes serve.json and serve.md.
+    echo "== serve: ${SERVE_POINTS:-1G} points, one client at 1920x1080"
+    POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT \
+      timeout 540 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

@@ -11,6 +11,9 @@ packages=(
   # the desktop viewer (GLFW is loaded at run time, the panel is Dear ImGui), its tests on a virtual X
   # server driven by xdotool, and video output of camera paths
   libglfw3-dev libimgui-dev libx11-dev xvfb xauth xdotool ffmpeg
+  # the browser viewer (civetweb is loaded at run time, TurboJPEG linked statically) and its tests in a
+  # headless chromium
+  libcivetweb-dev libturbojpeg0-dev chromium
 )
 
 missing=()

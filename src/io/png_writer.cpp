@@ -38,18 +38,26 @@ void writeToSink(void* context, void* data, int size) {
   }
 }
 
-} // namespace
+// stb takes int sizes and builds the whole filtered image in memory.
+bool encodable(uint32_t width, uint32_t height) {
+  return width > 0 && height > 0 && uint64_t(width) * height * 3 <= uint64_t(INT_MAX) / 2;
+}
 
-void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, const uint32_t* rgba) {
-  // stb takes int sizes and builds the whole filtered image in memory.
-  if (width == 0 || height == 0 || uint64_t(width) * height * 3 > uint64_t(INT_MAX) / 2)
-    fail(path, strFormat("cannot write a %u x %u PNG", width, height));
+std::vector<uint8_t> toRgb(uint32_t width, uint32_t height, const uint32_t* rgba) {
   std::vector<uint8_t> rgb(size_t(width) * height * 3);
   for (size_t i = 0; i < size_t(width) * height; ++i) {
     rgb[3 * i] = static_cast<uint8_t>(rgba[i]);
     rgb[3 * i + 1] = static_cast<uint8_t>(rgba[i] >> 8);
     rgb[3 * i + 2] = static_cast<uint8_t>(rgba[i] >> 16);
   }
+  return rgb;
+}
+
+} // namespace
+
+void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, const uint32_t* rgba) {
+  if (!encodable(width, height)) fail(path, strFormat("cannot write a %u x %u PNG", width, height));
+  std::vector<uint8_t> rgb = toRgb(width, height, rgba);
   PartialFile out(path);
   Sink sink;
   sink.file = &out;
@@ -58,6 +66,21 @@ void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height
   if (sink.failed) throw InputError(sink.error);
   if (!ok) fail(path, "PNG encoding failed (out of memory?)");
   out.commit();
+}
+
+std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const uint32_t* rgba) {
+  if (!encodable(width, height)) throw InputError(strFormat("cannot encode a %u x %u PNG", width, height));
+  std::vector<uint8_t> rgb = toRgb(width, height, rgba);
+  std::vector<uint8_t> png;
+  auto append = [](void* context, void* data, int size) {
+    auto* bytes = static_cast<const uint8_t*>(data);
+    static_cast<std::vector<uint8_t>*>(context)->insert(static_cast<std::vector<uint8_t>*>(context)->end(),
+                                                        bytes, bytes + size);
+  };
+  int ok = stbi_write_png_to_func(append, &png, static_cast<int>(width), static_cast<int>(height), 3,
+                                  rgb.data(), static_cast<int>(width * 3));
+  if (!ok) throw InputError("PNG encoding failed (out of memory?)");
+  return png;
 }
 
 } // namespace pointrast::io

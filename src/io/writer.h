@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <vector>
 
 #include "cloud/cloud.h"
 #include "cloud/octree.h"
@@ -51,5 +52,8 @@ uint64_t writeLasFromOctree(const std::filesystem::path& path, lod::NodeSource& 
 
 // Writes RGBA8 pixels (row 0 = top) as an 8-bit RGB PNG (alpha dropped).
 void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, const uint32_t* rgba);
+// The same PNG in memory, for a front end that sends it instead of writing it (the browser viewer's
+// screenshots). InputError for a size stb cannot encode.
+std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const uint32_t* rgba);
 
 } // namespace pointrast::io

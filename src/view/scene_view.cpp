@@ -185,4 +185,17 @@ std::vector<uint32_t> SceneView::screenshot(const Camera& camera, const ViewSett
   return boxDownsample(pixels, big.width(), big.height(), supersample);
 }
 
+void zoomAtCursor(Session& session, SceneView& view, glm::dvec2 position, double steps) {
+  std::optional<double> depth =
+      view.depthAt(session.camera(), session.settings(), session.viewport(), position);
+  session.wheel(position, steps, depth);
+}
+
+std::optional<glm::dvec3> pickPivot(Session& session, SceneView& view, glm::dvec2 position) {
+  std::optional<glm::dvec3> point =
+      view.pick(session.camera(), session.settings(), session.viewport(), position);
+  session.pivotPicked(point);
+  return point;
+}
+
 } // namespace pointrast::view

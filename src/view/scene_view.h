@@ -104,4 +104,10 @@ private:
   std::unique_ptr<Renderer> renderer_;
 };
 
+// The session's input that needs the GPU, served the same way by every front end: wheel steps towards
+// the depth under the cursor (read from the framebuffer, the pivot's plane over an empty pixel), and the
+// pivot picked under a double-click (Requests::pick). pickPivot returns the picked point, if any.
+void zoomAtCursor(Session& session, SceneView& view, glm::dvec2 position, double steps);
+std::optional<glm::dvec3> pickPivot(Session& session, SceneView& view, glm::dvec2 position);
+
 } // namespace pointrast::view

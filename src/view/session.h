@@ -128,8 +128,10 @@ public:
   const ViewSettings& settings() const { return settings_; }
   void setSettings(const ViewSettings& settings);
   ViewOptions& options() { return options_; }
+  const ViewOptions& options() const { return options_; }
 
   CameraPath& path() { return path_; }
+  const CameraPath& path() const { return path_; }
   void recordKeyframe() { path_.append(camera(), options_.keyframeSeconds); }
 
   // Whether the image is stale (camera, viewport, settings or content changed since the last frame), or

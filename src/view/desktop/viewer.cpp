@@ -227,16 +227,10 @@ void Viewer::takeScreenshot() {
 }
 
 void Viewer::handleRequests() {
-  if (auto wheel = input_.takeWheel()) {
-    std::optional<double> depth =
-        scene_.depthAt(session_.camera(), session_.settings(), session_.viewport(), wheel->position);
-    session_.wheel(wheel->position, wheel->steps, depth);
-  }
+  if (auto wheel = input_.takeWheel()) zoomAtCursor(session_, scene_, wheel->position, wheel->steps);
   Requests r = session_.takeRequests();
   if (r.pick) {
-    std::optional<glm::dvec3> point =
-        scene_.pick(session_.camera(), session_.settings(), session_.viewport(), *r.pick);
-    session_.pivotPicked(point);
+    std::optional<glm::dvec3> point = pickPivot(session_, scene_, *r.pick);
     if (options_.events)
       emit({{"event", "pick"},
             {"x", r.pick->x},

@@ -1,0 +1,365 @@
+// serve_load: a loopback load client for `pointrast serve`. It opens one WebSocket as a browser tab of the
+// given canvas size would, orbits the camera by a continuous drag (a pointer move every 1/rate s) and
+// measures what a user feels: frames per second received, the time from an input message to the first
+// frame that shows it (the frame header echoes the last input sequence number applied), and bytes per
+// frame while moving and at rest. Each frame is decoded (TurboJPEG) before it is acknowledged, as a page
+// draws it before acknowledging, unless --no-decode.
+//
+//   serve_load --port 8080 [--host 127.0.0.1] [--token T] [--width 1920] [--height 1080] [--seconds 10]
+//              [--rate 120] [--isolated 30] [--no-decode] [-o result.json] [--markdown result.md]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "view/web/jpeg.h"
+#include "view/web/protocol.h"
+#include "ws_client.h"
+
+namespace {
+
+using Json = nlohmann::json;
+using namespace pointrast;
+
+double clockSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct Args {
+  std::string host = "127.0.0.1", token, output, markdown;
+  uint16_t port = 8080;
+  uint32_t width = 1920, height = 1080, isolated = 30;
+  double seconds = 10, rate = 120;
+  bool decode = true;
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  size_t i = size_t(std::min<double>(double(v.size() - 1), std::floor(p * double(v.size() - 1) + 0.5)));
+  return v[i];
+}
+
+Json summary(const std::vector<double>& ms) {
+  return {{"inputs", ms.size()},
+          {"p50", percentile(ms, 0.5)},
+          {"p95", percentile(ms, 0.95)},
+          {"max", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())}};
+}
+
+struct Frame {
+  view::web::FrameHeader header;
+  size_t bytes = 0;
+  double arrived = 0;
+};
+
+class Load {
+public:
+  explicit Load(const Args& a) : args_(a) {}
+  int run();
+
+private:
+  bool connect();
+  // Receives until the deadline; frames are decoded, acknowledged and handed to onFrame_.
+  void pump(double until);
+  std::optional<Frame> waitFrame(double timeout, uint32_t minSeq, bool full);
+  uint32_t send(Json message);
+  Json motionPhase(double scale);
+  Json isolatedLatency();
+
+  const Args& args_;
+  wsclient::Client ws_;
+  Json info_, state_;
+  uint32_t seq_ = 0;
+  std::map<uint32_t, double> sentAt_; // input seq -> send time, until a frame showed it
+  std::vector<double> latencies_;     // ms, of the inputs shown since the last reset
+  std::vector<Frame> frames_;         // received since the last reset
+  std::vector<uint32_t> rgba_;
+};
+
+uint32_t Load::send(Json message) {
+  message["seq"] = ++seq_;
+  sentAt_[seq_] = clockSeconds();
+  ws_.sendText(message.dump());
+  return seq_;
+}
+
+bool Load::connect() {
+  std::string target = "/ws" + (args_.token.empty() ? "" : "?token=" + args_.token);
+  if (!ws_.connect(args_.host, args_.port, target)) {
+    std::fprintf(stderr, "serve_load: no WebSocket at %s:%u%s (HTTP %d)\n", args_.host.c_str(), args_.port,
+                 target.c_str(), ws_.response().status);
+    return false;
+  }
+  ws_.sendText(Json{{"t", "resize"}, {"w", args_.width}, {"h", args_.height}}.dump());
+  return true;
+}
+
+void Load::pump(double until) {
+  while (true) {
+    double left = until - clockSeconds();
+    if (left <= 0) return;
+    std::optional<wsclient::Message> m = ws_.receive(left);
+    if (!m) return;
+    if (m->opcode == 1) {
+      Json j = Json::parse(m->text(), nullptr, false);
+      if (j.is_object() && j.value("t", "") == "info") info_ = j;
+      if (j.is_object() && j.value("t", "") == "state") state_ = j;
+      continue;
+    }
+    if (m->opcode != 2 || m->data.size() < view::web::kFrameHeaderBytes) continue;
+    Frame f;
+    f.header = view::web::readFrameHeader(m->data.data());
+    if (f.header.magic != view::web::kFrameMagic) continue;
+    f.bytes = m->data.size();
+    if (args_.decode) {
+      uint32_t w = 0, h = 0;
+      view::web::decodeJpeg(
+          {m->data.data() + view::web::kFrameHeaderBytes, m->data.size() - view::web::kFrameHeaderBytes}, w,
+          h, rgba_);
+    }
+    f.arrived = clockSeconds();
+    ws_.sendText(Json{{"t", "ack"}, {"frame", f.header.frame}}.dump());
+    // Every input up to the frame's sequence number is shown by it.
+    for (auto it = sentAt_.begin(); it != sentAt_.end() && it->first <= f.header.seq;) {
+      latencies_.push_back((f.arrived - it->second) * 1e3);
+      it = sentAt_.erase(it);
+    }
+    frames_.push_back(f);
+  }
+}
+
+std::optional<Frame> Load::waitFrame(double timeout, uint32_t minSeq, bool full) {
+  double deadline = clockSeconds() + timeout;
+  size_t seen = frames_.size();
+  while (clockSeconds() < deadline) {
+    pump(std::min(deadline, clockSeconds() + 0.05));
+    for (size_t i = seen; i < frames_.size(); ++i)
+      if (frames_[i].header.seq >= minSeq && (!full || (frames_[i].header.flags & view::web::kFrameFull)))
+        return frames_[i];
+    seen = frames_.size();
+    if (!ws_.open()) break;
+  }
+  return std::nullopt;
+}
+
+Json Load::motionPhase(double scale) {
+  send({{"t", "stream"}, {"motionScale", scale}});
+  pump(clockSeconds() + 0.5);
+  frames_.clear();
+  latencies_.clear();
+  sentAt_.clear();
+  send({{"t", "down"}, {"b", 0}, {"x", 0.5}, {"y", 0.5}});
+  double start = clockSeconds(), next = start;
+  // A circle of a quarter canvas radius, once every 4 s: the camera swings back and forth without pause.
+  while (clockSeconds() - start < args_.seconds) {
+    double t = clockSeconds() - start;
+    send({{"t", "move"},
+          {"x", 0.5 + 0.25 * std::sin(t * M_PI / 2)},
+          {"y", 0.5 + 0.25 * (1 - std::cos(t * M_PI / 2))}});
+    next += 1.0 / args_.rate;
+    pump(next);
+  }
+  double elapsed = clockSeconds() - start;
+  std::vector<Frame> moving = frames_;
+  std::vector<double> latencies = latencies_;
+  uint32_t up = send({{"t", "up"}, {"b", 0}, {"x", 0.5}, {"y", 0.5}});
+  double upAt = clockSeconds();
+  std::optional<Frame> rest = waitFrame(5.0, up, true);
+  double motionBytes = 0;
+  size_t motionFrames = 0;
+  for (const Frame& f : moving)
+    if (!(f.header.flags & view::web::kFrameFull)) {
+      motionBytes += double(f.bytes);
+      motionFrames++;
+    }
+  Json stats = state_.is_object() ? state_.value("stats", Json::object()) : Json::object();
+  Json phase = {{"motion_scale", scale},
+                {"seconds", elapsed},
+                {"frames", moving.size()},
+                {"frames_per_second", double(moving.size()) / elapsed},
+                {"motion_frames", motionFrames},
+                {"motion_frame_size",
+                 moving.empty() ? Json() : Json{moving.back().header.width, moving.back().header.height}},
+                {"bytes_per_frame_moving", motionFrames ? motionBytes / double(motionFrames) : 0.0},
+                {"input_to_frame_ms", summary(latencies)},
+                {"server_render_ms", stats.value("renderMs", 0.0)},
+                {"server_encode_ms", stats.value("encodeMs", 0.0)},
+                {"server_host_ms", stats.value("hostMs", 0.0)},
+                {"frames_dropped", stats.value("framesDropped", 0)}};
+  if (rest) {
+    phase["bytes_per_frame_at_rest"] = rest->bytes;
+    phase["rest_frame_after_release_ms"] = (rest->arrived - upAt) * 1e3;
+  }
+  return phase;
+}
+
+// The time from one input after a pause to its frame: a discrete change, rendered at full quality.
+Json Load::isolatedLatency() {
+  std::vector<double> ms;
+  for (uint32_t i = 0; i < args_.isolated; ++i) {
+    pump(clockSeconds() + 0.4);
+    send({{"t", "down"}, {"b", 0}, {"x", 0.5}, {"y", 0.5}});
+    double x = 0.5 + (i % 2 ? -0.02 : 0.02);
+    double sent = clockSeconds();
+    uint32_t s = send({{"t", "move"}, {"x", x}, {"y", 0.5}});
+    std::optional<Frame> f = waitFrame(5.0, s, false);
+    if (f) ms.push_back((f->arrived - sent) * 1e3);
+    send({{"t", "up"}, {"b", 0}, {"x", x}, {"y", 0.5}});
+  }
+  return summary(ms);
+}
+
+// The targets a browser user needs: a smooth drag, and a frame soon after each input.
+constexpr double kTargetFramesPerSecond = 30;
+constexpr double kTargetLatencyMs = 50;
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0) {
+  char text[160];
+  std::snprintf(text, sizeof text, pattern, a, b, c);
+  return text;
+}
+
+// The result as a Markdown table: one row per motion phase, the isolated inputs below.
+std::string markdown(const Json& r) {
+  std::string md = "# pointrast serve: one client at " + std::to_string(r["width"].get<uint32_t>()) + "x" +
+                   std::to_string(r["height"].get<uint32_t>()) + "\n\n";
+  md += "Device " + r["device"].get<std::string>() + ", " + r["input"].get<std::string>() + " (" +
+        std::to_string(r["points"].get<uint64_t>()) + " points), method " + r["method"].get<std::string>() +
+        "; the load client `serve_load` over loopback, a continuous drag at " +
+        format("%.0f", r["input_rate_hz"].get<double>()) + " pointer moves/s, each frame decoded before " +
+        "its acknowledgement. Targets: >= " + format("%.0f", kTargetFramesPerSecond) +
+        " frames/s, <= " + format("%.0f", kTargetLatencyMs) + " ms from input to frame.\n\n";
+  md += "| motion scale | frame while moving | frames/s | input to frame p50 (ms) | p95 (ms) | KiB/frame "
+        "moving "
+        "| KiB/frame at rest | server render (ms) | server encode (ms) |\n";
+  md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const Json& p : r["phases"]) {
+    const Json& size = p["motion_frame_size"];
+    md += "| " + format("%.2f", p["motion_scale"].get<double>()) + " | " +
+          (size.is_array()
+               ? std::to_string(size[0].get<uint32_t>()) + "x" + std::to_string(size[1].get<uint32_t>())
+               : std::string("-")) +
+          " | " + format("%.1f", p["frames_per_second"].get<double>()) + " | " +
+          format("%.1f | %.1f", p["input_to_frame_ms"]["p50"].get<double>(),
+                 p["input_to_frame_ms"]["p95"].get<double>()) +
+          " | " + format("%.0f", p["bytes_per_frame_moving"].get<double>() / 1024) + " | " +
+          format("%.0f", p.value("bytes_per_frame_at_rest", 0.0) / 1024) + " | " +
+          format("%.2f | %.2f", p["server_render_ms"].get<double>(), p["server_encode_ms"].get<double>()) +
+          " |\n";
+  }
+  const Json& iso = r["isolated_input_to_frame_ms"];
+  md += "\nOne input after a pause (" + std::to_string(iso["inputs"].get<size_t>()) +
+        " inputs), to its frame: " +
+        format("p50 %.1f ms, p95 %.1f ms, max %.1f ms", iso["p50"].get<double>(), iso["p95"].get<double>(),
+               iso["max"].get<double>()) +
+        ".\n";
+  return md;
+}
+
+bool writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (out) return true;
+  std::fprintf(stderr, "serve_load: cannot write %s\n", path.c_str());
+  return false;
+}
+
+int Load::run() {
+  if (!connect()) return 1;
+  std::optional<Frame> first = waitFrame(300.0, 0, true);
+  if (!first) {
+    std::fprintf(stderr, "serve_load: no frame from the server\n");
+    return 1;
+  }
+  Json result = {{"tool", "serve_load"},
+                 {"server", args_.host + ":" + std::to_string(args_.port)},
+                 {"device", info_.value("device", "")},
+                 {"input", info_.value("input", "")},
+                 {"points", info_.value("points", 0)},
+                 {"width", args_.width},
+                 {"height", args_.height},
+                 {"method", state_.is_object() ? state_["settings"].value("method", "") : ""},
+                 {"decode", args_.decode},
+                 {"input_rate_hz", args_.rate},
+                 {"first_frame_bytes", first->bytes}};
+  Json phases = Json::array();
+  for (double scale : {0.5, 1.0})
+    phases.push_back(motionPhase(scale));
+  result["phases"] = phases;
+  result["isolated_input_to_frame_ms"] = isolatedLatency();
+  std::string text = result.dump(2);
+  std::printf("%s\n", text.c_str());
+  for (const Json& p : phases)
+    std::fprintf(
+        stderr,
+        "motion scale %.2f: %.1f frames/s at %ux%u canvas, input to frame p50 %.1f ms p95 %.1f ms, %.0f KiB "
+        "moving, %.0f KiB at rest\n",
+        p["motion_scale"].get<double>(), p["frames_per_second"].get<double>(), args_.width, args_.height,
+        p["input_to_frame_ms"]["p50"].get<double>(), p["input_to_frame_ms"]["p95"].get<double>(),
+        p["bytes_per_frame_moving"].get<double>() / 1024, p.value("bytes_per_frame_at_rest", 0.0) / 1024);
+  if (!args_.output.empty() && !writeFile(args_.output, text + "\n")) return 1;
+  if (!args_.markdown.empty() && !writeFile(args_.markdown, markdown(result))) return 1;
+  return 0;
+}
+
+bool parse(int argc, char** argv, Args& a) {
+  for (int i = 1; i < argc; ++i) {
+    std::string k = argv[i];
+    auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+    if (k == "--host")
+      a.host = value();
+    else if (k == "--port")
+      a.port = uint16_t(std::stoul(value()));
+    else if (k == "--token")
+      a.token = value();
+    else if (k == "--width")
+      a.width = uint32_t(std::stoul(value()));
+    else if (k == "--height")
+      a.height = uint32_t(std::stoul(value()));
+    else if (k == "--seconds")
+      a.seconds = std::stod(value());
+    else if (k == "--rate")
+      a.rate = std::stod(value());
+    else if (k == "--isolated")
+      a.isolated = uint32_t(std::stoul(value()));
+    else if (k == "--no-decode")
+      a.decode = false;
+    else if (k == "-o" || k == "--output")
+      a.output = value();
+    else if (k == "--markdown")
+      a.markdown = value();
+    else
+      return false;
+  }
+  return a.rate > 0 && a.seconds > 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  Args args;
+  try {
+    if (!parse(argc, argv, args)) {
+      std::fprintf(stderr,
+                   "usage: serve_load --port P [--host H] [--token T] [--width W] [--height H] [--seconds S] "
+                   "[--rate HZ] [--isolated N] [--no-decode] [-o result.json] [--markdown result.md]\n");
+      return 1;
+    }
+  } catch (const std::exception&) {
+    std::fprintf(stderr, "serve_load: bad number in the options\n");
+    return 1;
+  }
+  Load load(args);
+  return load.run();
+}

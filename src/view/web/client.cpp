@@ -1,0 +1,271 @@
+#include "view/web/client.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "io/writer.h"
+
+namespace pointrast::view::web {
+
+namespace {
+
+using Json = nlohmann::json;
+
+// While fly keys are held the camera moves every frame: the render thread comes back this often.
+constexpr double kFlyStepSeconds = 1.0 / 60.0;
+
+Json vec(const glm::dvec3& v) {
+  return {v.x, v.y, v.z};
+}
+
+Json rgb(uint32_t rgba) {
+  return {rgba & 0xFF, (rgba >> 8) & 0xFF, (rgba >> 16) & 0xFF};
+}
+
+} // namespace
+
+Viewport clampViewport(uint32_t width, uint32_t height, Viewport maxSize) {
+  double scale = std::min({1.0, double(maxSize.width) / width, double(maxSize.height) / height});
+  if (scale >= 1.0) return {width, height};
+  return {std::max(1u, uint32_t(std::lround(width * scale))),
+          std::max(1u, uint32_t(std::lround(height * scale)))};
+}
+
+Viewport scaleViewport(Viewport viewport, double scale) {
+  return {std::max(1u, uint32_t(std::lround(viewport.width * scale))),
+          std::max(1u, uint32_t(std::lround(viewport.height * scale)))};
+}
+
+WebClient::WebClient(const ClientSetup& setup, FrameStream& stream)
+    : setup_(setup), stream_(stream), full_(*setup.context, *setup.cloud),
+      motion_(*setup.context, *setup.cloud), settings_(setup.stream) {}
+
+glm::dvec2 WebClient::pixels(glm::dvec2 normalized) const {
+  Viewport v = session_->viewport();
+  return {normalized.x * v.width, normalized.y * v.height};
+}
+
+void WebClient::resize(uint32_t width, uint32_t height) {
+  Viewport viewport = clampViewport(width, height, setup_.maxSize);
+  if (!session_) {
+    Camera camera = setup_.camera ? *setup_.camera
+                                  : overviewCamera(setup_.cloud->bounds(), viewport.aspect(), setup_.fovY);
+    session_.emplace(setup_.cloud->bounds(), camera, viewport, setup_.settings);
+    session_->setContentSource(&full_);
+    return;
+  }
+  session_->resize(viewport);
+}
+
+void WebClient::pointer(const ClientMessage& m) {
+  glm::dvec2 at = pixels(m.position);
+  switch (m.type) {
+  case MessageType::Down:
+    session_->mouseDown(m.button, at);
+    break;
+  case MessageType::Move:
+    session_->mouseMove(at);
+    break;
+  case MessageType::Up:
+    session_->mouseUp(m.button, at);
+    break;
+  case MessageType::DoubleClick:
+    session_->doubleClick(at);
+    break;
+  case MessageType::Wheel:
+    // Gathered: one depth read for all the steps that arrived since the last frame, as on the desktop.
+    wheel_ += m.steps;
+    wheelAt_ = at;
+    break;
+  default:
+    break;
+  }
+}
+
+void WebClient::receive(const ClientMessage& m) {
+  if (m.seq) seq_ = *m.seq;
+  if (m.type == MessageType::Resize) {
+    resize(m.width, m.height);
+    return;
+  }
+  if (m.type == MessageType::Stream) {
+    if (m.motionScale) settings_.motionScale = *m.motionScale;
+    if (m.quality) settings_.quality = *m.quality;
+    if (m.motionQuality) settings_.motionQuality = *m.motionQuality;
+    stateChanged_ = true;
+    return;
+  }
+  if (!session_) return; // input before the canvas size means nothing yet
+  switch (m.type) {
+  case MessageType::Down:
+  case MessageType::Move:
+  case MessageType::Up:
+  case MessageType::DoubleClick:
+  case MessageType::Wheel: {
+    Camera before = session_->camera();
+    pointer(m);
+    // The wheel's steps are applied at the next frame; a drag's moves now.
+    if (m.type == MessageType::Wheel || !sameCamera(before, session_->camera())) quality_.input(m.received);
+    break;
+  }
+  case MessageType::Key:
+    if (m.down)
+      session_->keyDown(m.key, m.shift);
+    else
+      session_->keyUp(m.key);
+    stateChanged_ = true; // keyframes, the panel's visibility
+    break;
+  case MessageType::Settings: {
+    ViewSettings s = session_->settings();
+    if (m.method) s.method = *m.method;
+    if (m.background) s.background = *m.background;
+    session_->setSettings(s);
+    break;
+  }
+  case MessageType::Options:
+    if (m.supersample) session_->options().supersample = *m.supersample;
+    if (m.keyframeSeconds) session_->options().keyframeSeconds = *m.keyframeSeconds;
+    stateChanged_ = true;
+    break;
+  case MessageType::Action:
+    if (m.action == ClientAction::ClearKeyframes) session_->path().clear();
+    if (m.action == ClientAction::DownloadPath)
+      stream_.submitText(Json{{"t", "path"}, {"path", Json::parse(session_->path().toJson())}}.dump());
+    stateChanged_ = true;
+    break;
+  default:
+    break;
+  }
+}
+
+void WebClient::serveRequests() {
+  if (wheel_ != 0) {
+    zoomAtCursor(*session_, full_, wheelAt_, std::exchange(wheel_, 0.0));
+  }
+  Requests r = session_->takeRequests();
+  if (r.pick) {
+    std::optional<glm::dvec3> point = pickPivot(*session_, full_, *r.pick);
+    stream_.submitText(
+        Json{{"t", "pick"}, {"hit", point.has_value()}, {"pivot", vec(session_->pivot())}}.dump());
+    stateChanged_ = true;
+  }
+  if (r.printCamera)
+    stream_.submitText(Json{{"t", "camera"}, {"text", describeCamera(session_->camera())}}.dump());
+  if (r.screenshot) sendScreenshot();
+  // r.quit: a client closes its tab, it does not stop the server.
+}
+
+void WebClient::sendScreenshot() {
+  Viewport v = session_->viewport();
+  std::vector<uint32_t> rgba =
+      full_.screenshot(session_->camera(), session_->settings(), v, session_->options().supersample);
+  std::vector<uint8_t> png = io::encodePng(v.width, v.height, rgba.data());
+  FrameHeader h;
+  h.magic = kScreenshotMagic;
+  h.seq = seq_;
+  h.width = h.viewWidth = uint16_t(v.width);
+  h.height = h.viewHeight = uint16_t(v.height);
+  std::vector<uint8_t> message(kFrameHeaderBytes + png.size());
+  writeFrameHeader(h, message.data());
+  std::copy(png.begin(), png.end(), message.begin() + kFrameHeaderBytes);
+  stream_.submitBinary(std::move(message));
+  session_->invalidate(); // a supersampled shot drew with another renderer; the shown frame is redrawn
+}
+
+std::optional<double> WebClient::step(double now) {
+  if (!session_) return std::nullopt;
+  double elapsed = lastStep_ < 0 ? 0 : now - lastStep_;
+  lastStep_ = now;
+  serveRequests();
+  session_->advance(elapsed);
+  if (stream_.wantsFrame()) {
+    bool needed = session_->needsFrame();
+    if (needed || quality_.refineDue(now))
+      renderFrame(now, needed ? quality_.next(session_->camera(), now) : FrameQuality::Full);
+  }
+  if (stateChanged_) {
+    stream_.submitState(stateJson(nullptr));
+    stateChanged_ = false;
+  }
+  if (session_->animating()) return now + kFlyStepSeconds;
+  return quality_.refineAt();
+}
+
+void WebClient::renderFrame(double now, FrameQuality quality) {
+  auto start = std::chrono::steady_clock::now();
+  Viewport viewport = session_->viewport();
+  bool cheap = quality == FrameQuality::Motion && settings_.motionScale < 1.0;
+  Viewport size = cheap ? scaleViewport(viewport, settings_.motionScale) : viewport;
+  SceneView& view = cheap ? motion_ : full_;
+  FrameReport report = view.render(session_->camera(), session_->settings(), size);
+  RawFrame frame;
+  frame.rgba = view.renderer().image();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  session_->frameRendered(report);
+  quality_.rendered(session_->camera(), quality, now);
+
+  FrameHeader& h = frame.header;
+  h.frame = nextFrame_++;
+  h.seq = seq_;
+  h.width = uint16_t(size.width);
+  h.height = uint16_t(size.height);
+  h.viewWidth = uint16_t(viewport.width);
+  h.viewHeight = uint16_t(viewport.height);
+  h.flags = quality == FrameQuality::Full ? kFrameFull : 0;
+  h.renderMs = float(report.renderMs);
+  frame.jpeg.quality = quality == FrameQuality::Full ? settings_.quality : settings_.motionQuality;
+  frame.jpeg.fullChroma = quality == FrameQuality::Full;
+  frame.jpeg.fastDct = quality == FrameQuality::Motion;
+  stream_.submitState(stateJson(&h));
+  stateChanged_ = false;
+  stream_.submitFrame(std::move(frame));
+}
+
+std::string WebClient::stateJson(const FrameHeader* frame) const {
+  const Session& s = *session_;
+  const Statistics& st = s.statistics();
+  StreamStats ss = stream_.stats();
+  const Camera& c = s.camera();
+  Json stats = {{"frames", st.frames},
+                {"renderMs", st.renderMs},
+                {"hostMs", st.hostMs},
+                {"points", st.points},
+                {"pointsPerSecond", st.renderMs > 0 ? double(st.points) / (st.renderMs * 1e-3) : 0.0},
+                {"gpuBytes", st.gpuBytes},
+                {"encodeMs", ss.encodeMs},
+                {"framesPerSecond", ss.framesPerSecond},
+                {"motionBytes", ss.motionBytes},
+                {"fullBytes", ss.fullBytes},
+                {"framesSent", ss.framesSent},
+                {"framesDropped", ss.framesDropped}};
+  if (st.batch)
+    stats["batch"] = {{"batchesProcessed", st.batch->batchesProcessed},
+                      {"batchesRendered", st.batch->batchesRendered},
+                      {"pointsRendered", st.batch->pointsRendered}};
+  Json j = {{"t", "state"},
+            {"seq", seq_},
+            {"viewport", {s.viewport().width, s.viewport().height}},
+            {"camera", {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", c.fovY}}},
+            {"pivot", vec(s.pivot())},
+            {"settings",
+             {{"method", methodName(s.settings().method)}, {"background", rgb(s.settings().background)}}},
+            {"options",
+             {{"panel", s.options().panel},
+              {"supersample", s.options().supersample},
+              {"keyframeSeconds", s.options().keyframeSeconds}}},
+            {"stream",
+             {{"motionScale", settings_.motionScale},
+              {"quality", settings_.quality},
+              {"motionQuality", settings_.motionQuality}}},
+            {"keyframes",
+             {{"count", session_->path().keyframes().size()}, {"duration", session_->path().duration()}}},
+            {"stats", stats}};
+  // The frame this state goes with: the one it precedes, else the last one sent.
+  j["frame"] = frame ? frame->frame : nextFrame_ - 1;
+  return j.dump();
+}
+
+} // namespace pointrast::view::web

@@ -1,0 +1,410 @@
+// The browser viewer's page: input capture and display only. Every decision (camera navigation, settings,
+// when to render, statistics) is made by the server's session; this script turns DOM events into the
+// messages of src/view/web/protocol.h and shows the frames and the state that come back.
+'use strict';
+
+const FRAME_MAGIC = 0x31465250;      // "PRF1"
+const SCREENSHOT_MAGIC = 0x31535250; // "PRS1"
+const HEADER_BYTES = 32;
+const FLAG_FULL = 1;
+// CloudCompare's view keys on the number row and the keypad, and the viewer's letters (pointrast view).
+const KEYS = {
+  KeyW: 'Forward', KeyS: 'Back', KeyA: 'Left', KeyD: 'Right', KeyQ: 'Down', KeyE: 'Up',
+  KeyF: 'FrameAll', KeyK: 'Keyframe', KeyH: 'TogglePanel', KeyC: 'PrintCamera', F12: 'Screenshot',
+  Digit8: 'ViewTop', Numpad8: 'ViewTop', Digit2: 'ViewBottom', Numpad2: 'ViewBottom',
+  Digit5: 'ViewFront', Numpad5: 'ViewFront', Digit0: 'ViewBack', Numpad0: 'ViewBack',
+  Digit4: 'ViewLeft', Numpad4: 'ViewLeft', Digit6: 'ViewRight', Numpad6: 'ViewRight',
+  Digit1: 'ViewIso', Numpad1: 'ViewIso',
+};
+const FLY = new Set(['Forward', 'Back', 'Left', 'Right', 'Down', 'Up']);
+// Two taps within this time and distance (CSS pixels) are a double-tap: the pivot, as a double-click.
+const DOUBLE_TAP_MS = 350, DOUBLE_TAP_PX = 24;
+
+const canvas = document.getElementById('view');
+const ctx = canvas.getContext('2d');
+const $ = (id) => document.getElementById(id);
+
+// What tests and scripts read: the server's last info and state, and the frames drawn.
+const pointrast = window.pointrast = {
+  info: null, state: null, frames: 0, fullFrames: 0, lastFrame: null, lastPick: null, cameraText: null,
+  errors: [], closed: null, sentSeq: 0,
+};
+
+let socket = null;
+let seq = 0;
+let drawing = Promise.resolve();
+let pendingMove = null, pendingWheel = null, flushScheduled = false;
+const heldKeys = new Set();
+
+function send(message) {
+  if (!socket || socket.readyState !== WebSocket.OPEN) return;
+  if (message.t !== 'ack' && message.t !== 'resize') message.seq = pointrast.sentSeq = ++seq;
+  socket.send(JSON.stringify(message));
+}
+
+// --- connection -----------------------------------------------------------------------------------------
+
+function connect() {
+  const page = new URL(location.href);
+  const url = new URL('ws', page);
+  url.protocol = page.protocol === 'https:' ? 'wss:' : 'ws:';
+  url.search = '';
+  const token = page.searchParams.get('token');
+  if (token) {
+    url.searchParams.set('token', token);
+    // The server set a cookie with it: keep the token out of the address bar and the history.
+    page.searchParams.delete('token');
+    history.replaceState(null, '', page.pathname + page.search + page.hash);
+  }
+  socket = new WebSocket(url);
+  socket.binaryType = 'arraybuffer';
+  socket.onopen = () => { status(''); sendSize(true); };
+  socket.onmessage = (event) => {
+    if (typeof event.data === 'string') receiveText(JSON.parse(event.data));
+    else receiveBinary(event.data);
+  };
+  socket.onclose = (event) => {
+    pointrast.closed = { code: event.code, reason: event.reason };
+    const why = event.reason || (pointrast.errors.length ? pointrast.errors[pointrast.errors.length - 1] : '');
+    status('disconnected' + (why ? ': ' + why : '') + ' (reload to reconnect)', true);
+  };
+}
+
+function status(text, error) {
+  $('status').textContent = text;
+  $('status').className = error ? 'error' : '';
+}
+
+// --- frames ---------------------------------------------------------------------------------------------
+
+function receiveBinary(buffer) {
+  const view = new DataView(buffer);
+  const header = {
+    magic: view.getUint32(0, true), frame: view.getUint32(4, true), seq: view.getUint32(8, true),
+    width: view.getUint16(12, true), height: view.getUint16(14, true),
+    viewWidth: view.getUint16(16, true), viewHeight: view.getUint16(18, true),
+    quality: view.getUint8(20), full: (view.getUint8(21) & FLAG_FULL) !== 0,
+    renderMs: view.getFloat32(24, true), encodeMs: view.getFloat32(28, true),
+  };
+  const payload = new Uint8Array(buffer, HEADER_BYTES);
+  if (header.magic === SCREENSHOT_MAGIC) {
+    download(new Blob([payload], { type: 'image/png' }), 'pointrast-screenshot.png');
+    return;
+  }
+  if (header.magic !== FRAME_MAGIC) return;
+  // Frames are drawn in order, one decode at a time; the server sends at most two ahead of the acks.
+  drawing = drawing.then(() => drawFrame(header, payload));
+}
+
+async function drawFrame(header, jpeg) {
+  try {
+    const image = await createImageBitmap(new Blob([jpeg], { type: 'image/jpeg' }),
+                                          { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
+    // The canvas holds the server's viewport 1:1; a motion frame (smaller) is scaled up into it.
+    if (canvas.width !== header.viewWidth || canvas.height !== header.viewHeight) {
+      canvas.width = header.viewWidth;
+      canvas.height = header.viewHeight;
+    }
+    ctx.imageSmoothingEnabled = true;
+    ctx.drawImage(image, 0, 0, canvas.width, canvas.height);
+    image.close();
+    pointrast.frames++;
+    if (header.full) pointrast.fullFrames++;
+    pointrast.lastFrame = header;
+    showStream(header, jpeg.byteLength);
+  } catch (error) {
+    pointrast.errors.push('frame ' + header.frame + ': ' + error);
+  }
+  send({ t: 'ack', frame: header.frame });
+}
+
+function download(blob, name) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+}
+
+// --- state from the server ------------------------------------------------------------------------------
+
+function receiveText(message) {
+  switch (message.t) {
+    case 'info': pointrast.info = message; buildPanel(message); break;
+    case 'state': pointrast.state = message; showState(message); break;
+    case 'pick': pointrast.lastPick = message; break;
+    case 'camera': pointrast.cameraText = message.text; $('cameraText').textContent = 'render ' + message.text; break;
+    case 'path': download(new Blob([JSON.stringify(message.path, null, 1)], { type: 'application/json' }), 'path.json'); break;
+    case 'error': pointrast.errors.push(message.message); status(message.message, true); break;
+  }
+}
+
+function human(n) {
+  const units = [[1e12, 'T'], [1e9, 'G'], [1e6, 'M'], [1e3, 'k']];
+  for (const [v, u] of units) if (n >= v) return (n / v).toFixed(n / v >= 100 ? 0 : 1) + ' ' + u;
+  return String(Math.round(n));
+}
+
+const fmt = (v, d) => Number(v).toFixed(d);
+const vec = (v) => v.map((x) => fmt(x, 3)).join(', ');
+
+function buildPanel(info) {
+  const select = $('method');
+  select.textContent = '';
+  for (const m of info.methods) {
+    const option = document.createElement('option');
+    option.value = option.textContent = m.name;
+    option.title = m.help;
+    select.appendChild(option);
+  }
+  $('panel').hidden = false;
+}
+
+// What the stream delivers, measured here from the frames drawn: the server's state message goes before
+// its frame, so its figures would always lag one frame behind.
+const stream = { drawn: [], motionBytes: [], fullBytes: 0 };
+
+function showStream(header, bytes) {
+  const now = performance.now();
+  stream.drawn.push(now);
+  while (stream.drawn.length && now - stream.drawn[0] > 1000) stream.drawn.shift();
+  if (header.full) {
+    stream.fullBytes = bytes;
+  } else {
+    stream.motionBytes.push(bytes);
+    if (stream.motionBytes.length > 60) stream.motionBytes.shift();
+  }
+  const motion = stream.motionBytes.length ? stream.motionBytes.reduce((a, b) => a + b, 0) / stream.motionBytes.length : 0;
+  $('streamStats').textContent = [
+    `JPEG encode ${fmt(header.encodeMs, 3).padStart(8)} ms  (sender thread)`,
+    `stream ${header.width}x${header.height} q${header.quality}, ${stream.drawn.length} frames/s`,
+    `JPEG ${fmt(motion / 1024, 0)} KiB moving, ${fmt(stream.fullBytes / 1024, 0)} KiB at rest`,
+  ].join('\n');
+}
+
+function showState(s) {
+  const info = pointrast.info || { device: '', input: '', points: 0 };
+  const st = s.stats;
+  $('panel').hidden = !s.options.panel;
+  if (document.activeElement !== $('method')) $('method').value = s.settings.method;
+  const bg = s.settings.background.join(',');
+  let preset = false;
+  for (const r of document.querySelectorAll('input[name=background]')) { r.checked = r.value === bg; preset ||= r.checked; }
+  $('backgroundCustom').value = '#' + s.settings.background.map((c) => c.toString(16).padStart(2, '0')).join('');
+  const lines = [
+    info.device,
+    `${info.input}: ${human(info.points)} points`,
+    `GPU render  ${fmt(st.renderMs, 3).padStart(8)} ms  (clear + draw + resolve)`,
+    `frame (host) ${fmt(st.hostMs, 2).padStart(7)} ms, ${st.frames} frames`,
+    `points drawn ${human(st.points)}, ${human(st.pointsPerSecond)} points/s`,
+  ];
+  if (st.batch) lines.push(`batches ${human(st.batch.batchesRendered)} of ${human(st.batch.batchesProcessed)} rendered, ${human(st.batch.pointsRendered)} points passed early-z`);
+  lines.push(`GPU memory ${fmt(st.gpuBytes / 1048576, 1)} MiB (scene + targets)`);
+  $('stats').textContent = lines.join('\n');
+  $('camera').textContent = `eye    ${vec(s.camera.eye)}\ntarget ${vec(s.camera.target)}\npivot  ${vec(s.pivot)}`;
+  $('keyframes').textContent = `${s.keyframes.count} keyframes, ${fmt(s.keyframes.duration, 1)} s`;
+  if (document.activeElement !== $('keyframeSeconds')) $('keyframeSeconds').value = s.options.keyframeSeconds;
+  for (const r of document.querySelectorAll('input[name=supersample]')) r.checked = Number(r.value) === s.options.supersample;
+  if (document.activeElement !== $('motionScale')) $('motionScale').value = String(s.stream.motionScale);
+  if (document.activeElement !== $('quality')) $('quality').value = s.stream.quality;
+  if (document.activeElement !== $('motionQuality')) $('motionQuality').value = s.stream.motionQuality;
+}
+
+// --- panel controls -------------------------------------------------------------------------------------
+
+$('method').addEventListener('change', (e) => send({ t: 'settings', method: e.target.value }));
+for (const r of document.querySelectorAll('input[name=background]'))
+  r.addEventListener('change', () => send({ t: 'settings', background: r.value.split(',').map(Number) }));
+$('backgroundCustom').addEventListener('input', (e) => {
+  const hex = e.target.value;
+  send({ t: 'settings', background: [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16)) });
+});
+for (const b of document.querySelectorAll('button[data-key]'))
+  b.addEventListener('click', () => { send({ t: 'key', key: b.dataset.key, down: true }); canvas.focus(); });
+$('clearKeyframes').addEventListener('click', () => send({ t: 'action', name: 'clearKeyframes' }));
+$('downloadPath').addEventListener('click', () => send({ t: 'action', name: 'downloadPath' }));
+$('keyframeSeconds').addEventListener('change', (e) => {
+  const v = Number(e.target.value);
+  if (v >= 0.1 && v <= 60) send({ t: 'options', keyframeSeconds: v });
+});
+for (const r of document.querySelectorAll('input[name=supersample]'))
+  r.addEventListener('change', () => send({ t: 'options', supersample: Number(r.value) }));
+$('motionScale').addEventListener('change', (e) => send({ t: 'stream', motionScale: Number(e.target.value) }));
+$('quality').addEventListener('change', (e) => send({ t: 'stream', quality: Number(e.target.value) }));
+$('motionQuality').addEventListener('change', (e) => send({ t: 'stream', motionQuality: Number(e.target.value) }));
+
+// --- canvas size ----------------------------------------------------------------------------------------
+
+let sentSize = '';
+function sendSize(force) {
+  const r = canvas.getBoundingClientRect();
+  const w = Math.max(1, Math.round(r.width * devicePixelRatio));
+  const h = Math.max(1, Math.round(r.height * devicePixelRatio));
+  if (!force && `${w}x${h}` === sentSize) return;
+  sentSize = `${w}x${h}`;
+  send({ t: 'resize', w, h });
+}
+new ResizeObserver(() => requestAnimationFrame(() => sendSize(false))).observe(canvas);
+
+// --- pointer, wheel, touch ------------------------------------------------------------------------------
+
+// Positions go to the server normalized to the canvas (0..1): it scales them to its viewport.
+function position(e) {
+  const r = canvas.getBoundingClientRect();
+  return { x: (e.clientX - r.left) / r.width, y: (e.clientY - r.top) / r.height };
+}
+
+// Moves and wheel steps are sent at most once per displayed frame of the page, the last position and the
+// sum of the steps.
+function scheduleFlush() {
+  if (flushScheduled) return;
+  flushScheduled = true;
+  requestAnimationFrame(flush);
+}
+
+function flush() {
+  flushScheduled = false;
+  if (pendingMove) { send({ t: 'move', ...pendingMove }); pendingMove = null; }
+  if (pendingWheel) {
+    const steps = Math.max(-50, Math.min(50, pendingWheel.steps));
+    if (steps !== 0) send({ t: 'wheel', x: pendingWheel.x, y: pendingWheel.y, steps });
+    pendingWheel = null;
+  }
+}
+
+function clampPosition(p) {
+  return { x: Math.max(-4, Math.min(5, p.x)), y: Math.max(-4, Math.min(5, p.y)) };
+}
+
+const touches = new Map();
+let touchMode = null, pinchDistance = 0, lastTap = null;
+
+function midpoint() {
+  const [a, b] = [...touches.values()];
+  return { x: (a.x + b.x) / 2, y: (a.y + b.y) / 2 };
+}
+
+function spread() {
+  const [a, b] = [...touches.values()];
+  return Math.hypot(a.cx - b.cx, a.cy - b.cy);
+}
+
+function wheelAt(p, steps) {
+  if (!pendingWheel) pendingWheel = { x: p.x, y: p.y, steps: 0 };
+  pendingWheel.x = p.x;
+  pendingWheel.y = p.y;
+  pendingWheel.steps += steps;
+  scheduleFlush();
+}
+
+function touchDown(e) {
+  const p = clampPosition(position(e));
+  touches.set(e.pointerId, { ...p, cx: e.clientX, cy: e.clientY });
+  if (touches.size === 1) {
+    const now = performance.now();
+    if (lastTap && now - lastTap.time < DOUBLE_TAP_MS && Math.hypot(e.clientX - lastTap.cx, e.clientY - lastTap.cy) < DOUBLE_TAP_PX) {
+      send({ t: 'dblclick', ...p });
+      lastTap = null;
+      touchMode = null;
+      return;
+    }
+    lastTap = { time: now, cx: e.clientX, cy: e.clientY };
+    send({ t: 'down', b: 0, ...p });
+    touchMode = 'orbit';
+  } else if (touches.size === 2) {
+    flush();
+    if (touchMode === 'orbit') send({ t: 'up', b: 0, ...p });
+    send({ t: 'down', b: 2, ...midpoint() });
+    touchMode = 'pan';
+    pinchDistance = spread();
+  }
+}
+
+function touchMove(e) {
+  if (!touches.has(e.pointerId)) return;
+  const p = clampPosition(position(e));
+  touches.set(e.pointerId, { ...p, cx: e.clientX, cy: e.clientY });
+  if (touchMode === 'orbit') {
+    pendingMove = p;
+    scheduleFlush();
+  } else if (touchMode === 'pan' && touches.size === 2) {
+    const m = midpoint();
+    pendingMove = m;
+    const d = spread();
+    // Pinching apart by the wheel's zoom factor per step is one step in.
+    if (pinchDistance > 0 && d > 0) wheelAt(m, Math.log(d / pinchDistance) / Math.log(1 / pointrast.info.zoomPerStep));
+    pinchDistance = d;
+    scheduleFlush();
+  }
+}
+
+function touchUp(e) {
+  if (!touches.has(e.pointerId)) return;
+  const p = clampPosition(position(e));
+  flush();
+  if (touchMode === 'pan' && touches.size === 2) { send({ t: 'up', b: 2, ...midpoint() }); touchMode = null; }
+  touches.delete(e.pointerId);
+  if (touchMode === 'orbit' && touches.size === 0) { send({ t: 'up', b: 0, ...p }); touchMode = null; }
+}
+
+let buttonsDown = 0;
+canvas.addEventListener('pointerdown', (e) => {
+  canvas.focus();
+  canvas.setPointerCapture(e.pointerId);
+  if (e.pointerType === 'touch') return touchDown(e);
+  if (e.button > 2) return;
+  flush();
+  buttonsDown++;
+  send({ t: 'down', b: e.button, ...clampPosition(position(e)) });
+});
+canvas.addEventListener('pointermove', (e) => {
+  if (e.pointerType === 'touch') return touchMove(e);
+  if (buttonsDown === 0) return;
+  pendingMove = clampPosition(position(e));
+  scheduleFlush();
+});
+const release = (e) => {
+  if (e.pointerType === 'touch') return touchUp(e);
+  if (e.button > 2 || buttonsDown === 0) return;
+  flush();
+  buttonsDown--;
+  send({ t: 'up', b: e.button, ...clampPosition(position(e)) });
+};
+canvas.addEventListener('pointerup', release);
+canvas.addEventListener('pointercancel', release);
+canvas.addEventListener('dblclick', (e) => send({ t: 'dblclick', ...clampPosition(position(e)) }));
+canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  // One notch of a mouse wheel is about 100 pixels (3 lines) in Chromium and Firefox: one step.
+  const perStep = e.deltaMode === 1 ? 3 : e.deltaMode === 2 ? 1 : 100;
+  wheelAt(clampPosition(position(e)), -e.deltaY / perStep);
+}, { passive: false });
+
+// --- keys -----------------------------------------------------------------------------------------------
+
+function typing(e) {
+  const t = e.target;
+  return t instanceof HTMLInputElement || t instanceof HTMLSelectElement || t instanceof HTMLTextAreaElement;
+}
+
+window.addEventListener('keydown', (e) => {
+  const key = KEYS[e.code];
+  if (!key || typing(e) || e.ctrlKey || e.altKey || e.metaKey) return;
+  e.preventDefault();
+  if (e.repeat) return; // the server keeps held keys held
+  if (FLY.has(key)) heldKeys.add(key);
+  send({ t: 'key', key, down: true, shift: e.shiftKey });
+});
+window.addEventListener('keyup', (e) => {
+  const key = KEYS[e.code];
+  if (!key || !FLY.has(key)) return;
+  heldKeys.delete(key);
+  send({ t: 'key', key, down: false });
+});
+window.addEventListener('blur', () => {
+  for (const key of heldKeys) send({ t: 'key', key, down: false });
+  heldKeys.clear();
+});
+
+connect();

@@ -1,0 +1,298 @@
+#include "view/web/protocol.h"
+
+#include <cmath>
+#include <cstring>
+#include <initializer_list>
+
+#include <nlohmann/json.hpp>
+
+namespace pointrast::view::web {
+
+namespace {
+
+using Json = nlohmann::json;
+
+struct KeyName {
+  Key key;
+  const char* name;
+};
+constexpr KeyName kKeyNames[] = {
+    {Key::Forward, "Forward"},
+    {Key::Back, "Back"},
+    {Key::Left, "Left"},
+    {Key::Right, "Right"},
+    {Key::Down, "Down"},
+    {Key::Up, "Up"},
+    {Key::FrameAll, "FrameAll"},
+    {Key::Keyframe, "Keyframe"},
+    {Key::TogglePanel, "TogglePanel"},
+    {Key::PrintCamera, "PrintCamera"},
+    {Key::Screenshot, "Screenshot"},
+    {Key::ViewTop, "ViewTop"},
+    {Key::ViewBottom, "ViewBottom"},
+    {Key::ViewFront, "ViewFront"},
+    {Key::ViewBack, "ViewBack"},
+    {Key::ViewLeft, "ViewLeft"},
+    {Key::ViewRight, "ViewRight"},
+    {Key::ViewIso, "ViewIso"},
+};
+
+struct TypeName {
+  MessageType type;
+  const char* name;
+  std::initializer_list<const char*> fields; // besides "t" and "seq"
+};
+const TypeName kTypes[] = {
+    {MessageType::Resize, "resize", {"w", "h"}},
+    {MessageType::Down, "down", {"b", "x", "y"}},
+    {MessageType::Move, "move", {"x", "y"}},
+    {MessageType::Up, "up", {"b", "x", "y"}},
+    {MessageType::DoubleClick, "dblclick", {"x", "y"}},
+    {MessageType::Wheel, "wheel", {"x", "y", "steps"}},
+    {MessageType::Key, "key", {"key", "down", "shift"}},
+    {MessageType::Settings, "settings", {"method", "background"}},
+    {MessageType::Options, "options", {"supersample", "keyframeSeconds"}},
+    {MessageType::Stream, "stream", {"motionScale", "quality", "motionQuality"}},
+    {MessageType::Action, "action", {"name"}},
+    {MessageType::Ack, "ack", {"frame"}},
+};
+
+// Thrown inside the parser only; parseClientMessage turns it into the refusal's sentence.
+struct Refused {
+  std::string why;
+};
+
+[[noreturn]] void refuse(std::string why) {
+  throw Refused{std::move(why)};
+}
+
+const Json& field(const Json& j, const char* name) {
+  auto it = j.find(name);
+  if (it == j.end()) refuse(std::string("missing \"") + name + "\"");
+  return *it;
+}
+
+double number(const Json& j, const char* name, double lo, double hi) {
+  const Json& v = field(j, name);
+  if (!v.is_number()) refuse(std::string("\"") + name + "\" must be a number");
+  double d = v.get<double>();
+  if (!std::isfinite(d) || d < lo || d > hi) refuse(std::string("\"") + name + "\" is out of range");
+  return d;
+}
+
+uint64_t integer(const Json& j, const char* name, uint64_t lo, uint64_t hi) {
+  const Json& v = field(j, name);
+  if (!v.is_number_unsigned()) refuse(std::string("\"") + name + "\" must be a non-negative integer");
+  uint64_t n = v.get<uint64_t>();
+  if (n < lo || n > hi) refuse(std::string("\"") + name + "\" is out of range");
+  return n;
+}
+
+bool boolean(const Json& j, const char* name) {
+  const Json& v = field(j, name);
+  if (!v.is_boolean()) refuse(std::string("\"") + name + "\" must be true or false");
+  return v.get<bool>();
+}
+
+const std::string& string(const Json& j, const char* name) {
+  const Json& v = field(j, name);
+  if (!v.is_string()) refuse(std::string("\"") + name + "\" must be a string");
+  return v.get_ref<const std::string&>();
+}
+
+glm::dvec2 position(const Json& j) {
+  return {number(j, "x", -kPositionMargin, 1 + kPositionMargin),
+          number(j, "y", -kPositionMargin, 1 + kPositionMargin)};
+}
+
+MouseButton button(const Json& j) {
+  switch (integer(j, "b", 0, 2)) {
+  case 0:
+    return MouseButton::Left;
+  case 1:
+    return MouseButton::Middle;
+  default:
+    return MouseButton::Right;
+  }
+}
+
+void settings(const Json& j, std::span<const Method> methods, ClientMessage& m) {
+  if (j.contains("method")) {
+    const std::string& name = string(j, "method");
+    for (Method method : methods)
+      if (name == methodName(method)) m.method = method;
+    if (!m.method) refuse("\"method\" is not a method this device runs");
+  }
+  if (j.contains("background")) {
+    const Json& v = j["background"];
+    if (!v.is_array() || v.size() != 3) refuse("\"background\" must be [r, g, b]");
+    uint32_t rgba = 0xFF000000u;
+    for (int c = 0; c < 3; ++c) {
+      if (!v[c].is_number_unsigned() || v[c].get<uint64_t>() > 255) refuse("\"background\" takes 0..255");
+      rgba |= uint32_t(v[c].get<uint64_t>()) << (8 * c);
+    }
+    m.background = rgba;
+  }
+  if (!m.method && !m.background) refuse("\"settings\" changes nothing");
+}
+
+void options(const Json& j, ClientMessage& m) {
+  if (j.contains("supersample")) {
+    uint64_t s = integer(j, "supersample", 1, 4);
+    if (s == 3) refuse("\"supersample\" takes 1, 2 or 4");
+    m.supersample = uint32_t(s);
+  }
+  if (j.contains("keyframeSeconds")) m.keyframeSeconds = number(j, "keyframeSeconds", 0.1, 60);
+  if (!m.supersample && !m.keyframeSeconds) refuse("\"options\" changes nothing");
+}
+
+void stream(const Json& j, ClientMessage& m) {
+  if (j.contains("motionScale")) m.motionScale = number(j, "motionScale", 0.25, 1);
+  if (j.contains("quality")) m.quality = int(integer(j, "quality", 10, 100));
+  if (j.contains("motionQuality")) m.motionQuality = int(integer(j, "motionQuality", 10, 100));
+  if (!m.motionScale && !m.quality && !m.motionQuality) refuse("\"stream\" changes nothing");
+}
+
+ClientMessage parse(const Json& j, std::span<const Method> methods) {
+  if (!j.is_object()) refuse("a message must be a JSON object");
+  const std::string& t = string(j, "t");
+  const TypeName* type = nullptr;
+  for (const TypeName& candidate : kTypes)
+    if (t == candidate.name) type = &candidate;
+  if (!type) refuse("unknown message type");
+  for (const auto& [name, value] : j.items()) {
+    bool known = name == "t" || name == "seq";
+    for (const char* f : type->fields)
+      known = known || name == f;
+    if (!known) refuse("unknown field \"" + name.substr(0, 32) + "\"");
+  }
+  ClientMessage m;
+  m.type = type->type;
+  if (j.contains("seq")) m.seq = uint32_t(integer(j, "seq", 0, UINT32_MAX));
+  switch (m.type) {
+  case MessageType::Resize:
+    m.width = uint32_t(integer(j, "w", 1, kMaxCanvasSide));
+    m.height = uint32_t(integer(j, "h", 1, kMaxCanvasSide));
+    break;
+  case MessageType::Down:
+  case MessageType::Up:
+    m.button = button(j);
+    m.position = position(j);
+    break;
+  case MessageType::Move:
+  case MessageType::DoubleClick:
+    m.position = position(j);
+    break;
+  case MessageType::Wheel:
+    m.position = position(j);
+    m.steps = number(j, "steps", -kMaxWheelSteps, kMaxWheelSteps);
+    break;
+  case MessageType::Key: {
+    std::optional<Key> key = keyFromName(string(j, "key"));
+    if (!key) refuse("unknown key");
+    m.key = *key;
+    m.down = boolean(j, "down");
+    m.shift = j.contains("shift") && boolean(j, "shift");
+    break;
+  }
+  case MessageType::Settings:
+    settings(j, methods, m);
+    break;
+  case MessageType::Options:
+    options(j, m);
+    break;
+  case MessageType::Stream:
+    stream(j, m);
+    break;
+  case MessageType::Action: {
+    const std::string& name = string(j, "name");
+    if (name == "clearKeyframes")
+      m.action = ClientAction::ClearKeyframes;
+    else if (name == "downloadPath")
+      m.action = ClientAction::DownloadPath;
+    else
+      refuse("unknown action");
+    break;
+  }
+  case MessageType::Ack:
+    m.frame = uint32_t(integer(j, "frame", 0, UINT32_MAX));
+    break;
+  }
+  return m;
+}
+
+template <typename T> void put(uint8_t*& out, T value) {
+  std::memcpy(out, &value, sizeof value); // the wire is little-endian, as is every machine we build for
+  out += sizeof value;
+}
+
+template <typename T> T get(const uint8_t*& in) {
+  T value;
+  std::memcpy(&value, in, sizeof value);
+  in += sizeof value;
+  return value;
+}
+
+} // namespace
+
+std::optional<Key> keyFromName(std::string_view name) {
+  for (const KeyName& k : kKeyNames)
+    if (name == k.name) return k.key;
+  return std::nullopt;
+}
+
+const char* keyName(Key key) {
+  for (const KeyName& k : kKeyNames)
+    if (key == k.key) return k.name;
+  return "?";
+}
+
+std::variant<ClientMessage, std::string> parseClientMessage(std::string_view text,
+                                                            std::span<const Method> methods) {
+  if (text.size() > kMaxMessageBytes) return std::string("message too long");
+  // The JSON parser stops at a NUL byte as at the end of the text: what follows it would pass unread. JSON
+  // has no raw NUL anywhere (inside a string it is escaped).
+  if (text.find('\0') != std::string_view::npos) return std::string("a NUL byte");
+  // Invalid UTF-8 and nesting deeper than the 1 KiB allow fail the parse like any other malformed text.
+  Json j = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) return std::string("not JSON");
+  try {
+    return parse(j, methods);
+  } catch (const Refused& r) {
+    return r.why;
+  }
+}
+
+void writeFrameHeader(const FrameHeader& h, uint8_t* out) {
+  put(out, h.magic);
+  put(out, h.frame);
+  put(out, h.seq);
+  put(out, h.width);
+  put(out, h.height);
+  put(out, h.viewWidth);
+  put(out, h.viewHeight);
+  put(out, h.quality);
+  put(out, h.flags);
+  put(out, uint16_t(0));
+  put(out, h.renderMs);
+  put(out, h.encodeMs);
+}
+
+FrameHeader readFrameHeader(const uint8_t* in) {
+  FrameHeader h;
+  h.magic = get<uint32_t>(in);
+  h.frame = get<uint32_t>(in);
+  h.seq = get<uint32_t>(in);
+  h.width = get<uint16_t>(in);
+  h.height = get<uint16_t>(in);
+  h.viewWidth = get<uint16_t>(in);
+  h.viewHeight = get<uint16_t>(in);
+  h.quality = get<uint8_t>(in);
+  h.flags = get<uint8_t>(in);
+  get<uint16_t>(in);
+  h.renderMs = get<float>(in);
+  h.encodeMs = get<float>(in);
+  return h;
+}
+
+} // namespace pointrast::view::web

@@ -1,0 +1,155 @@
+// Drives Debian's chromium (through playwright-core, no browser download) against a running
+// `pointrast serve` for tests/web/browser_test.cpp, which starts the server, picks the scenario and checks
+// the JSON this prints on its last line. The network here is closed: chromium is started with everything
+// that would reach out turned off, and a fresh profile in a temporary folder.
+//
+//   node browser.mjs SCENARIO URL OUTDIR [JSON-ARGS]
+import { chromium } from 'playwright-core';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+
+const [scenario, url, outdir, argsText] = process.argv.slice(2);
+const args = argsText ? JSON.parse(argsText) : {};
+const TIMEOUT = 120000;
+
+async function launch(viewport) {
+  const profile = mkdtempSync(join(tmpdir(), 'pointrast-chromium-'));
+  const flags = ['--headless', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+                 '--disable-component-update', '--disable-sync'];
+  if (process.getuid && process.getuid() === 0) flags.push('--no-sandbox');
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: process.env.POINTRAST_CHROMIUM || '/usr/bin/chromium',
+    headless: true, args: flags, viewport, deviceScaleFactor: 1, timeout: TIMEOUT,
+  });
+  context.setDefaultTimeout(TIMEOUT);
+  return { context, close: async () => { await context.close(); rmSync(profile, { recursive: true, force: true }); } };
+}
+
+// Waits until the page has drawn a full frame (the one at rest) whose input sequence number is at least
+// `seq` and whose size is `size` when given, and the state that came with it.
+async function waitFull(page, seq = 0, size = null) {
+  await page.waitForFunction(([seq, size]) => {
+    const p = window.pointrast;
+    const f = p && p.lastFrame;
+    return f && f.full && f.seq >= seq && p.state && p.state.frame === f.frame &&
+           (!size || (f.viewWidth === size[0] && f.viewHeight === size[1]));
+  }, [seq, size], { timeout: TIMEOUT, polling: 50 });
+  return page.evaluate(() => ({ state: window.pointrast.state, frame: window.pointrast.lastFrame, frames: window.pointrast.frames }));
+}
+
+async function open(context, target) {
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  const response = await page.goto(target);
+  return { page, errors, status: response ? response.status() : 0 };
+}
+
+async function canvasPng(page, file) {
+  const data = await page.evaluate(() => document.getElementById('view').toDataURL('image/png'));
+  writeFileSync(file, Buffer.from(data.split(',')[1], 'base64'));
+}
+
+async function drag(page, from, to, button) {
+  await page.mouse.move(from[0], from[1]);
+  await page.mouse.down({ button });
+  await page.mouse.move(to[0], to[1], { steps: 8 });
+  await page.mouse.up({ button });
+}
+
+async function settle(page) {
+  // After the release the session rests: the next full frame shows the final camera.
+  await page.waitForTimeout(100);
+  const seq = await page.evaluate(() => window.pointrast.sentSeq);
+  return waitFull(page, seq);
+}
+
+const scenarios = {
+  // The first frame at rest, as a PNG of the canvas, with the state it came with.
+  async frame(context) {
+    const { page, errors, status } = await open(context, url);
+    const shown = await waitFull(page);
+    await canvasPng(page, join(outdir, 'canvas.png'));
+    const canvas = await page.evaluate(() => [document.getElementById('view').width, document.getElementById('view').height]);
+    return { status, errors, canvas, ...shown };
+  },
+  // A drag on the canvas: the cameras before and after, for the test to compare with the session core.
+  async drag(context) {
+    const { page, errors } = await open(context, url);
+    const before = await waitFull(page);
+    await drag(page, args.from, args.to, args.button || 'left');
+    const after = await settle(page);
+    return { errors, before, after };
+  },
+  // The window resized: frames follow at the new size.
+  async resize(context) {
+    const { page, errors } = await open(context, url);
+    const before = await waitFull(page);
+    await page.setViewportSize({ width: args.width, height: args.height });
+    const after = await waitFull(page, 0, [args.width, args.height]);
+    const canvas = await page.evaluate(() => [document.getElementById('view').width, document.getElementById('view').height]);
+    return { errors, before, after, canvas };
+  },
+  // Two tabs: a drag in the first moves only its camera.
+  async two(context) {
+    const a = await open(context, url), b = await open(context, url);
+    const a0 = await waitFull(a.page), b0 = await waitFull(b.page);
+    await a.page.bringToFront();
+    await drag(a.page, args.from, args.to, 'left');
+    const a1 = await settle(a.page);
+    await b.page.waitForTimeout(500);
+    const b1 = await b.page.evaluate(() => ({ state: window.pointrast.state, frames: window.pointrast.frames }));
+    return { errors: [...a.errors, ...b.errors], a0, b0, a1, b1 };
+  },
+  // Without the token, with a wrong one and with the right one: the page, and a WebSocket opened by script.
+  async token(context) {
+    const base = new URL(url);
+    base.search = '';
+    const results = {};
+    for (const [name, target] of [['none', base.href], ['wrong', base.href + '?token=wrong' + args.token.slice(5)], ['right', url]]) {
+      const page = await context.newPage();
+      const response = await page.goto(target);
+      results[name] = { status: response ? response.status() : 0 };
+      if (name === 'right') results[name].shown = await waitFull(page);
+      await page.close();
+    }
+    // The sockets are opened by script on the server's own origin (chromium keeps pages of other origins,
+    // about:blank included, from reaching local addresses), from its refusal page, without the cookie that
+    // the right token's page set.
+    await context.clearCookies();
+    const blank = await context.newPage();
+    await blank.goto(base.href);
+    const ws = base.href.replace('http:', 'ws:') + 'ws';
+    for (const [name, target] of [['wsNone', ws], ['wsWrong', ws + '?token=wrong' + args.token.slice(5)], ['wsRight', ws + '?token=' + args.token]]) {
+      results[name] = await blank.evaluate((target) => new Promise((resolve) => {
+        const socket = new WebSocket(target);
+        let opened = false;
+        socket.onopen = () => { opened = true; socket.close(); };
+        socket.onclose = () => resolve({ opened });
+        setTimeout(() => resolve({ opened, timeout: true }), 10000);
+      }), target);
+    }
+    return results;
+  },
+  // A picture of the page (panel and frame) for the README.
+  async pageshot(context) {
+    const { page, errors } = await open(context, url);
+    await waitFull(page);
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: join(outdir, args.file || 'page.png') });
+    return { errors };
+  },
+};
+
+const viewport = { width: args.viewportWidth || 640, height: args.viewportHeight || 480 };
+const browser = await launch(viewport);
+let result;
+try {
+  result = await scenarios[scenario](browser.context);
+} catch (error) {
+  result = { failure: String(error && error.stack || error) };
+}
+await browser.close();
+console.log(JSON.stringify(result));
