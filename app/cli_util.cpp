@@ -86,6 +86,10 @@ uint64_t parseCount(std::string_view text, std::string_view option) {
   return uint64_t(n);
 }
 
+std::string jsonText(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 uint64_t parseBytes(std::string_view text, std::string_view option) {
   std::string s(text);
   for (const char* suffix : {"iB", "B"})

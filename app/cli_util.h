@@ -7,6 +7,7 @@
 #include <utility>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 namespace pointrast::app {
 
@@ -18,6 +19,10 @@ std::pair<double, double> parseRange(std::string_view text, std::string_view opt
 uint32_t parseRgb(std::string_view text, std::string_view option);
 // "1000000", "1e6", "2.5M", "1.2G", "800k" -> count; throws InputError if not a non-negative integer.
 uint64_t parseCount(std::string_view text, std::string_view option);
+
+// One JSON line. Text that is not UTF-8 (a file name in another encoding) is replaced, not refused: the
+// result of a finished run is never lost to how a path was spelt.
+std::string jsonText(const nlohmann::json& j);
 
 // "8G", "512M", "1.5GiB", "4096" -> bytes (k, M, G, T are powers of 1024; "B" or "iB" may follow); throws
 // InputError naming the option on anything else.

@@ -185,7 +185,7 @@ private:
 void printJsonLine(nlohmann::json j, const gpu::Context& context) {
   j["device"] = context.info().name;
   j["device_type"] = context.info().typeName;
-  std::printf("%s\n", j.dump().c_str());
+  std::printf("%s\n", jsonText(j).c_str());
   std::fflush(stdout);
 }
 
@@ -197,8 +197,8 @@ std::filesystem::path reportDir(const BenchArgs& a, const gpu::Context& context)
 // What every run checks at its end: validation errors, and that something was measured at all.
 void checkRun(const gpu::Context& context, const std::vector<bench::DatasetOutcome>& datasets) {
   if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
+    throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                        " error(s), above; no report was written");
   bool measured = false;
   std::string skipped;
   for (const bench::DatasetOutcome& d : datasets) {
@@ -208,11 +208,15 @@ void checkRun(const gpu::Context& context, const std::vector<bench::DatasetOutco
   if (!measured) throw InputError("nothing was measured: " + skipped);
 }
 
-void printWritten(const BenchArgs& a, size_t results, double seconds, const bench::WrittenFiles& files) {
-  if (a.quiet && a.json) return;
-  std::FILE* to = a.json ? stderr : stdout;
-  std::fprintf(to, "%zu results in %.1f s; wrote %s, %s, %s\n", results, seconds, files.json.string().c_str(),
-               files.markdown.string().c_str(), files.svg.string().c_str());
+// The run's last words: the files written, and for a run a device fault ended, the fault as the one
+// error line (exit 1) after the reports that keep what was measured before it.
+void printWritten(const BenchArgs& a, const bench::RunRecord& run, size_t results,
+                  const bench::WrittenFiles& files) {
+  if (!(a.quiet && a.json))
+    std::fprintf(a.json ? stderr : stdout, "%zu results in %.1f s; wrote %s, %s, %s\n", results, run.seconds,
+                 files.json.string().c_str(), files.markdown.string().c_str(), files.svg.string().c_str());
+  if (run.faulted)
+    throw DeviceFault(run.stopped + "; " + files.json.string() + " holds what was measured before it");
 }
 
 gpu::ContextOptions contextOptions(const BenchArgs& a) {
@@ -336,7 +340,7 @@ int runSphereSuite(const BenchArgs& a) {
   lines.end();
   checkRun(context, run.datasets);
   bench::WrittenFiles files = bench::writeSphereReports(run, info, reportDir(a, context));
-  printWritten(a, run.results.size(), run.seconds, files);
+  printWritten(a, run, run.results.size(), files);
   return 0;
 }
 
@@ -403,7 +407,7 @@ int runLodSuite(const BenchArgs& a) {
   lines.end();
   checkRun(context, run.datasets);
   bench::WrittenFiles files = bench::writeLodSuiteReports(run, info, reportDir(a, context));
-  printWritten(a, run.sweeps.size() + run.streams.size(), run.seconds, files);
+  printWritten(a, run, run.sweeps.size() + run.streams.size(), files);
   return 0;
 }
 
@@ -539,7 +543,7 @@ int runBench(const BenchArgs& a) {
   lines.end();
   checkRun(context, run.datasets);
   bench::WrittenFiles files = bench::writeReports(run, info, reportDir(a, context));
-  printWritten(a, run.results.size(), run.seconds, files);
+  printWritten(a, run, run.results.size(), files);
   return 0;
 }
 
@@ -565,20 +569,24 @@ Command addBench(CLI::App& app) {
       "bench/results/<device>/. Without INPUT, the demo scene (terrain, 1 M points).\n\n"
       "--suite paper2021 generates stand-ins for the 2021 paper's data sets at its sizes (banyunibo 4 M "
       "tls,\n"
-      "eclepens 47 M terrain, retz 145 M terrain, endeavor 796 M tls), runs all methods x orders x views at\n"
-      "1920x1080, states the memory each needs and skips what does not fit. --scale 0.001 shrinks every "
+      "eclepens 47 M terrain, retz 145 M terrain, endeavor 796 M tls) and times, at 1920x1080, every order\n"
+      "and view with the methods that draw uploaded points one by one:\n  " +
+      methodNameList(bench::suiteDefaults("paper2021").methods) +
+      ".\nIt states the memory each data set needs and skips what does not fit. --scale 0.001 shrinks every "
       "size\n"
       "(4 k .. 796 k points) for a quick smoke run; NAME=PATH arguments replace a stand-in by a file.\n"
       "--suite paper2022 stands in for the 2022 paper (Software Rasterization of 2 Billion Points): scan69m\n"
       "(tls, 69 M), aerial279m (terrain, 279 M), scan529m (tls, 529 M, overview and closeup) and aerial1g\n"
       "(terrain, 1,000 M) in Morton order, plus tls-order (tls, 100 M) in scan (original) and Morton order,\n"
-      "overview and closeup; methods hw-points, batch, batch-prefetch, batch-hqs, dedup, hqs, and the LOD\n"
-      "methods lod and lod-hqs at 2560x1140. Its report adds the batch statistics of the paper's Table 2\n"
-      "(batches and points processed/rendered, points per coordinate precision) and the LOD half of it\n"
-      "(nodes and points selected, processed, rendered; the speed-up over batch-prefetch). Each data set is\n"
-      "uploaded once per scene layout its methods read (float and batched, 16 B/point each); the memory\n"
-      "estimate counts both. --methods, --orders, --views, --width and --height override the suite's;\n"
-      "--datasets aerial1g,... measures only the data sets named.\n\n"
+      "overview and closeup, at 2560x1140, with the methods\n  " +
+      methodNameList(bench::suiteDefaults("paper2022").methods) +
+      ".\nIts report adds the batch statistics of the paper's Table 2 (batches and points "
+      "processed/rendered,\n"
+      "points per coordinate precision) and the LOD half of it (nodes and points selected, processed,\n"
+      "rendered; the speed-up over batch-prefetch). Each data set is uploaded once per scene layout its\n"
+      "methods read (float and batched, 16 B/point each); the memory estimate counts both. --methods,\n"
+      "--orders, --views, --width and --height override the suite's; --datasets aerial1g,... measures only\n"
+      "the data sets named.\n\n"
       "The LOD methods draw each data set's octree (Potree 2.0), built once from its points with the octree\n"
       "builder of `pointrast lod` (in memory, on all cores) into the octree cache (--octree-cache, by\n"
       "default ~/.cache/pointrast/octrees) and reused by later runs and by the other suite: KEY/ is the\n"
@@ -601,7 +609,7 @@ Command addBench(CLI::App& app) {
       "overview views; each configuration as one stereo pass and as two mono renders of the same eyes.\n"
       "--views, --frames, --width and --height (each eye's) override the suite's.\n\n"
       "--suite spheres2023 stands in for the particle data sets of \"Efficient Sphere Rendering Revisited\"\n"
-      "(2023) with generated particle scenes at the sizes issue 5 gives them: laser (particles-laser, 306 "
+      "(2023) with generated particle scenes at the sizes of its data sets: laser (particles-laser, 306 "
       "M:\n"
       "laser ablation, a crystal slab with a crater and ejected clusters), riemann (particles-block, 4 M: a\n"
       "shock tube, dense block between vapor regions), drop (particles-drops, 30 M) and fluid\n"

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.h"
+#include "cli_util.h"
 #include "commands.h"
 #include "gpu/context.h"
 #include "io/format_table.h"
@@ -39,7 +40,7 @@ int listDevicesCommand(bool json) {
       std::printf("%zu: %s (%s, Vulkan %s, %s)\n", i, d.name.c_str(), d.typeName.c_str(), api.c_str(),
                   d.driver.c_str());
   }
-  if (json) std::printf("%s\n", list.dump().c_str());
+  if (json) std::printf("%s\n", jsonText(list).c_str());
   return 0;
 }
 
@@ -98,7 +99,7 @@ int mmpldInfo(const InfoArgs& a, const io::FormatInfo& format) {
       j["radius_min"] = stats.radiusMin;
       j["radius_max"] = stats.radiusMax;
     }
-    std::printf("%s\n", j.dump().c_str());
+    std::printf("%s\n", jsonText(j).c_str());
     return 0;
   }
   std::printf("file:    %s\n", a.input.c_str());
@@ -174,7 +175,7 @@ int runInfo(const InfoArgs& a) {
     if (info.hasColor) j["color_bits"] = info.colorBits;
     for (const auto& [key, value] : info.extra)
       j["extra"][key] = value;
-    std::printf("%s\n", j.dump().c_str());
+    std::printf("%s\n", jsonText(j).c_str());
     return 0;
   }
   std::printf("file:    %s\n", a.input.c_str());
@@ -209,7 +210,7 @@ std::string formatHelp() {
     if (f.openNodes) what += std::string(what.empty() ? "" : ", ") + "level-of-detail octree";
     if (what.empty()) what = "recognised, not read (says why)";
     char line[160];
-    std::snprintf(line, sizeof line, "  %-7s %-22s %s\n", f.name, *f.extensions ? f.extensions : "(folder)",
+    std::snprintf(line, sizeof line, "  %-11s %-20s %s\n", f.name, *f.extensions ? f.extensions : "(folder)",
                   what.c_str());
     help += line;
   }
@@ -235,7 +236,7 @@ Command addInfo(CLI::App& app) {
   cmd->add_option("FILE", a->input,
                   "A point cloud (" + io::formatList(io::FormatUse::Cloud) + ") or particle (" +
                       io::formatList(io::FormatUse::Particles) + ") file, or an octree folder (" +
-                       io::formatList(io::FormatUse::Octree) + ")");
+                      io::formatList(io::FormatUse::Octree) + ")");
   cmd->add_option("--frame", a->frame, "MMPLD: the frame to describe")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -104,26 +105,40 @@ lod::Foveation foveation(const RenderArgs& a) {
   return f;
 }
 
-// The PNG(s) of a frame: -o, or with --stereo-layout separate the two eyes as OUT-left.png and OUT-right.png.
-std::vector<std::string> writeOutput(const RenderArgs& a, const std::vector<uint32_t>& pixels) {
-  const uint32_t eyes = a.stereo ? 2 : 1;
-  if (!a.stereo || a.stereoLayout != "separate") {
-    io::writePng(a.output, a.width * eyes, a.height, pixels.data());
-    return {a.output};
-  }
+// The PNG file(s) of a frame: -o, or with --stereo-layout separate the two eyes as OUT-left.png and
+// OUT-right.png.
+std::vector<std::string> outputFiles(const RenderArgs& a) {
+  if (!a.stereo || a.stereoLayout != "separate") return {a.output};
   const std::filesystem::path out(a.output);
   std::vector<std::string> files;
+  for (const char* eye : {"-left", "-right"}) {
+    std::filesystem::path file = out;
+    file.replace_filename(out.stem().string() + eye + out.extension().string());
+    files.push_back(file.string());
+  }
+  return files;
+}
+
+// Writes the frame to outputFiles(a): one image (both eyes side by side in stereo) or one per eye.
+void writeOutput(const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  const std::vector<std::string> files = outputFiles(a);
+  const uint32_t eyes = a.stereo ? 2 : 1;
+  if (files.size() == 1) {
+    io::writePng(files[0], a.width * eyes, a.height, pixels.data());
+    return;
+  }
   for (uint32_t e = 0; e < 2; ++e) {
     std::vector<uint32_t> eye(uint64_t(a.width) * a.height);
     for (uint32_t y = 0; y < a.height; ++y)
       std::copy_n(pixels.begin() + (uint64_t(y) * 2 * a.width + uint64_t(e) * a.width), a.width,
                   eye.begin() + uint64_t(y) * a.width);
-    std::filesystem::path file = out;
-    file.replace_filename(out.stem().string() + (e == 0 ? "-left" : "-right") + out.extension().string());
-    io::writePng(file.string(), a.width, a.height, eye.data());
-    files.push_back(file.string());
+    io::writePng(files[e], a.width, a.height, eye.data());
   }
-  return files;
+}
+
+nlohmann::json outputJson(const RenderArgs& a) {
+  const std::vector<std::string> files = outputFiles(a);
+  return files.size() == 1 ? nlohmann::json(files[0]) : nlohmann::json(files);
 }
 
 nlohmann::json stereoJson(const RenderArgs& a, const StereoSettings& s, const Camera& camera) {
@@ -133,6 +148,110 @@ nlohmann::json stereoJson(const RenderArgs& a, const StereoSettings& s, const Ca
   j["convergence"] = std::isinf(convergence) ? nlohmann::json("inf") : nlohmann::json(convergence);
   j["layout"] = a.stereoLayout;
   return j;
+}
+
+// What every render checks before reading anything: the output, the image size, the frames, and the camera
+// options a user gave, each named.
+void checkCommonArgs(const RenderArgs& a) {
+  // -o is the single image; --path renders a camera path into --video or --frames-dir instead.
+  const bool pathMode = !a.path.path.empty();
+  if (!pathMode && (!a.path.video.empty() || !a.path.framesDir.empty()))
+    throw InputError("--video and --frames-dir need --path (a camera path)");
+  if (pathMode == !a.output.empty())
+    throw InputError(pathMode ? "--path replaces -o: give one of them" : "-o is required");
+  if (pathMode && isSphereMethodName(a.method))
+    throw InputError("--path renders the point methods, not " + a.method);
+  if (!pathMode && std::filesystem::path(a.output).extension() != ".png")
+    throw InputError("-o " + a.output + ": the output must be a .png file");
+  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (!(a.fov > 0 && a.fov < 180)) throw InputError("--fov must be between 0 and 180 degrees");
+  if (!(a.nearW >= 0) || !std::isfinite(a.nearW)) throw InputError("--near must be a number >= 0");
+  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  if (!a.eye.empty()) {
+    parseVec3(a.eye, "--eye");
+    parseVec3(a.up, "--up");
+    if (!a.target.empty()) parseVec3(a.target, "--target");
+  }
+}
+
+// What a camera problem means in terms of the options that set the camera.
+std::string cameraOptionText(CameraProblem problem) {
+  switch (problem) {
+  case CameraProblem::EyeIsTarget:
+    return "--eye and --target must differ (--target defaults to the center of the bounds)";
+  case CameraProblem::UpIsZero:
+    return "--up must not be zero";
+  case CameraProblem::UpAlongView:
+    return "--up is parallel to the view direction; give another --up";
+  default:
+    return describeCameraProblem(problem); // the rest was checked with its option's name already
+  }
+}
+
+// The camera of --eye/--target/--up, or the overview of `bounds`. The data is checked first (coordinates
+// pointrast can place a camera among), so what fails afterwards is an option the user gave.
+Camera renderCamera(const RenderArgs& a, const Bounds& bounds, const std::string& source) {
+  checkCoordinateRange(bounds, source);
+  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
+  if (!a.eye.empty()) {
+    camera.eye = parseVec3(a.eye, "--eye");
+    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
+    camera.up = parseVec3(a.up, "--up");
+  }
+  camera.nearW = a.nearW;
+  if (auto problem = findCameraProblem(camera))
+    throw InputError(a.eye.empty() ? source + ": no overview camera: " + describeCameraProblem(*problem)
+                                   : cameraOptionText(*problem));
+  return camera;
+}
+
+// Writes the image only once the frame can be trusted and its JSON line is made: a validation error, or a
+// result that cannot be printed, leaves no PNG behind. Then prints the JSON line, or calls `summary`.
+void finishImage(const RenderArgs& a, const gpu::Context& context, const std::vector<uint32_t>& pixels,
+                 const std::function<nlohmann::json()>& json, const std::function<void()>& summary) {
+  if (context.validationErrors() > 0)
+    throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                        " error(s), above; no image was written");
+  const std::string line = a.json ? jsonText(json()) : std::string();
+  writeOutput(a, pixels);
+  if (a.json)
+    std::printf("%s\n", line.c_str());
+  else if (!a.quiet)
+    summary();
+}
+
+double perSecond(uint64_t items, double medianMs) {
+  return medianMs > 0 ? double(items) / (medianMs * 1e-3) : 0.0;
+}
+
+bool isMeshMethod(SphereMethod method) {
+  return method == SphereMethod::MeshPoints || method == SphereMethod::MeshTriangles;
+}
+
+gpu::ContextOptions contextOptions(const RenderArgs& a) {
+  gpu::ContextOptions options;
+  options.deviceIndex = a.device;
+  options.announce = !a.quiet;
+  return options;
+}
+
+// The image size, the frames and their GPU times, as both kinds of render report them.
+void addTimes(nlohmann::json& j, const RenderArgs& a, uint32_t frames, double medianMs, double minMs,
+              double maxMs) {
+  j["width"] = a.width;
+  j["height"] = a.height;
+  j["frames"] = frames;
+  j["median_ms"] = medianMs;
+  j["min_ms"] = minMs;
+  j["max_ms"] = maxMs;
+}
+
+std::string hashText(const std::vector<uint32_t>& pixels) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
+  return hex;
 }
 
 // Whether any option of the resolve stage or of coloring was given (the sphere methods take none).
@@ -210,14 +329,12 @@ void printPostStats(const PostSettings& post, const PostStats& stats) {
               stats.splatMs, stats.dilateMs, post.edlStrength > 0 ? " + EDL" : "", stats.composeMs);
 }
 
-// The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
-// as spheres of --radius, through the SphereRenderer.
-int runRenderSpheres(const RenderArgs& a) {
+// The sphere options of the command line, checked before anything is read.
+SphereSettings sphereSettings(const RenderArgs& a) {
   SphereSettings settings;
   settings.method = parseSphereMethod(a.method);
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
-  if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
     throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
                      a.method);
@@ -230,7 +347,7 @@ int runRenderSpheres(const RenderArgs& a) {
     throw InputError(
         "--billboard and --conservative apply to the sphere methods that rasterize billboards (" +
         billboardMethodNames() + "), not to " + a.method);
-  bool mesh = settings.method == SphereMethod::MeshPoints || settings.method == SphereMethod::MeshTriangles;
+  const bool mesh = isMeshMethod(settings.method);
   if ((a.meshlet || a.taskCull) && !mesh)
     throw InputError("--meshlet and --task-cull apply to sphere-mesh-points and sphere-mesh-tris, not to " +
                      a.method);
@@ -240,12 +357,46 @@ int runRenderSpheres(const RenderArgs& a) {
     throw InputError("--meshlet takes " + std::to_string(shared::kSphereMeshletLarge) + " or " +
                      std::to_string(shared::kSphereMeshletSmall) + " (spheres per mesh workgroup), not " +
                      std::to_string(settings.meshlet));
-  if (std::filesystem::path(a.output).extension() != ".png")
-    throw InputError("-o " + a.output + ": the output must be a .png file");
+  return settings;
+}
+
+nlohmann::json sphereJson(const gpu::Context& context, const SphereSettings& settings, const ParticleSet& set,
+                          const GpuParticles& particles, const SphereStats& stats, const Camera& camera,
+                          const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  nlohmann::json j;
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  j["method"] = sphereMethodName(settings.method);
+  j["layout"] = particleLayoutName(particles.layout());
+  if (sphereMethodTakesBillboards(settings.method)) {
+    j["billboard"] = sphereBillboardName(settings.billboard);
+    j["conservative"] = settings.conservative;
+  }
+  if (isMeshMethod(settings.method)) {
+    j["meshlet"] = settings.meshlet;
+    j["task_cull"] = settings.taskCull;
+  }
+  if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
+  j["input"] = set.source;
+  j["particles"] = stats.particles;
+  addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
+  j["particles_per_second"] = perSecond(stats.particles, stats.medianMs);
+  j["large_chunks"] = stats.largeChunks;
+  j["spilled_spheres"] = stats.spilledSpheres;
+  j["clamped_spheres"] = stats.clampedSpheres;
+  j["camera"] = describeCamera(camera);
+  j["image_hash"] = hashText(pixels);
+  j["output"] = a.output;
+  return j;
+}
+
+// The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
+// as spheres of --radius, through the SphereRenderer.
+int runRenderSpheres(const RenderArgs& a) {
+  const SphereSettings settings = sphereSettings(a);
   ParticleUploadOptions upload;
   upload.progress = !a.quiet;
   if (a.layout != "auto") upload.layout = parseParticleLayout(a.layout);
-  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
 
   ParticleInputSpec spec;
   spec.source = a.input;
@@ -254,92 +405,33 @@ int runRenderSpheres(const RenderArgs& a) {
   spec.particles = parseCount(a.points, "--points");
   spec.seed = a.seed;
   spec.progress = !a.quiet;
-  ParticleSet set = loadParticles(spec);
+  const ParticleSet set = loadParticles(spec);
   std::string why;
   if (upload.layout && !layoutHolds(*upload.layout, set, &why)) throw InputError(why);
-  Bounds bounds = sphereBounds(set);
-  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
-  if (!a.eye.empty()) {
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
-    camera.up = parseVec3(a.up, "--up");
-  }
-  camera.nearW = a.nearW;
-  validateCamera(camera);
+  const Camera camera = renderCamera(a, sphereBounds(set), set.source);
 
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
+  gpu::Context context(contextOptions(a));
   if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the upload
   SphereRenderer renderer(context, a.width, a.height);
   GpuParticles particles(context, set, upload);
-  SphereStats stats = renderer.render(particles, camera, settings);
-  std::vector<uint32_t> pixels = renderer.image();
-  if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
-  io::writePng(a.output, a.width, a.height, pixels.data());
-  double perSecond = stats.medianMs > 0 ? double(stats.particles) / (stats.medianMs * 1e-3) : 0.0;
-  if (a.json) {
-    nlohmann::json j;
-    j["device"] = context.info().name;
-    j["device_type"] = context.info().typeName;
-    j["method"] = sphereMethodName(settings.method);
-    j["layout"] = particleLayoutName(particles.layout());
-    if (sphereMethodTakesBillboards(settings.method)) {
-      j["billboard"] = sphereBillboardName(settings.billboard);
-      j["conservative"] = settings.conservative;
-    }
-    if (mesh) {
-      j["meshlet"] = settings.meshlet;
-      j["task_cull"] = settings.taskCull;
-    }
-    if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
-    j["input"] = set.source;
-    j["particles"] = stats.particles;
-    j["width"] = a.width;
-    j["height"] = a.height;
-    j["frames"] = stats.frames;
-    j["median_ms"] = stats.medianMs;
-    j["min_ms"] = stats.minMs;
-    j["max_ms"] = stats.maxMs;
-    j["particles_per_second"] = perSecond;
-    j["large_chunks"] = stats.largeChunks;
-    j["spilled_spheres"] = stats.spilledSpheres;
-    j["clamped_spheres"] = stats.clampedSpheres;
-    j["camera"] = describeCamera(camera);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx",
-                  static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
-    j["image_hash"] = hex;
-    j["output"] = a.output;
-    std::printf("%s\n", j.dump().c_str());
-  } else if (!a.quiet) {
-    std::printf("%s: %s particles (%s), %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
-                "particles/s\n",
-                a.output.c_str(), humanCount(double(stats.particles)).c_str(),
-                particleLayoutName(particles.layout()), a.width, a.height, sphereMethodName(settings.method),
-                stats.medianMs, stats.frames, stats.minMs, stats.maxMs, humanCount(perSecond).c_str());
-    if (settings.method == SphereMethod::RayTracing)
-      std::printf("  acceleration structures built in %.3f ms of GPU time (not in the frame times)\n",
-                  stats.buildMs);
-  }
+  const SphereStats stats = renderer.render(particles, camera, settings);
+  const std::vector<uint32_t> pixels = renderer.image();
+  finishImage(
+      a, context, pixels,
+      [&] { return sphereJson(context, settings, set, particles, stats, camera, a, pixels); },
+      [&] {
+        std::printf(
+            "%s: %s particles (%s), %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
+            "particles/s\n",
+            a.output.c_str(), humanCount(double(stats.particles)).c_str(),
+            particleLayoutName(particles.layout()), a.width, a.height, sphereMethodName(settings.method),
+            stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+            humanCount(perSecond(stats.particles, stats.medianMs)).c_str());
+        if (settings.method == SphereMethod::RayTracing)
+          std::printf("  acceleration structures built in %.3f ms of GPU time (not in the frame times)\n",
+                      stats.buildMs);
+      });
   return 0;
-}
-
-// The camera of the point methods: --eye/--target/--up/--fov/--near, or the overview of `bounds`.
-Camera cameraFor(const RenderArgs& a, const Bounds& bounds) {
-  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
-  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
-  if (!a.eye.empty()) {
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
-    camera.up = parseVec3(a.up, "--up");
-  }
-  camera.nearW = a.nearW;
-  validateCamera(camera);
-  return camera;
 }
 
 void printLodStats(const lod::LodStats& s, const BatchStats& b) {
@@ -354,6 +446,36 @@ void printLodStats(const lod::LodStats& s, const BatchStats& b) {
               bytesText(s.bytesUploaded).c_str(), bytesText(s.cacheBytes).c_str());
 }
 
+// The JSON line of an octree render.
+nlohmann::json octreeJson(const gpu::Context& context, const RenderSettings& settings,
+                          const lod::OctreeMetadata& octree, const ColorChoice& colors, const FrameStats& stats,
+                          const Camera& camera, const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  nlohmann::json j;
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  j["method"] = methodName(settings.method);
+  j["input"] = octree.source;
+  j["format"] = octree.format;
+  j["octree_points"] = octree.pointCount;
+  j["points"] = stats.points;
+  addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
+  j["points_per_second"] = perSecond(stats.points, stats.medianMs);
+  j["precision"] = a.precision;
+  j["min_node_px"] = settings.minNodePx;
+  j["point_budget"] = settings.pointBudget;
+  j["batch_stats"] = bench::batchStatsJson(*stats.batch);
+  j["lod_stats"] = bench::lodStatsJson(*stats.lod);
+  if (settings.foveation.enabled)
+    j["foveation"] = {{"radius", settings.foveation.radius}, {"periphery", settings.foveation.periphery}};
+  if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
+  if (colors.source) j["color"] = colorSourceName(*colors.source);
+  if (stats.post) j["post"] = postJson(settings.post, *stats.post);
+  j["camera"] = describeCamera(camera);
+  j["image_hash"] = hashText(pixels);
+  j["output"] = outputJson(a);
+  return j;
+}
+
 // The LOD methods (--method lod, lod-hqs): an octree streamed through the node cache.
 int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   if (!a.path.path.empty())
@@ -364,16 +486,10 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   if (!(a.minNodePx >= 0)) throw InputError("--min-node-px must be 0 or more");
   settings.minNodePx = a.minNodePx;
   settings.pointBudget = parseCount(a.pointBudget, "--point-budget");
-  settings.background = parseRgb(a.background, "--background");
   settings.post = postSettings(a);
   settings.stereo = stereoSettings(a);
   settings.foveation = foveation(a);
   const ColorChoice colors = colorChoice(a);
-  settings.frames = a.frames;
-  if (a.frames == 0) throw InputError("--frames must be at least 1");
-  if (std::filesystem::path(a.output).extension() != ".png")
-    throw InputError("-o " + a.output + ": the output must be a .png file");
-  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
   if (a.input.empty() || isSceneName(a.input))
     throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
                      a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
@@ -383,81 +499,33 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   options.colorSource = colors.source;
   options.colorRange = colors.range;
   std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
-  const Camera camera =
-      cameraFor(a, source->metadata().bounds.empty() ? source->metadata().cube : source->metadata().bounds);
+  const lod::OctreeMetadata& octree = source->metadata();
+  const Camera camera = renderCamera(a, octree.bounds.empty() ? octree.cube : octree.bounds, octree.source);
 
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
+  gpu::Context context(contextOptions(a));
   std::string why;
   if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
   Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
-  lod::LodScene octree(context, *source, options);
-  FrameStats stats = renderer.render(octree, camera, settings);
-  std::vector<uint32_t> pixels = renderer.image();
-  if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
-  const std::vector<std::string> files = writeOutput(a, pixels);
-  const double perSecond = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
-  if (a.json) {
-    nlohmann::json j;
-    j["device"] = context.info().name;
-    j["device_type"] = context.info().typeName;
-    j["method"] = methodName(settings.method);
-    j["input"] = source->metadata().source;
-    j["format"] = source->metadata().format;
-    j["octree_points"] = source->metadata().pointCount;
-    j["points"] = stats.points;
-    j["width"] = a.width;
-    j["height"] = a.height;
-    j["frames"] = stats.frames;
-    j["median_ms"] = stats.medianMs;
-    j["min_ms"] = stats.minMs;
-    j["max_ms"] = stats.maxMs;
-    j["points_per_second"] = perSecond;
-    j["precision"] = a.precision;
-    j["min_node_px"] = settings.minNodePx;
-    j["point_budget"] = settings.pointBudget;
-    j["batch_stats"] = bench::batchStatsJson(*stats.batch);
-    j["lod_stats"] = bench::lodStatsJson(*stats.lod);
-    if (settings.foveation.enabled)
-      j["foveation"] = {{"radius", settings.foveation.radius}, {"periphery", settings.foveation.periphery}};
-    if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
-    if (colors.source) j["color"] = colorSourceName(*colors.source);
-    if (stats.post) j["post"] = postJson(settings.post, *stats.post);
-    j["camera"] = describeCamera(camera);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx",
-                  static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
-    j["image_hash"] = hex;
-    j["output"] = files.size() == 1 ? nlohmann::json(files[0]) : nlohmann::json(files);
-    std::printf("%s\n", j.dump().c_str());
-  } else if (!a.quiet) {
-    std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
-                "points/s\n",
-                a.output.c_str(), humanCount(double(stats.points)).c_str(),
-                humanCount(double(source->metadata().pointCount)).c_str(), a.width, a.height,
-                methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
-                humanCount(perSecond).c_str());
-    printLodStats(*stats.lod, *stats.batch);
-    if (stats.post) printPostStats(settings.post, *stats.post);
-  }
+  lod::LodScene scene(context, *source, options);
+  const FrameStats stats = renderer.render(scene, camera, settings);
+  const std::vector<uint32_t> pixels = renderer.image();
+  finishImage(
+      a, context, pixels, [&] { return octreeJson(context, settings, octree, colors, stats, camera, a, pixels); },
+      [&] {
+        std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), "
+                    "%s points/s\n",
+                    a.output.c_str(), humanCount(double(stats.points)).c_str(),
+                    humanCount(double(octree.pointCount)).c_str(), a.width, a.height,
+                    methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+                    humanCount(perSecond(stats.points, stats.medianMs)).c_str());
+        printLodStats(*stats.lod, *stats.batch);
+        if (stats.post) printPostStats(settings.post, *stats.post);
+      });
   return 0;
 }
 
-int runRender(const RenderArgs& a) {
-  Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
-  // -o is the single image; --path renders a camera path into --video or --frames-dir instead.
-  bool pathMode = !a.path.path.empty();
-  if (!pathMode && (!a.path.video.empty() || !a.path.framesDir.empty()))
-    throw InputError("--video and --frames-dir need --path (a camera path)");
-  if (pathMode == !a.output.empty())
-    throw InputError(pathMode ? "--path replaces -o: give one of them" : "-o is required");
-  if (pathMode && isSphereMethodName(a.method))
-    throw InputError("--path renders the point methods, not " + a.method);
-  if (isSphereMethodName(a.method)) return runRenderSpheres(a);
+// The point-method options of the command line, checked before anything is read.
+RenderSettings pointSettings(const RenderArgs& a) {
   if (!a.billboard.empty() || a.conservative)
     throw InputError("--billboard and --conservative apply to the sphere methods (" + billboardMethodNames() +
                      ")");
@@ -466,17 +534,11 @@ int runRender(const RenderArgs& a) {
   if (a.method.rfind("sphere-", 0) == 0) parseSphereMethod(a.method); // throws, naming the sphere methods
   if (isParticleSceneName(a.input) || std::filesystem::path(a.input).extension() == ".mmpld")
     throw InputError(a.input + " holds particles: draw them with a sphere method (--method sphere-compute)");
-  InputSpec spec;
-  spec.source = a.input;
-  spec.points = parseCount(a.points, "--points");
-  spec.seed = a.seed;
-  spec.order = parseOrder(a.order);
-  spec.progress = !a.quiet;
   RenderSettings settings;
   settings.method = parseMethod(a.method);
   settings.depth = parseDepthMode(a.depth);
   settings.precision = parsePrecision(a.precision);
-  const SceneLayout layout = methodInfo(settings.method).layout;
+  const SceneLayout layout = settings.method.info().layout;
   if (settings.precision != 0 && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
     throw InputError("--precision applies to the batch and LOD methods (" +
                      methodNamesReading(SceneLayout::Batched) + ", " +
@@ -485,71 +547,43 @@ int runRender(const RenderArgs& a) {
     throw InputError("--stereo draws both eyes in one pass with the batch and LOD methods (" +
                      methodNamesReading(SceneLayout::Batched) + ", " + methodNamesReading(SceneLayout::Octree) +
                      "), not " + a.method);
-  if (a.stereo && pathMode) throw InputError("--stereo renders one frame with -o, not a camera path");
-  if (layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  if (a.stereo && !a.path.path.empty()) throw InputError("--stereo renders one frame with -o, not a camera path");
+  settings.background = parseRgb(a.background, "--background");
+  settings.frames = a.frames;
+  if (layout == SceneLayout::Octree) return settings; // runRenderOctree checks the octree's own options
   if (a.foveated || a.foveaRadius || a.foveaPeriphery)
     throw InputError("--foveated applies to the LOD methods (" + methodNamesReading(SceneLayout::Octree) +
                      "), which choose octree nodes by their size on screen");
   if (a.lodOptionsGiven)
     throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
                      methodNamesReading(SceneLayout::Octree) + ")");
-  settings.background = parseRgb(a.background, "--background");
   settings.post = postSettings(a);
   settings.stereo = stereoSettings(a);
-  if (settings.post.enabled() && methodInfo(settings.method).output == MethodOutput::ColorOnly)
+  if (settings.post.enabled() && settings.method.info().output == MethodOutput::ColorOnly)
     throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
                      " keeps no depth per pixel to work on");
-  settings.frames = a.frames;
-  if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.parts == 0) throw InputError("--parts must be at least 1");
-  if (!pathMode && std::filesystem::path(a.output).extension() != ".png")
-    throw InputError("-o " + a.output + ": the output must be a .png file");
-  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
-  view::CameraPath cameraPath;
-  if (pathMode) cameraPath = loadPathForRender(a.path, a.width, a.height);
+  return settings;
+}
 
-  Camera camera;
-  bool explicitCamera = !a.eye.empty();
-  if (!a.target.empty() && !explicitCamera) throw InputError("--target needs --eye");
-  if (explicitCamera) {
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.up = parseVec3(a.up, "--up");
-    camera.fovY = a.fov;
-    camera.nearW = a.nearW;
-  }
-
-  PointCloud cloud = loadInput(spec);
-  const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
-  double aspect = double(a.width) / double(a.height);
-  if (explicitCamera) {
-    camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
-  } else {
-    camera = overviewCamera(cloud.bounds, aspect, a.fov);
-    camera.nearW = a.nearW;
-  }
-  validateCamera(camera);
-
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
-  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
-
-  // --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image
-  // as one upload (the atomic min does not care which dispatch a point came from).
-  std::vector<std::unique_ptr<GpuScene>> scenes;
-  uint64_t perPart = (cloud.size() + a.parts - 1) / a.parts;
+// --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image as one
+// upload (the atomic min does not care which dispatch a point came from).
+std::vector<std::unique_ptr<GpuScene>> uploadParts(gpu::Context& context, const PointCloud& cloud,
+                                                   SceneLayout layout,
+                                                   const std::optional<DisplayColorMode>& colors,
+                                                   const RenderArgs& a) {
+  const uint64_t perPart = (cloud.size() + a.parts - 1) / a.parts;
   if (layout == SceneLayout::Batched && perPart > 0) {
     // Said before uploading: the batch methods address 64 parts of a frame (4.29 billion points).
-    uint64_t capacity =
+    const uint64_t capacity =
         partCapacity(layout, 0, std::min(context.maxAllocationSize(), context.maxBufferSize()));
-    uint64_t parts = capacity ? uint64_t(a.parts) * ((perPart + capacity - 1) / capacity) : 0;
+    const uint64_t parts = capacity ? uint64_t(a.parts) * ((perPart + capacity - 1) / capacity) : 0;
     if (parts > shared::kMaxVisibilityParts)
       throw InputError(cloud.source + " needs " + std::to_string(parts) +
-                       " parts on this device; the batch methods "
-                       "draw at most " +
+                       " parts on this device; the batch methods draw at most " +
                        std::to_string(shared::kMaxVisibilityParts) + " (4.29 billion points) per frame");
   }
+  std::vector<std::unique_ptr<GpuScene>> scenes;
   for (uint32_t p = 0; p < a.parts; ++p) {
     UploadOptions upload;
     upload.first = uint64_t(p) * perPart;
@@ -559,68 +593,91 @@ int runRender(const RenderArgs& a) {
     upload.colors = colors;
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
-  std::vector<const GpuScene*> drawn;
-  for (auto& s : scenes)
-    drawn.push_back(s.get());
-  if (pathMode && cameraPath.empty()) cameraPath = view::orbitPath(camera);
-  if (pathMode)
-    return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
-  FrameStats stats = renderer.render(drawn, camera, settings);
-  std::vector<uint32_t> pixels = renderer.image();
-  const std::vector<std::string> files = writeOutput(a, pixels);
-  uint64_t hash = imageHash(pixels.data(), pixels.size());
+  return scenes;
+}
 
-  if (context.validationErrors() > 0)
-    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
-                     " error(s)");
-  if (a.json) {
-    nlohmann::json j;
-    j["device"] = context.info().name;
-    j["device_type"] = context.info().typeName;
-    j["method"] = methodName(settings.method);
-    j["depth"] = depthModeName(settings.depth);
-    j["input"] = cloud.source;
-    j["points"] = stats.points;
-    j["order"] = orderName(spec.order);
-    j["width"] = a.width;
-    j["height"] = a.height;
-    j["frames"] = stats.frames;
-    j["median_ms"] = stats.medianMs;
-    j["min_ms"] = stats.minMs;
-    j["max_ms"] = stats.maxMs;
-    j["points_per_second"] = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
-    j["parts"] = a.parts;
-    if (stats.batch) {
-      j["precision"] = a.precision;
-      j["batch_stats"] = bench::batchStatsJson(*stats.batch);
-    }
-    if (colors) j["color"] = colorSourceName(colors->source);
-    if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
-    if (stats.post) j["post"] = postJson(settings.post, *stats.post);
-    j["camera"] = describeCamera(camera);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-    j["image_hash"] = hex;
-    j["output"] = files.size() == 1 ? nlohmann::json(files[0]) : nlohmann::json(files);
-    std::printf("%s\n", j.dump().c_str());
-  } else if (!a.quiet) {
-    std::printf(
-        "%s: %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s points/s\n",
-        a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
-        methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
-        humanCount(stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0).c_str());
-    if (stats.batch) {
-      const BatchStats& b = *stats.batch;
-      std::printf(
-          "  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), %s "
-          "rendered\n",
-          (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
-          humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
-          humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
-          humanCount(double(b.pointsRendered)).c_str());
-    }
-    if (stats.post) printPostStats(settings.post, *stats.post);
+nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& settings, const PointCloud& cloud,
+                         Order order, const std::optional<DisplayColorMode>& colors, const FrameStats& stats,
+                         const Camera& camera, const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+  nlohmann::json j;
+  j["device"] = context.info().name;
+  j["device_type"] = context.info().typeName;
+  j["method"] = methodName(settings.method);
+  j["depth"] = depthModeName(settings.depth);
+  j["input"] = cloud.source;
+  j["points"] = stats.points;
+  j["order"] = orderName(order);
+  addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
+  j["points_per_second"] = perSecond(stats.points, stats.medianMs);
+  j["parts"] = a.parts;
+  if (stats.batch) {
+    j["precision"] = a.precision;
+    j["batch_stats"] = bench::batchStatsJson(*stats.batch);
   }
+  if (colors) j["color"] = colorSourceName(colors->source);
+  if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
+  if (stats.post) j["post"] = postJson(settings.post, *stats.post);
+  j["camera"] = describeCamera(camera);
+  j["image_hash"] = hashText(pixels);
+  j["output"] = outputJson(a);
+  return j;
+}
+
+void printPointSummary(const RenderArgs& a, const RenderSettings& settings, const FrameStats& stats) {
+  std::printf("%s: %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s points/s\n",
+              a.output.c_str(), humanCount(double(stats.points)).c_str(), a.width, a.height,
+              methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+              humanCount(perSecond(stats.points, stats.medianMs)).c_str());
+  if (stats.batch) {
+    const BatchStats& b = *stats.batch;
+    std::printf("  batches: %llu processed, %llu rendered; points: %s processed (1/2/3 words: %s/%s/%s), "
+                "%s rendered\n",
+                (unsigned long long)b.batchesProcessed, (unsigned long long)b.batchesRendered,
+                humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
+                humanCount(double(b.pointsByWords[1])).c_str(),
+                humanCount(double(b.pointsByWords[2])).c_str(), humanCount(double(b.pointsRendered)).c_str());
+  }
+  if (stats.post)
+    std::printf(
+        "  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
+        stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
+        stats.post->composeMs);
+}
+
+int runRender(const RenderArgs& a) {
+  Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
+  checkCommonArgs(a);
+  if (isSphereMethodName(a.method)) return runRenderSpheres(a);
+  const RenderSettings settings = pointSettings(a);
+  if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  view::CameraPath cameraPath;
+  if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
+  InputSpec spec;
+  spec.source = a.input;
+  spec.points = parseCount(a.points, "--points");
+  spec.seed = a.seed;
+  spec.order = parseOrder(a.order);
+  spec.progress = !a.quiet;
+
+  const PointCloud cloud = loadInput(spec);
+  const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
+  const Camera camera = renderCamera(a, cloud.bounds, cloud.source);
+  gpu::Context context(contextOptions(a));
+  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
+  const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
+  std::vector<const GpuScene*> drawn;
+  for (const auto& scene : scenes)
+    drawn.push_back(scene.get());
+  if (!a.path.path.empty()) {
+    if (cameraPath.empty()) cameraPath = view::orbitPath(camera);
+    return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
+  }
+  const FrameStats stats = renderer.render(drawn, camera, settings);
+  const std::vector<uint32_t> pixels = renderer.image();
+  finishImage(
+      a, context, pixels,
+      [&] { return pointJson(context, settings, cloud, spec.order, colors, stats, camera, a, pixels); },
+      [&] { printPointSummary(a, settings, stats); });
   return 0;
 }
 

@@ -3,9 +3,11 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "base/build_info.h"
 #include "base/error.h"
 #include "commands.h"
 #include "gpu/vulkan_api.h"
@@ -23,7 +25,7 @@ int main(int argc, char** argv) {
                "pointrast"};
   app.require_subcommand(1);
   app.fallthrough(false);
-  app.set_version_flag("--version", "pointrast 0.1.0");
+  app.set_version_flag("--version", std::string("pointrast 0.1.0 (") + buildCommit() + ")");
   app.footer("Run `pointrast COMMAND --help` for a command's options. Exit status: 0 success, 1 error.");
 
   app::Command info = app::addInfo(app);

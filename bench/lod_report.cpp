@@ -410,7 +410,7 @@ std::string lodSuiteSvg(const LodSuiteRun& run, const ReportInfo& info) {
 
 WrittenFiles writeLodSuiteReports(const LodSuiteRun& run, const ReportInfo& info,
                                   const std::filesystem::path& dir) {
-  return writeReportFiles(dir, info.name, lodSuiteJson(run, info).dump(2), lodSuiteMarkdown(run, info),
+  return writeReportFiles(dir, info.name, jsonFileText(lodSuiteJson(run, info)), lodSuiteMarkdown(run, info),
                           lodSuiteSvg(run, info));
 }
 

@@ -227,20 +227,16 @@ std::vector<Camera> jumpCameras(const Bounds& bounds, uint32_t count, double fov
 LodSuiteRun runLodSuite(gpu::Context& context, const LodSuiteConfig& config,
                         const LodSuiteCallbacks& callbacks) {
   const auto start = Clock::now();
-  auto note = [&](const std::string& line) {
+  const Note note = [&](const std::string& line) {
     if (callbacks.onNote) callbacks.onNote(line);
   };
   LodSuiteRun run;
-  run.device = context.info();
-  run.deviceLocalBytes = context.deviceLocalBytes();
   run.config = config;
   run.warmup = warmupFrames(config.frames);
-  run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
-  note(copyBandwidthText(run.copy));
-  Renderer renderer(context, config.width, config.height);
-  const size_t total = config.datasets.size();
-  size_t done = 0;
-  try {
+  runRecorded(context, run, config.copyBytes, config.copyRepeats, start, note, [&] {
+    Renderer renderer(context, config.width, config.height);
+    const size_t total = config.datasets.size();
+    size_t done = 0;
     for (const Dataset& d : config.datasets) {
       checkTimeLimit(start, config.timeLimitSeconds, done, total);
       DatasetOutcome outcome;
@@ -286,14 +282,7 @@ LodSuiteRun runLodSuite(gpu::Context& context, const LodSuiteConfig& config,
         note(d.label + ": stopped, " + e.what());
       }
     }
-  } catch (const DeviceFault& e) {
-    run.stopped = deviceFaultText(e);
-    note("stopped: " + run.stopped);
-  } catch (const TimeLimitReached& e) {
-    run.stopped = e.what();
-    note("stopped: " + run.stopped);
-  }
-  run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  });
   return run;
 }
 

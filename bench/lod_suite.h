@@ -34,7 +34,7 @@ struct LodSuiteConfig {
   double displayHz = 60;         // streaming frames are paced at this rate (0: as fast as they go)
   uint64_t copyBytes = uint64_t(1) << 30; // the copy bandwidth measured with the run (runner.h)
   int copyRepeats = 10;
-  double timeLimitSeconds = 0;   // as BenchConfig::timeLimitSeconds
+  double timeLimitSeconds = 0; // as BenchConfig::timeLimitSeconds
   bool progress = true;
   OctreeProvider octrees;
 };
@@ -83,18 +83,12 @@ struct LodStreamResult {
   bool ok() const { return status == "ok"; }
 };
 
-struct LodSuiteRun {
-  gpu::DeviceInfo device;
-  uint64_t deviceLocalBytes = 0;
-  gpu::CopyBandwidth copy;
+// Device, copy bandwidth, data sets and how the run ended as every run records them (RunRecord).
+struct LodSuiteRun : RunRecord {
   LodSuiteConfig config;
-  uint32_t warmup = 0;
-  std::vector<DatasetOutcome> datasets;
   std::vector<std::pair<std::string, DatasetOctree>> octrees;
   std::vector<LodSweepResult> sweeps;
   std::vector<LodStreamResult> streams;
-  double seconds = 0;
-  std::string stopped; // as BenchRun::stopped
 };
 
 struct LodSuiteCallbacks {

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "base/build_info.h"
 #include "base/error.h"
 #include "bench/lod_report.h"
 #include "bench/report_parts.h"
@@ -129,6 +130,7 @@ nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& devi
   j["title"] = info.title;
   j["command_line"] = info.commandLine;
   j["date"] = info.date;
+  j["commit"] = buildCommit();
   j["wall_seconds"] = seconds;
   j["device"] = {{"name", device.name},          {"type", device.typeName},
                  {"driver", device.driver},      {"vulkan", apiVersion(device.apiVersion)},
@@ -140,8 +142,10 @@ nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& devi
       {"gb_per_s", copy.bytesPerSecond * 1e-9},
       {"transfer_gb_per_s", copy.transferBytesPerSecond * 1e-9},
       {"shader_gb_per_s", copy.shaderBytesPerSecond * 1e-9},
-      {"note", "vkCmdCopyBuffer between two device buffers; counts bytes read + bytes written per second, "
-               "since a copy moves every byte through memory twice"}};
+      {"note",
+       "the faster of vkCmdCopyBuffer (transfer_gb_per_s) and a compute-shader copy of 16 B per "
+       "invocation (shader_gb_per_s) between two device buffers; counts bytes read + bytes written per "
+       "second, since a copy moves every byte through memory twice"}};
   return j;
 }
 
@@ -180,7 +184,8 @@ void markdownHeader(std::ostringstream& md, const ReportInfo& info, const gpu::D
 void markdownFooter(std::ostringstream& md, const ReportInfo& info, double seconds) {
   md << "- Ratios between methods of one run are the figures that count; absolute times depend on clocks "
         "and drivers.\n";
-  md << "- Date: " << info.date << "; the run took " << printf1("%.0f", seconds) << " s (wall clock).\n";
+  md << "- Date: " << info.date << "; the run took " << printf1("%.0f", seconds)
+     << " s (wall clock); pointrast " << buildCommit() << ".\n";
   md << "- Command: `" << info.commandLine << "`\n\n";
 }
 
@@ -308,6 +313,10 @@ std::string svgBars(const BarChart& chart) {
   }
   s << "</svg>\n";
   return s.str();
+}
+
+std::string jsonFileText(const nlohmann::json& j) {
+  return j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::string& name,
@@ -579,7 +588,7 @@ std::string svgChart(const BenchRun& run, const ReportInfo& info) {
 }
 
 WrittenFiles writeReports(const BenchRun& run, const ReportInfo& info, const std::filesystem::path& dir) {
-  return writeReportFiles(dir, info.name, runJson(run, info).dump(1) + "\n", markdownReport(run, info),
+  return writeReportFiles(dir, info.name, jsonFileText(runJson(run, info)), markdownReport(run, info),
                           svgChart(run, info));
 }
 
@@ -922,7 +931,7 @@ std::string sphereSvgChart(const SphereBenchRun& run, const ReportInfo& info) {
 
 WrittenFiles writeSphereReports(const SphereBenchRun& run, const ReportInfo& info,
                                 const std::filesystem::path& dir) {
-  return writeReportFiles(dir, info.name, sphereRunJson(run, info).dump(1) + "\n",
+  return writeReportFiles(dir, info.name, jsonFileText(sphereRunJson(run, info)),
                           sphereMarkdownReport(run, info), sphereSvgChart(run, info));
 }
 

@@ -43,6 +43,10 @@ struct BarChart {
 constexpr double kNoBar = -1, kNotMeasured = -2;
 std::string svgBars(const BarChart& chart);
 
+// A report's JSON, indented; text that is not UTF-8 (a file name in another encoding) is replaced rather
+// than failing the report of a finished run.
+std::string jsonFileText(const nlohmann::json& j);
+
 // Writes the three files of a report through ".partial" files renamed into place; everything is rendered
 // by the caller before the first file is written, so a failure leaves no mixed set.
 WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::string& name,

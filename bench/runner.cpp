@@ -33,9 +33,6 @@ const std::vector<View>& viewsOf(const Dataset& d, const BenchConfig& c) {
   return d.views.empty() ? c.views : d.views;
 }
 
-// Parallel gather in fixed blocks (as everywhere in src/cloud), so it costs a fraction of the sort.
-constexpr uint64_t kGatherBlock = uint64_t(1) << 16;
-
 } // namespace
 
 std::string printf1(const char* format, double value) {
@@ -63,18 +60,19 @@ std::string deviceFaultText(const DeviceFault& fault) {
 void checkTimeLimit(std::chrono::steady_clock::time_point start, double limitSeconds, size_t done,
                     size_t total) {
   if (!(limitSeconds > 0)) return;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = secondsSince(start);
   if (seconds > limitSeconds)
     throw TimeLimitReached("time limit of " + printf1("%g", limitSeconds) + " s reached after " +
                            std::to_string(done) + " of " + std::to_string(total) +
                            " combinations; the rest were not run");
 }
 
-double settleClocks(const std::function<double(uint32_t frames)>& renderMs) {
-  const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
+double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
+                    const std::function<double()>& clock) {
+  const auto steadyStart = std::chrono::steady_clock::now();
+  const std::function<double()> now = clock ? clock : [&] { return secondsSince(steadyStart); };
+  const double start = now();
+  auto elapsed = [&] { return now() - start; };
   uint32_t frames = 1;
   double last = 0;
   for (int round = 0; elapsed() < 3.0; ++round) {
@@ -153,50 +151,11 @@ PointCloud loadDataset(const Dataset& dataset, bool progress) {
   return cloud;
 }
 
-PointCloud reorderedCopy(const PointCloud& src, Order order, uint64_t seed) {
-  std::vector<uint64_t> permutation;
-  computeOrder(permutation, src, order, seed);
-  PointCloud dst;
-  dst.scale = src.scale;
-  dst.offset = src.offset;
-  dst.bounds = src.bounds;
-  dst.source = src.source;
-  dst.positions.resize(src.positions.size());
-  dst.colors.resize(src.colors.size());
-  const bool colors = !src.colors.empty();
-  parallelBlocks(src.size(), kGatherBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
-    for (uint64_t i = begin; i < end; ++i) {
-      const uint64_t from = permutation[i];
-      dst.positions[3 * i] = src.positions[3 * from];
-      dst.positions[3 * i + 1] = src.positions[3 * from + 1];
-      dst.positions[3 * i + 2] = src.positions[3 * from + 2];
-      if (colors) dst.colors[i] = src.colors[from];
-    }
-  });
-  return dst;
-}
+namespace {
 
-void completeRates(Result& r, const gpu::CopyBandwidth& copy) {
-  if (!r.ok() || !(r.stats.medianMs > 0)) return;
-  const double seconds = r.stats.medianMs * 1e-3;
-  r.pointsPerSecond = double(r.stats.points) / seconds;
-  r.effectiveBytesPerSecond =
-      (r.stats.batch ? double(r.stats.batch->bytesRead) : double(r.stats.points) * r.bytesPerPoint) / seconds;
-  r.copyFraction = copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / copy.bytesPerSecond : 0;
-}
-
-BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchCallbacks& callbacks) {
-  const auto start = std::chrono::steady_clock::now();
-  auto note = [&](const std::string& line) {
-    if (callbacks.onNote) callbacks.onNote(line);
-  };
-  BenchRun run;
-  run.device = context.info();
-  run.deviceLocalBytes = context.deviceLocalBytes();
-  run.config = config;
-  run.warmup = warmupFrames(config.frames);
-
-  // Every data set is sized before anything runs, so what will be skipped is said up front.
+// Sizes every data set before anything runs, so that what will be skipped is said up front. Returns the
+// number of combinations the run will measure.
+size_t sizeDatasets(const gpu::Context& context, const BenchConfig& config, BenchRun& run, const Note& note) {
   size_t total = 0;
   const size_t octrees = size_t(std::count_if(config.methods.begin(), config.methods.end(), [](Method m) {
     return methodInfo(m).layout == SceneLayout::Octree;
@@ -219,71 +178,143 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
                (ordersOf(d, config).size() * (config.methods.size() - octrees) + octrees);
     run.datasets.push_back(std::move(outcome));
   }
+  return total;
+}
 
-  // Before any scene is resident, so the copy buffers may take their full size.
-  run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
-  note(copyBandwidthText(run.copy));
+// One order of a data set on the GPU: a scene per layout the methods read (a suite mixing 2021 and batch
+// methods holds both). A layout that did not fit after all says why, for every combination that reads it.
+struct OrderScenes {
+  std::map<SceneLayout, std::unique_ptr<GpuScene>> scenes;
+  std::map<SceneLayout, std::string> failures;
+  const GpuScene* find(SceneLayout layout) const {
+    auto it = scenes.find(layout);
+    return it == scenes.end() ? nullptr : it->second.get();
+  }
+};
 
-  Renderer renderer(context, config.width, config.height);
-  const double aspect = double(config.width) / double(config.height);
-  size_t done = 0;
-  try {
+OrderScenes uploadOrder(gpu::Context& context, const PointCloud& cloud, Order order,
+                        const BenchConfig& config) {
+  OrderScenes out;
+  PointCloud ordered; // freed on return, before the GPU work
+  if (order != Order::Original) {
+    std::vector<uint64_t> permutation;
+    computeOrder(permutation, cloud, order, config.orderSeed);
+    ordered = orderedCopy(cloud, permutation);
+  }
+  for (SceneLayout layout : layoutsOf(config.methods)) {
+    UploadOptions upload;
+    upload.layout = layout;
+    upload.progress = config.progress;
+    try {
+      out.scenes[layout] =
+          std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
+    } catch (const UnsupportedError& e) {
+      out.failures[layout] = e.what(); // out of device memory after all
+    }
+  }
+  return out;
+}
+
+// Renders with the first method the device runs until the GPU's clocks are up again after the host's work
+// (settleClocks). What goes wrong here is left to the combinations, which report it; a DeviceFault ends the
+// run as there.
+void settleFirst(gpu::Context& context, Renderer& renderer, const OrderScenes& order,
+                 const BenchConfig& config, const Camera& camera) {
+  if (!settlesClocks(context)) return;
+  for (Method method : config.methods) {
+    const GpuScene* scene = order.find(method.info().layout);
+    if (!scene || !Renderer::supports(context, method)) continue;
+    try {
+      settleClocks([&](uint32_t frames) {
+        RenderSettings settle;
+        settle.method = method;
+        settle.frames = frames;
+        settle.warmup = 0;
+        return renderer.render(*scene, camera, settle).medianMs;
+      });
+    } catch (const UnsupportedError&) {
+    } catch (const InputError&) {
+    }
+    return;
+  }
+}
+
+// Times one combination, `r` naming it: --frames frames after the warm-up, or as many as the time budget
+// allows after a probe frame.
+void timeCombination(Renderer& renderer, const GpuScene& scene, const BenchRun& run, const Camera& camera,
+                     Result& r) {
+  const BenchConfig& config = run.config;
+  RenderSettings settings;
+  settings.method = r.method;
+  settings.frames = config.frames;
+  settings.warmup = run.warmup;
+  if (config.secondsPerCombination > 0) {
+    RenderSettings probe = settings;
+    probe.frames = 1;
+    probe.warmup = 0;
+    const double seconds = renderer.render(scene, camera, probe).medianMs * 1e-3;
+    settings.frames = budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
+    if (settings.frames < config.frames) settings.warmup = 1;
+  }
+  r.stats = renderer.render(scene, camera, settings);
+}
+
+} // namespace
+
+void completeRates(Result& r, const gpu::CopyBandwidth& copy) {
+  if (!r.ok() || !(r.stats.medianMs > 0)) return;
+  const double seconds = r.stats.medianMs * 1e-3;
+  r.pointsPerSecond = double(r.stats.points) / seconds;
+  const double bytes =
+      r.stats.batch ? double(r.stats.batch->bytesRead) : double(r.stats.points) * r.bytesPerPoint;
+  r.effectiveBytesPerSecond = bytes / seconds;
+  r.copyFraction = copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / copy.bytesPerSecond : 0;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+bool settlesClocks(const gpu::Context& context) {
+  return !context.info().software();
+}
+
+BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchCallbacks& callbacks) {
+  const auto start = std::chrono::steady_clock::now();
+  const Note note = [&](const std::string& line) {
+    if (callbacks.onNote) callbacks.onNote(line);
+  };
+  BenchRun run;
+  run.config = config;
+  run.warmup = warmupFrames(config.frames);
+  const size_t total = sizeDatasets(context, config, run, note);
+  runRecorded(context, run, config.copyBytes, config.copyRepeats, start, note, [&] {
+    Renderer renderer(context, config.width, config.height);
+    const double aspect = double(config.width) / double(config.height);
+    size_t done = 0;
+    auto record = [&](const Result& r) {
+      run.results.push_back(r);
+      ++done;
+      if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
+    };
     for (DatasetOutcome& outcome : run.datasets) {
       if (outcome.skipped) continue;
       checkTimeLimit(start, config.timeLimitSeconds, done, total); // preparing a data set takes a while
       const Dataset& d = outcome.dataset;
-      auto since = std::chrono::steady_clock::now();
-      auto secondsSince = [&since] {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-      };
       // Host-side preparation can take minutes at the paper's sizes; a line each keeps a log readable.
-      PointCloud cloud = loadDataset(d, config.progress);
+      auto since = std::chrono::steady_clock::now();
+      const PointCloud cloud = loadDataset(d, config.progress);
       outcome.points = cloud.size();
       outcome.description = cloud.source;
-      note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince()));
+      note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince(since)));
       for (Order order : ordersOf(d, config)) {
         checkTimeLimit(start, config.timeLimitSeconds, done, total);
         since = std::chrono::steady_clock::now();
-        // One scene per layout the methods read (a suite mixing 2021 and batch methods holds both).
-        std::map<SceneLayout, std::unique_ptr<GpuScene>> scenes;
-        std::map<SceneLayout, std::string> failures;
-        {
-          PointCloud ordered;
-          if (order != Order::Original) ordered = reorderedCopy(cloud, order, config.orderSeed);
-          for (SceneLayout layout : layoutsOf(config.methods)) {
-            UploadOptions upload;
-            upload.layout = layout;
-            upload.progress = config.progress;
-            try {
-              scenes[layout] =
-                  std::make_unique<GpuScene>(context, order == Order::Original ? cloud : ordered, upload);
-            } catch (const UnsupportedError& e) {
-              failures[layout] = e.what(); // out of device memory after all: every combination says so
-            }
-          }
-        } // the reordered host copy is freed here, before the GPU work
+        const OrderScenes scenes = uploadOrder(context, cloud, order, config);
         note(d.label + " / " + orderName(order) + ": ordered and uploaded in " +
-             printf1("%.1f s", secondsSince()));
-        // Clocks up again after the host's work, with the first supported method on the first view.
-        for (Method method : config.methods) {
-          const SceneLayout layout = methodInfo(method).layout;
-          if (layout == SceneLayout::Octree || !scenes[layout] || !Renderer::supports(context, method))
-            continue;
-          const Camera camera = viewCamera(viewsOf(d, config).front(), cloud.bounds, aspect, config.fovY);
-          try {
-            settleClocks([&](uint32_t frames) {
-              RenderSettings settle;
-              settle.method = method;
-              settle.frames = frames;
-              settle.warmup = 0;
-              return renderer.render(*scenes[layout], camera, settle).medianMs;
-            });
-          } catch (const UnsupportedError&) {
-            // Left to the combinations, which report it; a DeviceFault ends the run as there.
-          } catch (const InputError&) {
-          }
-          break;
-        }
+             printf1("%.1f s", secondsSince(since)));
+        settleFirst(context, renderer, scenes, config,
+                    viewCamera(viewsOf(d, config).front(), cloud.bounds, aspect, config.fovY));
         for (View view : viewsOf(d, config)) {
           const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
           for (Method method : config.methods) {
@@ -295,65 +326,30 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
             r.view = view;
             r.method = method;
             r.points = cloud.size();
-            r.bytesPerPoint = methodInfo(method).bytesPerPoint;
+            r.bytesPerPoint = method.info().bytesPerPoint;
             r.camera = describeCamera(camera);
             std::string why;
-            const SceneLayout layout = methodInfo(method).layout;
-            if (!scenes[layout]) {
+            const GpuScene* scene = scenes.find(method.info().layout);
+            if (!scene) {
               r.status = "unsupported";
-              r.reason = failures[layout];
+              r.reason = scenes.failures.at(method.info().layout);
             } else if (!Renderer::supports(context, method, &why)) {
               r.status = "unsupported";
               r.reason = why;
             } else {
-              RenderSettings settings;
-              settings.method = method;
-              settings.frames = config.frames;
-              settings.warmup = run.warmup;
               measureGuarded(
-                  r,
-                  [&] {
-                    if (config.secondsPerCombination > 0) {
-                      // One frame timed first decides how many the budget allows.
-                      RenderSettings probe = settings;
-                      probe.frames = 1;
-                      probe.warmup = 0;
-                      const double seconds = renderer.render(*scenes[layout], camera, probe).medianMs * 1e-3;
-                      settings.frames =
-                          budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
-                      if (settings.frames < config.frames) settings.warmup = 1;
-                    }
-                    r.stats = renderer.render(*scenes[layout], camera, settings);
-                  },
-                  [&](const Result& faulted) {
-                    run.results.push_back(faulted);
-                    ++done;
-                    if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
-                  });
+                  r, [&] { timeCombination(renderer, *scene, run, camera, r); }, record);
             }
             completeRates(r, run.copy);
-            run.results.push_back(r);
-            ++done;
-            if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
+            record(r);
           }
         }
       }
       checkTimeLimit(start, config.timeLimitSeconds, done, total);
       measureOctreeMethods(context, renderer, config, d, cloud, ordersOf(d, config).front(),
-                           viewsOf(d, config), run, [&](const Result& r) {
-                             run.results.push_back(r);
-                             ++done;
-                             if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
-                           });
+                           viewsOf(d, config), run, record);
     }
-  } catch (const DeviceFault& e) {
-    run.stopped = deviceFaultText(e);
-    note("stopped: " + run.stopped);
-  } catch (const TimeLimitReached& e) {
-    run.stopped = e.what();
-    note("stopped: " + run.stopped);
-  }
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  });
   return run;
 }
 

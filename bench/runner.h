@@ -74,8 +74,10 @@ std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 // after such a pause ran 5.7x slow in all 17 frames of its one submission (bench/NOTES.md). So before the
 // first combination of each scene, renderMs(frames) (which renders that many frames in one submission and
 // returns their median ms) is called in rounds of about 30 ms of GPU work until two rounds agree within 3 %
-// after at least 0.2 s, or 3 s have passed. Returns the wall seconds it took.
-double settleClocks(const std::function<double(uint32_t frames)>& renderMs);
+// after at least 0.2 s, or 3 s have passed. Returns the wall seconds it took. `clock` (seconds, monotonic)
+// is the steady clock unless a test passes its own, so that its rounds do not depend on the machine's load.
+double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
+                    const std::function<double()>& clock = {});
 
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);
@@ -134,19 +136,25 @@ struct DatasetOutcome {
   std::string reason; // why it was skipped
 };
 
-struct BenchRun {
+// What every benchmark run records besides its results: where it ran, the copy bandwidth measured in it,
+// its data sets, and how it ended.
+struct RunRecord {
   gpu::DeviceInfo device;
   uint64_t deviceLocalBytes = 0;
   gpu::CopyBandwidth copy;
-  BenchConfig config;
-  uint32_t warmup = 0;
+  uint32_t warmup = 0; // untimed frames before the timed ones (per camera for the sphere runner)
   std::vector<DatasetOutcome> datasets;
-  std::vector<Result> results;
-  std::vector<std::pair<std::string, DatasetOctree>> octrees; // by Dataset::name: the LOD methods' octrees
-  double seconds = 0;                                         // wall time of the whole run (not a GPU figure)
+  double seconds = 0; // wall time of the whole run (not a GPU figure)
   // Why the run ended before its last combination: the GPU stopped making progress (every later submission
   // would wait on the stuck one) or the time limit passed. The reports hold what was measured before.
   std::string stopped;
+  bool faulted = false; // stopped by a device fault (the CLI then exits 1 after writing the reports)
+};
+
+struct BenchRun : RunRecord {
+  BenchConfig config;
+  std::vector<Result> results;
+  std::vector<std::pair<std::string, DatasetOctree>> octrees; // by Dataset::name: the LOD methods' octrees
 };
 
 struct BenchCallbacks {
@@ -179,11 +187,29 @@ void measureGuarded(R& result, Measure&& measure, Record&& record) {
   }
 }
 
+// One line of a run's log (memory statements, skipped data sets, the copy bandwidth, times).
+using Note = std::function<void(const std::string&)>;
+
+// Wall seconds since `since` (for logs and the time limit; never a GPU figure).
+double secondsSince(std::chrono::steady_clock::time_point since);
+
 // Points per second, effective bandwidth and its fraction of the copy bandwidth of a measured result.
 void completeRates(Result& result, const gpu::CopyBandwidth& copy);
 
-// The line a run that met a device fault ends with (BenchRun::stopped).
+// The line a run that met a device fault ends with (RunRecord::stopped).
 std::string deviceFaultText(const DeviceFault& fault);
+
+// The frame both runners share. Fills the record's device, measures the copy bandwidth before anything is
+// resident (so the copy buffers may take their full size), then runs `combinations()`; a device fault or
+// the time limit (TimeLimitReached) ends it with what was measured, said in `stopped`. Keeps the wall time
+// since `start`.
+template <class Combinations>
+void runRecorded(gpu::Context& context, RunRecord& run, uint64_t copyBytes, int copyRepeats,
+                 std::chrono::steady_clock::time_point start, const Note& note, Combinations&& combinations);
+
+// Whether settleClocks is worth its time before a data set's first combination: GPUs lower their clocks
+// while the host prepares data; a CPU device (lavapipe) has no GPU clocks to raise.
+bool settlesClocks(const gpu::Context& context);
 
 // Thrown by checkTimeLimit between combinations: the run ends there like after a device fault.
 struct TimeLimitReached : std::runtime_error {
@@ -201,7 +227,24 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
 // The cloud of a data set, ready to upload: positions and display colors only.
 PointCloud loadDataset(const Dataset& dataset, bool progress);
 
-// dst = src with its points permuted into `order` (positions and colors; bounds, scale, offset kept).
-PointCloud reorderedCopy(const PointCloud& src, Order order, uint64_t seed);
+template <class Combinations>
+void runRecorded(gpu::Context& context, RunRecord& run, uint64_t copyBytes, int copyRepeats,
+                 std::chrono::steady_clock::time_point start, const Note& note, Combinations&& combinations) {
+  run.device = context.info();
+  run.deviceLocalBytes = context.deviceLocalBytes();
+  run.copy = gpu::measureCopy(context, copyBytes, copyRepeats);
+  note(copyBandwidthText(run.copy));
+  try {
+    combinations();
+  } catch (const DeviceFault& e) {
+    run.stopped = deviceFaultText(e);
+    run.faulted = true;
+    note("stopped: " + run.stopped);
+  } catch (const TimeLimitReached& e) {
+    run.stopped = e.what();
+    note("stopped: " + run.stopped);
+  }
+  run.seconds = secondsSince(start);
+}
 
 } // namespace pointrast::bench

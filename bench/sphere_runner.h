@@ -88,19 +88,12 @@ struct SphereOrbitCameras {
   std::vector<std::string> cameras;
 };
 
-struct SphereBenchRun {
-  gpu::DeviceInfo device;
-  uint64_t deviceLocalBytes = 0;
-  gpu::CopyBandwidth copy;
+struct SphereBenchRun : RunRecord {
   SphereBenchConfig config; // methods filled in when the configuration left them empty
-  uint32_t warmup = 0;      // per camera
-  std::vector<DatasetOutcome> datasets;
   std::vector<SphereOrbitCameras> cameras;
   std::vector<SphereResult> results;
   // Layouts a data set cannot be held in exactly (xyz drops per-particle colors), one line each.
   std::vector<std::string> skippedLayouts;
-  double seconds = 0;  // wall time of the whole run (not a GPU figure)
-  std::string stopped; // as BenchRun::stopped: the run stopped there
 };
 
 struct SphereBenchCallbacks {

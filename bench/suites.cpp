@@ -48,8 +48,8 @@ constexpr SuiteEntry kVr2022[] = {
     {"scan529m", Scene::Tls, 529'000'000, "a 529 M point laser scan, as an octree seen in a headset"},
 };
 
-// The four particle data sets of the 2023 sphere study, at the sizes the issue gives for them (306 M, 4 M,
-// 30 M, 200 M particles, in this order), each drawn by the particle scene closest to what it shows:
+// The four particle data sets of the 2023 sphere study, at their sizes (306 M, 4 M, 30 M, 200 M particles,
+// in this order), each drawn by the particle scene closest to what it shows:
 // laser ablation of a metal (a crystal slab with a molten crater and ejected clusters), a Riemann shock tube
 // (a dense block between two vapor regions), a drop and a fluid simulation (liquid droplets and filaments in
 // a vapor; particles-drops for both, at their two sizes).

@@ -18,8 +18,6 @@ layout(constant_id = 2) const uint STEREO = 0;
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
 
-const uint kNoPixel = 0xFFFFFFFFu;
-
 // Margin of the culling tests, relative to the sum of the absolute terms of a clip coordinate: the float
 // rounding of projecting (and of decoding) a point stays below a few ulps of that sum (2^-23 each), far
 // under 1e-5, so no test on the box drops a point that the per-point test would keep.

@@ -6,6 +6,9 @@
 
 #include "shared.h"
 
+// The pixel index of a point that lands on no pixel (dropped by the near plane or outside the image).
+const uint kNoPixel = 0xFFFFFFFFu;
+
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer FloatArray { float v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintArray { uint v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uint64Array { uint64_t v[]; };

@@ -23,8 +23,6 @@ layout(constant_id = 1) const uint POINTS_PER_THREAD = 1;
 #define DEPTH_INT40 0
 #include "point.inc.glsl"
 
-const uint kNoPixel = 0xFFFFFFFFu;
-
 void main() {
   // No early return anywhere: the subgroup operations of hqsBlend need every lane.
   uint first = firstPointOfThread(POINTS_PER_THREAD);

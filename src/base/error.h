@@ -26,6 +26,14 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+// A defect of pointrast or of the driver, caught by a check that runs in every build: the Vulkan
+// validation layer reported an error, a shader is missing from the build, a push-constant block does not
+// match its shader. Neither the input's fault nor a missing device feature; one clear line all the same.
+class InternalError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
 // The user interrupted long work (Ctrl-C): unwinding removes what was half written; the CLI exits 130.
 class Interrupted : public std::runtime_error {
 public:

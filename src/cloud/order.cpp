@@ -329,31 +329,41 @@ void computeOrder(std::vector<uint64_t>& order, const PointCloud& cloud, Order k
 }
 
 namespace {
-template <class T, size_t kPer> void gather(std::vector<T>& data, const std::vector<uint64_t>& order) {
+// out = data permuted by order (kPer values a point); nothing for an empty array.
+template <class T, size_t kPer>
+void gatherInto(std::vector<T>& out, const std::vector<T>& data, const std::vector<uint64_t>& order) {
+  out.clear();
   if (data.empty()) return;
   const uint64_t n = order.size();
   assert(data.size() == n * kPer && "attribute array length differs from the point count");
-  std::vector<T> out(data.size());
+  out.resize(data.size());
   parallelBlocks(n, uint64_t(1) << 18, [&](uint64_t, uint64_t begin, uint64_t end) {
     for (uint64_t i = begin; i < end; ++i)
       for (size_t k = 0; k < kPer; ++k)
         out[i * kPer + k] = data[order[i] * kPer + k];
   });
+}
+
+template <class T, size_t kPer> void gather(std::vector<T>& data, const std::vector<uint64_t>& order) {
+  std::vector<T> out;
+  gatherInto<T, kPer>(out, data, order);
   data.swap(out);
+}
+
+void assertPermutation([[maybe_unused]] const std::vector<uint64_t>& order, [[maybe_unused]] uint64_t size) {
+  assert(order.size() == size);
+#ifndef NDEBUG
+  std::vector<bool> seen(order.size(), false);
+  for (uint64_t i : order) {
+    assert(i < order.size() && !seen[i] && "order is not a permutation");
+    seen[i] = true;
+  }
+#endif
 }
 } // namespace
 
 void applyOrder(PointCloud& cloud, const std::vector<uint64_t>& order) {
-  assert(order.size() == cloud.size());
-#ifndef NDEBUG
-  {
-    std::vector<bool> seen(order.size(), false);
-    for (uint64_t i : order) {
-      assert(i < order.size() && !seen[i] && "order is not a permutation");
-      seen[i] = true;
-    }
-  }
-#endif
+  assertPermutation(order, cloud.size());
   // One array at a time, so the peak is one copy of the largest attribute (positions, 12 B/point).
   gather<int32_t, 3>(cloud.positions, order);
   gather<uint32_t, 1>(cloud.colors, order);
@@ -361,6 +371,21 @@ void applyOrder(PointCloud& cloud, const std::vector<uint64_t>& order) {
   gather<uint8_t, 1>(cloud.classification, order);
   gather<uint8_t, 1>(cloud.returnNumber, order);
   gather<uint16_t, 1>(cloud.pointSourceId, order);
+}
+
+PointCloud orderedCopy(const PointCloud& cloud, const std::vector<uint64_t>& order) {
+  assertPermutation(order, cloud.size());
+  PointCloud copy;
+  copy.scale = cloud.scale;
+  copy.offset = cloud.offset;
+  copy.bounds = cloud.bounds;
+  copy.source = cloud.source;
+  gatherInto<int32_t, 3>(copy.positions, cloud.positions, order);
+  gatherInto<uint32_t, 1>(copy.colors, cloud.colors, order);
+  gatherInto<uint16_t, 1>(copy.intensity, cloud.intensity, order);
+  gatherInto<uint8_t, 1>(copy.classification, cloud.classification, order);
+  gatherInto<uint8_t, 1>(copy.returnNumber, cloud.returnNumber, order);
+  return copy;
 }
 
 void reorder(PointCloud& cloud, Order kind, uint64_t seed) {

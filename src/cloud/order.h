@@ -44,6 +44,10 @@ void computeOrder(std::vector<uint64_t>& order, const PointCloud& cloud, Order k
 // the positions (12 B/point). Bounds are unchanged.
 void applyOrder(PointCloud& cloud, const std::vector<uint64_t>& order);
 
+// A copy of the cloud with every non-empty attribute array in `order` (a permutation as above), the source
+// left as it is: for a caller that keeps the original, such as a benchmark measuring several orders.
+PointCloud orderedCopy(const PointCloud& cloud, const std::vector<uint64_t>& order);
+
 // computeOrder + applyOrder (no-op for Original).
 void reorder(PointCloud& cloud, Order kind, uint64_t seed);
 

@@ -77,8 +77,4 @@ CopyBandwidth measureCopy(Context& context, uint64_t bytes, int repeats) {
   return result;
 }
 
-double measureCopyBandwidth(Context& context, uint64_t bytes, int repeats) {
-  return measureCopy(context, bytes, repeats).bytesPerSecond;
-}
-
 } // namespace pointrast::gpu

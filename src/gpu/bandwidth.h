@@ -31,6 +31,5 @@ uint64_t copyBytesFor(const Context& context, uint64_t requested);
 // most stream, and the denominator of "effective bandwidth as a fraction of copy bandwidth".
 // Throws UnsupportedError when the buffers cannot be allocated.
 CopyBandwidth measureCopy(Context& context, uint64_t bytes = uint64_t(1) << 30, int repeats = 10);
-double measureCopyBandwidth(Context& context, uint64_t bytes = uint64_t(1) << 30, int repeats = 10);
 
 } // namespace pointrast::gpu

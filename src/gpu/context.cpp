@@ -23,6 +23,18 @@ double submitTimeoutSeconds() {
   return 120.0;
 }
 
+// Test hook: POINTRAST_INJECT_DEVICE_LOST=N makes the Nth submission of the process (counting from 1) and
+// every later one fail with VK_ERROR_DEVICE_LOST instead of reaching the driver, so tests can show what a
+// lost device leaves behind (a benchmark's reports, one line from the CLI).
+bool injectedDeviceLoss() {
+  static const uint64_t from = [] {
+    const char* env = std::getenv("POINTRAST_INJECT_DEVICE_LOST");
+    return env && *env ? std::strtoull(env, nullptr, 10) : 0ull;
+  }();
+  static std::atomic<uint64_t> submissions{0};
+  return from > 0 && ++submissions >= from;
+}
+
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
 bool envFlag(const char* name) {
@@ -174,6 +186,7 @@ Context::Context(const ContextOptions& options) {
       info.pfnUserCallback = &Context::debugCallback;
       info.pUserData = this;
       VK_CHECK(vkCreateDebugUtilsMessengerEXT(instance_, &info, nullptr, &messenger_));
+      if (envFlag("POINTRAST_INJECT_VALIDATION_ERROR")) injectValidationError();
     }
     chooseDevice(options);
     createDevice();
@@ -209,6 +222,15 @@ void Context::destroy() {
   instance_ = VK_NULL_HANDLE;
 }
 
+void Context::injectValidationError() {
+  VkDebugUtilsMessengerCallbackDataEXT data{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CALLBACK_DATA_EXT};
+  data.pMessageIdName = "pointrast-injected";
+  data.pMessage = "an error injected by POINTRAST_INJECT_VALIDATION_ERROR (a test of what follows one)";
+  if (vkSubmitDebugUtilsMessageEXT)
+    vkSubmitDebugUtilsMessageEXT(instance_, VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+                                 VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT, &data);
+}
+
 VkBool32 VKAPI_PTR Context::debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                           VkDebugUtilsMessageTypeFlagsEXT,
                                           const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
@@ -236,7 +258,7 @@ void Context::chooseDevice(const ContextOptions& options) {
   if (index) {
     if (*index >= devices.size())
       throw InputError("device " + std::to_string(*index) + " does not exist; this machine has " +
-                       std::to_string(devices.size()) + " Vulkan device(s) (see `pointrast info --devices`)");
+                       std::to_string(devices.size()) + " Vulkan device(s), numbered from 0");
     physical_ = devices[*index];
   } else {
     physical_ = *std::max_element(devices.begin(), devices.end(), [](VkPhysicalDevice a, VkPhysicalDevice b) {
@@ -494,22 +516,26 @@ void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record,
     submit.pSignalSemaphores = &semaphores.signal;
   }
   VK_CHECK(vkResetFences(device_, 1, &fence_));
-  VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence_));
-  // Never hang: work that has not finished after kSubmitTimeoutSeconds is a GPU fault (or a shader that
+  // A lost device throws DeviceFault, exhausted memory UnsupportedError (nothing was submitted then).
+  const VkResult submitted =
+      injectedDeviceLoss() ? VK_ERROR_DEVICE_LOST : vkQueueSubmit(queue_, 1, &submit, fence_);
+  if (submitted != VK_SUCCESS) throwVulkanFailure(submitted, "vkQueueSubmit", __FILE__, __LINE__);
+  // Never hang: work that has not finished after submitTimeoutSeconds() is a GPU fault (or a shader that
   // never ends), reported as one clear error instead of a process that waits forever.
-  double limit = submitTimeoutSeconds();
-  VkResult waited =
-      VK_CHECK_ALLOW(vkWaitForFences(device_, 1, &fence_, VK_TRUE, uint64_t(limit * 1e9)), VK_TIMEOUT);
-  if (waited == VK_TIMEOUT) {
-    // The command buffer may still execute: it stays allocated until the pool goes with the context,
-    // after vkDeviceWaitIdle.
-    freeLater.cmd = VK_NULL_HANDLE;
-    markDeviceFaulted();
-    char seconds[32];
-    std::snprintf(seconds, sizeof seconds, "%g", limit);
-    throw DeviceFault("the GPU did not finish a submission within " + std::string(seconds) + " s on '" +
-                      info_.name + "' (a hung shader or a device fault)");
-  }
+  const double limit = submitTimeoutSeconds();
+  const VkResult waited = vkWaitForFences(device_, 1, &fence_, VK_TRUE, uint64_t(limit * 1e9));
+  if (waited == VK_SUCCESS) return;
+  // Timed out, or the wait failed (device lost, out of memory): the command buffer may still execute, so
+  // it stays allocated until the pool goes with the context, and the device counts as faulted.
+  freeLater.cmd = VK_NULL_HANDLE;
+  markDeviceFaulted();
+  if (waited != VK_TIMEOUT)
+    throw DeviceFault("the GPU failed while running a submission on '" + info_.name + "' (" +
+                      resultName(waited) + " from vkWaitForFences); nothing more can run on it");
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%g", limit);
+  throw DeviceFault("the GPU did not finish a submission within " + std::string(seconds) + " s on '" +
+                    info_.name + "' (a hung shader or a device fault)");
 }
 
 } // namespace pointrast::gpu

@@ -114,6 +114,10 @@ private:
   static VkBool32 VKAPI_PTR debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                           VkDebugUtilsMessageTypeFlagsEXT type,
                                           const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+  // Test hook: POINTRAST_INJECT_VALIDATION_ERROR=1 (with validation on) sends one error message through the
+  // validation messenger as soon as it exists, so tests can show what an error reported by the layer does
+  // to a command's output.
+  void injectValidationError();
   void chooseDevice(const ContextOptions& options);
   void createDevice();
   void destroy();

@@ -32,11 +32,7 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
   std::vector<SpirvReflection> reflections;
   for (const auto& [stage, words] : sources) {
     reflections.push_back(reflectSpirv(words));
-    uint32_t size = reflections.back().pushConstantSize;
-    // Every stage sees the same block from offset 0 (one struct from shared.h), or declares none.
-    assert((size == 0 || pushConstantSize_ == 0 || size == pushConstantSize_) &&
-           "the stages declare different push-constant blocks");
-    pushConstantSize_ = std::max(pushConstantSize_, size);
+    pushConstantSize_ = sharedPushSize(name_, pushConstantSize_, reflections.back().pushConstantSize);
     pushStages_ |= stage;
   }
   // Without maintenance5 a point list rasterizes with an undefined size unless the last vertex stage
@@ -50,7 +46,7 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
                        (options.topology == VK_PRIMITIVE_TOPOLOGY_POINT_LIST)) &&
          "topology does not name the mesh shader's output primitive");
   (void)firstVertexStage;
-  assertSpecDeclared(reflections, options.spec);
+  checkSpecDeclared(name_, reflections, options.spec);
   Specialization specialization(options.spec);
 
   ShaderModules modules(device_);

@@ -1,7 +1,9 @@
 #include "gpu/pipeline_parts.h"
 
 #include <algorithm>
-#include <cassert>
+#include <string>
+
+#include "base/error.h"
 
 namespace pointrast::gpu {
 
@@ -39,16 +41,21 @@ void destroyPipeline(VkDevice device, VkPipeline& pipeline, VkPipelineLayout& la
   layout = VK_NULL_HANDLE;
 }
 
-void assertSpecDeclared(std::span<const SpirvReflection> stages, std::span<const SpecConstant> spec) {
-  for (const SpecConstant& s : spec) {
-    assert(std::any_of(stages.begin(), stages.end(),
-                       [&](const SpirvReflection& r) {
-                         return std::find(r.specIds.begin(), r.specIds.end(), s.id) != r.specIds.end();
-                       }) &&
-           "specialization constant id not declared by any stage");
-    (void)s;
-  }
-  (void)stages;
+void checkSpecDeclared(const std::string& pipeline, std::span<const SpirvReflection> stages,
+                       std::span<const SpecConstant> spec) {
+  for (const SpecConstant& s : spec)
+    if (std::none_of(stages.begin(), stages.end(), [&](const SpirvReflection& r) {
+          return std::find(r.specIds.begin(), r.specIds.end(), s.id) != r.specIds.end();
+        }))
+      throw InternalError("internal error: specialization constant " + std::to_string(s.id) + " given to '" +
+                          pipeline + "', whose shaders declare no such constant");
+}
+
+uint32_t sharedPushSize(const std::string& pipeline, uint32_t size, uint32_t stageSize) {
+  if (stageSize != 0 && size != 0 && stageSize != size)
+    throw InternalError("internal error: the stages of '" + pipeline + "' declare push-constant blocks of " +
+                        std::to_string(size) + " and " + std::to_string(stageSize) + " bytes");
+  return std::max(size, stageSize);
 }
 
 Specialization::Specialization(std::span<const SpecConstant> spec) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "gpu/program.h"
@@ -40,8 +41,15 @@ VkPipelineLayout createPipelineLayout(VkDevice device, VkShaderStageFlags pushSt
 // the GPU may still use them: they are left to process exit.
 void destroyPipeline(VkDevice device, VkPipeline& pipeline, VkPipelineLayout& layout);
 
-// Asserts that at least one stage declares every constant of `spec` (a misspelt id would be ignored).
-void assertSpecDeclared(std::span<const SpirvReflection> stages, std::span<const SpecConstant> spec);
+// Throws InternalError naming `pipeline` unless some stage declares every constant of `spec` (a misspelt
+// id in a method table row would otherwise be ignored). Checked in every build: benchmarks run Release.
+void checkSpecDeclared(const std::string& pipeline, std::span<const SpirvReflection> stages,
+                       std::span<const SpecConstant> spec);
+
+// The push-constant size of a pipeline whose stages so far declare `size` bytes, after one more stage that
+// declares `stageSize`: every stage sees the same block from offset 0 (one struct from shared.h), or none.
+// Throws InternalError naming `pipeline` when two stages declare different blocks.
+uint32_t sharedPushSize(const std::string& pipeline, uint32_t size, uint32_t stageSize);
 
 // The specialization of every stage of a pipeline: 4-byte values in the order of `spec`. Not copyable:
 // info() points into it.

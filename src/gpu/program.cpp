@@ -1,8 +1,8 @@
 #include "gpu/program.h"
 
 #include <algorithm>
-#include <stdexcept>
 
+#include "base/error.h"
 #include "gpu/context.h"
 #include "gpu/pipeline_parts.h"
 #include "gpu/shader_registry.h"
@@ -40,7 +40,7 @@ ComputeProgram::ComputeProgram(Context& context, const std::string& shaderName,
   reflection_ = reflectSpirv(words);
   pushConstantSize_ = reflection_.pushConstantSize;
   pushStages_ = VK_SHADER_STAGE_COMPUTE_BIT;
-  assertSpecDeclared({&reflection_, 1}, spec);
+  checkSpecDeclared(name_, {&reflection_, 1}, spec);
   ShaderModules modules(device_);
   VkShaderModule module = modules.add(words);
   layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
@@ -68,8 +68,8 @@ void ComputeProgram::dispatchRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t
 
 void checkPushSize(const std::string& program, uint32_t given, uint32_t declared) {
   if (given != declared)
-    throw std::logic_error("internal error: " + std::to_string(given) + " bytes of push constants for '" +
-                           program + "', whose shaders declare " + std::to_string(declared));
+    throw InternalError("internal error: " + std::to_string(given) + " bytes of push constants for '" +
+                        program + "', whose shaders declare " + std::to_string(declared));
 }
 
 Grid gridFor(uint64_t items, uint32_t groupSize) {

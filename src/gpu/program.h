@@ -78,7 +78,7 @@ private:
   SpirvReflection reflection_;
 };
 
-// Throws std::logic_error unless `given` bytes of push constants match the `declared` block of `program`'s
+// Throws InternalError unless `given` bytes of push constants match the `declared` block of `program`'s
 // shaders: a struct out of step with its shader is a build mistake, caught in every build (benchmarks run
 // Release builds) before it reaches the device.
 void checkPushSize(const std::string& program, uint32_t given, uint32_t declared);

@@ -99,13 +99,11 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& 
   std::vector<SpirvReflection> reflections;
   for (const auto& [stage, name] : sources) {
     reflections.push_back(reflectSpirv(findShader(*name)));
-    uint32_t size = reflections.back().pushConstantSize;
-    assert((size == 0 || pushConstantSize_ == 0 || size == pushConstantSize_) &&
-           "the stages declare different push-constant blocks");
-    pushConstantSize_ = std::max(pushConstantSize_, size);
+    const uint32_t size = reflections.back().pushConstantSize;
+    pushConstantSize_ = sharedPushSize(name_, pushConstantSize_, size);
     if (size) pushStages_ |= stage;
   }
-  assertSpecDeclared(reflections, spec);
+  checkSpecDeclared(name_, reflections, spec);
   Specialization specialization(spec);
 
   const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& limits = context.rayTracingProperties();

@@ -1,7 +1,8 @@
 #include "gpu/shader_registry.h"
 
-#include <stdexcept>
 #include <string>
+
+#include "base/error.h"
 
 namespace pointrast::gpu {
 
@@ -10,7 +11,7 @@ std::span<const uint32_t> findShader(std::string_view name) {
     if (s.name == name) return s.words;
   // A build mistake (a misspelt name in the method table, a shader file not compiled), never a user
   // error; checked in every build, since benchmarks run Release builds.
-  throw std::logic_error("internal error: shader '" + std::string(name) + "' is not embedded in this build");
+  throw InternalError("internal error: shader '" + std::string(name) + "' is not embedded in this build");
 }
 
 } // namespace pointrast::gpu

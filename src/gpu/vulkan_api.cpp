@@ -131,9 +131,38 @@ const char* resultName(VkResult result) {
   }
 }
 
+namespace {
+
+// "vkQueueSubmit" of "vkQueueSubmit(queue_, 1, &submit, fence_)".
+std::string functionName(const char* call) {
+  std::string text = call;
+  return text.substr(0, text.find('('));
+}
+
+// "gpu/context.cpp" of "../../src/gpu/context.cpp": the place in the source tree, not the build's path.
+std::string sourcePlace(const char* file) {
+  std::string text = file;
+  const size_t src = text.rfind("src/");
+  return src == std::string::npos ? text : text.substr(src + 4);
+}
+
+} // namespace
+
 VulkanError::VulkanError(VkResult result, const char* call, const char* file, int line)
-    : std::runtime_error(std::string("Vulkan call failed with ") + resultName(result) + ": " + call + " (" +
-                         file + ":" + std::to_string(line) + ")"),
+    : std::runtime_error("internal error: " + functionName(call) + " failed with " + resultName(result) + " (" +
+                         sourcePlace(file) + ":" + std::to_string(line) + ")"),
       result_(result) {}
+
+void throwVulkanFailure(VkResult result, const char* call, const char* file, int line) {
+  const std::string what = std::string(resultName(result)) + " from " + functionName(call);
+  if (result == VK_ERROR_DEVICE_LOST) {
+    markDeviceFaulted();
+    throw DeviceFault("the GPU device was lost (" + what +
+                      "): the driver reset it or a shader faulted; nothing more can run on it in this process");
+  }
+  if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY) throw UnsupportedError("the GPU ran out of memory (" + what + ")");
+  if (result == VK_ERROR_OUT_OF_HOST_MEMORY) throw UnsupportedError("the host ran out of memory (" + what + ")");
+  throw VulkanError(result, call, file, line);
+}
 
 } // namespace pointrast::gpu

@@ -22,7 +22,8 @@
 
 // From VK_EXT_debug_utils: may be null when the extension is missing.
 #define PR_VK_DEBUG_FUNCTIONS(X) \
-  X(vkCreateDebugUtilsMessengerEXT) X(vkDestroyDebugUtilsMessengerEXT) X(vkSetDebugUtilsObjectNameEXT)
+  X(vkCreateDebugUtilsMessengerEXT) X(vkDestroyDebugUtilsMessengerEXT) X(vkSetDebugUtilsObjectNameEXT) \
+  X(vkSubmitDebugUtilsMessageEXT)
 
 #define PR_VK_DEVICE_FUNCTIONS(X) \
   X(vkDestroyDevice) X(vkGetDeviceQueue) X(vkDeviceWaitIdle) X(vkQueueSubmit) X(vkQueueWaitIdle) \
@@ -89,7 +90,9 @@ void loadSwapchainFunctions(VkDevice device);
 // vkGetInstanceProcAddr of the loaded libvulkan, for window libraries that create surfaces themselves.
 PFN_vkGetInstanceProcAddr instanceProcAddr();
 
-// A Vulkan call failed: which call, where, and the VkResult's name.
+// A Vulkan call failed in a way that is neither a lost device nor exhausted memory (those are DeviceFault
+// and UnsupportedError, see throwVulkanFailure): a defect of pointrast or of the driver. Says which call,
+// where, and the VkResult's name.
 class VulkanError : public std::runtime_error {
 public:
   VulkanError(VkResult result, const char* call, const char* file, int line);
@@ -101,7 +104,13 @@ private:
 
 const char* resultName(VkResult result);
 
-// Set once a submission did not finish in time (DeviceFault). From then on destructors leave Vulkan
+// Throws what a failed call means to the caller: VK_ERROR_DEVICE_LOST marks the device faulted
+// (markDeviceFaulted) and throws DeviceFault, which the benchmarks catch to keep what they measured;
+// VK_ERROR_OUT_OF_DEVICE_MEMORY / _HOST_MEMORY throw UnsupportedError (the work does not fit); anything
+// else throws VulkanError. `call` is the call's text; only the function's name is shown.
+[[noreturn]] void throwVulkanFailure(VkResult result, const char* call, const char* file, int line);
+
+// Set once a submission did not finish in time or the device was lost (DeviceFault). From then on destructors leave Vulkan
 // objects alone: the GPU may still be using them and waiting for it could take forever; the process
 // exits soon and the driver reclaims everything.
 bool deviceFaulted();
@@ -109,12 +118,13 @@ void markDeviceFaulted();
 
 } // namespace pointrast::gpu
 
-// Checks a VkResult in every build (benchmarks run in Release). Anything but VK_SUCCESS throws.
+// Checks a VkResult in every build (benchmarks run in Release). Anything but VK_SUCCESS throws, as
+// throwVulkanFailure decides.
 #define VK_CHECK(call)                                                                                       \
   do {                                                                                                       \
     VkResult pr_vk_result_ = (call);                                                                         \
     if (pr_vk_result_ != VK_SUCCESS)                                                                         \
-      throw ::pointrast::gpu::VulkanError(pr_vk_result_, #call, __FILE__, __LINE__);                         \
+      ::pointrast::gpu::throwVulkanFailure(pr_vk_result_, #call, __FILE__, __LINE__);                        \
   } while (0)
 
 // The narrow variant for calls where some non-success codes are legal (VK_NOT_READY from a query,
@@ -124,5 +134,5 @@ void markDeviceFaulted();
     VkResult pr_vk_result_ = (call);                                                                         \
     for (VkResult allowed : {VK_SUCCESS, __VA_ARGS__})                                                       \
       if (pr_vk_result_ == allowed) return pr_vk_result_;                                                    \
-    throw ::pointrast::gpu::VulkanError(pr_vk_result_, #call, __FILE__, __LINE__);                           \
+    ::pointrast::gpu::throwVulkanFailure(pr_vk_result_, #call, __FILE__, __LINE__);                          \
   }()

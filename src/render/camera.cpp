@@ -23,7 +23,11 @@ Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm
   Camera camera;
   camera.fovY = fovY;
   camera.up = up;
-  if (bounds.empty()) return camera;
+  if (bounds.empty()) { // a cloud without points: the same view of the origin
+    camera.target = glm::dvec3(0);
+    camera.eye = back;
+    return camera;
+  }
   glm::dvec3 center = bounds.center();
   glm::dvec3 right = glm::normalize(glm::cross(-back, camera.up));
   glm::dvec3 upv = glm::cross(right, -back);
@@ -40,28 +44,67 @@ Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm
     distance = std::max(
         {distance, std::abs(glm::dot(v, right)) / tanX + along, std::abs(glm::dot(v, upv)) / tanY + along});
   }
-  // Keep every corner in front of the eye even for degenerate (flat or single-point) bounds.
-  distance = std::max(distance * 1.05, deepest + 1e-3 * bounds.diagonal() + 1e-6);
+  // Keep every corner in front of the eye even for degenerate (flat or single-point) bounds, and the eye
+  // 1e-7 of the coordinates' magnitude (some 10^8 steps of double precision) away from the center however
+  // far that lies from the origin.
+  const double magnitude = std::max(glm::length(bounds.min), glm::length(bounds.max));
+  distance = std::max(distance * 1.05, deepest + 1e-3 * bounds.diagonal() + std::max(1e-6, 1e-7 * magnitude));
   camera.target = center;
   camera.eye = center + back * distance;
   return camera;
 }
 
-void validateCamera(const Camera& camera) {
+void checkCoordinateRange(const Bounds& bounds, const std::string& source) {
+  if (bounds.empty()) return;
+  double reach = 0;
+  for (const glm::dvec3& corner : {bounds.min, bounds.max})
+    for (int a = 0; a < 3; ++a)
+      reach = std::isfinite(corner[a]) ? std::max(reach, std::abs(corner[a])) : INFINITY;
+  if (reach <= kMaxCoordinate) return;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                ": coordinates reach %.3g, beyond the %.0e pointrast renders (doubles are coarser than 1/8 "
+                "there); a damaged header or file?",
+                reach, kMaxCoordinate);
+  throw InputError(source + text);
+}
+
+std::optional<CameraProblem> findCameraProblem(const Camera& camera) {
   auto finite = [](const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
   };
-  if (!finite(camera.eye) || !finite(camera.target) || !finite(camera.up))
-    throw InputError("camera: eye, target and up must be finite numbers");
+  if (!finite(camera.eye) || !finite(camera.target) || !finite(camera.up) || !std::isfinite(camera.shiftX))
+    return CameraProblem::NotFinite;
+  if (!(camera.fovY > 0 && camera.fovY < 180)) return CameraProblem::FieldOfView;
+  if (!(camera.nearW >= 0) || !std::isfinite(camera.nearW)) return CameraProblem::Near;
   glm::dvec3 view = camera.target - camera.eye;
-  if (glm::length(view) <= 0) throw InputError("camera: --eye and --target must differ");
-  if (glm::length(camera.up) <= 0) throw InputError("camera: --up must not be zero");
-  if (glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) < 1e-9)
-    throw InputError("camera: --up is parallel to the view direction; give another --up");
-  if (!(camera.fovY > 0 && camera.fovY < 180))
-    throw InputError("camera: --fov must be between 0 and 180 degrees");
-  if (!(camera.nearW >= 0) || !std::isfinite(camera.nearW)) throw InputError("camera: --near must be >= 0");
-  if (!std::isfinite(camera.shiftX)) throw InputError("camera: the stereo image shift must be finite");
+  if (!(glm::length(view) > 0)) return CameraProblem::EyeIsTarget;
+  if (!(glm::length(camera.up) > 0)) return CameraProblem::UpIsZero;
+  if (!(glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) >= 1e-9))
+    return CameraProblem::UpAlongView;
+  return std::nullopt;
+}
+
+const char* describeCameraProblem(CameraProblem problem) {
+  switch (problem) {
+  case CameraProblem::NotFinite:
+    return "the camera's eye, target and up must be finite numbers";
+  case CameraProblem::EyeIsTarget:
+    return "the camera's eye and target are the same point";
+  case CameraProblem::UpIsZero:
+    return "the camera's up direction is zero";
+  case CameraProblem::UpAlongView:
+    return "the camera's up direction is parallel to its view direction";
+  case CameraProblem::FieldOfView:
+    return "the field of view must be between 0 and 180 degrees";
+  case CameraProblem::Near:
+    return "the near distance must be a number >= 0";
+  }
+  return "the camera is not usable";
+}
+
+void validateCamera(const Camera& camera) {
+  if (auto problem = findCameraProblem(camera)) throw InputError(describeCameraProblem(*problem));
 }
 
 glm::dmat4 viewProjection(const Camera& camera, const glm::dvec3& origin, double aspect) {

@@ -3,6 +3,7 @@
 // dropped. Matrices handed to the GPU are built in double relative to a scene origin and rounded once.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -22,10 +23,19 @@ struct Camera {
   double shiftX = 0.0;
 };
 
-// The overview used when no --eye is given: looking at the center of the bounds from the south-west
+// The overview used when no camera is given: looking at the center of the bounds from the south-west
 // (direction (-1, -1, 1) from the center, i.e. 35.3 degrees above the horizon), z up, at the smallest
-// distance at which all eight corners of the bounding box are inside the image, plus 5 %.
+// distance at which all eight corners of the bounding box are inside the image, plus 5 %; never closer
+// than the coordinates' magnitude lets doubles tell the eye from the target. Empty bounds (a cloud without
+// points) get the same view of the origin. fovY must be in (0, 180).
 Camera overviewCamera(const Bounds& bounds, double aspect, double fovY = 60.0);
+
+// The largest coordinate magnitude pointrast renders: beyond it doubles are coarser than 1/8 unit, and no
+// survey, scan or simulation has such values; they come from a damaged header or file.
+constexpr double kMaxCoordinate = 1e15;
+// Throws InputError naming `source` when bounds are not finite or reach beyond kMaxCoordinate. Empty
+// bounds pass.
+void checkCoordinateRange(const Bounds& bounds, const std::string& source);
 
 // The same framing from any direction: looking at the center of the bounds along -back (unit vector from
 // the target towards the eye) with the given up (not parallel to back), at the smallest distance that
@@ -37,8 +47,20 @@ Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm
 // at or behind the eye.
 double defaultNear(const Bounds& bounds);
 
-// Checks eye != target, up not parallel to the view direction, 0 < fov < 180, finite values. Throws
-// InputError with the reason.
+// What can be wrong with a camera; front ends map each to their own option names.
+enum class CameraProblem {
+  NotFinite,   // eye, target or up not finite
+  EyeIsTarget, // no view direction
+  UpIsZero,
+  UpAlongView, // up parallel to the view direction
+  FieldOfView, // fovY outside (0, 180)
+  Near,        // nearW negative or not finite
+};
+// The first problem of the camera, if any.
+std::optional<CameraProblem> findCameraProblem(const Camera& camera);
+// One neutral sentence for a problem ("the camera's eye and target are the same point").
+const char* describeCameraProblem(CameraProblem problem);
+// Throws InputError with describeCameraProblem's sentence when the camera has a problem.
 void validateCamera(const Camera& camera);
 
 // Clip-from-world matrix with world coordinates taken relative to `origin`:

@@ -55,7 +55,8 @@ TEST(Suites, Paper2022SizesOrdersViewsAndDefaults) {
   EXPECT_EQ(suiteDefaults("paper2021").width, 1920u);
   EXPECT_THROW(suiteDefaults("paper1999"), InputError);
   EXPECT_THROW(suiteDatasets("paper2022", 1.0, 1, {"retz=/x.las"}), InputError) << "a paper2021 name";
-  EXPECT_NE(std::find(suiteNames().begin(), suiteNames().end(), "paper2022"), suiteNames().end());
+  const std::vector<std::string> names = suiteNames(); // one vector: begin and end of the same range
+  EXPECT_NE(std::find(names.begin(), names.end(), "paper2022"), names.end());
 }
 
 BenchRun runWithBatchResults() {

@@ -79,7 +79,8 @@ TEST(LodSuites, LodSuiteAndPaper2022CarryTheLodMethods) {
   EXPECT_FALSE(isLodSuite("paper2022"));
   EXPECT_EQ(suiteDefaults("lod").methods, std::vector<Method>({pointMethod("lod")}));
   EXPECT_EQ(suiteDefaults("lod").width, 2560u);
-  EXPECT_NE(std::find(suiteNames().begin(), suiteNames().end(), "lod"), suiteNames().end());
+  const std::vector<std::string> names = suiteNames(); // one vector: begin and end of the same range
+  EXPECT_NE(std::find(names.begin(), names.end(), "lod"), names.end());
   EXPECT_EQ(layoutsOf({pointMethod("lod"), pointMethod("batch")}),
             std::vector<SceneLayout>({SceneLayout::Batched}))
       << "no GPU scene for the octree methods";

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "base/build_info.h"
 #include "base/error.h"
 #include "bench/report.h"
 #include "bench/suites.h"
@@ -121,6 +122,11 @@ TEST(Report, JsonHoldsEverything) {
   EXPECT_EQ(j["datasets"].size(), 3u);
   EXPECT_EQ(j["datasets"][2]["status"], "skipped");
   EXPECT_EQ(j["command_line"], "pointrast bench x");
+  // The code measured: `git describe` of the build (a checkout here), never empty.
+  EXPECT_EQ(j["commit"], buildCommit());
+  EXPECT_FALSE(std::string(buildCommit()).empty());
+  EXPECT_NE(markdownReport(madeUpRun(), info()).find(std::string("pointrast ") + buildCommit()),
+            std::string::npos);
 }
 
 TEST(Report, WritesThreeFilesAndNoPartials) {

@@ -152,3 +152,87 @@ TEST(BenchCli, AGpuThatStopsMakingProgressIsOneClearErrorNotAHang) {
     for (const auto& entry : fs::directory_iterator(out))
       ADD_FAILURE() << "nothing should be written, found " << entry.path();
 }
+
+namespace {
+
+// Lines of stderr that are pointrast's own error lines.
+int errorLines(const std::string& err) {
+  int lines = 0;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    lines += line.rfind("pointrast:", 0) == 0;
+  return lines;
+}
+
+} // namespace
+
+TEST(BenchCli, ALostDeviceKeepsWhatWasMeasuredAndIsOneErrorLine) {
+  // POINTRAST_INJECT_DEVICE_LOST=6: the sixth submission (after the copy bandwidth, the upload and the
+  // first combinations) and every later one fail with VK_ERROR_DEVICE_LOST, as a driver reset would.
+  fs::path out = tempDir() / "lost";
+  fs::remove_all(out);
+  setenv("POINTRAST_INJECT_DEVICE_LOST", "6", 1);
+  Result r = run("bench terrain --points 20k --methods atomicmin,earlyz,reduce,reduce-earlyz,dedup-ballot,"
+                 "busyloop,justset --orders original --views overview --frames 2 --width 160 --height 100 "
+                 "--copy-size 16M --budget 0 -q --out " +
+                 out.string());
+  unsetenv("POINTRAST_INJECT_DEVICE_LOST");
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("device was lost (VK_ERROR_DEVICE_LOST from vkQueueSubmit)"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find(".cpp"), std::string::npos) << "no source locations in a device fault: " << r.err;
+  ASSERT_TRUE(fs::exists(out / "terrain-20k.json")) << r.err;
+  nlohmann::json report = nlohmann::json::parse(slurp(out / "terrain-20k.json"));
+  int ok = 0, faulted = 0;
+  for (const auto& result : report["results"]) {
+    ok += result["status"] == "ok";
+    faulted += result["status"] == "device-fault";
+  }
+  EXPECT_GE(ok, 1) << "what was measured before the fault is kept";
+  EXPECT_EQ(faulted, 1);
+  EXPECT_LT(report["results"].size(), 7u) << "nothing runs after the fault";
+  EXPECT_NE(slurp(out / "terrain-20k.md").find("Stopped early"), std::string::npos);
+}
+
+TEST(BenchCli, ALostDeviceInTheLodSuiteKeepsWhatWasMeasuredAndIsOneErrorLine) {
+  // The twentieth submission fails: after the copy bandwidth and several sweeps. Node uploads are
+  // submissions too and depend on the readers' timing, so where exactly the fault lands may vary.
+  fs::path dir = tempDir() / "lost-lod";
+  fs::remove_all(dir);
+  setenv("POINTRAST_INJECT_DEVICE_LOST", "20", 1);
+  Result r = run("bench --suite lod --views overview --flight-frames 6 --jumps 2 --scale 0.0001 --frames 1 "
+                 "--width 160 --height 100 --copy-size 16M --budget 0 -q --octree-cache " +
+                 (dir / "octrees").string() + " --out " + (dir / "out").string());
+  unsetenv("POINTRAST_INJECT_DEVICE_LOST");
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("device was lost"), std::string::npos) << r.err;
+  const fs::path json = dir / "out" / "lod-scale0.0001.json";
+  ASSERT_TRUE(fs::exists(json)) << r.err;
+  nlohmann::json report = nlohmann::json::parse(slurp(json));
+  int ok = 0, faulted = 0;
+  for (const char* part : {"sweeps", "streams"})
+    for (const auto& result : report[part]) {
+      ok += result["status"] == "ok";
+      faulted += result["status"] == "device-fault";
+    }
+  EXPECT_GE(ok, 1) << "what was measured before the fault is kept";
+  EXPECT_EQ(faulted, 1) << "nothing runs after the fault";
+  EXPECT_NE(report["stopped"].get<std::string>().find("device was lost"), std::string::npos);
+}
+
+TEST(BenchCli, ALostDeviceInRenderIsOneLineAndNoImage) {
+  fs::path png = tempDir() / "lost.png";
+  fs::remove(png);
+  setenv("POINTRAST_INJECT_DEVICE_LOST", "1", 1);
+  Result r = run("render terrain --points 20k --width 160 --height 100 -q -o " + png.string());
+  unsetenv("POINTRAST_INJECT_DEVICE_LOST");
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("device was lost"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
+}

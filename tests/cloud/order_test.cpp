@@ -273,6 +273,27 @@ TEST(ApplyOrder, KeepsAttributeRowsTogether) {
   EXPECT_EQ(cloud.bounds.min, before.min);
 }
 
+TEST(OrderedCopy, EqualsApplyOrderAndLeavesTheSourceAlone) {
+  PointCloud cloud = testing::randomCloud(20'000);
+  for (uint64_t i = 0; i < cloud.size(); ++i) {
+    cloud.colors.push_back(uint32_t(i * 7));
+    cloud.returnNumber.push_back(uint8_t(i));
+  }
+  const PointCloud original = cloud;
+  std::vector<uint64_t> order;
+  computeOrder(order, cloud, Order::ShuffledMorton, 4);
+  const PointCloud copy = orderedCopy(cloud, order);
+  applyOrder(cloud, order);
+  EXPECT_EQ(copy.positions, cloud.positions);
+  EXPECT_EQ(copy.colors, cloud.colors);
+  EXPECT_EQ(copy.returnNumber, cloud.returnNumber);
+  EXPECT_TRUE(copy.intensity.empty());
+  EXPECT_EQ(copy.bounds.min, original.bounds.min);
+  EXPECT_EQ(copy.bounds.max, original.bounds.max);
+  EXPECT_EQ(copy.scale, original.scale);
+  EXPECT_NE(copy.positions, original.positions);
+}
+
 TEST(ApplyOrder, LeavesMissingAttributesEmpty) {
   PointCloud cloud = testing::randomCloud(1000);
   reorder(cloud, Order::Morton, 1);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "base/error.h"
+#include "gpu/pipeline_parts.h"
 #include "gpu/shader_registry.h"
 #include "gpu/spirv_reflect.h"
 #include "render/method_table.h"
@@ -64,7 +65,29 @@ TEST(MethodTable, NameListsComeFromTheRows) {
 }
 
 TEST(ShaderRegistry, AMissingShaderIsAnErrorInEveryBuild) {
-  EXPECT_THROW(gpu::findShader("raster_no_such_thing.comp"), std::logic_error);
+  EXPECT_THROW(gpu::findShader("raster_no_such_thing.comp"), InternalError);
+}
+
+// The checks a row's shader and constants meet when its pipeline is made: errors in Release builds too,
+// where an assert would be gone and a misspelt constant silently ignored.
+TEST(PipelineChecks, AnUndeclaredConstantOrMismatchedPushBlockIsAnErrorInEveryBuild) {
+  const gpu::SpirvReflection closest = gpu::reflectSpirv(gpu::findShader("raster_closest.comp"));
+  const gpu::SpecConstant earlyZ[] = {{/* EARLY_Z= */ 0, 1}};
+  EXPECT_NO_THROW(gpu::checkSpecDeclared("raster_closest.comp", {&closest, 1}, earlyZ));
+  const gpu::SpecConstant misspelt[] = {{/* no such id */ 77, 1}};
+  try {
+    gpu::checkSpecDeclared("raster_closest.comp", {&closest, 1}, misspelt);
+    ADD_FAILURE() << "no error for constant 77";
+  } catch (const InternalError& e) {
+    EXPECT_NE(std::string(e.what()).find("specialization constant 77 given to 'raster_closest.comp'"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(gpu::sharedPushSize("p", 0, 48), 48u);
+  EXPECT_EQ(gpu::sharedPushSize("p", 48, 0), 48u) << "a stage without push constants";
+  EXPECT_EQ(gpu::sharedPushSize("p", 48, 48), 48u);
+  EXPECT_THROW(gpu::sharedPushSize("p", 48, 32), InternalError);
+  EXPECT_THROW(gpu::checkPushSize("p", 32, 48), InternalError);
 }
 
 } // namespace pointrast::test

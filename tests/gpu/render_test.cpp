@@ -11,7 +11,7 @@
 #include "cloud/generate.h"
 #include "gpu_fixture.h"
 #include "io/reader.h"
-#include "render/cpu_reference.h"
+#include "oracles/cpu_reference.h"
 #include "render/renderer.h"
 #include "test_data.h"
 

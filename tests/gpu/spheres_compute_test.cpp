@@ -1,4 +1,4 @@
-// sphere-compute against the CPU ray caster (double precision, render/spheres/cpu_spheres.h) and against
+// sphere-compute against the CPU ray caster (double precision, tests/oracles/cpu_spheres.h) and against
 // the image contract:
 // - a hand-built sphere: exact depth and color on the axis, background elsewhere, culling at the near plane;
 // - random sets in every particle layout: >= 99 % of pixels agree (same hit, color within 1 per channel),

@@ -11,7 +11,7 @@
 
 #include "gpu/context.h"
 #include "gpu_fixture.h"
-#include "render/spheres/cpu_spheres.h"
+#include "oracles/cpu_spheres.h"
 #include "render/spheres/gpu_particles.h"
 #include "render/spheres/sphere_renderer.h"
 

@@ -114,10 +114,10 @@ TEST(CameraPath, RefusesBadFilesWithOneClearError) {
   refuse(head + "[]}", "non-empty");
   refuse(head + R"([{"time":0,"eye":[0,1,1],"target":[0,0,0]}, {"time":0,"eye":[0,2,1],"target":[0,0,0]}]})",
          "increase strictly");
-  refuse(head + R"([{"time":0,"eye":[0,0,1],"target":[0,0,1]}]})", "must differ");
+  refuse(head + R"([{"time":0,"eye":[0,0,1],"target":[0,0,1]}]})", "eye and target are the same point");
   refuse(head + R"([{"time":0,"eye":[0,0],"target":[0,0,0]}]})", "\"eye\"");
   refuse(head + R"([{"time":0,"eye":[0,0,"x"],"target":[0,0,0]}]})", "finite");
-  refuse(head + R"([{"time":0,"eye":[0,1,1],"target":[0,0,0],"fov":200}]})", "fov");
+  refuse(head + R"([{"time":0,"eye":[0,1,1],"target":[0,0,0],"fov":200}]})", "field of view");
   refuse(head + R"([{"eye":[0,0,1],"target":[0,0,0]}]})", "\"time\"");
   refuse(head + R"([{"time":0,"eye":[0,0,1e999],"target":[0,0,0]}]})", "");
   EXPECT_THROW(CameraPath::load("/nonexistent/path.json"), InputError);

@@ -116,7 +116,7 @@ void LodScene::checkFits(uint32_t id) const {
   if (pages > pool_->capacity())
     throw UnsupportedError(hierarchy_->describe(id) + " needs " + bytesText(bytes) +
                            " of GPU memory, more than the node cache's budget of " +
-                           bytesText(pool_->capacity() * shared::kLodPageBytes) + " (--gpu-memory)");
+                           bytesText(pool_->capacity() * shared::kLodPageBytes));
   if (pages > staging_->capacity())
     throw UnsupportedError(
         hierarchy_->describe(id) + " needs " + bytesText(bytes) + " of staging memory, more than the " +

@@ -180,9 +180,10 @@ const char* sphereBillboardName(SphereBillboard billboard) {
 bool SphereRenderer::supports(gpu::Context& context, const SphereSettings& settings, std::string* why) {
   const SphereMethodInfo& info = sphereMethodInfo(settings.method);
   if (!info.rasterOptions && (settings.billboard != SphereBillboard::Screen || settings.conservative))
-    throw InputError(std::string("--billboard and --conservative apply to the sphere methods that rasterize "
-                                 "billboards (") +
-                     billboardMethodNames() + "); " + info.name + " draws none");
+    throw InputError(
+        std::string("billboard shapes and conservative rasterization apply to the sphere methods "
+                    "that rasterize billboards (") +
+        billboardMethodNames() + "); " + info.name + " draws none");
   if (!supports(context, settings.method, why)) return false;
   std::string reason;
   if (!info.rasterOptions || info.rasterOptions(context, settings, &reason)) return true;
@@ -263,7 +264,7 @@ SphereStats SphereRenderer::render(const GpuParticles& particles, const Camera& 
                      std::to_string(settings.meshlet));
   if (!mesh && (settings.taskCull || settings.meshlet != shared::kSphereMeshletLarge))
     throw InputError(
-        std::string("--meshlet and --task-cull apply to sphere-mesh-points and sphere-mesh-tris, "
+        std::string("meshlet sizes and task-shader culling apply to sphere-mesh-points and sphere-mesh-tris, "
                     "not to ") +
         sphereMethodName(settings.method));
   std::string why;

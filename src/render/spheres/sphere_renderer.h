@@ -1,6 +1,6 @@
 // Draws a particle set as ray-cast spheres with one of the sphere methods and returns an RGBA8 image,
 // plus the per-pixel view depth and particle index for tests. Every method shades with
-// shaders/sphere_shade.inc.glsl and is checked against the CPU ray caster (cpu_spheres.h).
+// shaders/sphere_shade.inc.glsl and is checked against the tests' CPU ray caster (tests/oracles/).
 //
 // Methods, after Gralka et al., "Efficient Sphere Rendering Revisited" (2023): the study draws ray-cast
 // sphere impostors through every rasterization pipeline (points, triangles, strips, geometry and mesh

@@ -1,4 +1,4 @@
-#include "render/cpu_reference.h"
+#include "oracles/cpu_reference.h"
 
 #include <atomic>
 #include <bit>

@@ -1,4 +1,4 @@
-#include "render/spheres/cpu_spheres.h"
+#include "oracles/cpu_spheres.h"
 
 #include <algorithm>
 #include <cmath>
