@@ -51,7 +51,7 @@ Command addConvert(CLI::App& app) {
     if (a->lasVersion != "auto" && a->lasVersion != "1.2" && a->lasVersion != "1.4")
       throw InputError("--las expects auto, 1.2 or 1.4");
     lasFlavorFor(a->output, 0);
-    if (!std::filesystem::exists(a->input)) throw InputError(a->input + ": no such file");
+    if (!pathExists(a->input)) throw InputError(a->input + ": no such file");
     InputSpec spec;
     spec.source = a->input;
     spec.order = parseOrder(a->order);

@@ -8,8 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.h"
+#include "base/text.h"
 #include "commands.h"
 #include "gpu/context.h"
+#include "input.h"
 #include "io/particles_io.h"
 #include "io/reader.h"
 
@@ -100,7 +102,7 @@ int mmpldInfo(const InfoArgs& a) {
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
-  std::printf("file:    %s\n", a.input.c_str());
+  std::printf("file:    %s\n", printableLine(a.input).c_str()); // one line whatever the name
   std::printf("format:  MMPLD %s (%u), %u frame%s\n", version.c_str(), info.version, info.frames,
               info.frames == 1 ? "" : "s");
   std::printf("frame:   %u, %zu list%s", info.frame, info.lists.size(), info.lists.size() == 1 ? "" : "s");
@@ -150,7 +152,7 @@ int mmpldInfo(const InfoArgs& a) {
 int runInfo(const InfoArgs& a) {
   if (a.devices) return listDevicesCommand(a.json);
   if (a.input.empty()) throw InputError("info needs a FILE (or --devices)");
-  if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file");
+  if (!pathExists(a.input)) throw InputError(a.input + ": no such file");
   if (io::detectFormat(a.input) == io::Format::Mmpld) return mmpldInfo(a);
   io::FileInfo info = io::probeFile(a.input);
   if (a.json) {
@@ -175,7 +177,7 @@ int runInfo(const InfoArgs& a) {
     std::printf("%s\n", j.dump().c_str());
     return 0;
   }
-  std::printf("file:    %s\n", a.input.c_str());
+  std::printf("file:    %s\n", printableLine(a.input).c_str()); // one line whatever the name
   std::printf("format:  %s\n", info.formatDetail.c_str());
   std::printf("points:  %llu\n", static_cast<unsigned long long>(info.pointCount));
   if (!info.bounds.empty()) {

@@ -86,8 +86,18 @@ int runRenderSpheres(const RenderArgs& a) {
   spec.particles = parseCount(a.points, "--points");
   spec.seed = a.seed;
   spec.progress = !a.quiet;
-  ParticleSet set = loadParticles(spec);
+  // Header counts first (a bad file is refused before the device starts), then the device's memory: a
+  // file too large for it is refused before its particles are read.
+  const std::optional<uint64_t> stated = statedParticles(spec);
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = a.device;
+  contextOptions.announce = !a.quiet;
+  gpu::Context context(contextOptions);
   std::string why;
+  if (stated && !particlesFit(context, upload.layout, *stated, &why))
+    throw UnsupportedError((a.input.empty() ? kDemoParticleScene : a.input) + ": " + why);
+  if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the read
+  ParticleSet set = loadParticles(spec);
   if (upload.layout && !layoutHolds(*upload.layout, set, &why)) throw InputError(why);
   Bounds bounds = sphereBounds(set);
   Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
@@ -99,11 +109,6 @@ int runRenderSpheres(const RenderArgs& a) {
   camera.nearW = a.nearW;
   validateCamera(camera);
 
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
-  if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the upload
   SphereRenderer renderer(context, a.width, a.height);
   GpuParticles particles(context, set, upload);
   SphereStats stats = renderer.render(particles, camera, settings);
@@ -202,6 +207,15 @@ int runRender(const RenderArgs& a) {
     camera.nearW = a.nearW;
   }
 
+  // As for spheres: the header's count before the device starts, the device's memory before the read.
+  const std::optional<uint64_t> stated = statedPoints(spec);
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = a.device;
+  contextOptions.announce = !a.quiet;
+  gpu::Context context(contextOptions);
+  std::string why;
+  if (stated && !sceneFits(context, layout, *stated, &why))
+    throw UnsupportedError((a.input.empty() ? kDemoScene : a.input) + ": " + why);
   PointCloud cloud = loadInput(spec);
   double aspect = double(a.width) / double(a.height);
   if (explicitCamera) {
@@ -212,10 +226,6 @@ int runRender(const RenderArgs& a) {
   }
   validateCamera(camera);
 
-  gpu::ContextOptions contextOptions;
-  contextOptions.deviceIndex = a.device;
-  contextOptions.announce = !a.quiet;
-  gpu::Context context(contextOptions);
   Renderer renderer(context, a.width, a.height);
 
   // --parts N: N separately uploaded scenes drawn into one framebuffer; they must give the same image

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
 #include "io/reader.h"
 
@@ -11,6 +12,9 @@ namespace pointrast::io::detail {
 FileInfo probeLas(const std::filesystem::path& path);
 FileInfo probePly(const std::filesystem::path& path);
 FileInfo probeXyz(const std::filesystem::path& path);
+
+// The vertex count of a PLY header where the file's size can hold it (statedPointCount()).
+std::optional<uint64_t> statedCountPly(const std::filesystem::path& path);
 
 // Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to
 // cross chunk boundaries with small files; 0 restores the default.

@@ -59,13 +59,37 @@ std::vector<LasVlr> walkVlrs(const InputFile& file, uint64_t start, uint32_t cou
 
 } // namespace
 
+namespace {
+
+// A path as one shell word, so that the suggested command can be pasted as it is: single quotes around
+// anything but plain characters, and "./" before a relative name that the tool would take for an option.
+std::string shellWord(const std::filesystem::path& path) {
+  std::string name = path.string();
+  if (!name.empty() && name[0] == '-') name = "./" + name;
+  const bool plain =
+      !name.empty() && name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                              "0123456789_./+,:=@%-") == std::string::npos;
+  if (plain) return name;
+  std::string quoted = "'";
+  for (char c : name)
+    quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+} // namespace
+
 void failCompressed(const std::filesystem::path& path) {
+  // The decompressed copy goes beside the input, under a name that is never the input's own: a LAZ file
+  // named .las must not be suggested a command that overwrites it.
   std::filesystem::path las = path;
-  las.replace_extension(".las");
-  fail(path,
-       strFormat("LAZ/COPC compressed files are not supported yet; decompress with "
-                 "`pdal translate %s %s` or `laszip -i %s -o %s`",
-                 path.string().c_str(), las.string().c_str(), path.string().c_str(), las.string().c_str()));
+  if (lowerExtension(path) == ".las")
+    las.replace_filename(path.stem().string() + "-decompressed.las");
+  else
+    las.replace_extension(".las");
+  const std::string in = shellWord(path), out = shellWord(las);
+  fail(path, strFormat("LAZ/COPC compressed files are not supported yet; decompress with "
+                       "`pdal translate %s %s` or `laszip -i %s -o %s`",
+                       in.c_str(), out.c_str(), in.c_str(), out.c_str()));
 }
 
 bool lasLooksCompressed(const InputFile& file) {

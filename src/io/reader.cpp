@@ -86,4 +86,20 @@ FileInfo probeFile(const std::filesystem::path& path) {
   }
 }
 
+std::optional<uint64_t> statedPointCount(const std::filesystem::path& path) {
+  Format format = detectFormat(path);
+  switch (format) {
+  case Format::Las: {
+    InputFile file(path);
+    return readLasHeader(file).pointCount; // checked against the file's size there
+  }
+  case Format::Ply:
+    return statedCountPly(path);
+  case Format::Xyz:
+    return std::nullopt;
+  default:
+    failUnreadable(path, format);
+  }
+}
+
 } // namespace pointrast::io

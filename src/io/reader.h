@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,11 @@ struct ReadOptions {
 // Reads the whole file into a PointCloud (bounds computed from the points). Throws InputError.
 PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& options = {});
 FileInfo probeFile(const std::filesystem::path& path);
+// The point count the file's header states, read without touching the points (probeFile() may read them
+// all: LAS color depth, PLY bounds), so that a caller can refuse a file it has no room for before reading
+// it. LAS: the header's count; PLY: the vertex count. nullopt where only reading tells (XYZ text, a PLY
+// count larger than the file holds). Throws InputError as probeFile() does.
+std::optional<uint64_t> statedPointCount(const std::filesystem::path& path);
 
 // Per format (readCloud dispatches to these).
 PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options = {});
