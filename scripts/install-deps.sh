@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config
   libvulkan-dev glslc spirv-tools mesa-vulkan-drivers vulkan-validationlayers
   libglm-dev libcli11-dev nlohmann-json3-dev libstb-dev libgtest-dev
+  clang libclang-rt-dev llvm # libFuzzer targets (scripts/fuzz.sh): the fuzzer runtime and llvm-symbolizer
 )
 
 missing=()

@@ -1,4 +1,5 @@
 // libFuzzer target for the Las reader: readLas and its probe on arbitrary bytes.
+// Seeds: las
 #include "fuzz_input.h"
 #include "io/formats.h"
 

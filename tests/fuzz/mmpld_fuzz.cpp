@@ -1,4 +1,5 @@
 // libFuzzer target for the MMPLD reader: readMmpld, probeMmpld and scanMmpld on arbitrary bytes.
+// Seeds: mmpld
 #include "fuzz_input.h"
 #include "io/particles_io.h"
 

@@ -1,4 +1,5 @@
 // libFuzzer target for the Ply reader: readPly and its probe on arbitrary bytes.
+// Seeds: ply
 #include "fuzz_input.h"
 #include "io/formats.h"
 

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz/NAME_fuzz.cpp) in their own tree with clang, ASan and UBSan,
+# and runs each for a bounded time, one after another. A target is seeded from the shared test data (the
+# folders its "// Seeds:" line names, else the folder NAME) and from its regression inputs
+# (tests/fuzz/regressions/NAME/). Exits 1 if any target finds a crash, a leak, undefined behaviour, an
+# input that takes over 10 s, or an allocation over 256 MiB (an input is at most 64 KiB: a reader
+# allocating that much trusts a count it should have checked); the input that did it is kept under
+# BUILD/findings/DATE-TIME/ and the command that replays it is printed.
+#
+#   scripts/fuzz.sh [SECONDS] [NAME...]    SECONDS per target (default 25), NAME: las, ply... (default all)
+#   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
+#                           found, so a later run starts from there.
+#   POINTRAST_DATA_DIR      the shared test data (default ../shared/data beside the checkout)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-25}"
+shift || true
+build="${POINTRAST_FUZZ_BUILD:-build-fuzz}"
+data="${POINTRAST_DATA_DIR:-$PWD/../shared/data}"
+
+names=("$@")
+if [ ${#names[@]} -eq 0 ]; then
+  for source in tests/fuzz/*_fuzz.cpp; do
+    name="$(basename "$source" _fuzz.cpp)"
+    names+=("$name")
+  done
+fi
+
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+# -O1 -g without -DNDEBUG: the asserts stay on (a file must never reach one), the stacks stay readable.
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DPOINTRAST_FUZZ=ON -DPOINTRAST_TESTS=OFF "${launcher[@]}" >/dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzz
+
+if [ -z "${ASAN_SYMBOLIZER_PATH:-}" ] && ! command -v llvm-symbolizer >/dev/null; then
+  for s in /usr/lib/llvm-*/bin/llvm-symbolizer; do
+    if [ -x "$s" ]; then export ASAN_SYMBOLIZER_PATH="$s"; fi
+  done
+fi
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
+
+findings="$build/findings/$(date +%Y%m%d-%H%M%S)"
+mkdir -p "$findings" "$build/logs"
+failed=()
+for name in "${names[@]}"; do
+  binary="$build/fuzz/${name}_fuzz"
+  [ -x "$binary" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
+  seeds=()
+  folders="$(sed -n 's|^// Seeds:[[:space:]]*||p' "tests/fuzz/${name}_fuzz.cpp" | head -n 1)"
+  for folder in ${folders:-$name}; do
+    if [ -d "$data/$folder" ]; then seeds+=("$data/$folder"); else echo "fuzz: $name: no seed folder $data/$folder"; fi
+  done
+  if [ -d "tests/fuzz/regressions/$name" ]; then seeds+=("tests/fuzz/regressions/$name"); fi
+  corpus="$build/corpus/$name"
+  log="$build/logs/$name.log"
+  mkdir -p "$corpus"
+  echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
+  if "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -malloc_limit_mb=256 \
+    -print_final_stats=1 -artifact_prefix="$findings/$name-" "$corpus" "${seeds[@]}" >"$log" 2>&1; then
+    # "#123456 DONE cov: 812 ft: 2931 corp: 401/1873Kb ..." and the executions from the final stats.
+    grep -E '^#[0-9]+[[:space:]]+DONE' "$log" | tail -n 1 || true
+    grep -E '^stat::(number_of_executed_units|average_exec_per_sec):' "$log" | tr '\n' ' ' || true
+    echo
+  else
+    failed+=("$name")
+    tail -n 80 "$log"
+    for input in "$findings/$name-"*; do
+      [ -e "$input" ] && echo "fuzz: $name: finding kept in $input; replay: $binary $input"
+    done
+  fi
+done
+
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "fuzz: findings in ${failed[*]} (logs in $build/logs)" >&2
+  exit 1
+fi
+echo "fuzz: ${#names[@]} targets, no findings"
