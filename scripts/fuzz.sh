@@ -2,15 +2,17 @@
 # Builds the libFuzzer targets (tests/fuzz/NAME_fuzz.cpp) in their own tree with clang, ASan and UBSan,
 # and runs each for a bounded time, one after another. A target is seeded from the shared test data (the
 # folders its "// Seeds:" line names, else the folder NAME) and from its regression inputs
-# (tests/fuzz/regressions/NAME/). Exits 1 if any target finds a crash, a leak, undefined behaviour, an
-# input that takes over 10 s, or an allocation over 256 MiB (an input is at most 64 KiB: a reader
-# allocating that much trusts a count it should have checked); the input that did it is kept under
-# BUILD/findings/DATE-TIME/ and the command that replays it is printed.
+# (tests/fuzz/regressions/NAME/), with the dictionary tests/fuzz/NAME.dict where there is one. Exits 1
+# if any target finds a crash, a leak, undefined behaviour, an input that takes over 10 s, or an
+# allocation over 256 MiB (an input is at most 64 KiB: a reader allocating that much trusts a count it
+# should have checked); the input that did it is kept under BUILD/findings/DATE-TIME/ and the command
+# that replays it is printed.
 #
 #   scripts/fuzz.sh [SECONDS] [NAME...]    SECONDS per target (default 25), NAME: las, ply... (default all)
 #   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
 #                           found, so a later run starts from there.
 #   POINTRAST_DATA_DIR      the shared test data (default ../shared/data beside the checkout)
+#   POINTRAST_FUZZ_FLAGS    more libFuzzer flags, e.g. "-use_value_profile=1" for long runs
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-25}"
@@ -53,12 +55,15 @@ for name in "${names[@]}"; do
     if [ -d "$data/$folder" ]; then seeds+=("$data/$folder"); else echo "fuzz: $name: no seed folder $data/$folder"; fi
   done
   if [ -d "tests/fuzz/regressions/$name" ]; then seeds+=("tests/fuzz/regressions/$name"); fi
+  dict=()
+  if [ -f "tests/fuzz/$name.dict" ]; then dict=(-dict="tests/fuzz/$name.dict"); fi
   corpus="$build/corpus/$name"
   log="$build/logs/$name.log"
   mkdir -p "$corpus"
   echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
   if "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -malloc_limit_mb=256 \
-    -print_final_stats=1 -artifact_prefix="$findings/$name-" "$corpus" "${seeds[@]}" >"$log" 2>&1; then
+    -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" \
+    >"$log" 2>&1; then
     # "#123456 DONE cov: 812 ft: 2931 corp: 401/1873Kb ..." and the executions from the final stats.
     grep -E '^#[0-9]+[[:space:]]+DONE' "$log" | tail -n 1 || true
     grep -E '^stat::(number_of_executed_units|average_exec_per_sec):' "$log" | tr '\n' ' ' || true
