@@ -254,7 +254,9 @@ struct MortonKey {
     const double cellsPerUnit = cube > 0 ? double(1 << 21) / cube : 0.0;
     for (int a = 0; a < 3; ++a) {
       ref[a] = s[a] >= 0 ? box.min[a] : box.max[a];
-      mul[a] = s[a] * cellsPerUnit; // with a negative scale, (q - max) * negative >= 0
+      // With a negative scale, (q - max) * negative >= 0. A subnormal cube (a file's subnormal scale)
+      // makes cellsPerUnit infinite and (q - ref) * mul NaN at the corner: then divide by the cube first.
+      mul[a] = std::isfinite(cellsPerUnit) ? s[a] * cellsPerUnit : s[a] / cube * double(1 << 21);
     }
   }
   uint64_t operator()(uint64_t i) const {

@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 
+#include "fuzz/prepare_steps.h"
 #include "io/formats.h"
 #include "io/io_test_util.h"
 #include "io/particles_io.h"
@@ -32,6 +33,7 @@ const std::map<std::string, std::vector<std::function<void(const fs::path&)>>> k
         io::scanMmpld(p, options);
       },
       [](const fs::path& p) { io::probeMmpld(p); }}},
+    {"prepare", {[](const fs::path& p) { fuzz::prepareLikeRender(io::readLas(p, iotest::quiet())); }}},
 };
 
 } // namespace
