@@ -25,6 +25,7 @@
 #include "commands.h"
 #include "gpu/context.h"
 #include "input.h"
+#include "io/format_table.h"
 #include "render/spheres/sphere_renderer.h"
 
 namespace pointrast::app {
@@ -311,10 +312,7 @@ int runBench(const BenchArgs& a) {
                      "spheres2023");
 
   bench::BenchConfig config;
-  std::vector<Method> allMethods;
-  for (const MethodInfo& m : methodTable())
-    allMethods.push_back(m.method);
-  config.methods = parseList(a.methods, "--methods", allMethods, parseMethod);
+  config.methods = parseList(a.methods, "--methods", allMethods(), parseMethod);
   config.orders = parseList(a.orders, "--orders", kAllOrders, parseOrder);
   std::vector<bench::View> allViews(bench::allViews().begin(), bench::allViews().end());
   config.views = parseList(a.views, "--views", allViews, bench::parseView);
@@ -434,7 +432,8 @@ Command addBench(CLI::App& app) {
       "  pointrast bench --suite spheres2023 --scale 0.0001 --cameras 2 --frames 1 --out /tmp/smoke\n"
       "  pointrast bench --suite spheres2023 --methods sphere-compute,sphere-points --orbits long");
   cmd->add_option("INPUT", a->inputs,
-                  "LAS/PLY/XYZ files or scene names (terrain, tls); with --suite, NAME=PATH");
+                  "Point cloud files (" + io::formatList(io::FormatUse::Cloud) +
+                      ") or scene names (terrain, tls); with --suite, NAME=PATH");
   cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022 or spheres2023");
   cmd->add_option("--scale", a->scale, "Multiply every size of the suite (e.g. 0.001 for a smoke run)")
       ->each([a](const std::string&) { a->scaleGiven = true; });

@@ -10,6 +10,8 @@
 #include "base/progress.h"
 #include "commands.h"
 #include "input.h"
+#include "io/format_table.h"
+#include "io/potree.h"
 #include "io/writer.h"
 
 namespace pointrast::app {
@@ -21,6 +23,29 @@ struct ConvertArgs {
   uint64_t seed = 1;
   bool quiet = false;
 };
+
+// Whether an octree's classes or return numbers (by metadata.json's ranges) need LAS 1.4's point format 7
+// to be exported exactly (formats 0-5 hold classes up to 31 and return numbers up to 7).
+bool needsExtendedFormat(const io::PotreeFolderInfo& folder) {
+  for (const io::PotreeAttributeInfo& a : folder.attributes) {
+    const double max = a.max.empty() ? 0 : a.max[0];
+    if ((a.name == "classification" && max > 31) || (a.name == "return number" && max > 7)) return true;
+  }
+  return false;
+}
+
+// An octree in its own order: streamed node by node, every integer, scale/offset and 16-bit color as the
+// octree stores it.
+int convertOctree(const ConvertArgs& a) {
+  const io::PotreeFolderInfo folder = io::probePotree(a.input);
+  std::unique_ptr<lod::NodeSource> source = io::openPotree(a.input);
+  io::LasFlavor flavor = lasFlavorFor(a.output, source->metadata().pointCount);
+  if (a.lasVersion == "1.4" || (a.lasVersion == "auto" && needsExtendedFormat(folder)))
+    flavor = io::LasFlavor::Las14Pf7;
+  const uint64_t points = io::writeLasFromOctree(a.output, *source, flavor, !a.quiet);
+  if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(points)).c_str());
+  return 0;
+}
 
 } // namespace
 
@@ -38,9 +63,14 @@ Command addConvert(CLI::App& app) {
       "\nOrders (the 2021 paper's vertex orders): original, morton (Z-order over the cubic bounds, 21 bits\n"
       "per axis), shuffled (random permutation), shuffled-morton (Morton, then runs of 128 points\n"
       "shuffled as wholes). Output: LAS 1.2 point format 3, or 1.4 format 7 with --las 1.4 or when\n"
-      "the cloud has more than 4,294,967,295 points.\n\n"
-      "Example:\n  pointrast convert scan.ply scan_morton.las --order morton");
-  cmd->add_option("IN", a->input, "LAS/PLY/XYZ file")->required();
+      "the cloud has more than 4,294,967,295 points.\n"
+      "A Potree 2.0 octree (its folder or metadata.json) is exported exactly: its integers, scale/offset\n"
+      "and 16-bit colors, node after node (LAS 1.4 format 7 when its classes or return numbers need it).\n\n"
+      "Examples:\n  pointrast convert scan.ply scan_morton.las --order morton\n"
+      "  pointrast convert octree/ all.las");
+  cmd->add_option("IN", a->input,
+                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + ") or Potree 2.0 octree folder")
+      ->required();
   cmd->add_option("OUT", a->output, "LAS file to write")->required();
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the shuffled orders")->capture_default_str();
@@ -51,7 +81,9 @@ Command addConvert(CLI::App& app) {
     if (a->lasVersion != "auto" && a->lasVersion != "1.2" && a->lasVersion != "1.4")
       throw InputError("--las expects auto, 1.2 or 1.4");
     lasFlavorFor(a->output, 0);
-    if (!pathExists(a->input)) throw InputError(a->input + ": no such file");
+    if (!pathExists(a->input)) throw InputError(a->input + ": no such file or folder");
+    const io::FormatInfo* format = io::detectFormat(a->input);
+    if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
     InputSpec spec;
     spec.source = a->input;
     spec.order = parseOrder(a->order);

@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "gpu/context.h"
 #include "input.h"
+#include "io/format_table.h"
 #include "io/particles_io.h"
 #include "io/reader.h"
 
@@ -55,7 +56,7 @@ std::string rgba(uint32_t c) {
 
 // MMPLD: the headers of the file and of one frame, then what only a pass over the particles can tell
 // (how many are usable, the bounds of their centers, the radius range).
-int mmpldInfo(const InfoArgs& a) {
+int mmpldInfo(const InfoArgs& a, const io::FormatInfo& format) {
   const io::MmpldInfo info = io::probeMmpld(a.input, a.frame);
   io::MmpldReadOptions options;
   options.frame = a.frame;
@@ -64,7 +65,7 @@ int mmpldInfo(const InfoArgs& a) {
   if (a.json) {
     nlohmann::json j;
     j["file"] = a.input;
-    j["format"] = io::formatName(io::Format::Mmpld);
+    j["format"] = format.name;
     j["version"] = version;
     j["frames"] = info.frames;
     j["frame"] = info.frame;
@@ -152,13 +153,14 @@ int mmpldInfo(const InfoArgs& a) {
 int runInfo(const InfoArgs& a) {
   if (a.devices) return listDevicesCommand(a.json);
   if (a.input.empty()) throw InputError("info needs a FILE (or --devices)");
-  if (!pathExists(a.input)) throw InputError(a.input + ": no such file");
-  if (io::detectFormat(a.input) == io::Format::Mmpld) return mmpldInfo(a);
+  if (!pathExists(a.input)) throw InputError(a.input + ": no such file or folder");
+  const io::FormatInfo* format = io::detectFormat(a.input);
+  if (format && format->content == io::FormatContent::Particles) return mmpldInfo(a, *format);
   io::FileInfo info = io::probeFile(a.input);
   if (a.json) {
     nlohmann::json j;
     j["file"] = a.input;
-    j["format"] = io::formatName(info.format);
+    j["format"] = info.format->name;
     j["detail"] = info.formatDetail;
     j["points"] = info.pointCount;
     if (!info.bounds.empty()) {
@@ -166,7 +168,7 @@ int runInfo(const InfoArgs& a) {
       j["bounds_max"] = {info.bounds.max.x, info.bounds.max.y, info.bounds.max.z};
     }
     j["bounds_from_header"] = info.boundsFromHeader;
-    if (info.format == io::Format::Las) {
+    if (info.scale != glm::dvec3(0)) {
       j["scale"] = {info.scale.x, info.scale.y, info.scale.z};
       j["offset"] = {info.offset.x, info.offset.y, info.offset.z};
     }
@@ -185,7 +187,7 @@ int runInfo(const InfoArgs& a) {
                 info.bounds.min.z, info.bounds.max.x, info.bounds.max.y, info.bounds.max.z,
                 info.boundsFromHeader ? " (header)" : "");
   }
-  if (info.format == io::Format::Las) {
+  if (info.scale != glm::dvec3(0)) {
     std::printf("scale:   %g, %g, %g\n", info.scale.x, info.scale.y, info.scale.z);
     std::printf("offset:  %.6f, %.6f, %.6f\n", info.offset.x, info.offset.y, info.offset.z);
   }
@@ -198,6 +200,24 @@ int runInfo(const InfoArgs& a) {
   return 0;
 }
 
+// "  LAS    .las    point cloud" per row of the format table: what `info`, `render` and `convert` read.
+std::string formatHelp() {
+  std::string help;
+  for (const io::FormatInfo& f : io::formatTable()) {
+    std::string what;
+    if (f.content == io::FormatContent::Particles) what = "particles (spheres)";
+    if (f.read) what = "point cloud";
+    if (f.openPoints) what += ", streamed";
+    if (f.openNodes) what += std::string(what.empty() ? "" : ", ") + "level-of-detail octree";
+    if (what.empty()) what = "recognised, not read (says why)";
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-7s %-22s %s\n", f.name, *f.extensions ? f.extensions : "(folder)",
+                  what.c_str());
+    help += line;
+  }
+  return help;
+}
+
 } // namespace
 
 Command addInfo(CLI::App& app) {
@@ -208,10 +228,16 @@ Command addInfo(CLI::App& app) {
       "\nReads the header (and for LAS the color values, to tell 8-bit from 16-bit color). For MMPLD\n"
       "particle files: the version, frames, each list of one frame (vertex and color type, count,\n"
       "global radius or color, intensity range), then from a pass over its particles how many are\n"
-      "usable, the bounds of their centers and the radius range.\n"
-      "Examples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n"
-      "  pointrast info particles.mmpld --frame 3\n  pointrast info --devices");
-  cmd->add_option("FILE", a->input, "LAS/PLY/XYZ or MMPLD file");
+      "usable, the bounds of their centers and the radius range. For a level-of-detail octree: points,\n"
+      "nodes, depth, spacing, attributes, encoding, bounds and its writer.\n"
+      "\nFormats (recognised by their content; text formats, which have no signature, by extension):\n" +
+      formatHelp() +
+      "\nExamples:\n  pointrast info autzen.las\n  pointrast info autzen.las --json\n"
+      "  pointrast info particles.mmpld --frame 3\n  pointrast info octree/\n  pointrast info --devices");
+  cmd->add_option("FILE", a->input,
+                  "A point cloud (" + io::formatList(io::FormatUse::Cloud) + ") or particle (" +
+                      io::formatList(io::FormatUse::Particles) + ") file, or an octree folder (" +
+                       io::formatList(io::FormatUse::Octree) + ")");
   cmd->add_option("--frame", a->frame, "MMPLD: the frame to describe")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_flag("--devices", a->devices, "List the Vulkan devices (indices for --device)");

@@ -19,9 +19,11 @@
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
 #include "input.h"
+#include "io/format_table.h"
 #include "io/writer.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
+#include "render_path.h"
 
 namespace pointrast::app {
 
@@ -43,6 +45,7 @@ struct RenderArgs {
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
+  PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
 };
 
 // The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
@@ -167,6 +170,14 @@ int runRenderSpheres(const RenderArgs& a) {
 
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
+  // -o is the single image; --path renders a camera path into --video or --frames-dir instead.
+  bool pathMode = !a.path.path.empty();
+  if (!pathMode && (!a.path.video.empty() || !a.path.framesDir.empty()))
+    throw InputError("--video and --frames-dir need --path (a camera path)");
+  if (pathMode == !a.output.empty())
+    throw InputError(pathMode ? "--path replaces -o: give one of them" : "-o is required");
+  if (pathMode && isSphereMethodName(a.method))
+    throw InputError("--path renders the point methods, not " + a.method);
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
   if (!a.billboard.empty() || a.conservative)
     throw InputError("--billboard and --conservative apply to the sphere methods (" + billboardMethodNames() +
@@ -188,14 +199,17 @@ int runRender(const RenderArgs& a) {
   settings.precision = parsePrecision(a.precision);
   const SceneLayout layout = methodInfo(settings.method).layout;
   if (settings.precision != 0 && layout != SceneLayout::Batched)
-    throw InputError("--precision applies to the batch methods (batch, batch-prefetch, batch-hqs)");
+    throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
+                     ")");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.parts == 0) throw InputError("--parts must be at least 1");
-  if (std::filesystem::path(a.output).extension() != ".png")
+  if (!pathMode && std::filesystem::path(a.output).extension() != ".png")
     throw InputError("-o " + a.output + ": the output must be a .png file");
   if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  view::CameraPath cameraPath;
+  if (pathMode) cameraPath = loadPathForRender(a.path, a.width, a.height);
 
   Camera camera;
   bool explicitCamera = !a.eye.empty();
@@ -254,6 +268,9 @@ int runRender(const RenderArgs& a) {
   std::vector<const GpuScene*> drawn;
   for (auto& s : scenes)
     drawn.push_back(s.get());
+  if (pathMode && cameraPath.empty()) cameraPath = view::orbitPath(camera);
+  if (pathMode)
+    return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
   FrameStats stats = renderer.render(drawn, camera, settings);
   std::vector<uint32_t> pixels = renderer.image();
   io::writePng(a.output, a.width, a.height, pixels.data());
@@ -312,9 +329,9 @@ int runRender(const RenderArgs& a) {
 // "  name  description" per point method, from the method table.
 std::string methodList() {
   std::string list;
-  for (const MethodInfo& m : methodTable()) {
-    std::string name = m.name;
-    list += "  " + name + std::string(name.size() < 16 ? 16 - name.size() : 1, ' ') + m.description + "\n";
+  for (Method m : allMethods()) {
+    std::string name = m.name();
+    list += "  " + name + std::string(name.size() < 16 ? 16 - name.size() : 1, ' ') + m.info().help + "\n";
   }
   return list;
 }
@@ -349,6 +366,7 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
       "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
       "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
+      "  pointrast render autzen.las --path path.json --video fly.mp4 --fps 60 --width 3840 --height 2160\n"
       "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
       std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
       sphereMethodList() + "The pipelines that rasterize billboards (" + billboardMethodNames() +
@@ -358,8 +376,10 @@ Command addRender(CLI::App& app) {
       "  pointrast render particles-drops --points 10M --method sphere-compute -o d.png\n"
       "  pointrast render md.mmpld --method sphere-compute --layout soa8 -o md.png --json\n"
       "  pointrast render particles-laser --points 10M --method sphere-strip --billboard camera -o l.png");
-  cmd->add_option("FILE", a->input, "LAS/PLY/XYZ file, or a scene name (terrain, tls)");
-  cmd->add_option("-o,--output", a->output, "PNG to write")->required();
+  cmd->add_option("FILE", a->input,
+                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + "), particle file (" +
+                      io::formatList(io::FormatUse::Particles) + ") or a scene name (terrain, tls)");
+  cmd->add_option("-o,--output", a->output, "PNG to write (required unless --path)");
   cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
   cmd->add_option("--height", a->height, "Image height in pixels")->capture_default_str();
   cmd->add_option("--eye", a->eye, "Camera position x,y,z (default: overview)");
@@ -412,6 +432,7 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");
+  addPathOptions(*cmd, a->path);
   return [a] { return runRender(*a); };
 }
 

@@ -6,6 +6,7 @@
 #include "base/error.h"
 #include "cloud/generate.h"
 #include "cloud/particles_generate.h"
+#include "io/format_table.h"
 #include "io/particles_io.h"
 #include "io/reader.h"
 
@@ -56,7 +57,8 @@ ParticleSet loadParticles(const ParticleInputSpec& spec) {
     return particlesFromCloud(cloud, spec.radius);
   };
   if (pathExists(source)) {
-    if (io::detectFormat(source) != io::Format::Mmpld) {
+    const io::FormatInfo* format = io::detectFormat(source);
+    if (!format || format->content != io::FormatContent::Particles) {
       io::ReadOptions options;
       options.progress = spec.progress;
       return pointsAsSpheres(io::readCloud(source, options));
@@ -94,7 +96,9 @@ ParticleSet loadParticles(const ParticleInputSpec& spec) {
 std::optional<uint64_t> statedParticles(const ParticleInputSpec& spec) {
   const std::string source = spec.source.empty() ? kDemoParticleScene : spec.source;
   if (pathExists(source)) {
-    if (io::detectFormat(source) == io::Format::Mmpld) return io::probeMmpld(source, spec.frame).particles();
+    const io::FormatInfo* format = io::detectFormat(source);
+    if (format && format->content == io::FormatContent::Particles)
+      return io::probeMmpld(source, spec.frame).particles();
     return io::statedPointCount(source);
   }
   if (isParticleSceneName(source)) return spec.source.empty() ? kDemoPoints : spec.particles;

@@ -38,7 +38,7 @@ PointCloud loadInput(const InputSpec& spec);
 std::optional<uint64_t> statedPoints(const InputSpec& spec);
 
 struct ParticleInputSpec {
-  // An MMPLD file; a LAS/PLY/XYZ file or a point scene name (terrain, tls), drawn as spheres of `radius`;
+  // An MMPLD file; a point cloud file or a point scene name (terrain, tls), drawn as spheres of `radius`;
   // or a particle scene name (particles-block, ...). Empty = the particle demo scene.
   std::string source;
   uint32_t frame = 0; // MMPLD: the frame to read

@@ -41,7 +41,7 @@ int runCommand(int argc, char** argv) {
                "shaders (Vulkan 1.3; any GPU, or the CPU through lavapipe).\n\n"
                "Examples:\n"
                "  pointrast render -o demo.png                       # built-in demo scene\n"
-               "  pointrast render cloud.las -o out.png --json       # a LAS/PLY/XYZ file, timing as JSON\n"
+               "  pointrast render cloud.las -o out.png --json       # a point cloud file, timing as JSON\n"
                "  pointrast info cloud.las                           # what a file holds\n"
                "  pointrast generate terrain --points 10M -o t.las   # a synthetic scene as LAS\n"
                "  pointrast convert in.ply out.las --order morton    # reorder and write LAS\n",
@@ -56,6 +56,7 @@ int runCommand(int argc, char** argv) {
   app::Command convert = app::addConvert(app);
   app::Command generate = app::addGenerate(app);
   app::Command bench = app::addBench(app);
+  app::Command view = app::addView(app);
 
   try {
     app.parse(argc, argv);
@@ -78,6 +79,7 @@ int runCommand(int argc, char** argv) {
       if (sub->get_name() == "convert") return convert();
       if (sub->get_name() == "generate") return generate();
       if (sub->get_name() == "bench") return bench();
+      if (sub->get_name() == "view") return view();
     }
     return 1;
   } catch (const InputError& e) {

@@ -29,15 +29,15 @@ class ResultIndex {
 public:
   explicit ResultIndex(const BenchRun& run) {
     for (const Result& r : run.results)
-      map_[{r.dataset, int(r.order), int(r.view), int(r.method)}] = &r;
+      map_[{r.dataset, int(r.order), int(r.view), r.method.index()}] = &r;
   }
   const Result* find(const std::string& dataset, Order order, View view, Method method) const {
-    auto it = map_.find({dataset, int(order), int(view), int(method)});
+    auto it = map_.find({dataset, int(order), int(view), method.index()});
     return it == map_.end() ? nullptr : it->second;
   }
 
 private:
-  std::map<std::tuple<std::string, int, int, int>, const Result*> map_;
+  std::map<std::tuple<std::string, int, int, uint32_t>, const Result*> map_;
 };
 
 std::vector<const DatasetOutcome*> measuredDatasets(const std::vector<DatasetOutcome>& datasets) {
@@ -546,8 +546,9 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
                << methodName(m) << " | " << b.batchesProcessed << " | " << b.batchesRendered << " | "
                << count(b.pointsProcessed) << " | " << share(b.pointsByWords[0]) << " / "
                << share(b.pointsByWords[1]) << " / " << share(b.pointsByWords[2]) << " | "
-               << count(b.pointsRendered) << " | " << (m == Method::BatchHqs ? count(b.pointsBlended) : "-")
-               << " | " << formatMs(r->stats.medianMs) << " |\n";
+               << count(b.pointsRendered) << " | "
+               << (m.info().output == MethodOutput::Blend ? count(b.pointsBlended) : "-") << " | "
+               << formatMs(r->stats.medianMs) << " |\n";
           }
     md << "\n";
   }

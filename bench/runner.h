@@ -109,7 +109,7 @@ struct Result {
   std::string dataset; // Dataset::name
   Order order = Order::Original;
   View view = View::Overview;
-  Method method = Method::AtomicMin;
+  Method method;
   std::string status = "ok"; // "ok", or "unsupported" (reason says why: device feature, memory)
   std::string reason;
   uint64_t points = 0;

@@ -113,13 +113,13 @@ SuiteDefaults suiteDefaults(std::string_view suite) {
   if (suite == "paper2021") {
     // The 2021 family and its hardware baseline: every method that reads the float layout. The batch
     // methods are the 2022 suite's (they can still be asked for with --methods).
-    for (const MethodInfo& m : methodTable())
-      if (m.layout == SceneLayout::Float) d.methods.push_back(m.method);
+    for (Method m : allMethods())
+      if (m.info().layout == SceneLayout::Float) d.methods.push_back(m);
   }
   if (suite == "paper2022") {
     // The paper's comparison: the hardware baseline, its three methods, and the best 2021 methods.
-    d.methods = {Method::HwPoints, Method::Batch, Method::BatchPrefetch,
-                 Method::BatchHqs, Method::Dedup, Method::Hqs};
+    d.methods = {pointMethod("hw-points"), pointMethod("batch"), pointMethod("batch-prefetch"),
+                 pointMethod("batch-hqs"), pointMethod("dedup"), pointMethod("hqs")};
     d.orders = {Order::Morton, Order::Original};
     d.views = {View::Overview, View::Closeup};
     d.width = 2560;

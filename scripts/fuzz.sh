@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (tests/fuzz/NAME_fuzz.cpp) in their own tree with clang, ASan and UBSan,
 # and runs each for a bounded time, one after another. A target is seeded from the shared test data (the
-# folders its "// Seeds:" line names, else the folder NAME) and from its regression inputs
+# folders its "// Seeds:" line names, else the folder NAME; a target that generates its seeds reads the
+# folder to write them to from NAME_FUZZ_SEEDS, e.g. POTREE_FUZZ_SEEDS) and from its regression inputs
 # (tests/fuzz/regressions/NAME/), with the dictionary tests/fuzz/NAME.dict where there is one. Exits 1
 # if any target finds a crash, a leak, undefined behaviour, an input that takes over 10 s, or an
 # allocation over 256 MiB (an input is at most 64 KiB: a reader allocating that much trusts a count it
@@ -50,10 +51,20 @@ for name in "${names[@]}"; do
   binary="$build/fuzz/${name}_fuzz"
   [ -x "$binary" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
   seeds=()
-  folders="$(sed -n 's|^// Seeds:[[:space:]]*||p' "tests/fuzz/${name}_fuzz.cpp" | head -n 1)"
-  for folder in ${folders:-$name}; do
-    if [ -d "$data/$folder" ]; then seeds+=("$data/$folder"); else echo "fuzz: $name: no seed folder $data/$folder"; fi
-  done
+  generator=()
+  # A target that writes its own seeds (valid inputs of a layout no data file has) reads NAME_FUZZ_SEEDS:
+  # it fills that folder when it starts, before the corpus is loaded.
+  variable="$(echo "$name" | tr '[:lower:]' '[:upper:]')_FUZZ_SEEDS"
+  if grep -q "$variable" "tests/fuzz/${name}_fuzz.cpp"; then
+    mkdir -p "$build/seeds/$name"
+    generator=(env "$variable=$build/seeds/$name")
+    seeds+=("$build/seeds/$name")
+  else
+    folders="$(sed -n 's|^// Seeds:[[:space:]]*||p' "tests/fuzz/${name}_fuzz.cpp" | head -n 1)"
+    for folder in ${folders:-$name}; do
+      if [ -d "$data/$folder" ]; then seeds+=("$data/$folder"); else echo "fuzz: $name: no seed folder $data/$folder"; fi
+    done
+  fi
   if [ -d "tests/fuzz/regressions/$name" ]; then seeds+=("tests/fuzz/regressions/$name"); fi
   dict=()
   if [ -f "tests/fuzz/$name.dict" ]; then dict=(-dict="tests/fuzz/$name.dict"); fi
@@ -61,7 +72,7 @@ for name in "${names[@]}"; do
   log="$build/logs/$name.log"
   mkdir -p "$corpus"
   echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
-  if "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -malloc_limit_mb=256 \
+  if "${generator[@]}" "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 -malloc_limit_mb=256 \
     -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" \
     >"$log" 2>&1; then
     # "#123456 DONE cov: 812 ft: 2931 corp: 401/1873Kb ..." and the executions from the final stats.

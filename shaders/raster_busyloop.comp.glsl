@@ -8,13 +8,12 @@
 // the lock finishes its critical section and releases in the same loop iteration, so no lane ever waits
 // on a lock held by a lane of its own subgroup that cannot advance.
 //
-// RELEASE orders the color store before the release on GPUs: 1 = memoryBarrierBuffer() before the
-// exchange, 2 = the lock taken with acquire and released with release semantics (memory scope
-// semantics), 0 = nothing. On lavapipe (Mesa 22.3) the barrier appears to park the invocation until the
-// other subgroups of its workgroup reach one; a lane spinning on its lock never does, lavapipe's loop
-// limiter ends the spin and the point is lost (pixels were left locked). CPU devices need no ordering
-// there: x86 keeps the store before the sequentially consistent atomic that releases. So it is 0 on CPU
-// devices.
+// RELEASE orders the color store before the release on GPUs: 1 = the lock taken with acquire and
+// released with release semantics (memory scope semantics), 0 = nothing. On lavapipe (Mesa 22.3) a buffer
+// memory barrier appeared to park the invocation until the other subgroups of its workgroup reached one; a
+// lane spinning on its lock never does, lavapipe's loop limiter ended the spin and the point was lost
+// (pixels were left locked). CPU devices need no ordering there: x86 keeps the store before the
+// sequentially consistent atomic that releases. So it is 0 on CPU devices.
 #extension GL_KHR_memory_scope_semantics : require
 #include "common.inc.glsl"
 #include "grid.inc.glsl"
@@ -45,7 +44,7 @@ void main() {
     if (depthBits > oldDepth) {
       done = true; // early-z: farther than what is (or is being) stored
     } else if ((old & kPixelLockBit) == 0u) {
-      uint seen = RELEASE == 2 ? atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit, gl_ScopeDevice,
+      uint seen = RELEASE == 1 ? atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit, gl_ScopeDevice,
                                                 gl_StorageSemanticsBuffer, gl_SemanticsAcquire,
                                                 gl_StorageSemanticsBuffer, gl_SemanticsRelaxed)
                                : atomicCompSwap(depth.v[pixel], old, old | kPixelLockBit);
@@ -54,8 +53,7 @@ void main() {
         bool closer = depthBits < oldDepth || color < colors.v[pixel];
         if (closer) colors.v[pixel] = color;
         uint released = closer ? depthBits : oldDepth;
-        if (RELEASE == 1) memoryBarrierBuffer();
-        if (RELEASE == 2)
+        if (RELEASE == 1)
           atomicExchange(depth.v[pixel], released, gl_ScopeDevice, gl_StorageSemanticsBuffer, gl_SemanticsRelease);
         else
           atomicExchange(depth.v[pixel], released);

@@ -285,6 +285,30 @@ struct SphereRtPush {
   uint pad;
 };
 
+// Push constants of the viewer's present pass (shaders/view_present.*.glsl): one full-screen triangle
+// whose fragments copy the renderer's RGBA8 image into the swapchain image, pixel for pixel where the
+// sizes agree (nearest pixel otherwise, for the frames between a resize and the next render).
+struct PresentPush {
+  uint64_t image;     // uint[imageWidth * imageHeight], RGBA8, row 0 = top
+  uint imageWidth;
+  uint imageHeight;
+  uint targetWidth;   // the swapchain image's size
+  uint targetHeight;
+};
+
+// Push constants of the viewer's panel (Dear ImGui draw lists, shaders/view_panel.*.glsl): one draw per
+// ImDrawCmd, vertices pulled from the list's buffers by device address.
+struct PanelPush {
+  uint64_t vertices;  // ImDrawVert[]: vec2 position, vec2 uv, RGBA8 color (20 B)
+  uint64_t indices;   // 16-bit indices, two to a uint
+  uint64_t font;      // the font atlas, one byte of coverage a texel, four texels to a uint
+  uint firstIndex;    // of this draw in `indices`
+  uint vertexOffset;  // added to every index
+  uint fontWidth;
+  uint fontHeight;
+  float scaleX, scaleY; // pixels -> normalized device coordinates
+};
+
 PR_NAMESPACE_END
 
 #endif

@@ -59,9 +59,13 @@ void Progress::draw(bool final) {
   double secs = seconds();
   double pct = total_ ? 100.0 * done / static_cast<double>(total_) : 100.0;
   double rate = secs > 0 ? done / secs : 0;
-  if (tty_)
+  if (tty_) {
     std::fprintf(stderr, "\r\033[K%s: %5.1f%%  %s%s  %s%s/s", label_.c_str(), pct, humanCount(done).c_str(),
                  unit_.c_str(), humanCount(rate).c_str(), unit_.c_str());
+    // The time left at the rate so far, once there is a rate to go by.
+    if (!final && total_ && rate > 0 && done < double(total_))
+      std::fprintf(stderr, "  ETA %.0f s", (double(total_) - done) / rate);
+  }
   if (final) {
     if (tty_) std::fprintf(stderr, "\r\033[K");
     std::fprintf(stderr, "%s: %s%s in %.2f s (%s%s/s)\n", label_.c_str(), humanCount(done).c_str(),

@@ -51,6 +51,18 @@ inline uint64_t spreadBits3(uint32_t v) {
   return x;
 }
 
+// The inverse of spreadBits3: gathers bits 0, 3, 6, ... of x into its low 21 bits, the same masks in
+// reverse order.
+inline uint32_t compactBits3(uint64_t x) {
+  x &= 0x1249249249249249ull;
+  x = (x | x >> 2) & 0x10c30c30c30c30c3ull;
+  x = (x | x >> 4) & 0x100f00f00f00f00full;
+  x = (x | x >> 8) & 0x1f0000ff0000ffull;
+  x = (x | x >> 16) & 0x1f00000000ffffull;
+  x = (x | x >> 32) & 0x1fffffull;
+  return static_cast<uint32_t>(x);
+}
+
 // ---- parallel sample sort of indices by (key(i), i) --------------------------------------------------
 
 struct KeyIndex {
@@ -296,6 +308,12 @@ uint64_t mortonCode(uint32_t x, uint32_t y, uint32_t z) {
   // bit:  ... 8  7  6  5  4  3  2  1  0
   //       ... z2 y2 x2 z1 y1 x1 z0 y0 x0
   return spreadBits3(x) | spreadBits3(y) << 1 | spreadBits3(z) << 2;
+}
+
+void mortonDecode(uint64_t code, uint32_t& x, uint32_t& y, uint32_t& z) {
+  x = compactBits3(code);
+  y = compactBits3(code >> 1);
+  z = compactBits3(code >> 2);
 }
 
 void computeOrder(std::vector<uint64_t>& order, const PointCloud& cloud, Order kind, uint64_t seed) {

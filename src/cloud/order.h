@@ -28,6 +28,8 @@ const char* orderName(Order order);
 // 63-bit Morton code of a point given as 21-bit integer cell coordinates:
 // bit 3k = x bit k, bit 3k+1 = y bit k, bit 3k+2 = z bit k.
 uint64_t mortonCode(uint32_t x, uint32_t y, uint32_t z);
+// The inverse: the 21-bit coordinates of a 63-bit Morton code (bit 63 ignored).
+void mortonDecode(uint64_t code, uint32_t& x, uint32_t& y, uint32_t& z);
 
 // Fills order[0..count) with the permutation that puts the cloud's points into `order`; order[i] is the
 // index in the current cloud of the point that goes to position i. Deterministic for a given seed, and

@@ -6,12 +6,17 @@ namespace pointrast {
 
 void appendRecords(PointCloud& cloud, const PointRecord* records, size_t count, const RecordFields& fields,
                    int colorShift) {
-  const size_t first = cloud.size();
+  const uint64_t first = cloud.size();
   cloud.positions.resize(3 * (first + count));
   if (fields.color) cloud.colors.resize(first + count);
   if (fields.intensity) cloud.intensity.resize(first + count);
   if (fields.classification) cloud.classification.resize(first + count);
   if (fields.returnNumber) cloud.returnNumber.resize(first + count);
+  storeRecords(cloud, first, records, count, fields, colorShift);
+}
+
+void storeRecords(PointCloud& cloud, uint64_t first, const PointRecord* records, size_t count,
+                  const RecordFields& fields, int colorShift) {
   for (size_t i = 0; i < count; ++i) {
     const PointRecord& r = records[i];
     int32_t* p = &cloud.positions[3 * (first + i)];

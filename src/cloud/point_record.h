@@ -52,5 +52,9 @@ namespace pointrast {
 // carry are left alone (they must be empty, or the caller keeps them the same length).
 void appendRecords(PointCloud& cloud, const PointRecord* records, size_t count, const RecordFields& fields,
                    int colorShift);
+// The same into points [first, first + count) of a cloud whose arrays the caller has already sized for
+// the fields, so that several threads can fill disjoint ranges at once.
+void storeRecords(PointCloud& cloud, uint64_t first, const PointRecord* records, size_t count,
+                  const RecordFields& fields, int colorShift);
 
 } // namespace pointrast

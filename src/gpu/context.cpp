@@ -80,7 +80,7 @@ struct Instance {
   bool debugUtils = false;
 };
 
-Instance createInstance(bool validation) {
+Instance createInstance(bool validation, const std::vector<std::string>& surfaceExtensions = {}) {
   loadVulkanLoader();
   uint32_t version = 0;
   VK_CHECK(vkEnumerateInstanceVersion(&version));
@@ -96,6 +96,13 @@ Instance createInstance(bool validation) {
   for (const auto& e : available)
     if (std::strcmp(e.extensionName, VK_EXT_DEBUG_UTILS_EXTENSION_NAME) == 0) result.debugUtils = true;
   if (result.debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  for (const std::string& wanted : surfaceExtensions) {
+    bool found = std::any_of(available.begin(), available.end(),
+                             [&](const VkExtensionProperties& e) { return wanted == e.extensionName; });
+    if (!found)
+      throw UnsupportedError("the Vulkan loader lacks " + wanted + ", which showing a window needs");
+    extensions.push_back(wanted.c_str());
+  }
 
   std::vector<const char*> layers;
   if (validation) {
@@ -127,6 +134,7 @@ Instance createInstance(bool validation) {
                            "for software rendering, or your GPU vendor's driver");
   VK_CHECK(r);
   loadInstanceFunctions(result.handle);
+  if (!surfaceExtensions.empty()) loadSurfaceFunctions(result.handle);
   return result;
 }
 
@@ -151,7 +159,8 @@ std::vector<DeviceInfo> listDevices() {
 
 Context::Context(const ContextOptions& options) {
   validation_ = options.validation.value_or(envFlag("POINTRAST_VALIDATION"));
-  Instance instance = createInstance(validation_);
+  presenting_ = !options.surfaceExtensions.empty();
+  Instance instance = createInstance(validation_, options.surfaceExtensions);
   instance_ = instance.handle;
   debugUtils_ = instance.debugUtils && vkCreateDebugUtilsMessengerEXT && vkSetDebugUtilsObjectNameEXT;
   try {
@@ -411,6 +420,11 @@ void Context::createDevice() {
     rayTracingProperties_ = {};
     accelerationProperties_ = {};
   }
+  if (presenting_) {
+    if (!hasExtension(VK_KHR_SWAPCHAIN_EXTENSION_NAME))
+      throw UnsupportedError("device '" + info_.name + "' cannot present to a window (no VK_KHR_swapchain)");
+    enabled.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  }
   if (partitioned && hasExtension(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME)) {
     enabled.push_back(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME);
     features_.subgroupPartitionedNV = true;
@@ -424,6 +438,7 @@ void Context::createDevice() {
   VK_CHECK(vkCreateDevice(physical_, &create, nullptr, &device_));
   loadDeviceFunctions(device_);
   loadExtensionDeviceFunctions(device_, features_.meshShader, features_.rayTracing);
+  if (presenting_) loadSwapchainFunctions(device_);
   vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
   VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -445,7 +460,8 @@ void Context::setName(VkObjectType type, uint64_t handle, const std::string& nam
   VK_CHECK(vkSetDebugUtilsObjectNameEXT(device_, &info));
 }
 
-void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) {
+void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record,
+                            const Semaphores& semaphores) {
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = commandPool_;
   alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
@@ -468,6 +484,15 @@ void Context::submitAndWait(const std::function<void(VkCommandBuffer)>& record) 
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd;
+  if (semaphores.wait) {
+    submit.waitSemaphoreCount = 1;
+    submit.pWaitSemaphores = &semaphores.wait;
+    submit.pWaitDstStageMask = &semaphores.waitStage;
+  }
+  if (semaphores.signal) {
+    submit.signalSemaphoreCount = 1;
+    submit.pSignalSemaphores = &semaphores.signal;
+  }
   VK_CHECK(vkResetFences(device_, 1, &fence_));
   VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence_));
   // Never hang: work that has not finished after kSubmitTimeoutSeconds is a GPU fault (or a shader that

@@ -7,6 +7,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "gpu/vulkan_api.h"
 
@@ -20,6 +21,10 @@ struct ContextOptions {
   std::optional<bool> validation;
   // Print the chosen device (one line on stderr).
   bool announce = true;
+  // Presenting to a window: instance extensions the window system needs (VK_KHR_surface and its platform
+  // extension, as the window library lists them) and VK_KHR_swapchain on the device. UnsupportedError when
+  // the loader or the device lacks them.
+  std::vector<std::string> surfaceExtensions;
 };
 
 struct DeviceInfo {
@@ -87,11 +92,20 @@ public:
   // Nanoseconds per timestamp tick.
   double timestampPeriodNs() const { return properties_.limits.timestampPeriod; }
   bool validationEnabled() const { return validation_; }
+  bool presenting() const { return presenting_; }
   // Errors reported by the validation layer so far (tests assert this is zero).
   uint32_t validationErrors() const { return validationErrors_.load(); }
 
   // Records commands with `record`, submits them and waits for completion.
-  void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
+  void submitAndWait(const std::function<void(VkCommandBuffer)>& record) { submitAndWait(record, {}); }
+  // The same, waiting for and signalling binary semaphores (a swapchain image acquired, rendering done
+  // for presentation); null handles are left out.
+  struct Semaphores {
+    VkSemaphore wait = VK_NULL_HANDLE;
+    VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    VkSemaphore signal = VK_NULL_HANDLE;
+  };
+  void submitAndWait(const std::function<void(VkCommandBuffer)>& record, const Semaphores& semaphores);
 
   // Gives a Vulkan object a name that shows in validation messages and debuggers.
   void setName(VkObjectType type, uint64_t handle, const std::string& name) const;
@@ -125,6 +139,7 @@ private:
   uint64_t deviceLocalBytes_ = 0;
   bool validation_ = false;
   bool debugUtils_ = false;
+  bool presenting_ = false; // VK_KHR_swapchain enabled (ContextOptions::surfaceExtensions)
   std::atomic<uint32_t> validationErrors_{0};
 };
 

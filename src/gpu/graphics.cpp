@@ -12,7 +12,10 @@ namespace pointrast::gpu {
 
 GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShader,
                                  const std::string& fragmentShader, const GraphicsOptions& options)
-    : device_(context.device()), options_(options) {
+    : Pipeline(context.device(),
+               (options.taskShader.empty() ? "" : options.taskShader + " + ") + vertexShader + " + " +
+                   (options.geometryShader.empty() ? "" : options.geometryShader + " + ") + fragmentShader),
+      options_(options) {
   bool geometry = !options.geometryShader.empty();
   bool mesh = options.meshShader;
   assert((!mesh || (!geometry && context.features().meshShader)) && "a mesh pipeline the device cannot make");
@@ -51,130 +54,104 @@ GraphicsProgram::GraphicsProgram(Context& context, const std::string& vertexShad
   Specialization specialization(options.spec);
 
   ShaderModules modules(device_);
-  try {
-    for (const auto& source : sources)
-      modules.add(source.second);
-    layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
+  for (const auto& source : sources)
+    modules.add(source.second);
+  layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
 
-    std::vector<VkPipelineShaderStageCreateInfo> stages(
-        sources.size(), {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO});
-    for (size_t i = 0; i < sources.size(); ++i) {
-      stages[i].stage = sources[i].first;
-      stages[i].module = modules[i];
-      stages[i].pName = "main";
-      stages[i].pSpecializationInfo = specialization.info();
-    }
-
-    VkPipelineVertexInputStateCreateInfo vertexInput{
-        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    VkPipelineInputAssemblyStateCreateInfo assembly{
-        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    assembly.topology = options.topology;
-    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    viewport.viewportCount = 1;
-    viewport.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    raster.polygonMode = VK_POLYGON_MODE_FILL;
-    raster.cullMode = VK_CULL_MODE_NONE;
-    raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    raster.lineWidth = 1.0f;
-    VkPipelineRasterizationConservativeStateCreateInfoEXT conservative{
-        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_CONSERVATIVE_STATE_CREATE_INFO_EXT};
-    conservative.conservativeRasterizationMode = VK_CONSERVATIVE_RASTERIZATION_MODE_OVERESTIMATE_EXT;
-    conservative.extraPrimitiveOverestimationSize = 0.0f; // the device's own overestimation suffices
-    if (options.conservative) {
-      assert(context.features().conservativeRasterization &&
-             (context.features().conservativePoints || geometry ||
-              options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST) &&
-             "conservative rasterization the device does not support");
-      raster.pNext = &conservative;
-    }
-    VkPipelineMultisampleStateCreateInfo multisample{
-        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-    VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-    depth.depthTestEnable = VK_TRUE;
-    depth.depthWriteEnable = VK_TRUE;
-    depth.depthCompareOp = options.depthCompare;
-    VkFormat colorFormats[2] = {options.colorFormat, options.secondColorFormat};
-    uint32_t colorCount = options.secondColorFormat == VK_FORMAT_UNDEFINED ? 1 : 2;
-    VkPipelineColorBlendAttachmentState blendAttachments[2] = {};
-    for (VkPipelineColorBlendAttachmentState& b : blendAttachments)
-      b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
-                         VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = colorCount;
-    blend.pAttachments = blendAttachments;
-    VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = 2;
-    dynamic.pDynamicStates = dynamicStates;
-    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    rendering.colorAttachmentCount = colorCount;
-    rendering.pColorAttachmentFormats = colorFormats;
-    rendering.depthAttachmentFormat = options.depthFormat;
-
-    VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &rendering};
-    info.stageCount = uint32_t(stages.size());
-    info.pStages = stages.data();
-    info.pVertexInputState = mesh ? nullptr : &vertexInput; // ignored with a mesh shader: none given
-    info.pInputAssemblyState = mesh ? nullptr : &assembly;
-    info.pViewportState = &viewport;
-    info.pRasterizationState = &raster;
-    info.pMultisampleState = &multisample;
-    info.pDepthStencilState = &depth;
-    info.pColorBlendState = &blend;
-    info.pDynamicState = &dynamic;
-    info.layout = layout_;
-    VK_CHECK(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
-    context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_),
-                    (options.taskShader.empty() ? "" : options.taskShader + " + ") + vertexShader + " + " +
-                        (geometry ? options.geometryShader + " + " : "") + fragmentShader);
-  } catch (...) {
-    release();
-    throw;
+  std::vector<VkPipelineShaderStageCreateInfo> stages(sources.size(),
+                                                      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO});
+  for (size_t i = 0; i < sources.size(); ++i) {
+    stages[i].stage = sources[i].first;
+    stages[i].module = modules[i];
+    stages[i].pName = "main";
+    stages[i].pSpecializationInfo = specialization.info();
   }
-}
 
-GraphicsProgram::~GraphicsProgram() {
-  release();
-}
-
-void GraphicsProgram::release() {
-  destroyPipeline(device_, pipeline_, layout_);
-}
-
-GraphicsProgram::GraphicsProgram(GraphicsProgram&& other) noexcept {
-  *this = std::move(other);
-}
-
-GraphicsProgram& GraphicsProgram::operator=(GraphicsProgram&& other) noexcept {
-  if (this != &other) {
-    release();
-    device_ = other.device_;
-    layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
-    pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
-    pushConstantSize_ = other.pushConstantSize_;
-    pushStages_ = other.pushStages_;
-    options_ = other.options_;
+  VkPipelineVertexInputStateCreateInfo vertexInput{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  VkPipelineInputAssemblyStateCreateInfo assembly{
+      VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  assembly.topology = options.topology;
+  VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  viewport.viewportCount = 1;
+  viewport.scissorCount = 1;
+  VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  raster.polygonMode = VK_POLYGON_MODE_FILL;
+  raster.cullMode = VK_CULL_MODE_NONE;
+  raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  raster.lineWidth = 1.0f;
+  VkPipelineRasterizationConservativeStateCreateInfoEXT conservative{
+      VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_CONSERVATIVE_STATE_CREATE_INFO_EXT};
+  conservative.conservativeRasterizationMode = VK_CONSERVATIVE_RASTERIZATION_MODE_OVERESTIMATE_EXT;
+  conservative.extraPrimitiveOverestimationSize = 0.0f; // the device's own overestimation suffices
+  if (options.conservative) {
+    assert(context.features().conservativeRasterization &&
+           (context.features().conservativePoints || geometry ||
+            options.topology != VK_PRIMITIVE_TOPOLOGY_POINT_LIST) &&
+           "conservative rasterization the device does not support");
+    raster.pNext = &conservative;
   }
-  return *this;
+  VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  depth.depthTestEnable = options.depthFormat != VK_FORMAT_UNDEFINED;
+  depth.depthWriteEnable = depth.depthTestEnable;
+  depth.depthCompareOp = options.depthCompare;
+  VkFormat colorFormats[2] = {options.colorFormat, options.secondColorFormat};
+  uint32_t colorCount = options.secondColorFormat == VK_FORMAT_UNDEFINED ? 1 : 2;
+  VkPipelineColorBlendAttachmentState blendAttachments[2] = {};
+  for (VkPipelineColorBlendAttachmentState& b : blendAttachments)
+    b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                       VK_COLOR_COMPONENT_A_BIT;
+  if (options.blend) {
+    VkPipelineColorBlendAttachmentState& b = blendAttachments[0];
+    b.blendEnable = VK_TRUE;
+    b.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+    b.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.colorBlendOp = VK_BLEND_OP_ADD;
+    b.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.alphaBlendOp = VK_BLEND_OP_ADD;
+  }
+  VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  blend.attachmentCount = colorCount;
+  blend.pAttachments = blendAttachments;
+  VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+  dynamic.dynamicStateCount = 2;
+  dynamic.pDynamicStates = dynamicStates;
+  VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+  rendering.colorAttachmentCount = colorCount;
+  rendering.pColorAttachmentFormats = colorFormats;
+  rendering.depthAttachmentFormat = options.depthFormat;
+
+  VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &rendering};
+  info.stageCount = uint32_t(stages.size());
+  info.pStages = stages.data();
+  info.pVertexInputState = mesh ? nullptr : &vertexInput; // ignored with a mesh shader: none given
+  info.pInputAssemblyState = mesh ? nullptr : &assembly;
+  info.pViewportState = &viewport;
+  info.pRasterizationState = &raster;
+  info.pMultisampleState = &multisample;
+  info.pDepthStencilState = &depth;
+  info.pColorBlendState = &blend;
+  info.pDynamicState = &dynamic;
+  info.layout = layout_;
+  VK_CHECK(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
+  context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_), name_);
 }
 
 void GraphicsProgram::drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_t instanceCount,
                               const void* push, uint32_t size) const {
+  bind(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, push, size);
   if (vertexCount == 0 || instanceCount == 0) return;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-  if (size) vkCmdPushConstants(cmd, layout_, pushStages_, 0, size, push);
   vkCmdDraw(cmd, vertexCount, instanceCount, 0, 0);
 }
 
 void GraphicsProgram::drawMeshTasksRaw(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY,
                                        const void* push, uint32_t size) const {
   assert(options_.meshShader && vkCmdDrawMeshTasksEXT && "drawMeshTasks needs a mesh pipeline");
+  bind(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, push, size);
   if (groupsX == 0 || groupsY == 0) return;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-  if (size) vkCmdPushConstants(cmd, layout_, pushStages_, 0, size, push);
   vkCmdDrawMeshTasksEXT(cmd, groupsX, groupsY, 1);
 }
 

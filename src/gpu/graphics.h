@@ -6,7 +6,7 @@
 // so no render pass objects; viewport and scissor are dynamic state, set with setViewport.
 //
 //   GraphicsProgram points(ctx, "points_hw.vert", "points_hw.frag", {.depthCompare = VK_COMPARE_OP_GREATER});
-//   points.draw(cmd, count, push);  // asserts sizeof(push) == the shaders' push-constant block
+//   points.draw(cmd, count, push);  // checks sizeof(push) == the shaders' push-constant block
 #pragma once
 
 #include <cassert>
@@ -25,7 +25,7 @@ class Context;
 struct GraphicsOptions {
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_POINT_LIST;
   VkFormat colorFormat = VK_FORMAT_R8G8B8A8_UNORM;
-  VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
+  VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;   // UNDEFINED: no depth attachment, no depth test
   VkCompareOp depthCompare = VK_COMPARE_OP_LESS; // with depth writes; GREATER for reverse-Z
   // A geometry shader between vertex and fragment shader; empty for none (needs the geometryShader
   // feature, DeviceFeatures::geometryShader).
@@ -38,6 +38,8 @@ struct GraphicsOptions {
   // primitive touches gets a fragment, not only those whose center it covers. Needs
   // DeviceFeatures::conservativeRasterization, and conservativePoints for a point list drawn as points.
   bool conservative = false;
+  // Alpha blending of the (first) color attachment: SRC_ALPHA, ONE_MINUS_SRC_ALPHA (overlays, the panel).
+  bool blend = false;
   // A mesh pipeline (VK_EXT_mesh_shader, DeviceFeatures::meshShader): the first shader named is a mesh
   // shader instead of a vertex shader, preceded by taskShader unless empty (DeviceFeatures::taskShader).
   // No vertex input or input assembly; draw with drawMeshTasks. `topology` then names the list of the
@@ -46,18 +48,12 @@ struct GraphicsOptions {
   std::string taskShader;
 };
 
-class GraphicsProgram {
+class GraphicsProgram : public Pipeline {
 public:
   GraphicsProgram() = default;
   GraphicsProgram(Context& context, const std::string& vertexShader, const std::string& fragmentShader,
                   const GraphicsOptions& options = {});
-  ~GraphicsProgram();
-  GraphicsProgram(GraphicsProgram&& other) noexcept;
-  GraphicsProgram& operator=(GraphicsProgram&& other) noexcept;
-  GraphicsProgram(const GraphicsProgram&) = delete;
-  GraphicsProgram& operator=(const GraphicsProgram&) = delete;
 
-  uint32_t pushConstantSize() const { return pushConstantSize_; }
   const GraphicsOptions& options() const { return options_; }
 
   // Binds the pipeline, pushes the constants and draws vertexCount vertices of each of instanceCount
@@ -65,7 +61,6 @@ public:
   // options() formats.
   template <class Push>
   void draw(VkCommandBuffer cmd, uint32_t vertexCount, const Push& push, uint32_t instanceCount = 1) const {
-    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
     drawRaw(cmd, vertexCount, instanceCount, &push, sizeof(Push));
   }
 
@@ -73,7 +68,6 @@ public:
   // workgroups without a task shader), between vkCmdBeginRendering and vkCmdEndRendering.
   template <class Push>
   void drawMeshTasks(VkCommandBuffer cmd, uint32_t groupsX, uint32_t groupsY, const Push& push) const {
-    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
     drawMeshTasksRaw(cmd, groupsX, groupsY, &push, sizeof(Push));
   }
 
@@ -82,12 +76,6 @@ private:
                         uint32_t size) const;
   void drawRaw(VkCommandBuffer cmd, uint32_t vertexCount, uint32_t instanceCount, const void* push,
                uint32_t size) const;
-  void release();
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  uint32_t pushConstantSize_ = 0;
-  VkShaderStageFlags pushStages_ = 0;
   GraphicsOptions options_;
 };
 

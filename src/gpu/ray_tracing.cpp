@@ -86,7 +86,8 @@ ScratchBuffer::ScratchBuffer(Context& context, uint64_t size) : size_(size) {
 
 RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& shaders,
                                      std::vector<SpecConstant> spec)
-    : device_(context.device()) {
+    : Pipeline(context.device(), shaders.rayGen + " + " + shaders.miss + " + " + shaders.intersection +
+                                     " + " + shaders.closestHit) {
   assert(context.features().rayTracing && vkCreateRayTracingPipelinesKHR);
   // Stage order = the indices the shader groups name.
   enum { kRayGen, kMiss, kIntersection, kClosestHit, kStages };
@@ -115,114 +116,77 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingShaders& 
                            std::to_string(limits.maxShaderGroupStride) + ") is below its handle size");
 
   ShaderModules modules(device_);
-  try {
-    for (const auto& source : sources)
-      modules.add(findShader(*source.second));
-    layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
+  for (const auto& source : sources)
+    modules.add(findShader(*source.second));
+  layout_ = createPipelineLayout(device_, pushStages_, pushConstantSize_);
 
-    VkPipelineShaderStageCreateInfo stages[kStages];
-    for (uint32_t i = 0; i < kStages; ++i) {
-      stages[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-      stages[i].stage = sources[i].first;
-      stages[i].module = modules[i];
-      stages[i].pName = "main";
-      stages[i].pSpecializationInfo = specialization.info();
-    }
-    // Groups (the order of their handles in the table): ray generation, miss, one procedural hit group.
-    VkRayTracingShaderGroupCreateInfoKHR groups[3];
-    for (VkRayTracingShaderGroupCreateInfoKHR& g : groups) {
-      g = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
-      g.generalShader = g.closestHitShader = g.anyHitShader = g.intersectionShader = VK_SHADER_UNUSED_KHR;
-    }
-    groups[0].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
-    groups[0].generalShader = kRayGen;
-    groups[1].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
-    groups[1].generalShader = kMiss;
-    groups[2].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_PROCEDURAL_HIT_GROUP_KHR;
-    groups[2].intersectionShader = kIntersection;
-    groups[2].closestHitShader = kClosestHit;
-    VkRayTracingPipelineCreateInfoKHR info{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
-    info.stageCount = kStages;
-    info.pStages = stages;
-    info.groupCount = 3;
-    info.pGroups = groups;
-    info.maxPipelineRayRecursionDepth = 1; // rays are traced from the ray generation shader only
-    info.layout = layout_;
-    VK_CHECK(vkCreateRayTracingPipelinesKHR(device_, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &info, nullptr,
-                                            &pipeline_));
-    context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_),
-                    shaders.rayGen + " + " + shaders.miss + " + " + shaders.intersection + " + " +
-                        shaders.closestHit);
-
-    // The table: handles copied to their records, in device-local memory whose start is aligned to
-    // shaderGroupBaseAlignment (a buffer's address need not be, so it is allocated that much larger).
-    uint32_t handleSize = limits.shaderGroupHandleSize;
-    std::vector<uint8_t> handles(3 * size_t(handleSize));
-    VK_CHECK(vkGetRayTracingShaderGroupHandlesKHR(device_, pipeline_, 0, 3, handles.size(), handles.data()));
-    uint64_t base = std::max<uint64_t>(limits.shaderGroupBaseAlignment, 1);
-    table_ = Buffer(context, table.size + base,
-                    VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
-                        VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                    MemoryKind::Device, "shader binding table");
-    uint64_t start = alignUp(table_.address(), base);
-    uint64_t offset = start - table_.address();
-    Buffer staging(context, table.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::Upload,
-                   "shader binding table staging");
-    auto* bytes = static_cast<uint8_t*>(staging.mapped());
-    std::memset(bytes, 0, table.size);
-    std::memcpy(bytes + table.rayGenOffset, handles.data() + 0 * handleSize, handleSize);
-    std::memcpy(bytes + table.missOffset, handles.data() + 1 * handleSize, handleSize);
-    std::memcpy(bytes + table.hitOffset, handles.data() + 2 * handleSize, handleSize);
-    context.submitAndWait([&](VkCommandBuffer cmd) {
-      VkBufferCopy region{0, offset, table.size};
-      vkCmdCopyBuffer(cmd, staging.handle(), table_.handle(), 1, &region);
-      fullBarrier(cmd); // the copy before any later trace reads the table (the barrier's scope reaches past
-                        // this submission)
-    });
-    rayGen_ = {start + table.rayGenOffset, table.stride, table.rayGenSize};
-    miss_ = {start + table.missOffset, table.stride, table.missSize};
-    hit_ = {start + table.hitOffset, table.stride, table.hitSize};
-    callable_ = {0, 0, 0};
-  } catch (...) {
-    release();
-    throw;
+  VkPipelineShaderStageCreateInfo stages[kStages];
+  for (uint32_t i = 0; i < kStages; ++i) {
+    stages[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stages[i].stage = sources[i].first;
+    stages[i].module = modules[i];
+    stages[i].pName = "main";
+    stages[i].pSpecializationInfo = specialization.info();
   }
-}
-
-RayTracingProgram::~RayTracingProgram() {
-  release();
-}
-
-void RayTracingProgram::release() {
-  destroyPipeline(device_, pipeline_, layout_);
-}
-
-RayTracingProgram::RayTracingProgram(RayTracingProgram&& other) noexcept {
-  *this = std::move(other);
-}
-
-RayTracingProgram& RayTracingProgram::operator=(RayTracingProgram&& other) noexcept {
-  if (this != &other) {
-    release();
-    device_ = other.device_;
-    layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
-    pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
-    pushConstantSize_ = other.pushConstantSize_;
-    pushStages_ = other.pushStages_;
-    table_ = std::move(other.table_);
-    rayGen_ = other.rayGen_;
-    miss_ = other.miss_;
-    hit_ = other.hit_;
-    callable_ = other.callable_;
+  // Groups (the order of their handles in the table): ray generation, miss, one procedural hit group.
+  VkRayTracingShaderGroupCreateInfoKHR groups[3];
+  for (VkRayTracingShaderGroupCreateInfoKHR& g : groups) {
+    g = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
+    g.generalShader = g.closestHitShader = g.anyHitShader = g.intersectionShader = VK_SHADER_UNUSED_KHR;
   }
-  return *this;
+  groups[0].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
+  groups[0].generalShader = kRayGen;
+  groups[1].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
+  groups[1].generalShader = kMiss;
+  groups[2].type = VK_RAY_TRACING_SHADER_GROUP_TYPE_PROCEDURAL_HIT_GROUP_KHR;
+  groups[2].intersectionShader = kIntersection;
+  groups[2].closestHitShader = kClosestHit;
+  VkRayTracingPipelineCreateInfoKHR info{VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR};
+  info.stageCount = kStages;
+  info.pStages = stages;
+  info.groupCount = 3;
+  info.pGroups = groups;
+  info.maxPipelineRayRecursionDepth = 1; // rays are traced from the ray generation shader only
+  info.layout = layout_;
+  VK_CHECK(
+      vkCreateRayTracingPipelinesKHR(device_, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
+  context.setName(VK_OBJECT_TYPE_PIPELINE, uint64_t(pipeline_), name_);
+
+  // The table: handles copied to their records, in device-local memory whose start is aligned to
+  // shaderGroupBaseAlignment (a buffer's address need not be, so it is allocated that much larger).
+  uint32_t handleSize = limits.shaderGroupHandleSize;
+  std::vector<uint8_t> handles(3 * size_t(handleSize));
+  VK_CHECK(vkGetRayTracingShaderGroupHandlesKHR(device_, pipeline_, 0, 3, handles.size(), handles.data()));
+  uint64_t base = std::max<uint64_t>(limits.shaderGroupBaseAlignment, 1);
+  table_ = Buffer(context, table.size + base,
+                  VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                      VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                  MemoryKind::Device, "shader binding table");
+  uint64_t start = alignUp(table_.address(), base);
+  uint64_t offset = start - table_.address();
+  Buffer staging(context, table.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::Upload,
+                 "shader binding table staging");
+  auto* bytes = static_cast<uint8_t*>(staging.mapped());
+  std::memset(bytes, 0, table.size);
+  std::memcpy(bytes + table.rayGenOffset, handles.data() + 0 * handleSize, handleSize);
+  std::memcpy(bytes + table.missOffset, handles.data() + 1 * handleSize, handleSize);
+  std::memcpy(bytes + table.hitOffset, handles.data() + 2 * handleSize, handleSize);
+  context.submitAndWait([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{0, offset, table.size};
+    vkCmdCopyBuffer(cmd, staging.handle(), table_.handle(), 1, &region);
+    fullBarrier(cmd); // the copy before any later trace reads the table (the barrier's scope reaches past
+                      // this submission)
+  });
+  rayGen_ = {start + table.rayGenOffset, table.stride, table.rayGenSize};
+  miss_ = {start + table.missOffset, table.stride, table.missSize};
+  hit_ = {start + table.hitOffset, table.stride, table.hitSize};
+  callable_ = {0, 0, 0};
 }
 
 void RayTracingProgram::traceRaysRaw(VkCommandBuffer cmd, uint32_t width, uint32_t height, const void* push,
                                      uint32_t size) const {
+  bind(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, push, size);
   if (width == 0 || height == 0) return;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline_);
-  if (size) vkCmdPushConstants(cmd, layout_, pushStages_, 0, size, push);
   vkCmdTraceRaysKHR(cmd, &rayGen_, &miss_, &hit_, &callable_, width, height, 1);
 }
 

@@ -6,7 +6,7 @@
 // table is laid out and filled at construction.
 //
 //   RayTracingProgram rt(ctx, {"x.rgen", "x.rmiss", "x.rint", "x.rchit"}, {{/* LAYOUT= */ 0, layout}});
-//   rt.traceRays(cmd, width, height, push); // asserts sizeof(push) == the shaders' push-constant block
+//   rt.traceRays(cmd, width, height, push); // checks sizeof(push) == the shaders' push-constant block
 #pragma once
 
 #include <cassert>
@@ -89,34 +89,20 @@ struct RayTracingShaders {
   std::string closestHit;
 };
 
-class RayTracingProgram {
+class RayTracingProgram : public Pipeline {
 public:
   RayTracingProgram() = default;
   RayTracingProgram(Context& context, const RayTracingShaders& shaders, std::vector<SpecConstant> spec = {});
-  ~RayTracingProgram();
-  RayTracingProgram(RayTracingProgram&& other) noexcept;
-  RayTracingProgram& operator=(RayTracingProgram&& other) noexcept;
-  RayTracingProgram(const RayTracingProgram&) = delete;
-  RayTracingProgram& operator=(const RayTracingProgram&) = delete;
-
-  uint32_t pushConstantSize() const { return pushConstantSize_; }
 
   // Binds the pipeline, pushes the constants and traces width x height rays (one per launch id).
   template <class Push>
   void traceRays(VkCommandBuffer cmd, uint32_t width, uint32_t height, const Push& push) const {
-    assert(sizeof(Push) == pushConstantSize_ && "push-constant struct does not match the shaders");
     traceRaysRaw(cmd, width, height, &push, sizeof(Push));
   }
 
 private:
   void traceRaysRaw(VkCommandBuffer cmd, uint32_t width, uint32_t height, const void* push,
                     uint32_t size) const;
-  void release();
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  uint32_t pushConstantSize_ = 0;
-  VkShaderStageFlags pushStages_ = 0;
   Buffer table_; // the shader binding table, device-local
   VkStridedDeviceAddressRegionKHR rayGen_{}, miss_{}, hit_{}, callable_{};
 };

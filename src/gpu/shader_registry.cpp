@@ -1,18 +1,16 @@
 #include "gpu/shader_registry.h"
 
-#include <cassert>
-#include <cstdio>
-#include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 namespace pointrast::gpu {
 
 std::span<const uint32_t> findShader(std::string_view name) {
   for (const EmbeddedShader& s : embeddedShaders())
     if (s.name == name) return s.words;
-  // A missing embedded shader is a build mistake, never a user error.
-  std::fprintf(stderr, "internal error: shader '%.*s' is not embedded in this build\n", int(name.size()),
-               name.data());
-  std::abort();
+  // A build mistake (a misspelt name in the method table, a shader file not compiled), never a user
+  // error; checked in every build, since benchmarks run Release builds.
+  throw std::logic_error("internal error: shader '" + std::string(name) + "' is not embedded in this build");
 }
 
 } // namespace pointrast::gpu

@@ -14,7 +14,7 @@ struct EmbeddedShader {
 
 std::span<const EmbeddedShader> embeddedShaders();
 
-// Finds a module by name; asserts if it is missing (a build mistake, not a user error).
+// Finds a module by name; throws std::logic_error if it is missing (a build mistake, not a user error).
 std::span<const uint32_t> findShader(std::string_view name);
 
 } // namespace pointrast::gpu

@@ -51,4 +51,8 @@ static_assert(offsetof(SphereAabbPush, count) == 24);
 static_assert(sizeof(SphereRtPush) == 24 && offsetof(SphereRtPush, pieceParticles) == 16);
 static_assert(kSphereTaskSpheres % kSphereTaskGroupSize == 0 && kSphereTaskGroupSize <= 32); // one mask word
 
+static_assert(sizeof(PresentPush) == 24 && offsetof(PresentPush, targetHeight) == 20);
+static_assert(sizeof(PanelPush) == 48 && offsetof(PanelPush, firstIndex) == 24 &&
+              offsetof(PanelPush, scaleY) == 44);
+
 } // namespace pointrast::shared

@@ -15,6 +15,8 @@ PR_VK_DEBUG_FUNCTIONS(PR_VK_DEFINE)
 PR_VK_DEVICE_FUNCTIONS(PR_VK_DEFINE)
 PR_VK_MESH_FUNCTIONS(PR_VK_DEFINE)
 PR_VK_RAY_TRACING_FUNCTIONS(PR_VK_DEFINE)
+PR_VK_SURFACE_FUNCTIONS(PR_VK_DEFINE)
+PR_VK_SWAPCHAIN_FUNCTIONS(PR_VK_DEFINE)
 #undef PR_VK_DEFINE
 
 namespace {
@@ -75,6 +77,28 @@ void loadExtensionDeviceFunctions(VkDevice device, bool meshShader, bool rayTrac
 #undef PR_VK_LOAD
 }
 
+void loadSurfaceFunctions(VkInstance instance) {
+#define PR_VK_LOAD(name)                                                                                     \
+  name = reinterpret_cast<PFN_##name>(getInstanceProcAddr(instance, #name));                                 \
+  if (!name) throw UnsupportedError("the Vulkan loader lacks " #name ", although VK_KHR_surface is "         \
+                                                                     "enabled");
+  PR_VK_SURFACE_FUNCTIONS(PR_VK_LOAD)
+#undef PR_VK_LOAD
+}
+
+void loadSwapchainFunctions(VkDevice device) {
+#define PR_VK_LOAD(name)                                                                                     \
+  name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device, #name));                                   \
+  if (!name)                                                                                                 \
+    throw UnsupportedError("the Vulkan driver lacks " #name ", although VK_KHR_swapchain is enabled");
+  PR_VK_SWAPCHAIN_FUNCTIONS(PR_VK_LOAD)
+#undef PR_VK_LOAD
+}
+
+PFN_vkGetInstanceProcAddr instanceProcAddr() {
+  return getInstanceProcAddr;
+}
+
 namespace {
 std::atomic<bool> gDeviceFaulted{false};
 }
@@ -94,7 +118,8 @@ const char* resultName(VkResult result) {
     PR_CASE(VK_SUCCESS)
     PR_CASE(VK_NOT_READY)
     PR_CASE(VK_TIMEOUT)
-    PR_CASE(VK_INCOMPLETE) PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    PR_CASE(VK_INCOMPLETE)
+    PR_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) PR_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
         PR_CASE(VK_ERROR_INITIALIZATION_FAILED) PR_CASE(VK_ERROR_DEVICE_LOST)
             PR_CASE(VK_ERROR_MEMORY_MAP_FAILED) PR_CASE(VK_ERROR_LAYER_NOT_PRESENT)
                 PR_CASE(VK_ERROR_EXTENSION_NOT_PRESENT) PR_CASE(VK_ERROR_FEATURE_NOT_PRESENT)

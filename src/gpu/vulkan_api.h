@@ -50,6 +50,15 @@
   X(vkGetAccelerationStructureBuildSizesKHR) X(vkGetAccelerationStructureDeviceAddressKHR) \
   X(vkCmdBuildAccelerationStructuresKHR) X(vkCreateRayTracingPipelinesKHR) \
   X(vkGetRayTracingShaderGroupHandlesKHR) X(vkCmdTraceRaysKHR)
+// Presenting to a window (the viewer): VK_KHR_surface on the instance, VK_KHR_swapchain on the device,
+// enabled only when a Context is asked for them (ContextOptions); null otherwise.
+#define PR_VK_SURFACE_FUNCTIONS(X) \
+  X(vkDestroySurfaceKHR) X(vkGetPhysicalDeviceSurfaceSupportKHR) \
+  X(vkGetPhysicalDeviceSurfaceCapabilitiesKHR) X(vkGetPhysicalDeviceSurfaceFormatsKHR) \
+  X(vkGetPhysicalDeviceSurfacePresentModesKHR)
+#define PR_VK_SWAPCHAIN_FUNCTIONS(X) \
+  X(vkCreateSwapchainKHR) X(vkDestroySwapchainKHR) X(vkGetSwapchainImagesKHR) X(vkAcquireNextImageKHR) \
+  X(vkQueuePresentKHR) X(vkCreateSemaphore) X(vkDestroySemaphore)
 // clang-format on
 
 namespace pointrast::gpu {
@@ -61,6 +70,8 @@ PR_VK_DEBUG_FUNCTIONS(PR_VK_DECLARE)
 PR_VK_DEVICE_FUNCTIONS(PR_VK_DECLARE)
 PR_VK_MESH_FUNCTIONS(PR_VK_DECLARE)
 PR_VK_RAY_TRACING_FUNCTIONS(PR_VK_DECLARE)
+PR_VK_SURFACE_FUNCTIONS(PR_VK_DECLARE)
+PR_VK_SWAPCHAIN_FUNCTIONS(PR_VK_DECLARE)
 #undef PR_VK_DECLARE
 
 // Opens libvulkan.so.1 and loads the global functions. Throws UnsupportedError naming the package to
@@ -71,6 +82,12 @@ void loadDeviceFunctions(VkDevice device);
 // The functions of the optional extensions that were enabled on `device`; the others become null (asking
 // for a function of an extension that is not enabled is not allowed).
 void loadExtensionDeviceFunctions(VkDevice device, bool meshShader, bool rayTracing);
+// The surface functions (after an instance with VK_KHR_surface) and the swapchain functions (after a
+// device with VK_KHR_swapchain).
+void loadSurfaceFunctions(VkInstance instance);
+void loadSwapchainFunctions(VkDevice device);
+// vkGetInstanceProcAddr of the loaded libvulkan, for window libraries that create surfaces themselves.
+PFN_vkGetInstanceProcAddr instanceProcAddr();
 
 // A Vulkan call failed: which call, where, and the VkResult's name.
 class VulkanError : public std::runtime_error {

@@ -1,9 +1,10 @@
-// Per-format entry points that are private to src/io/ (reader.cpp dispatches to them).
+// Per-format entry points that are private to src/io/ (the rows of format_table.cpp name them).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "io/reader.h"
 
@@ -12,8 +13,14 @@ namespace pointrast::io::detail {
 FileInfo probeLas(const std::filesystem::path& path);
 FileInfo probePly(const std::filesystem::path& path);
 FileInfo probeXyz(const std::filesystem::path& path);
+FileInfo probePotreeFolder(const std::filesystem::path& path);
 
-// The vertex count of a PLY header where the file's size can hold it (statedPointCount()).
+// "not a LAS, LAZ, ... file (unrecognised content and extension)", naming every row.
+std::string unrecognisedFormatText();
+
+// Header counts (statedPointCount()): LAS's count, checked against the file's size; PLY's vertex
+// count where the file's size can hold it.
+std::optional<uint64_t> statedCountLas(const std::filesystem::path& path);
 std::optional<uint64_t> statedCountPly(const std::filesystem::path& path);
 
 // Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to

@@ -179,6 +179,13 @@ void PartialFile::write(const void* data, size_t n) {
   if (n && std::fwrite(data, 1, n, file_) != n) failWrite(errno ? errno : EIO);
 }
 
+void PartialFile::writeAt(uint64_t offset, const void* data, size_t n) {
+  if (std::fflush(file_) != 0 || ::fseeko(file_, static_cast<off_t>(offset), SEEK_SET) != 0)
+    failWrite(errno ? errno : EIO);
+  write(data, n);
+  if (::fseeko(file_, 0, SEEK_END) != 0) failWrite(errno ? errno : EIO);
+}
+
 void PartialFile::commit() {
   errno = 0;
   int flushed = std::fflush(file_);

@@ -143,6 +143,8 @@ public:
   PartialFile& operator=(const PartialFile&) = delete;
 
   void write(const void* data, size_t n);
+  // Overwrites bytes already written (a header whose counts are known at the end); later writes append.
+  void writeAt(uint64_t offset, const void* data, size_t n);
   void commit();
   const std::filesystem::path& target() const { return target_; }
 

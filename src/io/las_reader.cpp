@@ -208,11 +208,15 @@ uint64_t lasChunkBytes() {
   return gChunkBytes;
 }
 
+std::optional<uint64_t> statedCountLas(const std::filesystem::path& path) {
+  InputFile file(path);
+  return readLasHeader(file).pointCount;
+}
+
 FileInfo probeLas(const std::filesystem::path& path) {
   InputFile file(path);
   const LasHeader hd = readLasHeader(file);
   FileInfo info;
-  info.format = Format::Las;
   uint16_t formatSize = las::kRecordSize[static_cast<size_t>(hd.pointFormat)];
   info.formatDetail = strFormat("LAS %d.%d, point format %d (%u B records", hd.versionMajor, hd.versionMinor,
                                 hd.pointFormat, hd.recordLength);

@@ -690,7 +690,6 @@ FileInfo probePly(const std::filesystem::path& path) {
   InputFile file(path);
   const PlyHeader h = readPlyHeader(file);
   FileInfo info;
-  info.format = Format::Ply;
   info.formatDetail = "PLY " + h.formatLine;
   info.pointCount = h.vertexElement().count;
   info.hasColor = h.hasColor();

@@ -248,7 +248,6 @@ FileInfo probeXyz(const std::filesystem::path& path) {
   InputFile file(path);
   XyzData d = parseXyz(file, nullptr);
   FileInfo info;
-  info.format = Format::Xyz;
   info.formatDetail = strFormat("XYZ text, %d columns (%s)", d.columns, describeColumns(d.columns));
   info.pointCount = d.xyz.size() / 3;
   for (size_t i = 0; i + 2 < d.xyz.size(); i += 3)

@@ -15,12 +15,16 @@ double defaultNear(const Bounds& bounds) {
 }
 
 Camera overviewCamera(const Bounds& bounds, double aspect, double fovY) {
+  return framingCamera(bounds, aspect, fovY, glm::normalize(glm::dvec3(-1, -1, 1)), {0, 0, 1});
+}
+
+Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm::dvec3& back,
+                     const glm::dvec3& up) {
   Camera camera;
   camera.fovY = fovY;
-  camera.up = {0, 0, 1};
+  camera.up = up;
   if (bounds.empty()) return camera;
   glm::dvec3 center = bounds.center();
-  glm::dvec3 back = glm::normalize(glm::dvec3(-1, -1, 1)); // from the target towards the eye
   glm::dvec3 right = glm::normalize(glm::cross(-back, camera.up));
   glm::dvec3 upv = glm::cross(right, -back);
   double tanY = std::tan(glm::radians(fovY) / 2), tanX = tanY * aspect;

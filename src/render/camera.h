@@ -24,6 +24,12 @@ struct Camera {
 // distance at which all eight corners of the bounding box are inside the image, plus 5 %.
 Camera overviewCamera(const Bounds& bounds, double aspect, double fovY = 60.0);
 
+// The same framing from any direction: looking at the center of the bounds along -back (unit vector from
+// the target towards the eye) with the given up (not parallel to back), at the smallest distance that
+// keeps all eight corners in the image, plus 5 %. Views from the axes and "frame all" in the viewer.
+Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm::dvec3& back,
+                     const glm::dvec3& up);
+
 // 1e-5 of the bounds' diagonal (at least 1e-9): far below any visible point, so it only drops points
 // at or behind the eye.
 double defaultNear(const Bounds& bounds);

@@ -40,9 +40,6 @@ class PointMethod {
 public:
   virtual ~PointMethod() = default;
   virtual void recordFrame(const Frame& frame, Targets& targets) = 0;
-  // Whether the method fills targets.words with depth << 32 | color words (every compute method but
-  // HQS, which blends; justset's words are valid words of some point, not the closest).
-  virtual bool hasCanonicalWords() const { return true; }
   // Counts of the last frame, for methods that keep them (the batch methods); read after the frame's
   // submission finished.
   virtual std::optional<BatchStats> readStats() { return std::nullopt; }
@@ -84,11 +81,14 @@ double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera)
 shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint64_t framebuffer,
                                 uint32_t groupSize);
 
-std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, Method method, DepthMode depth);
-std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width,
+// One factory per MethodFamily; each builds its programs from the method's row of the table.
+std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, const MethodInfo& method,
+                                                 DepthMode depth);
+std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width,
                                              uint32_t height);
-std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, uint32_t width, uint32_t height);
-std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, Method method, uint32_t width,
-                                               uint32_t height);
+std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, const MethodInfo& method,
+                                                  uint32_t width, uint32_t height);
+std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, const MethodInfo& method,
+                                               uint32_t width, uint32_t height);
 
 } // namespace pointrast

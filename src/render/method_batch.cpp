@@ -39,13 +39,11 @@ void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frame
 
 class BatchMethod : public PointMethod {
 public:
-  BatchMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
-      : context_(context), hqs_(method == Method::BatchHqs) {
-    // batch: 32-bit loads; batch-prefetch (and batch-hqs's depth pass): one 128-bit load of 4
-    // consecutive points.
-    uint32_t prefetch = method != Method::Batch;
-    raster_ = gpu::ComputeProgram(context, "raster_batch.comp",
-                                  {{/* PREFETCH= */ 0, prefetch}, {/* DEPTH_ONLY= */ 1, uint32_t(hqs_)}});
+  BatchMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
+      : context_(context), hqs_(method.output == MethodOutput::Blend) {
+    // The row's constants: PREFETCH (one 128-bit load of 4 consecutive points) and, for the blending
+    // rows, DEPTH_ONLY (the depth pass before the accumulation).
+    raster_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
     if (hqs_) {
       accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp");
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
@@ -67,7 +65,8 @@ public:
     VkCommandBuffer cmd = frame.cmd;
     const uint64_t pixels = targets.pixels();
     // The frame's constants, written here (before the submission) and copied into device memory at the
-    // start of the frame: 600 bytes, and every workgroup reads them from the GPU's caches.
+    // start of the frame: sizeof(shared::BatchFrame) bytes, which every workgroup reads from the GPU's
+    // caches.
     shared::BatchFrame f{};
     f.framebuffer = targets.framebuffer.address();
     f.stats = stats_.address();
@@ -108,8 +107,6 @@ public:
     gpu::fullBarrier(cmd);
   }
 
-  bool hasCanonicalWords() const override { return !hqs_; }
-
   std::optional<BatchStats> readStats() override {
     uint64_t rows[shared::kBatchStatSlots][shared::kBatchStatCount];
     gpu::readBuffer(context_, stats_, 0, rows, sizeof rows);
@@ -149,8 +146,8 @@ private:
 
 } // namespace
 
-std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, Method method, uint32_t width,
-                                               uint32_t height) {
+std::unique_ptr<PointMethod> createBatchMethod(gpu::Context& context, const MethodInfo& method,
+                                               uint32_t width, uint32_t height) {
   return std::make_unique<BatchMethod>(context, method, width, height);
 }
 

@@ -1,5 +1,6 @@
-// The closest-point methods: atomicmin, earlyz, reduce, reduce-earlyz, dedup (NV and ballot), justset
-// (raster_closest*.comp with specialization constants) and busyloop (its own shader and layout).
+// The closest-point families: one raster shader per point and one resolve. MethodFamily::Closest (atomicmin,
+// earlyz, reduce, dedup, justset... : the row's shader with its specialization constants) and
+// MethodFamily::BusyLoop (the per-pixel lock, which keeps depth and color in two uint arrays).
 #include "base/error.h"
 #include "gpu/context.h"
 #include "render/method.h"
@@ -8,44 +9,33 @@ namespace pointrast {
 
 namespace {
 
+// Resolve LAYOUT (resolve.comp): 64-bit words with float depth, with int40 depth, or busyloop's two
+// uint arrays.
+constexpr uint32_t kResolveFloat = 0, kResolveInt40 = 1, kResolveLockArrays = 2;
+
 class ClosestMethod : public PointMethod {
 public:
-  ClosestMethod(gpu::Context& context, Method method, DepthMode depth) : method_(method), depth_(depth) {
-    bool int40 = depth == DepthMode::Int40;
-    uint32_t earlyZ = method == Method::EarlyZ || method == Method::ReduceEarlyZ || method == Method::Dedup ||
-                      method == Method::DedupBallot;
-    uint32_t reduce = method == Method::Reduce || method == Method::ReduceEarlyZ ? 1
-                      : method == Method::DedupBallot                            ? 2
-                                                                                 : 0;
-    uint32_t justSet = method == Method::JustSet;
-    if (method == Method::BusyLoop) {
+  ClosestMethod(gpu::Context& context, const MethodInfo& method, DepthMode depth)
+      : lockArrays_(method.family == MethodFamily::BusyLoop) {
+    const bool int40 = depth == DepthMode::Int40;
+    if (lockArrays_) {
       // No release ordering on CPU devices: see the shader for why lavapipe needs that.
-      uint32_t release = context.info().software() ? 0u : 2u;
-      raster_ = gpu::ComputeProgram(context, "raster_busyloop.comp", {{/* RELEASE= */ 0, release}});
+      const uint32_t release = context.info().software() ? 0u : 1u;
+      raster_ = gpu::ComputeProgram(context, method.shader, method.spec.with({{/* RELEASE= */ 0, release}}));
       pointsPerGroup_ = raster_.groupSize();
-    } else if (method == Method::Dedup) {
-      // The NV variant partitions instead of reducing: it has no REDUCE constant.
-      raster_ = gpu::ComputeProgram(context, int40 ? "raster_dedup_nv_int40.comp" : "raster_dedup_nv.comp",
-                                    {{/* EARLY_Z= */ 0, earlyZ},
-                                     {/* JUST_SET= */ 2, justSet},
-                                     {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
-      pointsPerGroup_ = raster_.groupSize() * kPointsPerThread;
     } else {
-      raster_ = gpu::ComputeProgram(context, int40 ? "raster_closest_int40.comp" : "raster_closest.comp",
-                                    {{/* EARLY_Z= */ 0, earlyZ},
-                                     {/* REDUCE= */ 1, reduce},
-                                     {/* JUST_SET= */ 2, justSet},
-                                     {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
+      raster_ = gpu::ComputeProgram(context, int40 ? method.int40Shader : method.shader,
+                                    method.spec.with({{/* POINTS_PER_THREAD= */ 4, kPointsPerThread}}));
       pointsPerGroup_ = raster_.groupSize() * kPointsPerThread;
     }
-    uint32_t layout = method == Method::BusyLoop ? 2 : int40 ? 1 : 0;
+    const uint32_t layout = lockArrays_ ? kResolveLockArrays : int40 ? kResolveInt40 : kResolveFloat;
     resolve_ = gpu::ComputeProgram(context, "resolve.comp", {{/* LAYOUT= */ 0, layout}});
   }
 
   void recordFrame(const Frame& frame, Targets& targets) override {
     VkCommandBuffer cmd = frame.cmd;
     uint64_t pixels = targets.pixels();
-    if (method_ == Method::BusyLoop) {
+    if (lockArrays_) {
       // Two uint arrays: depth (empty = kEmptyDepthBits, unlocked) then color.
       gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 4, shared::kEmptyDepthBits);
       gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), pixels * 4, pixels * 4, 0xFFFFFFFFu);
@@ -67,8 +57,7 @@ public:
   }
 
 private:
-  Method method_;
-  DepthMode depth_;
+  bool lockArrays_; // busyloop: depth array then color array, not 64-bit words
   gpu::ComputeProgram raster_;
   gpu::ComputeProgram resolve_;
   uint32_t pointsPerGroup_ = 0; // points one workgroup of raster_ draws
@@ -76,7 +65,8 @@ private:
 
 } // namespace
 
-std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, Method method, DepthMode depth) {
+std::unique_ptr<PointMethod> createClosestMethod(gpu::Context& context, const MethodInfo& method,
+                                                 DepthMode depth) {
   return std::make_unique<ClosestMethod>(context, method, depth);
 }
 

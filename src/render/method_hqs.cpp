@@ -8,10 +8,17 @@ namespace pointrast {
 
 namespace {
 
+// ONE_ROUND (id 0) of the row: hqs1r's packed single atomic and its accumulator layout.
+bool oneRound(const MethodInfo& method) {
+  for (const gpu::SpecConstant& s : method.spec.span())
+    if (s.id == 0) return s.value != 0;
+  return false;
+}
+
 class HqsMethod : public PointMethod {
 public:
-  HqsMethod(gpu::Context& context, Method method, uint32_t width, uint32_t height)
-      : oneRound_(method == Method::Hqs1r) {
+  HqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
+      : oneRound_(oneRound(method)) {
     uint64_t pixels = uint64_t(width) * height;
     // hqs: 2 uint64 sums per pixel. hqs1r: 1 packed uint64 + 2 uint64 fallback sums per pixel.
     accumulators_ =
@@ -24,10 +31,10 @@ public:
                                   {/* REDUCE= */ 1, 1},
                                   {/* DEPTH_ONLY= */ 3, 1},
                                   {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
-    accumulate_ = gpu::ComputeProgram(
-        context, "raster_hqs.comp",
-        {{/* ONE_ROUND= */ 0, oneRound_}, {/* POINTS_PER_THREAD= */ 1, kPointsPerThread}});
-    resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, oneRound_}});
+    accumulate_ = gpu::ComputeProgram(context, method.shader,
+                                      method.spec.with({{/* POINTS_PER_THREAD= */ 1, kPointsPerThread}}));
+    // The resolve reads the accumulators in the layout ONE_ROUND chose (the same constant id).
+    resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", method.spec.span());
   }
 
   void recordFrame(const Frame& frame, Targets& targets) override {
@@ -56,8 +63,6 @@ public:
     gpu::fullBarrier(cmd);
   }
 
-  bool hasCanonicalWords() const override { return false; }
-
 private:
   bool oneRound_;
   gpu::Buffer accumulators_;
@@ -68,7 +73,7 @@ private:
 
 } // namespace
 
-std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, Method method, uint32_t width,
+std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width,
                                              uint32_t height) {
   return std::make_unique<HqsMethod>(context, method, width, height);
 }

@@ -20,8 +20,8 @@ constexpr float kClearDepth = 0.0f;
 
 class HwPointsMethod : public PointMethod {
 public:
-  HwPointsMethod(gpu::Context& context, uint32_t width, uint32_t height)
-      : program_(context, "points_hw.vert", "points_hw.frag",
+  HwPointsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
+      : program_(context, method.shader, "points_hw.frag",
                  {VK_PRIMITIVE_TOPOLOGY_POINT_LIST, kColorFormat, kDepthFormat, VK_COMPARE_OP_GREATER}),
         color_(context, width, height, kColorFormat,
                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "hw-points color"),
@@ -90,9 +90,6 @@ public:
     gpu::fullBarrier(cmd);
   }
 
-  // The color attachment holds colors only; there is no depth << 32 | color word to capture.
-  bool hasCanonicalWords() const override { return false; }
-
 private:
   gpu::GraphicsProgram program_;
   gpu::Image color_;
@@ -101,8 +98,9 @@ private:
 
 } // namespace
 
-std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, uint32_t width, uint32_t height) {
-  return std::make_unique<HwPointsMethod>(context, width, height);
+std::unique_ptr<PointMethod> createHwPointsMethod(gpu::Context& context, const MethodInfo& method,
+                                                  uint32_t width, uint32_t height) {
+  return std::make_unique<HwPointsMethod>(context, method, width, height);
 }
 
 } // namespace pointrast

@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
 #include "base/error.h"
@@ -12,79 +13,24 @@ namespace pointrast {
 
 namespace {
 
-// bytesPerPoint: 12 B position + 4 B color read by every closest-point method; HQS reads positions in its
-// depth pass and positions and colors in its blending pass: 28 B.
-constexpr MethodInfo kMethods[] = {
-    {Method::AtomicMin, "atomicmin", "one 64-bit atomicMin of depth<<32|color per point (2019)", true, true,
-     16},
-    {Method::EarlyZ, "earlyz", "read the pixel first, atomicMin only if closer (2021)", true, true, 16},
-    {Method::Reduce, "reduce", "subgroup minimum when a subgroup hits one pixel, else pairs (2021)", true,
-     true, 16},
-    {Method::ReduceEarlyZ, "reduce-earlyz", "reduce and early-z (2021)", true, true, 16},
-    {Method::Dedup, "dedup",
-     "one atomic per distinct pixel of a subgroup, VK_NV_shader_subgroup_partitioned, "
-     "with early-z (2021)",
-     true, true, 16},
-    {Method::DedupBallot, "dedup-ballot", "dedup from portable subgroup ballots, with early-z", true, true,
-     16},
-    {Method::BusyLoop, "busyloop", "per-pixel lock in the depth word, then color (2013), with early-z", true,
-     false, 16},
-    {Method::JustSet, "justset", "plain stores, no depth test: a speed reference, not a correct image", false,
-     true, 16},
-    {Method::Hqs, "hqs", "high-quality splatting: blend points within 1% of the closest depth (2019)", false,
-     false, 28},
-    {Method::Hqs1r, "hqs1r", "HQS with one packed 64-bit atomicAdd and overflow fallback (2022)", false,
-     false, 28},
-    {Method::HwPoints, "hw-points",
-     "Vulkan point-list pipeline, 1-pixel points, hardware depth test: the GL_POINTS "
-     "baseline",
-     false, false, 16},
-    // Batch methods read 4 to 12 B of coordinates a point (adaptive precision) plus the colors of visible
-    // points only; 4 is the least, FrameStats::batch says what a frame read.
-    {Method::Batch, "batch",
-     "2022: a workgroup per batch of 10240 points, frustum culling, adaptive coordinate precision, "
-     "visibility buffer",
-     true, false, 4, SceneLayout::Batched},
-    {Method::BatchPrefetch, "batch-prefetch",
-     "batch with 128-bit loads, four points in flight per thread (2022)", true, false, 4,
-     SceneLayout::Batched},
-    {Method::BatchHqs, "batch-hqs",
-     "HQS on batches: prefetch depth pass, one packed atomicAdd per point with overflow fallback (2022)",
-     false, false, 8, SceneLayout::Batched},
+// What each MethodNeeds flag asks of the device, and how a refusal names it.
+struct NeedCheck {
+  MethodNeeds need;
+  bool gpu::DeviceFeatures::*present;
+  const char* what;
+};
+constexpr NeedCheck kNeedChecks[] = {
+    {MethodNeeds::Subgroups, &gpu::DeviceFeatures::subgroupCompute,
+     "subgroup vote, ballot, shuffle and arithmetic in compute shaders"},
+    {MethodNeeds::PartitionedNV, &gpu::DeviceFeatures::subgroupPartitionedNV,
+     "VK_NV_shader_subgroup_partitioned (NVIDIA GPUs)"},
 };
 
 // 16384 x 16384 pixels: 2 GiB of framebuffer words, the most a single allocation is guaranteed to hold
 // on common devices.
 constexpr uint32_t kMaxSide = 16384;
 
-template <class T> std::string choices(std::span<const T> items) {
-  std::string known;
-  for (const T& m : items)
-    known += (known.empty() ? "" : ", ") + std::string(m.name);
-  return known;
-}
-
 } // namespace
-
-std::span<const MethodInfo> methodTable() {
-  return kMethods;
-}
-
-const MethodInfo& methodInfo(Method method) {
-  for (const MethodInfo& m : kMethods)
-    if (m.method == method) return m;
-  return kMethods[0];
-}
-
-Method parseMethod(std::string_view name) {
-  for (const MethodInfo& m : kMethods)
-    if (name == m.name) return m.method;
-  throw InputError("unknown method '" + std::string(name) + "'; choose one of: " + choices(methodTable()));
-}
-
-const char* methodName(Method method) {
-  return methodInfo(method).name;
-}
 
 DepthMode parseDepthMode(std::string_view name) {
   if (name == "float") return DepthMode::Float;
@@ -132,27 +78,14 @@ double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera)
 
 bool Renderer::supports(gpu::Context& context, Method method, std::string* why) {
   const gpu::DeviceFeatures& f = context.features();
-  std::string reason;
-  bool subgroups = f.subgroupCompute;
-  switch (method) {
-  case Method::Reduce:
-  case Method::ReduceEarlyZ:
-  case Method::DedupBallot:
-  case Method::Hqs:
-  case Method::Hqs1r:
-  case Method::BatchHqs:
-    if (!subgroups) reason = "needs subgroup vote/ballot/shuffle/arithmetic in compute shaders";
-    break;
-  case Method::Dedup:
-    if (!subgroups || !f.subgroupPartitionedNV)
-      reason = "needs VK_NV_shader_subgroup_partitioned (NVIDIA); use dedup-ballot, the portable variant";
-    break;
-  default:
-    break;
-  }
-  if (!reason.empty() && why)
-    *why = std::string(methodName(method)) + " is not available on '" + context.info().name + "': " + reason;
-  return reason.empty();
+  std::string missing;
+  for (const NeedCheck& check : kNeedChecks)
+    if (hasNeed(method.info().needs, check.need) && !(f.*check.present))
+      missing += (missing.empty() ? "" : " and ") + std::string(check.what);
+  if (!missing.empty() && why)
+    *why = std::string(method.name()) + " is not available on '" + context.info().name + "': it needs " +
+           missing;
+  return missing.empty();
 }
 
 Renderer::Renderer(gpu::Context& context, uint32_t width, uint32_t height)
@@ -179,10 +112,11 @@ uint32_t Renderer::height() const {
 
 PointMethod& Renderer::method(const RenderSettings& settings) {
   const MethodInfo& info = methodInfo(settings.method);
-  if (settings.depth == DepthMode::Int40 && !info.int40)
-    throw InputError(std::string(info.name) + " has no int40 depth encoding; use --depth float");
+  if (settings.depth == DepthMode::Int40 && !info.int40Shader)
+    throw InputError(std::string(info.name) + " has no int40 depth encoding, only float");
   if (settings.depth == DepthMode::Int40 && !context_.features().float64)
-    throw UnsupportedError("--depth int40 needs double precision in shaders (shaderFloat64), which '" +
+    throw UnsupportedError("the int40 depth encoding needs double precision in shaders (shaderFloat64), "
+                           "which '" +
                            context_.info().name + "' lacks");
   std::string why;
   if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
@@ -190,14 +124,21 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
   auto found = methods_.find(key);
   if (found != methods_.end()) return *found->second;
   std::unique_ptr<PointMethod> created;
-  if (settings.method == Method::Hqs || settings.method == Method::Hqs1r)
-    created = createHqsMethod(context_, settings.method, targets_->width, targets_->height);
-  else if (settings.method == Method::HwPoints)
-    created = createHwPointsMethod(context_, targets_->width, targets_->height);
-  else if (info.layout == SceneLayout::Batched)
-    created = createBatchMethod(context_, settings.method, targets_->width, targets_->height);
-  else
-    created = createClosestMethod(context_, settings.method, settings.depth);
+  switch (info.family) {
+  case MethodFamily::Closest:
+  case MethodFamily::BusyLoop:
+    created = createClosestMethod(context_, info, settings.depth);
+    break;
+  case MethodFamily::Hqs:
+    created = createHqsMethod(context_, info, targets_->width, targets_->height);
+    break;
+  case MethodFamily::HwPoints:
+    created = createHwPointsMethod(context_, info, targets_->width, targets_->height);
+    break;
+  case MethodFamily::Batch:
+    created = createBatchMethod(context_, info, targets_->width, targets_->height);
+    break;
+  }
   return *methods_.emplace(key, std::move(created)).first->second;
 }
 
@@ -251,7 +192,7 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
       timestamps.end(cmd, f);
     }
   });
-  wordsCaptured_ = settings.captureWords && m.hasCanonicalWords();
+  wordsCaptured_ = settings.captureWords && hasCanonicalWords(info);
   std::vector<double> ms = timestamps.milliseconds();
   FrameStats stats;
   stats.frames = frames;
@@ -277,6 +218,22 @@ std::vector<uint64_t> Renderer::framebufferWords() {
   std::vector<uint64_t> words(targets_->pixels());
   gpu::readBuffer(context_, targets_->words, 0, words.data(), words.size() * 8);
   return words;
+}
+
+std::vector<uint64_t> Renderer::framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h) {
+  assert(uint64_t(x) + w <= targets_->width && uint64_t(y) + h <= targets_->height && "outside the image");
+  if (!wordsCaptured_)
+    throw InputError("no canonical framebuffer words: the last frame was not rendered with captureWords by a "
+                     "closest-point method");
+  std::vector<uint64_t> words(uint64_t(w) * h);
+  for (uint32_t row = 0; row < h; ++row)
+    gpu::readBuffer(context_, targets_->words, ((uint64_t(y) + row) * targets_->width + x) * 8,
+                    words.data() + uint64_t(row) * w, uint64_t(w) * 8);
+  return words;
+}
+
+uint64_t Renderer::imageAddress() const {
+  return targets_->image.address();
 }
 
 } // namespace pointrast

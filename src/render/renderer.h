@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/method_table.h"
 #include "render/scene.h"
 
 namespace pointrast {
@@ -21,50 +22,16 @@ namespace gpu {
 class Context;
 }
 
-enum class Method {
-  AtomicMin,     // 2019: one 64-bit atomicMin of (depth << 32 | color) per point
-  EarlyZ,        // 2021: read first, atomicMin only if closer
-  Reduce,        // 2021: subgroup reduction before the atomic
-  ReduceEarlyZ,  // 2021: both
-  Dedup,         // 2021: one atomic per distinct pixel of the subgroup (VK_NV_shader_subgroup_partitioned)
-  DedupBallot,   // dedup built from portable subgroup ballots
-  BusyLoop,      // 2013 per-pixel lock, with early-z
-  JustSet,       // plain stores without depth test: a speed reference only
-  Hqs,           // 2019 high-quality splatting: depth pass + two-atomic accumulation + resolve
-  Hqs1r,         // 2022 single-atomic HQS (16-bit packed) with overflow fallback
-  HwPoints,      // the hardware point list (GL_POINTS): graphics pipeline, 1-pixel points, depth test
-  Batch,         // 2022: one workgroup per batch, culling, adaptive precision, visibility buffer
-  BatchPrefetch, // batch with 128-bit loads, four points in flight per thread
-  BatchHqs,      // HQS on batches: depth pass + single-atomic accumulation with overflow fallback
-};
-
 enum class DepthMode {
   Float, // IEEE bits of the linear depth, 32 bits, color in the low 32 bits
   Int40, // 2019 poster: depth in double precision, 40-bit integer steps, color in the low 24 bits
 };
 
-struct MethodInfo {
-  Method method;
-  const char* name;
-  const char* description;
-  bool closest;           // writes the canonical closest-point framebuffer (bit-identical across methods;
-                          // the batch methods' quantized coordinates pick the same point on >= 99.9 % of
-                          // pixels at full precision)
-  bool int40;             // supports --depth int40
-  uint32_t bytesPerPoint; // point data the method must read per point per frame (for effective bandwidth)
-                          // batch methods: the least (one word); FrameStats::batch has what was read
-  SceneLayout layout = SceneLayout::Float; // the scene layout the method reads
-};
-std::span<const MethodInfo> methodTable();
-const MethodInfo& methodInfo(Method method);
-// Throws InputError listing the known names.
-Method parseMethod(std::string_view name);
-const char* methodName(Method method);
 DepthMode parseDepthMode(std::string_view name);
 const char* depthModeName(DepthMode mode);
 
 struct RenderSettings {
-  Method method = Method::AtomicMin;
+  Method method; // the first row of the method table: atomicmin
   DepthMode depth = DepthMode::Float;
   // int40: integer steps per unit of linear depth. 0 (default): the 40 bits span [0, distance from the
   // eye to the farthest corner of the scene bounds], e.g. 9 nm per step for a scene 10 km deep.
@@ -125,6 +92,12 @@ public:
   // Canonical words (depth << 32 | color, all ones where empty) of the last frame rendered with
   // captureWords; for closest-point methods only.
   std::vector<uint64_t> framebufferWords();
+  // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
+  // reads to pick the point under the cursor.
+  std::vector<uint64_t> framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h);
+  // Device address of the RGBA8 image of the last frame (width() x height() words, row 0 at the top), for
+  // front ends that show it without a copy to the host. Valid until the Renderer is destroyed.
+  uint64_t imageAddress() const;
 
   uint32_t width() const;
   uint32_t height() const;

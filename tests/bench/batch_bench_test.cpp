@@ -40,16 +40,17 @@ TEST(Suites, Paper2022SizesOrdersViewsAndDefaults) {
   SuiteDefaults defaults = suiteDefaults("paper2022");
   EXPECT_EQ(defaults.width, 2560u);
   EXPECT_EQ(defaults.height, 1140u);
-  EXPECT_EQ(defaults.methods, std::vector<Method>({Method::HwPoints, Method::Batch, Method::BatchPrefetch,
-                                                   Method::BatchHqs, Method::Dedup, Method::Hqs}));
+  EXPECT_EQ(defaults.methods, std::vector<Method>({pointMethod("hw-points"), pointMethod("batch"),
+                                                   pointMethod("batch-prefetch"), pointMethod("batch-hqs"),
+                                                   pointMethod("dedup"), pointMethod("hqs")}));
   EXPECT_EQ(layoutsOf(defaults.methods),
             std::vector<SceneLayout>({SceneLayout::Float, SceneLayout::Batched}));
   const std::vector<Method> family = suiteDefaults("paper2021").methods;
   EXPECT_EQ(family.size(), 11u)
       << "hw-points, the closest-point family (6 with dedup-ballot), busyloop, justset, hqs, hqs1r";
   EXPECT_EQ(layoutsOf(family), std::vector<SceneLayout>({SceneLayout::Float})) << "no batch method";
-  EXPECT_NE(std::find(family.begin(), family.end(), Method::HwPoints), family.end());
-  EXPECT_NE(std::find(family.begin(), family.end(), Method::Hqs1r), family.end());
+  EXPECT_NE(std::find(family.begin(), family.end(), pointMethod("hw-points")), family.end());
+  EXPECT_NE(std::find(family.begin(), family.end(), pointMethod("hqs1r")), family.end());
   EXPECT_EQ(suiteDefaults("paper2021").width, 1920u);
   EXPECT_THROW(suiteDefaults("paper1999"), InputError);
   EXPECT_THROW(suiteDatasets("paper2022", 1.0, 1, {"retz=/x.las"}), InputError) << "a paper2021 name";
@@ -60,7 +61,7 @@ BenchRun runWithBatchResults() {
   BenchRun run;
   run.device.name = "Made-up GPU 9000";
   run.copy.bytesPerSecond = 1e12;
-  run.config.methods = {Method::Dedup, Method::BatchPrefetch, Method::BatchHqs};
+  run.config.methods = {pointMethod("dedup"), pointMethod("batch-prefetch"), pointMethod("batch-hqs")};
   run.config.orders = {Order::Morton, Order::Original};
   run.config.views = {View::Overview, View::Closeup};
   DatasetOutcome d;
@@ -77,7 +78,7 @@ BenchRun runWithBatchResults() {
     r.points = d.points;
     r.stats.medianMs = 5;
     r.stats.points = d.points;
-    if (m != Method::Dedup) {
+    if (m != pointMethod("dedup")) {
       BatchStats b;
       b.batchesProcessed = 97'657;
       b.batchesRendered = 90'000;
@@ -85,7 +86,7 @@ BenchRun runWithBatchResults() {
       b.pointsByWords[0] = 900'000'000;
       b.pointsByWords[1] = 21'600'000;
       b.pointsRendered = 12'345'678;
-      b.pointsBlended = m == Method::BatchHqs ? 600'000'000 : 0;
+      b.pointsBlended = m == pointMethod("batch-hqs") ? 600'000'000 : 0;
       r.stats.batch = b;
     }
     run.results.push_back(r);
@@ -129,7 +130,8 @@ TEST_F(BatchBench, MixedRunUploadsBothLayoutsAndReportsStatistics) {
   study.orders = {Order::Original, Order::Morton};
   study.views = {View::Overview, View::Closeup};
   config.datasets = {tiny, study};
-  config.methods = {Method::AtomicMin, Method::Batch, Method::BatchPrefetch, Method::BatchHqs};
+  config.methods = {pointMethod("atomicmin"), pointMethod("batch"), pointMethod("batch-prefetch"),
+                    pointMethod("batch-hqs")};
   config.orders = {Order::Morton, Order::Original};
   config.views = {View::Overview, View::Closeup};
   config.width = 96;

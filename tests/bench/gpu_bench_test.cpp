@@ -76,8 +76,8 @@ TEST_F(BenchGpu, RunSkipsWhatDoesNotFitAndSaysSo) {
   // More points than any device holds: skipped from the estimate alone, never generated.
   bench::Dataset huge{"huge", "huge (tls, 1T)", "tls", uint64_t(1) << 40, 1, false};
   bench::BenchConfig config =
-      smallConfig({huge, tiny}, {Method::AtomicMin, Method::Dedup}, {Order::Original, Order::ShuffledMorton},
-                  {bench::View::Closeup}, 1);
+      smallConfig({huge, tiny}, {pointMethod("atomicmin"), pointMethod("dedup")},
+                  {Order::Original, Order::ShuffledMorton}, {bench::View::Closeup}, 1);
   std::vector<std::string> notes;
   size_t calls = 0, lastTotal = 0;
   bench::BenchCallbacks callbacks;
@@ -149,9 +149,9 @@ TEST(BenchBudget, SlowMethodsGetFewerFramesFastOnesAll) {
 }
 
 TEST_F(BenchGpu, BudgetShortensEveryCombinationOfASlowRun) {
-  bench::BenchConfig config =
-      smallConfig({bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}},
-                  {Method::AtomicMin, Method::Hqs1r}, {Order::Original}, {bench::View::Overview}, 10);
+  bench::BenchConfig config = smallConfig(
+      {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}},
+      {pointMethod("atomicmin"), pointMethod("hqs1r")}, {Order::Original}, {bench::View::Overview}, 10);
   // Far less than any frame takes: every combination is timed over the minimum of 3 frames.
   config.secondsPerCombination = 1e-9;
   bench::BenchRun run = bench::runBench(*context, config, {});
@@ -181,9 +181,10 @@ TEST(BenchTimeLimit, StopsOnlyOnceTheLimitHasPassed) {
 }
 
 TEST_F(BenchGpu, TimeLimitEndsTheRunWithWhatItMeasured) {
-  bench::BenchConfig config = smallConfig(
-      {bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}},
-      {Method::AtomicMin, Method::EarlyZ}, {Order::Original, Order::Morton}, {bench::View::Overview}, 3);
+  bench::BenchConfig config =
+      smallConfig({bench::Dataset{"tiny", "tiny (terrain, 20k)", "terrain", 20'000, 1, false}},
+                  {pointMethod("atomicmin"), pointMethod("earlyz")}, {Order::Original, Order::Morton},
+                  {bench::View::Overview}, 3);
   config.timeLimitSeconds = 1e-9; // passed before the first data set is prepared
   bench::BenchRun run = bench::runBench(*context, config, {});
   EXPECT_TRUE(run.results.empty());

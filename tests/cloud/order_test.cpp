@@ -112,6 +112,23 @@ TEST(MortonCode, MatchesBitwiseInterleaveAndItsOrder) {
   }
 }
 
+TEST(MortonCode, DecodeInvertsEncode) {
+  std::mt19937_64 rng(4);
+  for (int k = 0; k < 100'000; ++k) {
+    const uint32_t x = rng() & 0x1fffff, y = rng() & 0x1fffff, z = rng() & 0x1fffff;
+    uint32_t dx = 0, dy = 0, dz = 0;
+    mortonDecode(mortonCode(x, y, z), dx, dy, dz);
+    ASSERT_EQ(dx, x);
+    ASSERT_EQ(dy, y);
+    ASSERT_EQ(dz, z);
+  }
+  uint32_t x, y, z;
+  mortonDecode(~uint64_t(0), x, y, z); // bit 63 is not part of a code
+  EXPECT_EQ(x, 0x1fffffu);
+  EXPECT_EQ(y, 0x1fffffu);
+  EXPECT_EQ(z, 0x1fffffu);
+}
+
 class MortonOrder : public ::testing::TestWithParam<uint64_t> {};
 
 TEST_P(MortonOrder, IsPermutationWithNonDecreasingCodesAndIndexTies) {

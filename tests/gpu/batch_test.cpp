@@ -40,7 +40,7 @@ struct Drawn {
 };
 
 struct Draw {
-  Method method = Method::Batch;
+  Method method = pointMethod("batch");
   uint32_t precision = 0;
   bool culling = true;
 };
@@ -56,7 +56,7 @@ Drawn draw(gpu::Context& context, std::span<const GpuScene* const> scenes, const
   settings.background = 0;
   Drawn out;
   out.stats = renderer.render(scenes, camera, settings);
-  if (methodInfo(d.method).closest) out.words = renderer.framebufferWords();
+  if (methodInfo(d.method).output == MethodOutput::Closest) out.words = renderer.framebufferWords();
   out.image = renderer.image();
   return out;
 }
@@ -244,10 +244,10 @@ TEST_F(GpuTest, BatchAtFullPrecisionMatchesAtomicMin) {
       GpuScene batchScene(*context, cloud, batched());
       for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
         std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
-        Drawn reference = draw(*context, floatScene, camera, w, h, {Method::AtomicMin});
+        Drawn reference = draw(*context, floatScene, camera, w, h, {pointMethod("atomicmin")});
         EXPECT_GT(litCount(reference.image), 100u) << where;
-        Drawn batch = draw(*context, batchScene, camera, w, h, {Method::Batch, 3});
-        Drawn prefetch = draw(*context, batchScene, camera, w, h, {Method::BatchPrefetch, 3});
+        Drawn batch = draw(*context, batchScene, camera, w, h, {pointMethod("batch"), 3});
+        Drawn prefetch = draw(*context, batchScene, camera, w, h, {pointMethod("batch-prefetch"), 3});
         double same = equalLitFraction(batch.image, reference.image);
         EXPECT_GE(same, 0.999) << where;
         if (same < 1.0) std::printf("%s: %.4f %% of lit pixels equal\n", where.c_str(), 100 * same);
@@ -293,7 +293,7 @@ TEST_F(GpuTest, AdaptivePrecisionMovesNoPointByMoreThanOnePixel) {
       for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
         std::string where =
             cloudName + " / " + viewName + " / " + std::to_string(w) + "x" + std::to_string(h);
-        for (Method method : {Method::Batch, Method::BatchPrefetch}) {
+        for (Method method : {pointMethod("batch"), pointMethod("batch-prefetch")}) {
           Drawn full = draw(*context, scene, camera, w, h, {method, 3});
           Drawn adaptive = draw(*context, scene, camera, w, h, {method, 0});
           size_t litFull = litCount(full.image), litAdaptive = litCount(adaptive.image);
@@ -322,7 +322,7 @@ TEST_F(GpuTest, AdaptivePrecisionMovesNoPointByMoreThanOnePixel) {
           if (viewName == "overview") {
             EXPECT_GT(s.pointsByWords[0], 0u) << where << ": adaptive precision never used one word";
           }
-          if (method == Method::Batch && w == 2400)
+          if (method == pointMethod("batch") && w == 2400)
             std::printf("%-28s words 1/2/3: %8llu %8llu %8llu  compared %6zu, moved %5zu, lit %zu / %zu\n",
                         where.c_str(), (unsigned long long)s.pointsByWords[0],
                         (unsigned long long)s.pointsByWords[1], (unsigned long long)s.pointsByWords[2],
@@ -353,8 +353,9 @@ TEST_F(GpuTest, BatchCullingNeverDropsAVisiblePoint) {
       for (auto& [viewName, camera] : cameras) {
         std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
         for (uint32_t precision : {0u, 3u}) {
-          Drawn culled = draw(*context, scene, camera, w, h, {Method::BatchPrefetch, precision, true});
-          Drawn all = draw(*context, scene, camera, w, h, {Method::BatchPrefetch, precision, false});
+          Drawn culled =
+              draw(*context, scene, camera, w, h, {pointMethod("batch-prefetch"), precision, true});
+          Drawn all = draw(*context, scene, camera, w, h, {pointMethod("batch-prefetch"), precision, false});
           EXPECT_EQ(culled.words, all.words) << where << ", precision " << precision;
           EXPECT_EQ(all.stats.batch->batchesRendered, all.stats.batch->batchesProcessed) << where;
           culledSomewhere += culled.stats.batch->batchesRendered < culled.stats.batch->batchesProcessed;
@@ -416,7 +417,7 @@ TEST_F(GpuTest, BatchStatisticsAreExactOnAHandBuiltScene) {
   Camera camera = axisCamera();
   for (uint64_t partPoints : {uint64_t(0), uint64_t(10240), uint64_t(20480)}) {
     GpuScene scene(*context, cloud, batched(partPoints));
-    for (Method method : {Method::Batch, Method::BatchPrefetch, Method::BatchHqs}) {
+    for (Method method : {pointMethod("batch"), pointMethod("batch-prefetch"), pointMethod("batch-hqs")}) {
       for (uint32_t precision : {0u, 1u, 2u, 3u}) {
         std::string where = std::string(methodName(method)) + ", parts of " + std::to_string(partPoints) +
                             ", precision " + std::to_string(precision);
@@ -427,7 +428,7 @@ TEST_F(GpuTest, BatchStatisticsAreExactOnAHandBuiltScene) {
         EXPECT_EQ(s.batchesRendered, 3u) << where;
         EXPECT_EQ(s.pointsProcessed, 10240u + 10240u + 1000u) << where;
         EXPECT_EQ(s.pointsRendered, 256u * 1 + 256u * 20 + 1000u) << where;
-        EXPECT_EQ(s.pointsBlended, method == Method::BatchHqs ? 512u + 1000u : 0u) << where;
+        EXPECT_EQ(s.pointsBlended, method == pointMethod("batch-hqs") ? 512u + 1000u : 0u) << where;
         if (precision != 0) {
           EXPECT_EQ(s.pointsByWords[precision - 1], s.pointsProcessed) << where;
         } else {
@@ -435,7 +436,8 @@ TEST_F(GpuTest, BatchStatisticsAreExactOnAHandBuiltScene) {
         }
         uint64_t words = s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2];
         uint64_t once = 5 * 32 + 4 * words;
-        EXPECT_EQ(s.bytesRead, method == Method::BatchHqs ? 2 * once + 4 * s.pointsBlended : once) << where;
+        EXPECT_EQ(s.bytesRead, method == pointMethod("batch-hqs") ? 2 * once + 4 * s.pointsBlended : once)
+            << where;
         EXPECT_EQ(litCount(d.image), 1512u) << where;
       }
     }
@@ -462,7 +464,7 @@ TEST_F(GpuTest, BatchPartsAndScenesGiveTheFramebufferOfOnePart) {
     scenes.push_back(std::make_unique<GpuScene>(*context, cloud, o));
   }
   const GpuScene* three[] = {scenes[0].get(), scenes[1].get(), scenes[2].get()};
-  for (Method method : {Method::Batch, Method::BatchPrefetch}) {
+  for (Method method : {pointMethod("batch"), pointMethod("batch-prefetch")}) {
     for (uint32_t precision : {0u, 3u}) {
       Drawn reference = draw(*context, whole, camera, 256, 128, {method, precision});
       EXPECT_GT(litCount(reference.image), 1000u);
@@ -482,13 +484,13 @@ TEST_F(GpuTest, BatchLayoutAndPartLimitsAreClearErrors) {
   GpuScene batchScene(*context, cloud, batched());
   Renderer renderer(*context, 8, 8);
   RenderSettings settings;
-  settings.method = Method::Batch;
+  settings.method = pointMethod("batch");
   EXPECT_THROW(renderer.render(floatScene, axisCamera(), settings), InputError);
-  settings.method = Method::AtomicMin;
+  settings.method = pointMethod("atomicmin");
   EXPECT_THROW(renderer.render(batchScene, axisCamera(), settings), InputError);
-  settings.method = Method::HwPoints;
+  settings.method = pointMethod("hw-points");
   EXPECT_THROW(renderer.render(batchScene, axisCamera(), settings), InputError);
-  settings.method = Method::BatchPrefetch;
+  settings.method = pointMethod("batch-prefetch");
   settings.precision = 4;
   EXPECT_THROW(renderer.render(batchScene, axisCamera(), settings), InputError);
   settings.precision = 0;
@@ -562,9 +564,9 @@ TEST_F(GpuTest, BatchHqsMatchesHqs) {
     reorder(ordered, order, 1);
     GpuScene floatScene(*context, ordered, floats());
     GpuScene batchScene(*context, ordered, batched(10240));
-    std::vector<uint32_t> hqs = draw(*context, floatScene, axisCamera(), W, H, {Method::Hqs}).image;
+    std::vector<uint32_t> hqs = draw(*context, floatScene, axisCamera(), W, H, {pointMethod("hqs")}).image;
     for (uint32_t precision : {3u, 0u}) {
-      Drawn b = draw(*context, batchScene, axisCamera(), W, H, {Method::BatchHqs, precision});
+      Drawn b = draw(*context, batchScene, axisCamera(), W, H, {pointMethod("batch-hqs"), precision});
       EXPECT_TRUE(b.words.empty());
       EXPECT_LE(maxChannelDiff(b.image, hqs), 1) << orderName(order) << ", precision " << precision;
       EXPECT_NE(b.image[20 * W + 10], 0u);
@@ -579,8 +581,8 @@ TEST_F(GpuTest, BatchHqsMatchesHqs) {
   Camera camera = overviewCamera(terrain.bounds, 1.6);
   GpuScene floatScene(*context, terrain, floats());
   GpuScene batchScene(*context, terrain, batched());
-  std::vector<uint32_t> hqs = draw(*context, floatScene, camera, 320, 200, {Method::Hqs}).image;
-  Drawn b = draw(*context, batchScene, camera, 320, 200, {Method::BatchHqs, 3});
+  std::vector<uint32_t> hqs = draw(*context, floatScene, camera, 320, 200, {pointMethod("hqs")}).image;
+  Drawn b = draw(*context, batchScene, camera, 320, 200, {pointMethod("batch-hqs"), 3});
   double withinOne = 0;
   maxChannelDiff(b.image, hqs, &withinOne);
   EXPECT_GE(withinOne, 0.998);

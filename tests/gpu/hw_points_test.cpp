@@ -68,8 +68,8 @@ double compareWithAtomicMin(gpu::Context& context, const std::string& name, cons
     upload.progress = false;
     GpuScene scene(context, cloud, upload);
     for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
-      std::vector<uint32_t> reference = renderImage(context, scene, camera, w, h, Method::AtomicMin);
-      std::vector<uint32_t> hw = renderImage(context, scene, camera, w, h, Method::HwPoints);
+      std::vector<uint32_t> reference = renderImage(context, scene, camera, w, h, pointMethod("atomicmin"));
+      std::vector<uint32_t> hw = renderImage(context, scene, camera, w, h, pointMethod("hw-points"));
       Agreement a = agreement(hw, reference);
       std::printf("hw-points vs atomicmin, %-8s %-16s %-8s: %.3f %% of pixels equal, %.3f %% of lit pixels\n",
                   name.c_str(), orderName(order), viewName.c_str(), 100 * a.all, 100 * a.lit);
@@ -114,7 +114,7 @@ TEST_F(GpuTest, HwPointsHandBuiltContract) {
     upload.progress = false;
     GpuScene scene(*context, cloud, upload);
     std::vector<uint32_t> image =
-        renderImage(*context, scene, axisCamera(), 4, 4, Method::HwPoints, kBackground);
+        renderImage(*context, scene, axisCamera(), 4, 4, pointMethod("hw-points"), kBackground);
     for (uint32_t i = 0; i < 16; ++i) {
       uint32_t x = i % 4, y = i / 4;
       uint32_t expected = x == 2 && y == 1   ? kRed
@@ -124,7 +124,7 @@ TEST_F(GpuTest, HwPointsHandBuiltContract) {
       EXPECT_EQ(image[i], expected) << "pixel " << x << "," << y
                                     << (greenFirst ? " (green drawn first)" : "");
     }
-    EXPECT_EQ(renderImage(*context, scene, axisCamera(), 4, 4, Method::AtomicMin, kBackground), image);
+    EXPECT_EQ(renderImage(*context, scene, axisCamera(), 4, 4, pointMethod("atomicmin"), kBackground), image);
   }
 }
 
@@ -159,11 +159,12 @@ TEST_F(GpuTest, HwPointsDrawsPartsAndScenesInOrder) {
   UploadOptions whole;
   whole.progress = false;
   std::vector<uint32_t> reference =
-      renderImage(*context, GpuScene(*context, cloud, whole), camera, 256, 128, Method::HwPoints);
+      renderImage(*context, GpuScene(*context, cloud, whole), camera, 256, 128, pointMethod("hw-points"));
   UploadOptions small = whole;
   small.maxPartPoints = 10240; // 5 parts, the last one short
-  EXPECT_EQ(renderImage(*context, GpuScene(*context, cloud, small), camera, 256, 128, Method::HwPoints),
-            reference);
+  EXPECT_EQ(
+      renderImage(*context, GpuScene(*context, cloud, small), camera, 256, 128, pointMethod("hw-points")),
+      reference);
 
   std::vector<std::unique_ptr<GpuScene>> scenes;
   uint64_t cuts[] = {0, 20'001, cloud.size()};
@@ -176,7 +177,7 @@ TEST_F(GpuTest, HwPointsDrawsPartsAndScenesInOrder) {
   const GpuScene* drawn[] = {scenes[0].get(), scenes[1].get()};
   Renderer renderer(*context, 256, 128);
   RenderSettings settings;
-  settings.method = Method::HwPoints;
+  settings.method = pointMethod("hw-points");
   settings.background = 0;
   settings.frames = 3; // several frames in one command buffer: the barriers between them must hold
   FrameStats stats = renderer.render(drawn, camera, settings);
@@ -192,10 +193,10 @@ TEST_F(GpuTest, HwPointsHasNoInt40Depth) {
   GpuScene scene(*context, cloud, upload);
   Renderer renderer(*context, 8, 8);
   RenderSettings settings;
-  settings.method = Method::HwPoints;
+  settings.method = pointMethod("hw-points");
   settings.depth = DepthMode::Int40;
   EXPECT_THROW(renderer.render(scene, axisCamera(), settings), InputError);
-  EXPECT_EQ(parseMethod("hw-points"), Method::HwPoints);
+  EXPECT_EQ(parseMethod("hw-points"), pointMethod("hw-points"));
 }
 
 } // namespace pointrast::test

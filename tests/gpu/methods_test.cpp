@@ -3,9 +3,11 @@
 // - justset lights exactly the pixels atomicmin lights;
 // - hqs equals a CPU average within 1 per channel; hqs1r equals hqs, also past 1,000 points per pixel;
 // - int40 depth separates surfaces 1 mm apart at 10 km that float depth merges.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <random>
 
 #include "base/error.h"
@@ -32,7 +34,7 @@ Result draw(gpu::Context& context, const GpuScene& scene, const Camera& camera, 
   settings.captureWords = true;
   settings.background = 0;
   renderer.render(scene, camera, settings);
-  bool blends = method == Method::Hqs || method == Method::Hqs1r;
+  bool blends = method == pointMethod("hqs") || method == pointMethod("hqs1r");
   return {blends ? std::vector<uint64_t>{} : renderer.framebufferWords(), renderer.image()};
 }
 
@@ -69,62 +71,129 @@ std::vector<std::pair<std::string, Camera>> views(const Bounds& bounds, double a
 
 } // namespace
 
-TEST_F(GpuTest, ClosestPointMethodsAreBitIdentical) {
-  // busyloop runs with its release barrier on GPUs and without it on CPU devices (see its shader), so
-  // this test covers the variant each kind of device uses.
-  std::vector<Method> methods = {Method::EarlyZ,      Method::Reduce,   Method::ReduceEarlyZ,
-                                 Method::DedupBallot, Method::BusyLoop, Method::Dedup};
-  uint32_t w = 160, h = 100;
+namespace {
+
+// Every row of the method table that must write atomicmin's words bit for bit: the closest-point rows of
+// the float layout (the batch rows quantize: batch_test.cpp). A row added to the table is tested here
+// without any change to this file.
+std::vector<Method> closestFloatMethods() {
+  std::vector<Method> methods;
+  for (Method m : allMethods())
+    if (m != pointMethod("atomicmin") && m.info().output == MethodOutput::Closest &&
+        m.info().layout == SceneLayout::Float)
+      methods.push_back(m);
+  return methods;
+}
+
+// atomicmin's result per cloud, order and view, drawn once for all the rows compared with it.
+const Result& referenceFor(gpu::Context& context, const std::string& where, const GpuScene& scene,
+                           const Camera& camera, uint32_t w, uint32_t h, DepthMode depth = DepthMode::Float) {
+  static std::map<std::string, Result> references;
+  const std::string key = where + (depth == DepthMode::Int40 ? " / int40" : "");
+  auto found = references.find(key);
+  if (found == references.end())
+    found =
+        references.emplace(key, draw(context, scene, camera, w, h, pointMethod("atomicmin"), depth)).first;
+  return found->second;
+}
+
+constexpr uint32_t kWidth = 160, kHeight = 100;
+
+// Calls check(where, scene, camera, reference) for every test cloud, vertex order and view, with
+// atomicmin's result as the reference (which lights some pixels in every case).
+template <class Check> void forEachCase(gpu::Context& context, Check&& check) {
   for (auto& [cloudName, original] : testClouds()) {
     for (Order order : {Order::Original, Order::Morton, Order::Shuffled, Order::ShuffledMorton}) {
       PointCloud cloud = original;
       reorder(cloud, order, 5);
       UploadOptions upload;
       upload.progress = false;
-      GpuScene scene(*context, cloud, upload);
-      for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
-        std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
-        Result reference = draw(*context, scene, camera, w, h, Method::AtomicMin);
-        size_t lit = std::count_if(reference.words.begin(), reference.words.end(),
-                                   [](uint64_t v) { return v != ~0ull; });
-        EXPECT_GT(lit, 0u) << where;
-        for (Method method : methods) {
-          std::string why;
-          if (!Renderer::supports(*context, method, &why)) {
-            static bool said = false;
-            if (!said) std::printf("[  SKIP    ] %s\n", why.c_str());
-            said = true;
-            continue;
-          }
-          Result r = draw(*context, scene, camera, w, h, method);
-          EXPECT_EQ(r.words, reference.words) << methodName(method) << " differs from atomicmin on " << where;
-          EXPECT_EQ(r.image, reference.image) << methodName(method) << " image differs on " << where;
-        }
-        Result set = draw(*context, scene, camera, w, h, Method::JustSet);
-        for (size_t i = 0; i < set.words.size(); ++i)
-          ASSERT_EQ(set.words[i] == ~0ull, reference.words[i] == ~0ull)
-              << "justset lit pixels differ on " << where;
+      GpuScene scene(context, cloud, upload);
+      for (auto& [viewName, camera] : views(cloud.bounds, double(kWidth) / kHeight)) {
+        const std::string where = cloudName + " / " + orderName(order) + " / " + viewName;
+        const Result& reference = referenceFor(context, where, scene, camera, kWidth, kHeight);
+        EXPECT_GT(std::count_if(reference.words.begin(), reference.words.end(),
+                                [](uint64_t v) { return v != ~0ull; }),
+                  0)
+            << where;
+        check(where, scene, camera, reference);
       }
     }
   }
 }
 
-TEST_F(GpuTest, Int40ClosestMethodsAgree) {
+// The terrain test cloud uploaded, and its overview camera in `camera`.
+std::unique_ptr<GpuScene> terrainScene(gpu::Context& context, Camera& camera) {
   auto clouds = testClouds();
   const PointCloud& cloud = clouds.at("terrain");
   UploadOptions upload;
   upload.progress = false;
-  GpuScene scene(*context, cloud, upload);
-  Camera camera = overviewCamera(cloud.bounds, 1.6);
-  Result reference = draw(*context, scene, camera, 160, 100, Method::AtomicMin, DepthMode::Int40);
-  for (Method method :
-       {Method::EarlyZ, Method::Reduce, Method::ReduceEarlyZ, Method::DedupBallot, Method::Dedup}) {
-    if (!Renderer::supports(*context, method)) continue;
-    EXPECT_EQ(draw(*context, scene, camera, 160, 100, method, DepthMode::Int40).words, reference.words)
-        << methodName(method);
+  camera = overviewCamera(cloud.bounds, 1.6);
+  return std::make_unique<GpuScene>(context, cloud, upload);
+}
+
+class ClosestMethodTest : public GpuTest, public ::testing::WithParamInterface<Method> {
+protected:
+  void SetUp() override {
+    GpuTest::SetUp();
+    if (!context) return;
+    std::string why;
+    if (!Renderer::supports(*context, GetParam(), &why)) GTEST_SKIP() << why;
   }
+};
+
+std::string paramName(const ::testing::TestParamInfo<Method>& info) {
+  std::string name = info.param.name();
+  std::replace(name.begin(), name.end(), '-', '_');
+  return name;
+}
+
+} // namespace
+
+// busyloop runs with its release ordering on GPUs and without it on CPU devices (see its shader), so this
+// covers the variant each kind of device uses.
+TEST_P(ClosestMethodTest, WritesAtomicMinsWordsBitForBit) {
+  const Method method = GetParam();
+  forEachCase(*context, [&](const std::string& where, const GpuScene& scene, const Camera& camera,
+                            const Result& reference) {
+    Result r = draw(*context, scene, camera, kWidth, kHeight, method);
+    EXPECT_EQ(r.words, reference.words) << methodName(method) << " differs from atomicmin on " << where;
+    EXPECT_EQ(r.image, reference.image) << methodName(method) << " image differs on " << where;
+  });
+}
+
+TEST_P(ClosestMethodTest, Int40AgreesWithAtomicMin) {
+  const Method method = GetParam();
+  if (!method.info().int40Shader) GTEST_SKIP() << methodName(method) << " has no int40 encoding";
+  if (!context->features().float64) GTEST_SKIP() << "no shaderFloat64 on this device";
+  Camera camera;
+  const std::unique_ptr<GpuScene> terrain = terrainScene(*context, camera);
+  const GpuScene& scene = *terrain;
+  const Result& reference =
+      referenceFor(*context, "terrain int40", scene, camera, 160, 100, DepthMode::Int40);
+  EXPECT_EQ(draw(*context, scene, camera, 160, 100, method, DepthMode::Int40).words, reference.words)
+      << methodName(method);
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, ClosestMethodTest, ::testing::ValuesIn(closestFloatMethods()), paramName);
+
+TEST_F(GpuTest, JustSetLightsThePixelsAtomicMinLights) {
+  forEachCase(*context, [&](const std::string& where, const GpuScene& scene, const Camera& camera,
+                            const Result& reference) {
+    Result set = draw(*context, scene, camera, kWidth, kHeight, pointMethod("justset"));
+    for (size_t i = 0; i < set.words.size(); ++i)
+      ASSERT_EQ(set.words[i] == ~0ull, reference.words[i] == ~0ull)
+          << "justset lit pixels differ on " << where;
+  });
+}
+
+TEST_F(GpuTest, Int40LightsThePixelsFloatDepthLights) {
+  Camera camera;
+  const std::unique_ptr<GpuScene> terrain = terrainScene(*context, camera);
+  const GpuScene& scene = *terrain;
+  Result reference = draw(*context, scene, camera, 160, 100, pointMethod("atomicmin"), DepthMode::Int40);
   // Same pixels lit as with float depth; colors are RGB with alpha restored.
-  Result floatDepth = draw(*context, scene, camera, 160, 100, Method::AtomicMin);
+  Result floatDepth = draw(*context, scene, camera, 160, 100, pointMethod("atomicmin"));
   size_t samePixels = 0;
   for (size_t i = 0; i < reference.words.size(); ++i)
     samePixels += (reference.words[i] == ~0ull) == (floatDepth.words[i] == ~0ull);
@@ -160,7 +229,7 @@ double backSurfaceFraction(gpu::Context& context, double gap, double distance, D
   UploadOptions upload;
   upload.progress = false;
   GpuScene scene(context, cloud, upload);
-  Result r = draw(context, scene, camera, 128, 128, Method::AtomicMin, mode);
+  Result r = draw(context, scene, camera, 128, 128, pointMethod("atomicmin"), mode);
   size_t back = 0, lit = 0;
   for (uint32_t c : r.image) {
     lit += c != 0;
@@ -272,8 +341,8 @@ TEST_F(GpuTest, HqsMatchesCpuAverageAndHqs1rMatchesHqs) {
   upload.progress = false;
   GpuScene scene(*context, cloud, upload);
   std::vector<uint32_t> cpu = cpuHqs(view, colors, pixels, W * H);
-  std::vector<uint32_t> hqs = draw(*context, scene, camera, W, H, Method::Hqs).image;
-  std::vector<uint32_t> hqs1r = draw(*context, scene, camera, W, H, Method::Hqs1r).image;
+  std::vector<uint32_t> hqs = draw(*context, scene, camera, W, H, pointMethod("hqs")).image;
+  std::vector<uint32_t> hqs1r = draw(*context, scene, camera, W, H, pointMethod("hqs1r")).image;
   auto maxChannelDiff = [](const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
     int worst = 0;
     for (size_t i = 0; i < a.size(); ++i)
@@ -294,11 +363,11 @@ TEST_F(GpuTest, UnsupportedCombinationsAreClearErrors) {
   GpuScene scene(*context, cloud, upload);
   Renderer renderer(*context, 8, 8);
   RenderSettings settings;
-  settings.method = Method::Hqs;
+  settings.method = pointMethod("hqs");
   settings.depth = DepthMode::Int40;
   EXPECT_THROW(renderer.render(scene, overviewCamera(cloud.bounds, 1.0), settings), InputError);
-  if (!Renderer::supports(*context, Method::Dedup)) {
-    settings.method = Method::Dedup;
+  if (!Renderer::supports(*context, pointMethod("dedup"))) {
+    settings.method = pointMethod("dedup");
     settings.depth = DepthMode::Float;
     EXPECT_THROW(renderer.render(scene, overviewCamera(cloud.bounds, 1.0), settings), UnsupportedError);
   }

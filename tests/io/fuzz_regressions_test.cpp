@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 using pointrast::InputError;
 namespace io = pointrast::io;
 
-const fs::path kRegressions = POINTRAST_FUZZ_REGRESSIONS;
+const fs::path kRegressions = fs::path(POINTRAST_SOURCE_DIR) / "tests" / "fuzz" / "regressions";
 
 // Each reader a target calls; every call must succeed or throw InputError.
 const std::map<std::string, std::vector<std::function<void(const fs::path&)>>> kReaders = {

@@ -15,12 +15,19 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "io/format_table.h"
 #include "io/reader.h"
 
 namespace iotest {
 
 inline std::filesystem::path data(const std::string& relative) {
   return std::filesystem::path(POINTRAST_DATA_DIR) / relative;
+}
+
+// The name of the format row that recognises the file ("LAS", "XYZ"...), empty when none does.
+inline std::string formatOf(const std::filesystem::path& path) {
+  const pointrast::io::FormatInfo* format = pointrast::io::detectFormat(path);
+  return format ? format->name : "";
 }
 
 inline pointrast::io::ReadOptions quiet() {

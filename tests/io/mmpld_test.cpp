@@ -16,6 +16,7 @@ using pointrast::particleRamp;
 using pointrast::ParticleSet;
 using namespace pointrast::io;
 using iotest::data;
+using iotest::formatOf;
 
 namespace {
 
@@ -192,7 +193,7 @@ class ReferenceFile : public ::testing::TestWithParam<Reference> {};
 TEST_P(ReferenceFile, HeadersAreAsStated) {
   const Reference& r = GetParam();
   const MmpldInfo info = probeMmpld(referencePath(r));
-  EXPECT_EQ(detectFormat(referencePath(r)), Format::Mmpld);
+  EXPECT_EQ(formatOf(referencePath(r)), "MMPLD");
   EXPECT_EQ(info.version, 102);
   EXPECT_EQ(info.frames, 1u);
   EXPECT_TRUE(info.hasTimestamp);

@@ -46,7 +46,7 @@ TEST(PlyReader, SimpleTextAndBinaryAgree) {
   EXPECT_EQ(text.bounds.min, glm::dvec3(-1, 0, 0));
   EXPECT_EQ(text.bounds.max, glm::dvec3(1, 1, 0));
   FileInfo info = probeFile(data("ply/simple_binary.ply"));
-  EXPECT_EQ(info.format, Format::Ply);
+  EXPECT_STREQ(info.format->name, "PLY");
   EXPECT_EQ(info.formatDetail, "PLY binary_little_endian 1.0");
   EXPECT_EQ(info.pointCount, 3u);
   EXPECT_FALSE(info.boundsFromHeader);

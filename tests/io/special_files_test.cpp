@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/format_table.h"
 #include "io/formats.h"
 #include "io/io_test_util.h"
 #include "io/las_format.h"
@@ -72,7 +73,7 @@ TEST(SpecialFiles, NamedPipeIsRefusedWithoutWaitingForAWriter) {
 
 TEST(SpecialFiles, DirectoriesAndDevicesAreNamedForWhatTheyAre) {
   iotest::TempDir dir;
-  EXPECT_NE(refusal([&] { readCloud(dir.path(), iotest::quiet()); }).find("is a directory"),
+  EXPECT_NE(refusal([&] { readCloud(dir.path(), iotest::quiet()); }).find("a folder, not a point cloud file"),
             std::string::npos);
   EXPECT_NE(refusal([] { probeFile("/dev/null"); }).find("/dev/null: is a character device"),
             std::string::npos);

@@ -9,6 +9,7 @@ using pointrast::packRgba;
 using pointrast::PointCloud;
 using namespace pointrast::io;
 using iotest::data;
+using iotest::formatOf;
 using iotest::quiet;
 
 namespace {
@@ -28,7 +29,7 @@ std::string refusal(const std::string& text, const std::string& name = "t.csv") 
 }
 
 TEST(XyzReader, GriddedDem) {
-  EXPECT_EQ(detectFormat(data("xyz/data.xyz")), Format::Xyz);
+  EXPECT_EQ(formatOf(data("xyz/data.xyz")), "XYZ");
   PointCloud cloud = readCloud(data("xyz/data.xyz"), quiet());
   ASSERT_EQ(cloud.size(), 400u);
   EXPECT_FALSE(cloud.hasColor());
@@ -41,7 +42,7 @@ TEST(XyzReader, GriddedDem) {
   EXPECT_NEAR(cloud.world(0).y, 3751290, 1e-6);
   EXPECT_NEAR(cloud.world(0).z, 107, 1e-6);
   FileInfo info = probeFile(data("xyz/data.xyz"));
-  EXPECT_EQ(info.format, Format::Xyz);
+  EXPECT_STREQ(info.format->name, "XYZ");
   EXPECT_EQ(info.pointCount, 400u);
   EXPECT_EQ(info.formatDetail, "XYZ text, 3 columns (x y z)");
 }
@@ -151,10 +152,10 @@ TEST(XyzReader, OnlyTextExtensionsAreTriedAsText) {
   iotest::TempDir dir;
   for (const char* name : {"a.xyz", "a.TXT", "a.csv", "a.pts"}) {
     iotest::writeText(dir / name, "1 2 3\n");
-    EXPECT_EQ(detectFormat(dir / name), Format::Xyz) << name;
+    EXPECT_EQ(formatOf(dir / name), "XYZ") << name;
   }
   iotest::writeText(dir / "a.dat", "1 2 3\n");
-  EXPECT_EQ(detectFormat(dir / "a.dat"), Format::Unknown);
+  EXPECT_EQ(formatOf(dir / "a.dat"), "");
   EXPECT_THROW(readCloud(dir / "a.dat", quiet()), InputError);
 }
 

@@ -1,0 +1,118 @@
+// pointrast view [FILE|SCENE]: the desktop viewer.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "base/error.h"
+#include "base/progress.h"
+#include "cli_util.h"
+#include "commands.h"
+#include "input.h"
+#include "view/desktop/viewer.h"
+
+namespace pointrast::app {
+
+namespace {
+
+struct ViewArgs {
+  std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
+  std::string method = "atomicmin", points = "1M", path = "path.json", screenshots = ".";
+  uint32_t width = 1280, height = 720;
+  double fov = 60;
+  uint64_t seed = 1;
+  std::optional<uint32_t> device;
+  bool noPanel = false, noVsync = false, events = false, quiet = false;
+};
+
+int runView(const ViewArgs& a) {
+  // Said before anything is loaded: there is no window to show it in.
+  if (!view::hasDisplay())
+    throw InputError("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset): view in a "
+                     "browser with `pointrast serve`, or render images with `pointrast render`");
+  Progress::setEnabled(!a.quiet);
+  view::ViewerOptions options;
+  options.width = a.width;
+  options.height = a.height;
+  options.vsync = !a.noVsync;
+  options.panel = !a.noPanel;
+  options.events = a.events;
+  options.fovY = a.fov;
+  options.settings.method = parseMethod(a.method);
+  options.settings.background = parseRgb(a.background, "--background");
+  options.pathFile = a.path;
+  options.screenshotDir = a.screenshots;
+  options.device = a.device;
+  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+
+  InputSpec spec;
+  spec.source = a.input;
+  spec.points = parseCount(a.points, "--points");
+  spec.seed = a.seed;
+  spec.order = parseOrder(a.order);
+  spec.progress = !a.quiet;
+  PointCloud cloud = loadInput(spec);
+  if (!a.eye.empty()) {
+    Camera camera;
+    camera.eye = parseVec3(a.eye, "--eye");
+    camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
+    camera.up = parseVec3(a.up, "--up");
+    camera.fovY = a.fov;
+    validateCamera(camera);
+    options.camera = camera;
+  }
+  options.title = "pointrast - " + cloud.source;
+  return view::runViewer(cloud, options);
+}
+
+} // namespace
+
+Command addView(CLI::App& app) {
+  auto a = std::make_shared<ViewArgs>();
+  CLI::App* cmd =
+      app.add_subcommand("view", "View a point cloud in a window (GLFW + Vulkan), with a settings panel");
+  cmd->footer(
+      "\nMouse: left drag orbits around the pivot, right or middle drag pans, the wheel zooms towards the\n"
+      "point under the cursor, a double-click makes the clicked point the pivot.\n"
+      "Keys: W A S D Q E fly (Shift: faster); 8 2 5 0 4 6 top, bottom, front, back, left, right views,\n"
+      "1 the overview's direction; F frames the whole cloud; K records a keyframe (saved to --path at "
+      "once);\n"
+      "C prints the camera as render options; F12 writes a screenshot; H hides the panel; Escape quits.\n"
+      "Keyframes render to a video with `pointrast render FILE --path path.json --video out.mp4`.\n"
+      "Without a display, use `pointrast serve` (a browser) or `pointrast render` (images).\n\n"
+      "Examples:\n"
+      "  pointrast view autzen.las\n"
+      "  pointrast view terrain --points 10M --method batch-prefetch\n"
+      "  pointrast view autzen.las --eye 636000,848900,700 --target 636600,849200,450 --no-panel");
+  cmd->add_option("FILE", a->input,
+                  "LAS/PLY/XYZ file, or a scene name (terrain, tls); default: the demo scene");
+  cmd->add_option("--width", a->width, "Window width in pixels")->capture_default_str();
+  cmd->add_option("--height", a->height, "Window height in pixels")->capture_default_str();
+  cmd->add_option("--eye", a->eye, "Starting camera position x,y,z (default: overview)");
+  cmd->add_option("--target", a->target, "Point looked at x,y,z (default: center of the bounds)");
+  cmd->add_option("--up", a->up, "Up direction x,y,z")->capture_default_str();
+  cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
+  cmd->add_option("--method", a->method, "Rasterization method (changeable in the panel)")
+      ->capture_default_str();
+  cmd->add_option("--background", a->background, "Background color r,g,b (0..255)")->capture_default_str();
+  cmd->add_option("--order", a->order, "Vertex order: original, morton, shuffled, shuffled-morton")
+      ->capture_default_str();
+  cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 100M)")
+      ->capture_default_str();
+  cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
+  cmd->add_option("--path", a->path, "Keyframes file: loaded when it exists, written on every K")
+      ->capture_default_str();
+  cmd->add_option("--screenshot-dir", a->screenshots, "Folder of F12 screenshots (pointrast-0001.png, ...)")
+      ->capture_default_str();
+  cmd->add_flag("--no-panel", a->noPanel, "Start with the panel hidden (H toggles it)");
+  cmd->add_flag("--no-vsync", a->noVsync, "Present as fast as frames come instead of at the display's rate");
+  cmd->add_flag(
+      "--events", a->events,
+      "Print one JSON object a line on stdout for every frame shown and every action (for scripts)");
+  cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
+  cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
+  return [a] { return runView(*a); };
+}
+
+} // namespace pointrast::app

@@ -1,0 +1,37 @@
+// The viewer's settings panel (Dear ImGui): method, background, camera views, keyframes, screenshots and
+// live statistics. Built once per shown frame; edits go to a copy of the settings that the caller hands
+// to Session::setSettings, which renders only when something really changed.
+#pragma once
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "view/session.h"
+
+namespace pointrast::view {
+
+struct PanelInfo {
+  std::string device;
+  std::string input;
+  uint64_t points = 0;
+  std::vector<Method> methods; // the methods this device runs
+  std::string pathFile;
+};
+
+struct PanelActions {
+  bool screenshot = false;
+  bool frameAll = false;
+  bool addKeyframe = false;
+  bool clearKeyframes = false;
+  std::optional<StandardView> view;
+};
+
+// Screen rectangles (x, y, width, height in pixels) of the panel's controls by label, for --events.
+using PanelItems = std::map<std::string, std::array<float, 4>>;
+
+PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& settings, PanelItems& items);
+
+} // namespace pointrast::view

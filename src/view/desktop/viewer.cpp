@@ -1,0 +1,365 @@
+#include "view/desktop/viewer.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <system_error>
+
+#include <imgui.h>
+#include <nlohmann/json.hpp>
+
+#include "base/error.h"
+#include "cloud/cloud.h"
+#include "gpu/context.h"
+#include "gpu/swapchain.h"
+#include "io/writer.h"
+#include "view/desktop/glfw_api.h"
+#include "view/desktop/input.h"
+#include "view/desktop/panel.h"
+#include "view/desktop/presenter.h"
+#include "view/scene_view.h"
+
+namespace pointrast::view {
+
+namespace {
+
+// While idle the loop sleeps in the window system until an event comes, waking this often at most.
+constexpr double kIdleWaitSeconds = 0.5;
+
+// GLFW's library and its window, released in the right order by scope.
+struct GlfwLibrary {
+  GlfwLibrary() {
+    glfw::load();
+    glfw::glfwSetErrorCallback(
+        [](int, const char* text) { std::fprintf(stderr, "pointrast: GLFW: %s\n", text); });
+    if (!glfw::glfwInit())
+      throw UnsupportedError("cannot open the display: use `pointrast serve` to view in a browser, or "
+                             "`pointrast render` for images");
+  }
+  ~GlfwLibrary() { glfw::glfwTerminate(); }
+};
+
+struct Window {
+  GLFWwindow* handle = nullptr;
+  Window(uint32_t width, uint32_t height, const std::string& title) {
+    glfw::glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API); // Vulkan draws, no OpenGL context
+    handle = glfw::glfwCreateWindow(int(width), int(height), title.c_str(), nullptr, nullptr);
+    if (!handle) throw UnsupportedError("cannot create a window on this display");
+  }
+  ~Window() { glfw::glfwDestroyWindow(handle); }
+};
+
+struct ImGuiContextScope {
+  ImGuiContextScope() {
+    ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    io.IniFilename = nullptr; // the panel's layout is not worth a file in the user's folder
+    io.LogFilename = nullptr;
+    mapImGuiKeys(io);
+  }
+  ~ImGuiContextScope() { ImGui::DestroyContext(); }
+};
+
+gpu::Context createContext(const ViewerOptions& options) {
+  if (!glfw::glfwVulkanSupported())
+    throw UnsupportedError("GLFW finds no Vulkan loader to show a window with");
+  uint32_t count = 0;
+  const char** names = glfw::glfwGetRequiredInstanceExtensions(&count);
+  if (!names) throw UnsupportedError("this display offers no Vulkan surface extension");
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = options.device;
+  contextOptions.surfaceExtensions.assign(names, names + count);
+  return gpu::Context(contextOptions);
+}
+
+nlohmann::json vec(const glm::dvec3& v) {
+  return {v.x, v.y, v.z};
+}
+
+nlohmann::json cameraJson(const Camera& c) {
+  return {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", c.fovY}};
+}
+
+void emit(const nlohmann::json& event) {
+  std::printf("%s\n", event.dump().c_str());
+  std::fflush(stdout);
+}
+
+// pointrast-0001.png, pointrast-0002.png, ...: the first name not taken in the folder.
+std::filesystem::path screenshotName(const std::filesystem::path& folder) {
+  for (uint32_t n = 1;; ++n) {
+    char name[32];
+    std::snprintf(name, sizeof name, "pointrast-%04u.png", n);
+    std::filesystem::path p = folder / name;
+    std::error_code error;
+    if (!std::filesystem::exists(p, error)) return p;
+  }
+}
+
+class Viewer {
+public:
+  Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Context& context, GLFWwindow* window,
+         gpu::Swapchain& swapchain);
+  int run();
+
+private:
+  void showFrame();
+  void handleRequests();
+  void handlePanel(const PanelActions& actions);
+  void takeScreenshot();
+  void saveKeyframes();
+  ImDrawData* buildPanelFrame(double seconds);
+
+  const PointCloud& cloud_;
+  const ViewerOptions& options_;
+  gpu::Context& context_;
+  GLFWwindow* window_;
+  gpu::Swapchain& swapchain_;
+  GpuCloud gpuCloud_;
+  SceneView scene_;
+  Session session_;
+  DesktopInput input_;
+  Presenter presenter_;
+  PanelInfo info_;
+  PanelItems items_;
+  ShownImage shown_;
+  int presentsPending_ = 1;
+  size_t savedKeyframes_ = 0;
+  bool swapchainStale_ = false;
+  bool running_ = true;
+};
+
+Camera startCamera(const PointCloud& cloud, const ViewerOptions& options, Viewport viewport) {
+  if (options.camera) return *options.camera;
+  return overviewCamera(cloud.bounds, viewport.aspect(), options.fovY);
+}
+
+Viewport framebufferViewport(GLFWwindow* window) {
+  int w = 0, h = 0;
+  glfw::glfwGetFramebufferSize(window, &w, &h);
+  return {uint32_t(std::max(w, 1)), uint32_t(std::max(h, 1))};
+}
+
+Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Context& context,
+               GLFWwindow* window, gpu::Swapchain& swapchain)
+    : cloud_(cloud), options_(options), context_(context), window_(window), swapchain_(swapchain),
+      gpuCloud_(context, cloud), scene_(context, gpuCloud_),
+      session_(cloud.bounds, startCamera(cloud, options, {swapchain.width(), swapchain.height()}),
+               {swapchain.width(), swapchain.height()}, options.settings),
+      input_(window, session_), presenter_(context, swapchain) {
+  session_.options().panel = options.panel;
+  session_.setContentSource(&scene_);
+  std::error_code error;
+  if (std::filesystem::exists(options.pathFile, error)) {
+    CameraPath loaded = CameraPath::load(options.pathFile);
+    session_.path() = loaded;
+    savedKeyframes_ = loaded.keyframes().size();
+  }
+  info_.device = context.info().name;
+  info_.input = cloud.source;
+  info_.points = cloud.size();
+  info_.pathFile = options.pathFile.string();
+  for (Method m : allMethods())
+    if (Renderer::supports(context, m)) info_.methods.push_back(m);
+}
+
+ImDrawData* Viewer::buildPanelFrame(double seconds) {
+  input_.setPanelVisible(session_.options().panel);
+  if (!session_.options().panel) return nullptr;
+  ImGuiIO& io = ImGui::GetIO();
+  io.DisplaySize = ImVec2(float(swapchain_.width()), float(swapchain_.height()));
+  io.DeltaTime = float(std::max(seconds, 1e-4));
+  ImGui::NewFrame();
+  input_.panelFrameDone();
+  ViewSettings edited = session_.settings();
+  PanelActions actions = buildPanel(session_, info_, edited, items_);
+  ImGui::Render();
+  input_.setPanelRect(items_["panel"]);
+  session_.setSettings(edited);
+  handlePanel(actions);
+  return ImGui::GetDrawData();
+}
+
+void Viewer::handlePanel(const PanelActions& actions) {
+  Viewport viewport = session_.viewport();
+  if (actions.frameAll) session_.keyDown(Key::FrameAll);
+  if (actions.view) {
+    session_.navigation().viewFrom(*actions.view, viewport);
+    session_.invalidate();
+  }
+  if (actions.addKeyframe) session_.keyDown(Key::Keyframe);
+  if (actions.clearKeyframes) {
+    session_.path().clear();
+    saveKeyframes();
+  }
+  if (actions.screenshot) takeScreenshot();
+}
+
+void Viewer::saveKeyframes() {
+  session_.path().save(options_.pathFile);
+  savedKeyframes_ = session_.path().keyframes().size();
+  if (options_.events)
+    emit({{"event", "keyframes"},
+          {"count", session_.path().keyframes().size()},
+          {"duration", session_.path().duration()},
+          {"file", options_.pathFile.string()}});
+  else
+    std::printf("%zu keyframes (%.2f s) saved to %s\n", session_.path().keyframes().size(),
+                session_.path().duration(), options_.pathFile.string().c_str());
+}
+
+void Viewer::takeScreenshot() {
+  std::filesystem::path file = screenshotName(options_.screenshotDir);
+  Viewport viewport = session_.viewport();
+  std::vector<uint32_t> pixels =
+      scene_.screenshot(session_.camera(), session_.settings(), viewport, session_.options().supersample);
+  io::writePng(file, viewport.width, viewport.height, pixels.data());
+  session_.invalidate(); // a supersampled shot used another renderer; draw the window's image again
+  if (options_.events)
+    emit({{"event", "screenshot"},
+          {"file", file.string()},
+          {"width", viewport.width},
+          {"height", viewport.height}});
+  else
+    std::printf("screenshot: %s (%ux%u)\n", file.string().c_str(), viewport.width, viewport.height);
+  std::fflush(stdout);
+}
+
+void Viewer::handleRequests() {
+  if (auto wheel = input_.takeWheel()) {
+    std::optional<double> depth =
+        scene_.depthAt(session_.camera(), session_.settings(), session_.viewport(), wheel->position);
+    session_.wheel(wheel->position, wheel->steps, depth);
+  }
+  Requests r = session_.takeRequests();
+  if (r.pick) {
+    std::optional<glm::dvec3> point =
+        scene_.pick(session_.camera(), session_.settings(), session_.viewport(), *r.pick);
+    session_.pivotPicked(point);
+    if (options_.events)
+      emit({{"event", "pick"},
+            {"x", r.pick->x},
+            {"y", r.pick->y},
+            {"hit", point.has_value()},
+            {"pivot", vec(session_.pivot())}});
+  }
+  if (r.printCamera) {
+    if (options_.events)
+      emit(
+          {{"event", "camera"}, {"camera", cameraJson(session_.camera())}, {"pivot", vec(session_.pivot())}});
+    else
+      std::printf("camera: %s\n", describeCamera(session_.camera()).c_str());
+    std::fflush(stdout);
+  }
+  if (r.screenshot) takeScreenshot();
+  if (r.quit) running_ = false;
+  // K records in the session as the key arrives; the file follows here.
+  if (session_.path().keyframes().size() != savedKeyframes_) saveKeyframes();
+}
+
+void Viewer::showFrame() {
+  bool rendered = false;
+  FrameReport report;
+  if (session_.needsFrame()) {
+    report = scene_.render(session_.camera(), session_.settings(), session_.viewport());
+    shown_ = {scene_.renderer().imageAddress(), scene_.renderer().width(), scene_.renderer().height()};
+    rendered = true;
+  }
+  if (!rendered && presentsPending_ == 0) return;
+  Presenter::Result result =
+      presenter_.present(shown_, session_.options().panel ? ImGui::GetDrawData() : nullptr);
+  if (!result.presented) swapchainStale_ = true;
+  presentsPending_ = std::max(0, presentsPending_ - 1);
+  if (!rendered) return;
+  report.presentMs = result.gpuMs;
+  session_.frameRendered(report);
+  if (!options_.events) return;
+  nlohmann::json event = {{"event", "frame"},
+                          {"frame", session_.statistics().frames},
+                          {"width", shown_.width},
+                          {"height", shown_.height},
+                          {"camera", cameraJson(session_.camera())},
+                          {"pivot", vec(session_.pivot())},
+                          {"method", methodName(session_.settings().method)},
+                          {"background", session_.settings().background},
+                          {"panel", session_.options().panel},
+                          {"render_ms", report.renderMs},
+                          {"present_ms", report.presentMs}};
+  if (session_.options().panel) {
+    nlohmann::json items = nlohmann::json::object();
+    for (const auto& [label, rect] : items_)
+      items[label] = {rect[0], rect[1], rect[2], rect[3]};
+    event["panel_items"] = items;
+  }
+  emit(event);
+}
+
+int Viewer::run() {
+  double last = glfw::glfwGetTime();
+  while (running_ && !glfw::glfwWindowShouldClose(window_)) {
+    bool busy = session_.animating() || presentsPending_ > 0 || session_.needsFrame() || swapchainStale_;
+    if (busy)
+      glfw::glfwPollEvents();
+    else
+      glfw::glfwWaitEventsTimeout(kIdleWaitSeconds);
+    // Input changes the panel's look (hover, clicks): show two frames, the second with the settled state.
+    if (input_.takeArrived()) presentsPending_ = std::max(presentsPending_, 2);
+    double now = glfw::glfwGetTime();
+    session_.advance(now - last);
+    Viewport fb = framebufferViewport(window_);
+    int w = 0, h = 0;
+    glfw::glfwGetFramebufferSize(window_, &w, &h);
+    if (w == 0 || h == 0) { // minimized: nothing to show
+      last = now;
+      continue;
+    }
+    if (swapchainStale_ || fb.width != swapchain_.width() || fb.height != swapchain_.height()) {
+      swapchain_.recreate(fb.width, fb.height);
+      session_.resize({swapchain_.width(), swapchain_.height()});
+      swapchainStale_ = false;
+      presentsPending_ = std::max(presentsPending_, 1);
+    }
+    handleRequests();
+    buildPanelFrame(now - last);
+    last = now;
+    showFrame();
+  }
+  uint32_t errors = context_.validationErrors();
+  if (options_.events)
+    emit({{"event", "exit"},
+          {"frames", session_.statistics().frames},
+          {"camera", cameraJson(session_.camera())},
+          {"pivot", vec(session_.pivot())},
+          {"validation_errors", errors}});
+  if (errors > 0) {
+    std::fprintf(stderr, "pointrast: the Vulkan validation layer reported %u error(s)\n", errors);
+    return 1;
+  }
+  return 0;
+}
+
+} // namespace
+
+bool hasDisplay() {
+  const char* x11 = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  return (x11 && *x11) || (wayland && *wayland);
+}
+
+int runViewer(const PointCloud& cloud, const ViewerOptions& options) {
+  if (options.width == 0 || options.height == 0) throw InputError("--width and --height must be at least 1");
+  if (cloud.size() == 0) throw InputError(cloud.source + ": no points to view");
+  GlfwLibrary library;
+  gpu::Context context = createContext(options);
+  Window window(options.width, options.height, options.title);
+  VkSurfaceKHR surface = VK_NULL_HANDLE;
+  VK_CHECK(glfw::glfwCreateWindowSurface(context.instance(), window.handle, nullptr, &surface));
+  Viewport fb = framebufferViewport(window.handle);
+  gpu::Swapchain swapchain(context, surface, fb.width, fb.height, options.vsync);
+  ImGuiContextScope imgui;
+  Viewer viewer(cloud, options, context, window.handle, swapchain);
+  return viewer.run();
+}
+
+} // namespace pointrast::view

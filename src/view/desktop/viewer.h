@@ -1,0 +1,43 @@
+// The desktop viewer: a GLFW window with a Vulkan swapchain showing the session's frames, navigation by
+// mouse and keys, and a Dear ImGui panel. One function for app/ to call.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "render/camera.h"
+#include "view/session.h"
+
+namespace pointrast {
+struct PointCloud;
+}
+
+namespace pointrast::view {
+
+struct ViewerOptions {
+  uint32_t width = 1280, height = 720; // the window's initial size in pixels
+  bool vsync = true;
+  bool panel = true;
+  // One JSON object a line on stdout for every frame shown and every action (picks, screenshots,
+  // keyframes, the exit), for scripts and tests that drive the viewer.
+  bool events = false;
+  std::optional<Camera> camera; // starting camera; the overview when absent
+  double fovY = 60;             // of the overview
+  ViewSettings settings;
+  std::filesystem::path pathFile = "path.json"; // keyframes: loaded when it exists, saved on every K
+  std::filesystem::path screenshotDir = ".";    // F12 writes pointrast-NNNN.png here
+  std::optional<uint32_t> device;
+  std::string title = "pointrast";
+};
+
+// Whether a display is there to open a window on: X11 (DISPLAY) or Wayland (WAYLAND_DISPLAY).
+bool hasDisplay();
+
+// Runs the viewer until the window is closed or Escape is pressed. Returns the exit code (1 when the
+// validation layer reported errors). Throws UnsupportedError without GLFW, a display or a presenting
+// device, InputError for bad options.
+int runViewer(const PointCloud& cloud, const ViewerOptions& options);
+
+} // namespace pointrast::view

@@ -1,0 +1,185 @@
+#include "view/scene_view.h"
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+
+#include "cloud/cloud.h"
+#include "gpu/context.h"
+#include "render/scene.h"
+
+namespace pointrast::view {
+
+namespace {
+
+// Where picking reads canonical words: the current method when it writes them with float depth, else the
+// plain closest-point method of the same scene layout.
+RenderSettings pickSettings(const ViewSettings& view) {
+  RenderSettings settings = renderSettings(view);
+  const MethodInfo& info = methodInfo(view.method);
+  if (info.output != MethodOutput::Closest)
+    settings.method = info.layout == SceneLayout::Batched ? pointMethod("batch") : pointMethod("atomicmin");
+  settings.depth = DepthMode::Float;
+  settings.captureWords = true;
+  return settings;
+}
+
+constexpr uint64_t kEmptyWord = ~0ull;
+
+} // namespace
+
+RenderSettings renderSettings(const ViewSettings& view) {
+  RenderSettings settings;
+  settings.method = view.method;
+  settings.background = view.background;
+  settings.frames = 1;
+  settings.warmup = 0;
+  return settings;
+}
+
+std::vector<uint32_t> boxDownsample(std::span<const uint32_t> rgba, uint32_t width, uint32_t height,
+                                    uint32_t factor) {
+  assert(factor > 0 && width % factor == 0 && height % factor == 0 &&
+         rgba.size() == uint64_t(width) * height);
+  uint32_t w = width / factor, h = height / factor;
+  std::vector<uint32_t> out(uint64_t(w) * h);
+  uint32_t count = factor * factor;
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x) {
+      uint32_t sum[4] = {0, 0, 0, 0};
+      for (uint32_t dy = 0; dy < factor; ++dy)
+        for (uint32_t dx = 0; dx < factor; ++dx) {
+          uint32_t p = rgba[(uint64_t(y) * factor + dy) * width + uint64_t(x) * factor + dx];
+          for (int c = 0; c < 4; ++c)
+            sum[c] += (p >> (8 * c)) & 0xFF;
+        }
+      uint32_t pixel = 0;
+      for (int c = 0; c < 4; ++c)
+        pixel |= ((sum[c] + count / 2) / count) << (8 * c);
+      out[uint64_t(y) * w + x] = pixel;
+    }
+  return out;
+}
+
+GpuCloud::GpuCloud(gpu::Context& context, const PointCloud& cloud, bool progress)
+    : context_(context), cloud_(cloud), progress_(progress) {}
+
+GpuCloud::~GpuCloud() = default;
+
+const GpuScene& GpuCloud::scene(SceneLayout layout) {
+  std::unique_ptr<GpuScene>& slot = scenes_[int(layout)];
+  if (!slot) {
+    UploadOptions upload;
+    upload.layout = layout;
+    upload.progress = progress_;
+    slot = std::make_unique<GpuScene>(context_, cloud_, upload);
+  }
+  return *slot;
+}
+
+const Bounds& GpuCloud::bounds() const {
+  return cloud_.bounds;
+}
+
+uint64_t GpuCloud::pointCount() const {
+  return cloud_.size();
+}
+
+uint64_t GpuCloud::bytes() const {
+  uint64_t bytes = 0;
+  for (const auto& s : scenes_)
+    if (s) bytes += s->bytes();
+  return bytes;
+}
+
+SceneView::SceneView(gpu::Context& context, GpuCloud& cloud) : context_(context), cloud_(cloud) {}
+
+SceneView::~SceneView() = default;
+
+uint64_t SceneView::gpuBytes() const {
+  uint64_t bytes = cloud_.bytes();
+  // Framebuffer (8 B), image (4 B) and, once a pick asked for them, canonical words (8 B) per pixel.
+  if (renderer_) bytes += uint64_t(renderer_->width()) * renderer_->height() * 20;
+  return bytes;
+}
+
+void SceneView::ensureRenderer(Viewport viewport) {
+  if (renderer_ && renderer_->width() == viewport.width && renderer_->height() == viewport.height) return;
+  renderer_.reset(); // its targets go before the new ones are allocated
+  renderer_ = std::make_unique<Renderer>(context_, viewport.width, viewport.height);
+}
+
+FrameReport SceneView::render(const Camera& camera, const ViewSettings& settings, Viewport viewport) {
+  auto start = std::chrono::steady_clock::now();
+  ensureRenderer(viewport);
+  RenderSettings rs = renderSettings(settings);
+  const GpuScene& s = scene(methodInfo(settings.method).layout);
+  FrameStats stats = renderer_->render(s, camera, rs);
+  FrameReport report;
+  report.renderMs = stats.medianMs;
+  report.points = stats.points;
+  report.batch = stats.batch;
+  report.gpuBytes = gpuBytes();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+std::optional<SceneView::Picked> SceneView::pickPoint(const Camera& camera, const ViewSettings& settings,
+                                                      Viewport viewport, glm::dvec2 position) {
+  if (!(position.x >= 0 && position.y >= 0 && position.x < viewport.width && position.y < viewport.height))
+    return std::nullopt;
+  ensureRenderer(viewport);
+  RenderSettings rs = pickSettings(settings);
+  renderer_->render(scene(methodInfo(rs.method).layout), camera, rs);
+  int px = int(position.x), py = int(position.y), r = int(kPickRadius);
+  int x0 = std::max(0, px - r), y0 = std::max(0, py - r);
+  int x1 = std::min(int(viewport.width) - 1, px + r), y1 = std::min(int(viewport.height) - 1, py + r);
+  std::vector<uint64_t> words =
+      renderer_->framebufferWords(uint32_t(x0), uint32_t(y0), uint32_t(x1 - x0 + 1), uint32_t(y1 - y0 + 1));
+  std::optional<Picked> best;
+  int bestDistance = 0;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      uint64_t word = words[size_t(y - y0) * size_t(x1 - x0 + 1) + size_t(x - x0)];
+      if (word == kEmptyWord) continue;
+      int distance = (x - px) * (x - px) + (y - py) * (y - py);
+      double depth = std::bit_cast<float>(uint32_t(word >> 32));
+      if (best && (distance > bestDistance || (distance == bestDistance && depth >= best->depth))) continue;
+      // The point lies somewhere in its pixel: its center is within half a pixel's footprint of it.
+      best = Picked{unproject(camera, viewport, {x + 0.5, y + 0.5}, depth), depth};
+      bestDistance = distance;
+    }
+  // Picking may have drawn with another method: show the current one again.
+  if (rs.method != settings.method) render(camera, settings, viewport);
+  return best;
+}
+
+std::optional<glm::dvec3> SceneView::pick(const Camera& camera, const ViewSettings& settings,
+                                          Viewport viewport, glm::dvec2 position) {
+  auto picked = pickPoint(camera, settings, viewport, position);
+  if (!picked) return std::nullopt;
+  return picked->point;
+}
+
+std::optional<double> SceneView::depthAt(const Camera& camera, const ViewSettings& settings,
+                                         Viewport viewport, glm::dvec2 position) {
+  auto picked = pickPoint(camera, settings, viewport, position);
+  if (!picked) return std::nullopt;
+  return picked->depth;
+}
+
+std::vector<uint32_t> SceneView::screenshot(const Camera& camera, const ViewSettings& settings,
+                                            Viewport viewport, uint32_t supersample) {
+  if (supersample <= 1) {
+    render(camera, settings, viewport);
+    return renderer_->image();
+  }
+  Renderer big(context_, viewport.width * supersample, viewport.height * supersample);
+  big.render(scene(methodInfo(settings.method).layout), camera, renderSettings(settings));
+  std::vector<uint32_t> pixels = big.image();
+  return boxDownsample(pixels, big.width(), big.height(), supersample);
+}
+
+} // namespace pointrast::view

@@ -1,0 +1,107 @@
+// The GPU side of an interactive session, shared by the front ends: a cloud uploaded in the layouts its
+// methods read (each on first use, GpuCloud), and per view one Renderer at the viewport's size, picking
+// the point under a pixel from the framebuffer words, and screenshots (optionally supersampled). Views
+// of one GpuCloud share its uploads: the browser viewer's clients each have a SceneView (their own
+// camera and image size) drawing one GpuCloud. Like the rest of the gpu layer, one thread at a time.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/renderer.h"
+#include "view/navigation.h"
+#include "view/session.h"
+
+namespace pointrast {
+struct PointCloud;
+namespace gpu {
+class Context;
+}
+} // namespace pointrast
+
+namespace pointrast::view {
+
+// The renderer's settings for one interactive frame: one timed frame, no warm-up.
+RenderSettings renderSettings(const ViewSettings& settings);
+
+// Pixels within this distance of a picked position are searched for the closest point, so that a
+// double-click between the points of a sparse cloud still finds one.
+constexpr uint32_t kPickRadius = 2;
+
+// The RGBA8 image of width x height pixels reduced by `factor` per side: each output pixel is the
+// rounded mean of its factor x factor block, per channel. width and height are multiples of factor.
+std::vector<uint32_t> boxDownsample(std::span<const uint32_t> rgba, uint32_t width, uint32_t height,
+                                    uint32_t factor);
+
+class GpuCloud {
+public:
+  // Keeps a reference to the cloud (it must outlive this) to upload a layout when a method first needs
+  // it. Uploads throw UnsupportedError when the device lacks the memory.
+  GpuCloud(gpu::Context& context, const PointCloud& cloud, bool progress = true);
+  ~GpuCloud();
+  const GpuScene& scene(SceneLayout layout);
+  const Bounds& bounds() const;
+  uint64_t pointCount() const;
+  // Bytes of GPU memory of the layouts uploaded so far.
+  uint64_t bytes() const;
+
+private:
+  gpu::Context& context_;
+  const PointCloud& cloud_;
+  bool progress_;
+  std::unique_ptr<GpuScene> scenes_[2]; // by SceneLayout
+};
+
+class SceneView : public ContentSource {
+public:
+  // The cloud must outlive the view.
+  SceneView(gpu::Context& context, GpuCloud& cloud);
+  ~SceneView() override;
+
+  // Renders a frame; recreates the renderer when the viewport changed.
+  FrameReport render(const Camera& camera, const ViewSettings& settings, Viewport viewport);
+  Renderer& renderer() { return *renderer_; }
+  bool hasRenderer() const { return renderer_ != nullptr; }
+
+  // The point under a viewport position (the closest point within kPickRadius pixels, the nearest pixel
+  // first), from the framebuffer words of a closest-point method (the current method when it is one).
+  // The renderer's image is the current settings' again afterwards.
+  std::optional<glm::dvec3> pick(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                                 glm::dvec2 position);
+  // Linear depth of the point pick() would return, for zooming towards the cursor.
+  std::optional<double> depthAt(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                                glm::dvec2 position);
+
+  // RGBA8 pixels (row 0 at the top) of a frame at the viewport's size, rendered at `supersample` times
+  // the size and box-filtered down when supersample > 1.
+  std::vector<uint32_t> screenshot(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                                   uint32_t supersample);
+
+  // The scenes a method reads, uploaded on first use.
+  const GpuScene& scene(SceneLayout layout) { return cloud_.scene(layout); }
+  // Bytes of GPU memory of the uploaded scenes and this view's targets.
+  uint64_t gpuBytes() const;
+
+  // The level-of-detail hook: the brute-force scenes never change; an octree source will answer whether
+  // nodes arrived since the last frame.
+  bool changedSinceLastFrame() override { return false; }
+
+private:
+  struct Picked {
+    glm::dvec3 point;
+    double depth;
+  };
+  void ensureRenderer(Viewport viewport);
+  std::optional<Picked> pickPoint(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                                  glm::dvec2 position);
+  gpu::Context& context_;
+  GpuCloud& cloud_;
+  std::unique_ptr<Renderer> renderer_;
+};
+
+} // namespace pointrast::view

@@ -1,0 +1,166 @@
+// The interactive session every front end shares (the desktop window, the browser viewer): it turns input
+// events into camera moves and requests, holds the view settings, decides when a new frame must be
+// rendered, records keyframes and keeps the statistics of recent frames. No GPU and no window here: a
+// front end translates its events into these calls, asks needsFrame(), renders with SceneView and reports
+// the frame back.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "render/renderer.h"
+#include "view/camera_path.h"
+#include "view/navigation.h"
+
+namespace pointrast::view {
+
+// What a frame is rendered with. Every change goes through Session::setSettings, which compares, so an
+// unchanged panel costs no frame.
+struct ViewSettings {
+  Method method; // the first row of the method table: atomicmin
+  uint32_t background = 0xFF000000u; // RGBA8
+  // The level-of-detail controls (point budget, threshold) and the resolve options (point size, dilation,
+  // eye-dome lighting, coloring) join this struct when their render stages exist; each is compared in
+  // operator== and so triggers a frame like the method does.
+  bool operator==(const ViewSettings&) const = default;
+};
+
+// Front-end state that is not part of the rendered image.
+struct ViewOptions {
+  bool panel = true;        // the settings panel is shown
+  uint32_t supersample = 1; // screenshots: rendered at this multiple, box-filtered down
+  double keyframeSeconds = kDefaultKeyframeSeconds; // spacing of keyframes recorded with K
+};
+
+// Keys the session understands; front ends map their key codes to these.
+enum class Key {
+  Forward,
+  Back,
+  Left,
+  Right,
+  Down,
+  Up,          // fly: W S A D Q E
+  FrameAll,    // F
+  Keyframe,    // K
+  TogglePanel, // H
+  PrintCamera, // C
+  Screenshot,  // F12
+  ViewTop,
+  ViewBottom,
+  ViewFront,
+  ViewBack,
+  ViewLeft,
+  ViewRight,
+  ViewIso, // 8 2 5 0 4 6 and 1
+  Quit,    // Escape
+};
+
+enum class MouseButton { Left, Right, Middle };
+
+// Statistics of one rendered frame, reported by the front end.
+struct FrameReport {
+  double renderMs = 0;  // GPU time of the point rendering (clear + draw + resolve)
+  double presentMs = 0; // GPU time of showing the image (and drawing the panel), where the front end has it
+  uint64_t points = 0;  // points submitted
+  std::optional<BatchStats> batch;
+  uint64_t gpuBytes = 0; // GPU memory the scene and targets occupy
+  double seconds = 0;    // wall-clock time of the frame on the host (render to present)
+};
+
+// Medians over the last kStatsWindow frames.
+struct Statistics {
+  uint64_t frames = 0; // frames rendered since the start
+  double renderMs = 0, presentMs = 0, hostMs = 0;
+  uint64_t points = 0;
+  std::optional<BatchStats> batch; // of the last frame
+  uint64_t gpuBytes = 0;
+};
+constexpr size_t kStatsWindow = 60;
+
+// What a front end must do on the session's behalf, taken (and cleared) by the front end.
+struct Requests {
+  std::optional<glm::dvec2> pick; // read the depth under this viewport position, then call pivotPicked
+  bool screenshot = false;
+  bool printCamera = false;
+  bool quit = false;
+};
+
+// Something besides input that changes what a frame shows: the level-of-detail engine, when nodes
+// arrived since the last frame. The session asks it on every needsFrame().
+class ContentSource {
+public:
+  virtual ~ContentSource() = default;
+  virtual bool changedSinceLastFrame() = 0;
+};
+
+class Session {
+public:
+  Session(const Bounds& bounds, const Camera& camera, Viewport viewport, const ViewSettings& settings = {});
+
+  // Input, in viewport pixels (x right, y down).
+  void mouseDown(MouseButton button, glm::dvec2 position);
+  void mouseMove(glm::dvec2 position);
+  void mouseUp(MouseButton button, glm::dvec2 position);
+  void doubleClick(glm::dvec2 position); // asks for a pick; pivotPicked sets the pivot
+  // Wheel steps (positive: zoom in); `depth` is the linear depth under the cursor when the front end has
+  // it (see Navigation::zoom).
+  void wheel(glm::dvec2 position, double steps, std::optional<double> depth = std::nullopt);
+  void keyDown(Key key, bool shift = false);
+  void keyUp(Key key);
+  void resize(Viewport viewport);
+  // Advances time-based motion (fly keys held); returns whether the camera moved.
+  bool advance(double seconds);
+
+  // Answer to Requests::pick: the point under the position, or nothing (an empty pixel).
+  void pivotPicked(std::optional<glm::dvec3> point);
+  Requests takeRequests();
+
+  const Camera& camera() const { return navigation_.camera(); }
+  const glm::dvec3& pivot() const { return navigation_.pivot(); }
+  Viewport viewport() const { return viewport_; }
+  Navigation& navigation() { return navigation_; }
+  void setCamera(const Camera& camera);
+
+  const ViewSettings& settings() const { return settings_; }
+  void setSettings(const ViewSettings& settings);
+  ViewOptions& options() { return options_; }
+
+  CameraPath& path() { return path_; }
+  void recordKeyframe() { path_.append(camera(), options_.keyframeSeconds); }
+
+  // Whether the image is stale (camera, viewport, settings or content changed since the last frame), or
+  // motion is under way that will change it.
+  bool needsFrame();
+  // Whether keys are held that move the camera over time: the front end keeps the loop running.
+  bool animating() const { return fly_.any(); }
+  void setContentSource(ContentSource* source) { content_ = source; }
+  // Marks the image stale without a camera or settings change (e.g. a method's device state was reset).
+  void invalidate() { ++generation_; }
+  void frameRendered(const FrameReport& report);
+  const Statistics& statistics() const { return statistics_; }
+
+private:
+  void flyKey(Key key, int value);
+  Navigation navigation_;
+  Viewport viewport_;
+  ViewSettings settings_;
+  ViewOptions options_;
+  CameraPath path_;
+  Requests requests_;
+  FlyInput fly_;
+  int flyKeys_[6] = {0, 0, 0, 0, 0, 0}; // held state of Forward..Up
+  uint64_t generation_ = 1, renderedGeneration_ = 0;
+  ContentSource* content_ = nullptr;
+  glm::dvec2 cursor_{0};
+  std::deque<FrameReport> recent_;
+  Statistics statistics_;
+};
+
+// "top", "front", ...: the standard view a key selects, if any.
+std::optional<StandardView> standardViewForKey(Key key);
+
+} // namespace pointrast::view

@@ -1,0 +1,299 @@
+// `pointrast view` in a real window on Xvfb (lavapipe, validation layer on): what the window shows equals
+// `render`, mouse input moves the camera by the expected amounts, a double-click picks a point of the cloud,
+// the panel changes the image, resizing keeps rendering, and the validation layer stays silent.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb_image.h>
+
+#include "cloud/cloud.h"
+#include "io/reader.h"
+#include "viewer_harness.h"
+
+namespace pointrast::test {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr uint32_t kWidth = 480, kHeight = 360;
+
+std::string autzen() {
+  return (dataDir() / "las" / "autzen_trim.las").string();
+}
+
+// A camera over autzen_trim looking north-east and down, so that most pixels hold points.
+const char* kCamera = "--eye 636300,848700,900 --target 636600,849200,450 --up 0,0,1 --fov 60";
+
+std::filesystem::path tempDir() {
+  static std::filesystem::path dir = [] {
+    auto d = std::filesystem::temp_directory_path() / ("pointrast_window_" + std::to_string(getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::vector<uint32_t> readPng(const std::filesystem::path& file, uint32_t& width, uint32_t& height) {
+  int w = 0, h = 0, comp = 0;
+  uint8_t* data = stbi_load(file.c_str(), &w, &h, &comp, 4);
+  std::vector<uint32_t> pixels;
+  if (!data) return pixels;
+  width = uint32_t(w);
+  height = uint32_t(h);
+  pixels.resize(size_t(w) * size_t(h));
+  std::memcpy(pixels.data(), data, pixels.size() * 4);
+  stbi_image_free(data);
+  for (uint32_t& p : pixels)
+    p |= 0xFF000000u;
+  return pixels;
+}
+
+// `pointrast render` with the same input and camera; its pixels.
+std::vector<uint32_t> renderReference(const std::string& args, uint32_t width, uint32_t height) {
+  std::filesystem::path out = tempDir() / "reference.png";
+  std::string command = "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() + "' render " +
+                        args + " --width " + std::to_string(width) + " --height " + std::to_string(height) +
+                        " -o '" + out.string() + "' -q --frames 1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  uint32_t w = 0, h = 0;
+  std::vector<uint32_t> pixels = readPng(out, w, h);
+  EXPECT_EQ(w, width);
+  EXPECT_EQ(h, height);
+  return pixels;
+}
+
+double equalFraction(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+  if (a.size() != b.size() || a.empty()) return 0;
+  size_t same = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    same += a[i] == b[i];
+  return double(same) / double(a.size());
+}
+
+// The window's pixels once they equal `expected` on at least `fraction` of the pixels (the X server shows a
+// presented image a moment after the viewer reports it), or the last capture after `seconds`.
+Capture captureMatching(const std::string& display, unsigned long window,
+                        const std::vector<uint32_t>& expected, double fraction, double seconds = 20) {
+  auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+  Capture capture;
+  do {
+    capture = captureWindow(display, window);
+    if (equalFraction(capture.rgba, expected) >= fraction) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  } while (Clock::now() < deadline);
+  return capture;
+}
+
+glm::dvec3 vec3(const nlohmann::json& j) {
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+std::string cameraArgs(const nlohmann::json& camera) {
+  char text[512];
+  glm::dvec3 e = vec3(camera["eye"]), t = vec3(camera["target"]), u = vec3(camera["up"]);
+  std::snprintf(text, sizeof text,
+                "--eye %.17g,%.17g,%.17g --target %.17g,%.17g,%.17g --up %.17g,%.17g,%.17g --fov %.17g", e.x,
+                e.y, e.z, t.x, t.y, t.z, u.x, u.y, u.z, camera["fov"].get<double>());
+  return text;
+}
+
+class ViewerWindow : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() { xvfb_ = new Xvfb(); }
+  static void TearDownTestSuite() {
+    delete xvfb_;
+    xvfb_ = nullptr;
+  }
+  void SetUp() override {
+    ASSERT_FALSE(xvfb_->display().empty()) << "Xvfb did not start (scripts/install-deps.sh installs xvfb)";
+    ASSERT_EQ(std::system("command -v xdotool >/dev/null"), 0)
+        << "xdotool is missing (scripts/install-deps.sh)";
+  }
+  std::unique_ptr<Viewer> start(const std::string& args) {
+    auto viewer = std::make_unique<Viewer>(
+        xvfb_->display(), args + " --width " + std::to_string(kWidth) + " --height " +
+                              std::to_string(kHeight) + " --path '" + (tempDir() / "path.json").string() +
+                              "' --screenshot-dir '" + tempDir().string() + "'");
+    first_ = viewer->waitEvent("frame", 0, 120);
+    EXPECT_TRUE(first_) << viewer->errors();
+    return viewer;
+  }
+  // Escape: exit status 0 and a silent validation layer.
+  void finish(Viewer& viewer) {
+    EXPECT_EQ(viewer.quit(), 0) << viewer.errors();
+    auto exit = viewer.waitEvent("exit", 0, 5);
+    ASSERT_TRUE(exit) << viewer.errors();
+    EXPECT_EQ((*exit)["validation_errors"].get<int>(), 0) << viewer.errors();
+  }
+  const std::string& display() const { return xvfb_->display(); }
+  static Xvfb* xvfb_;
+  std::optional<nlohmann::json> first_;
+};
+Xvfb* ViewerWindow::xvfb_ = nullptr;
+
+TEST_F(ViewerWindow, ShowsTheSameImageAsRender) {
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  EXPECT_EQ((*first_)["width"].get<uint32_t>(), kWidth);
+  EXPECT_EQ((*first_)["height"].get<uint32_t>(), kHeight);
+  std::vector<uint32_t> expected =
+      renderReference("'" + autzen() + "' " + std::string(kCamera), kWidth, kHeight);
+  Capture shown = captureMatching(display(), viewer->window(), expected, 0.999);
+  ASSERT_EQ(shown.width, kWidth);
+  ASSERT_EQ(shown.height, kHeight);
+  EXPECT_GE(equalFraction(shown.rgba, expected), 0.999);
+  // The image is not trivially empty: points cover a good part of the window (110 k points, gaps between).
+  size_t background = 0;
+  for (uint32_t p : expected)
+    background += p == 0xFF000000u;
+  EXPECT_LT(background, expected.size() * 8 / 10);
+  finish(*viewer);
+}
+
+TEST_F(ViewerWindow, DragOrbitsAroundThePivotByTheExpectedAngle) {
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  size_t from = viewer->eventCount();
+  // 120 px to the right on a 360 px high window: the camera turns by -120/360 * 180 degrees about the
+  // vertical through the pivot (the target), clockwise seen from above.
+  viewer->xdotool("mousemove --window $W 100 200 mousedown 1 mousemove --window $W 160 200 "
+                  "mousemove --window $W 220 200 mouseup 1");
+  glm::dvec3 target{636600, 849200, 450}, eye{636300, 848700, 900};
+  double angle = -120.0 / kHeight * kPi;
+  glm::dvec3 offset = eye - target;
+  glm::dvec3 expected =
+      target + glm::dvec3(offset.x * std::cos(angle) - offset.y * std::sin(angle),
+                          offset.x * std::sin(angle) + offset.y * std::cos(angle), offset.z);
+  auto turned = viewer->waitFor(
+      [&](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && glm::length(vec3(e["camera"]["eye"]) - expected) < 1e-6;
+      },
+      from, 30);
+  ASSERT_TRUE(turned) << "the camera never reached the expected orbit; last: " << viewer->eventCount();
+  EXPECT_NEAR(glm::length(vec3((*turned)["camera"]["target"]) - target), 0, 1e-6);
+  // A pan with the right button then moves eye and target by the same vector.
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 240 180 mousedown 3 mousemove --window $W 250 180 "
+                  "mousemove --window $W 260 180 mouseup 3");
+  auto panned = viewer->waitFor(
+      [&](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && glm::length(vec3(e["camera"]["target"]) - target) > 1;
+      },
+      from, 30);
+  ASSERT_TRUE(panned);
+  glm::dvec3 moveEye = vec3((*panned)["camera"]["eye"]) - expected;
+  glm::dvec3 moveTarget = vec3((*panned)["camera"]["target"]) - target;
+  EXPECT_LT(glm::length(moveEye - moveTarget), 1e-6);
+  finish(*viewer);
+}
+
+TEST_F(ViewerWindow, DoubleClickSetsThePivotOnTheClickedPoint) {
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  viewer->xdotool("mousemove --window $W 240 200 click --repeat 2 --delay 60 1");
+  auto pick = viewer->waitEvent("pick", 0, 30);
+  ASSERT_TRUE(pick) << viewer->errors();
+  ASSERT_TRUE((*pick)["hit"].get<bool>());
+  glm::dvec3 pivot = vec3((*pick)["pivot"]);
+  // The pivot is the position of a cloud point seen within the pick radius of the click, up to one
+  // pixel's footprint at its depth (the pivot is that pixel's center at the point's depth).
+  PointCloud cloud = io::readCloud(autzen());
+  double nearest = 1e30;
+  for (uint64_t i = 0; i < cloud.size(); ++i)
+    nearest = std::min(nearest, glm::length(cloud.world(i) - pivot));
+  glm::dvec3 eye{636300, 848700, 900};
+  double footprint = 2 * glm::length(pivot - eye) * std::tan(kPi / 6) / kHeight;
+  EXPECT_LE(nearest, footprint) << "footprint " << footprint;
+  EXPECT_GT((*pick)["x"].get<double>(), 239);
+  // The next orbit turns around the new pivot: it stays where it is.
+  size_t from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 100 100 mousedown 1 mousemove --window $W 180 100 mouseup 1");
+  auto turned = viewer->waitEvent("frame", from, 30);
+  ASSERT_TRUE(turned);
+  EXPECT_LT(glm::length(vec3((*turned)["pivot"]) - pivot), 1e-9);
+  finish(*viewer);
+}
+
+TEST_F(ViewerWindow, PanelControlChangesTheImage) {
+  auto viewer = start("'" + autzen() + "' " + kCamera);
+  ASSERT_TRUE(first_);
+  ASSERT_TRUE((*first_)["panel"].get<bool>());
+  ASSERT_TRUE((*first_)["panel_items"].contains("White"));
+  std::vector<float> white = (*first_)["panel_items"]["White"].get<std::vector<float>>();
+  Capture before = captureWindow(display(), viewer->window());
+  size_t from = viewer->eventCount();
+  int x = int(white[0] + 8), y = int(white[1] + white[3] / 2);
+  viewer->xdotool("mousemove --window $W " + std::to_string(x) + " " + std::to_string(y) + " click 1");
+  auto changed = viewer->waitFor(
+      [](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && e["background"].get<uint32_t>() == 0xFFFFFFFFu;
+      },
+      from, 30);
+  ASSERT_TRUE(changed) << viewer->errors();
+  // The background outside the panel turned white: the sky above the cloud and the gaps between points.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  Capture after = captureWindow(display(), viewer->window());
+  ASSERT_EQ(after.rgba.size(), before.rgba.size());
+  EXPECT_LT(equalFraction(before.rgba, after.rgba), 0.9);
+  size_t whiteNow = 0;
+  for (uint32_t p : after.rgba)
+    whiteNow += p == 0xFFFFFFFFu;
+  EXPECT_GT(whiteNow, after.rgba.size() / 20);
+  finish(*viewer);
+}
+
+TEST_F(ViewerWindow, ResizingKeepsRenderingTheSameCamera) {
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  size_t from = viewer->eventCount();
+  viewer->xdotool("windowsize --sync $W 400 300");
+  auto resized = viewer->waitFor(
+      [](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && e["width"] == 400 && e["height"] == 300;
+      },
+      from, 30);
+  ASSERT_TRUE(resized) << viewer->errors();
+  std::vector<uint32_t> expected =
+      renderReference("'" + autzen() + "' " + cameraArgs((*resized)["camera"]), 400, 300);
+  Capture shown = captureMatching(display(), viewer->window(), expected, 0.999);
+  EXPECT_GE(equalFraction(shown.rgba, expected), 0.999);
+  finish(*viewer);
+}
+
+TEST_F(ViewerWindow, KeysRecordKeyframesAndScreenshots) {
+  std::filesystem::remove(tempDir() / "path.json");
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  viewer->xdotool("mousemove --window $W 200 200 key k key 8 key k key F12");
+  auto shot = viewer->waitEvent("screenshot", 0, 30);
+  ASSERT_TRUE(shot) << viewer->errors();
+  uint32_t w = 0, h = 0;
+  EXPECT_FALSE(readPng((*shot)["file"].get<std::string>(), w, h).empty());
+  EXPECT_EQ(w, kWidth);
+  EXPECT_EQ(h, kHeight);
+  auto saved = viewer->waitFor(
+      [](const nlohmann::json& e) { return e.value("event", "") == "keyframes" && e["count"] == 2; }, 0, 30);
+  ASSERT_TRUE(saved);
+  finish(*viewer);
+  std::string json = shellOutput("cat '" + (tempDir() / "path.json").string() + "'");
+  EXPECT_NE(json.find("pointrast-camera-path"), std::string::npos);
+  EXPECT_NE(json.find("636300"), std::string::npos) << "the first keyframe is the starting camera";
+}
+
+TEST(ViewerWithoutDisplay, SaysSoInOneLineAndExits1) {
+  std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY '" + pointrastBinary() + "' view '" + autzen() +
+                        "' 2>&1; echo \"exit=$?\"";
+  std::string out = shellOutput(command);
+  EXPECT_NE(out.find("no display"), std::string::npos) << out;
+  EXPECT_NE(out.find("pointrast serve"), std::string::npos) << out;
+  EXPECT_NE(out.find("exit=1"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 2) << "one line, then the exit status: " << out;
+}
+
+} // namespace
+} // namespace pointrast::test
