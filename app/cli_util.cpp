@@ -40,6 +40,13 @@ glm::dvec3 parseVec3(std::string_view text, std::string_view option) {
   return {v[0], v[1], v[2]};
 }
 
+std::pair<double, double> parseRange(std::string_view text, std::string_view option) {
+  std::vector<double> v = parseNumbers(text, option, 2);
+  if (!(v[0] < v[1]))
+    throw InputError(std::string(option) + " expects lo,hi with lo < hi, got '" + std::string(text) + "'");
+  return {v[0], v[1]};
+}
+
 uint32_t parseRgb(std::string_view text, std::string_view option) {
   std::vector<double> v = parseNumbers(text, option, 3);
   for (double c : v)
@@ -75,6 +82,31 @@ uint64_t parseCount(std::string_view text, std::string_view option) {
   double n = v * scale;
   if (s.empty() || *end != '\0' || !std::isfinite(n) || n < 0 || n > 1e15 || n != std::floor(n))
     throw InputError(std::string(option) + " expects a count such as 1000000, 2.5M or 1.2G, got '" +
+                     std::string(text) + "'");
+  return uint64_t(n);
+}
+
+uint64_t parseBytes(std::string_view text, std::string_view option) {
+  std::string s(text);
+  for (const char* suffix : {"iB", "B"})
+    if (s.size() > std::string(suffix).size() && s.ends_with(suffix)) {
+      s.resize(s.size() - std::string(suffix).size());
+      break;
+    }
+  double scale = 1;
+  if (!s.empty()) {
+    const std::string units = "kKMGT";
+    const size_t unit = units.find(s.back());
+    if (unit != std::string::npos) {
+      scale = std::ldexp(1.0, 10 * int(unit == 0 ? 1 : unit));
+      s.pop_back();
+    }
+  }
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  const double n = std::floor(v * scale);
+  if (s.empty() || *end != '\0' || !std::isfinite(n) || n < 0 || n > 1e18)
+    throw InputError(std::string(option) + " expects a size such as 8G, 512M or 1.5GiB, got '" +
                      std::string(text) + "'");
   return uint64_t(n);
 }

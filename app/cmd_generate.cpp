@@ -21,13 +21,13 @@ namespace pointrast::app {
 namespace {
 
 struct GenerateArgs {
-  std::string scene, output, points = "1M", order = "original", mmpld = "1.3";
+  std::string scene, output, points = "1M", order = "original", mmpld = "1.3", pointFormat = "auto";
   uint64_t seed = 1;
   float radius = 0.5f;
   bool perParticleRadius = false, quiet = false;
   // Options that apply to one kind of scene only, to refuse them for the other.
   CLI::Option *orderOption = nullptr, *radiusOption = nullptr, *perParticleOption = nullptr,
-              *mmpldOption = nullptr;
+              *mmpldOption = nullptr, *pointFormatOption = nullptr;
 };
 
 int generatePoints(const GenerateArgs& a) {
@@ -38,20 +38,29 @@ int generatePoints(const GenerateArgs& a) {
   Scene scene = parseScene(a.scene);
   Order order = parseOrder(a.order);
   lasFlavorFor(a.output, 0); // refuse a non-LAS name before spending minutes generating
+  if (a.pointFormat != "auto" && a.pointFormat != "2" && a.pointFormat != "3")
+    throw InputError("--point-format expects auto, 2 or 3, got '" + a.pointFormat + "'");
   GenerateOptions options;
   options.points = parseCount(a.points, "--points");
   options.seed = a.seed;
   options.progress = !a.quiet;
   PointCloud cloud = generateScene(scene, options);
   reorder(cloud, order, a.seed);
-  io::writeLas(a.output, cloud, lasFlavorFor(a.output, cloud.size()));
+  io::LasFlavor flavor = lasFlavorFor(a.output, cloud.size());
+  // Point format 2 (26 B, no GPS time) keeps large benchmark inputs small; LAS 1.2 needs < 2^32 points.
+  if (a.pointFormat != "auto" && flavor == io::LasFlavor::Las14Pf7)
+    throw InputError("--point-format " + a.pointFormat +
+                     " is LAS 1.2, which holds at most 4,294,967,295 points");
+  if (a.pointFormat == "2") flavor = io::LasFlavor::Las12Pf2;
+  io::writeLas(a.output, cloud, flavor);
   if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(cloud.size())).c_str());
   return 0;
 }
 
 int generateParticleScene(const GenerateArgs& a) {
-  if (a.orderOption->count())
-    throw InputError("--order applies to point scenes (terrain, tls), not to " + a.scene);
+  for (const CLI::Option* o : {a.orderOption, a.pointFormatOption})
+    if (o->count())
+      throw InputError(o->get_name() + " applies to point scenes (terrain, tls), not to " + a.scene);
   if (a.mmpld != "1.0" && a.mmpld != "1.3")
     throw InputError("--mmpld expects 1.0 or 1.3, got '" + a.mmpld + "'");
   if (std::filesystem::path(a.output).extension() != ".mmpld")
@@ -105,6 +114,11 @@ Command addGenerate(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "Random seed")->capture_default_str();
   a->orderOption = cmd->add_option("--order", a->order, "Point scenes: vertex order of the written file")
                        ->capture_default_str();
+  a->pointFormatOption =
+      cmd->add_option(
+             "--point-format", a->pointFormat,
+             "Point scenes: LAS point format, auto (3, or 7 past 2^32-1 points), 3 or 2 (no GPS time, 26 B)")
+          ->capture_default_str();
   a->radiusOption =
       cmd->add_option("--radius", a->radius, "Particle scenes: sphere radius")->capture_default_str();
   a->perParticleOption = cmd->add_flag("--per-particle-radius", a->perParticleRadius,

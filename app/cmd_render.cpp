@@ -12,8 +12,12 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "base/text.h"
+#include "bench/lod_report.h"
 #include "bench/report.h"
 #include "cli_util.h"
+#include "cloud/attribute_colors.h"
+#include "cloud/generate.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
 #include "gpu/context.h"
@@ -21,6 +25,7 @@
 #include "input.h"
 #include "io/format_table.h"
 #include "io/writer.h"
+#include "render/lod/lod_scene.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
 #include "render_path.h"
@@ -33,6 +38,10 @@ struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
   std::string precision = "adaptive"; // batch methods
+  double minNodePx = 100;             // LOD methods
+  std::string pointBudget = "0";      // LOD methods; 0: no limit
+  std::string gpuMemory;              // LOD methods: node cache budget; empty: half the device
+  bool lodOptionsGiven = false;       // one of the three above was given
   std::string layout = "auto";        // sphere methods
   std::string billboard;              // sphere methods that rasterize billboards; empty: screen
   bool conservative = false;          // the same: VK_EXT_conservative_rasterization
@@ -46,7 +55,71 @@ struct RenderArgs {
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
   PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
+  // Point methods: coloring and the resolve stage.
+  std::string color = "auto", colorRange;
+  float pointSize = 1, pointSizeMax = 16;
+  std::string pointShape = "square", pointSizeMode = "fixed";
+  uint32_t dilate = 0;
+  bool edl = false;
+  std::optional<float> edlStrength, edlRadius;
 };
+
+// Whether any option of the resolve stage or of coloring was given (the sphere methods take none).
+bool postOrColorGiven(const RenderArgs& a) {
+  return a.color != "auto" || !a.colorRange.empty() || a.pointSize != 1 || a.pointSizeMax != 16 ||
+         a.pointShape != "square" || a.pointSizeMode != "fixed" || a.dilate != 0 || a.edl || a.edlStrength ||
+         a.edlRadius;
+}
+
+// --point-size, --point-shape, --point-size-mode, --point-size-max, --dilate, --edl*.
+PostSettings postSettings(const RenderArgs& a) {
+  PostSettings post;
+  post.pointSize = a.pointSize;
+  post.shape = parsePointShape(a.pointShape);
+  post.sizeMode = parsePointSizeMode(a.pointSizeMode);
+  post.maxPointSize = a.pointSizeMax;
+  post.dilate = a.dilate;
+  // --edl-strength or --edl-radius alone turn eye-dome lighting on, with Potree's defaults for the other.
+  if (a.edl || a.edlStrength || a.edlRadius) {
+    post.edlStrength = a.edlStrength.value_or(1.0f);
+    post.edlRadius = a.edlRadius.value_or(post.edlRadius);
+  }
+  validatePostSettings(post);
+  return post;
+}
+
+// --color and --color-range: nullopt for auto (displayColorMode's choice).
+std::optional<DisplayColorMode> colorMode(const RenderArgs& a, const PointCloud& cloud) {
+  if (a.color == "auto") {
+    if (!a.colorRange.empty()) throw InputError("--color-range applies to --color intensity and elevation");
+    return std::nullopt;
+  }
+  DisplayColorMode::Source source = parseColorSource(a.color);
+  std::optional<ColorRange> range;
+  if (!a.colorRange.empty()) {
+    if (source != DisplayColorMode::Source::Intensity && source != DisplayColorMode::Source::Elevation)
+      throw InputError("--color-range applies to --color intensity and elevation, not " + a.color);
+    auto [lo, hi] = parseRange(a.colorRange, "--color-range");
+    range = ColorRange{lo, hi};
+  }
+  return displayColorMode(cloud, source, range);
+}
+
+// The resolve stage's settings and per-pass GPU times.
+nlohmann::json postJson(const PostSettings& post, const PostStats& stats) {
+  nlohmann::json j;
+  j["point_size"] = post.pointSize;
+  j["point_shape"] = pointShapeName(post.shape);
+  j["point_size_mode"] = pointSizeModeName(post.sizeMode);
+  if (post.sizeMode == PointSizeMode::Attenuated) j["point_size_max"] = post.maxPointSize;
+  j["dilate"] = post.dilate;
+  j["edl_strength"] = post.edlStrength;
+  if (post.edlStrength > 0) j["edl_radius"] = post.edlRadius;
+  j["splat_ms"] = stats.splatMs;
+  j["dilate_ms"] = stats.dilateMs;
+  j["compose_ms"] = stats.composeMs;
+  return j;
+}
 
 // The sphere methods (--method sphere-*): particles from an MMPLD file, a particle scene, or points drawn
 // as spheres of --radius, through the SphereRenderer.
@@ -58,6 +131,9 @@ int runRenderSpheres(const RenderArgs& a) {
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.order != "original" || a.depth != "float" || a.parts != 1 || a.precision != "adaptive")
     throw InputError("--order, --depth, --parts and --precision apply to the point methods, not to " +
+                     a.method);
+  if (postOrColorGiven(a))
+    throw InputError("--color, --point-size, --dilate and --edl apply to the point methods, not to " +
                      a.method);
   if (!a.billboard.empty()) settings.billboard = parseSphereBillboard(a.billboard);
   settings.conservative = a.conservative;
@@ -168,6 +244,113 @@ int runRenderSpheres(const RenderArgs& a) {
   return 0;
 }
 
+// The camera of the point methods: --eye/--target/--up/--fov/--near, or the overview of `bounds`.
+Camera cameraFor(const RenderArgs& a, const Bounds& bounds) {
+  if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
+  if (!a.eye.empty()) {
+    camera.eye = parseVec3(a.eye, "--eye");
+    camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
+    camera.up = parseVec3(a.up, "--up");
+  }
+  camera.nearW = a.nearW;
+  validateCamera(camera);
+  return camera;
+}
+
+void printLodStats(const lod::LodStats& s, const BatchStats& b) {
+  std::printf("  nodes: %llu selected (%s points%s), %llu drawn in %u pass%s, %llu rendered; points: %s "
+              "processed, %s rendered\n",
+              (unsigned long long)s.nodesSelected, humanCount(double(s.pointsSelected)).c_str(),
+              s.budgetReached ? ", point budget reached" : "", (unsigned long long)s.nodesDrawn, s.passes,
+              s.passes == 1 ? "" : "es", (unsigned long long)b.batchesRendered,
+              humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsRendered)).c_str());
+  std::printf("  streamed %s of %llu nodes in %.2f s (%s uploaded, node cache %s)\n",
+              bytesText(s.bytesStreamed).c_str(), (unsigned long long)s.nodesLoaded, s.streamSeconds,
+              bytesText(s.bytesUploaded).c_str(), bytesText(s.cacheBytes).c_str());
+}
+
+// The LOD methods (--method lod, lod-hqs): an octree streamed through the node cache.
+int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
+  if (!a.path.path.empty())
+    throw InputError("--path renders the methods that draw a loaded cloud, not " + a.method + " (an octree)");
+  if (a.order != "original" || a.parts != 1 || a.depth != "float")
+    throw InputError("--order, --parts and --depth do not apply to " + a.method +
+                     ", which draws an octree's nodes in their stored order");
+  if (!(a.minNodePx >= 0)) throw InputError("--min-node-px must be 0 or more");
+  settings.minNodePx = a.minNodePx;
+  settings.pointBudget = parseCount(a.pointBudget, "--point-budget");
+  settings.background = parseRgb(a.background, "--background");
+  settings.frames = a.frames;
+  if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (std::filesystem::path(a.output).extension() != ".png")
+    throw InputError("-o " + a.output + ": the output must be a .png file");
+  if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
+  if (a.input.empty() || isSceneName(a.input))
+    throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
+                     a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
+                     "): build one with `pointrast lod FILE -o DIR`");
+  lod::LodOptions options;
+  if (!a.gpuMemory.empty()) options.gpuBytes = parseBytes(a.gpuMemory, "--gpu-memory");
+  std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
+  const Camera camera =
+      cameraFor(a, source->metadata().bounds.empty() ? source->metadata().cube : source->metadata().bounds);
+
+  gpu::ContextOptions contextOptions;
+  contextOptions.deviceIndex = a.device;
+  contextOptions.announce = !a.quiet;
+  gpu::Context context(contextOptions);
+  std::string why;
+  if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
+  Renderer renderer(context, a.width, a.height);
+  lod::LodScene octree(context, *source, options);
+  FrameStats stats = renderer.render(octree, camera, settings);
+  std::vector<uint32_t> pixels = renderer.image();
+  if (context.validationErrors() > 0)
+    throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                     " error(s)");
+  io::writePng(a.output, a.width, a.height, pixels.data());
+  const double perSecond = stats.medianMs > 0 ? double(stats.points) / (stats.medianMs * 1e-3) : 0.0;
+  if (a.json) {
+    nlohmann::json j;
+    j["device"] = context.info().name;
+    j["device_type"] = context.info().typeName;
+    j["method"] = methodName(settings.method);
+    j["input"] = source->metadata().source;
+    j["format"] = source->metadata().format;
+    j["octree_points"] = source->metadata().pointCount;
+    j["points"] = stats.points;
+    j["width"] = a.width;
+    j["height"] = a.height;
+    j["frames"] = stats.frames;
+    j["median_ms"] = stats.medianMs;
+    j["min_ms"] = stats.minMs;
+    j["max_ms"] = stats.maxMs;
+    j["points_per_second"] = perSecond;
+    j["precision"] = a.precision;
+    j["min_node_px"] = settings.minNodePx;
+    j["point_budget"] = settings.pointBudget;
+    j["batch_stats"] = bench::batchStatsJson(*stats.batch);
+    j["lod_stats"] = bench::lodStatsJson(*stats.lod);
+    j["camera"] = describeCamera(camera);
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(imageHash(pixels.data(), pixels.size())));
+    j["image_hash"] = hex;
+    j["output"] = a.output;
+    std::printf("%s\n", j.dump().c_str());
+  } else if (!a.quiet) {
+    std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), %s "
+                "points/s\n",
+                a.output.c_str(), humanCount(double(stats.points)).c_str(),
+                humanCount(double(source->metadata().pointCount)).c_str(), a.width, a.height,
+                methodName(settings.method), stats.medianMs, stats.frames, stats.minMs, stats.maxMs,
+                humanCount(perSecond).c_str());
+    printLodStats(*stats.lod, *stats.batch);
+  }
+  return 0;
+}
+
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   // -o is the single image; --path renders a camera path into --video or --frames-dir instead.
@@ -198,10 +381,19 @@ int runRender(const RenderArgs& a) {
   settings.depth = parseDepthMode(a.depth);
   settings.precision = parsePrecision(a.precision);
   const SceneLayout layout = methodInfo(settings.method).layout;
-  if (settings.precision != 0 && layout != SceneLayout::Batched)
-    throw InputError("--precision applies to the batch methods (" + methodNamesReading(SceneLayout::Batched) +
-                     ")");
+  if (settings.precision != 0 && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
+    throw InputError("--precision applies to the batch and LOD methods (" +
+                     methodNamesReading(SceneLayout::Batched) + ", " +
+                     methodNamesReading(SceneLayout::Octree) + ")");
+  if (layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  if (a.lodOptionsGiven)
+    throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
+                     methodNamesReading(SceneLayout::Octree) + ")");
   settings.background = parseRgb(a.background, "--background");
+  settings.post = postSettings(a);
+  if (settings.post.enabled() && methodInfo(settings.method).output == MethodOutput::ColorOnly)
+    throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
+                     " keeps no depth per pixel to work on");
   settings.frames = a.frames;
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.parts == 0) throw InputError("--parts must be at least 1");
@@ -231,6 +423,7 @@ int runRender(const RenderArgs& a) {
   if (stated && !sceneFits(context, layout, *stated, &why))
     throw UnsupportedError((a.input.empty() ? kDemoScene : a.input) + ": " + why);
   PointCloud cloud = loadInput(spec);
+  const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
   double aspect = double(a.width) / double(a.height);
   if (explicitCamera) {
     camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
@@ -263,6 +456,7 @@ int runRender(const RenderArgs& a) {
     upload.count = perPart;
     upload.layout = layout;
     upload.progress = !a.quiet;
+    upload.colors = colors;
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
   std::vector<const GpuScene*> drawn;
@@ -300,6 +494,8 @@ int runRender(const RenderArgs& a) {
       j["precision"] = a.precision;
       j["batch_stats"] = bench::batchStatsJson(*stats.batch);
     }
+    if (colors) j["color"] = colorSourceName(colors->source);
+    if (stats.post) j["post"] = postJson(settings.post, *stats.post);
     j["camera"] = describeCamera(camera);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
@@ -322,6 +518,11 @@ int runRender(const RenderArgs& a) {
           humanCount(double(b.pointsByWords[1])).c_str(), humanCount(double(b.pointsByWords[2])).c_str(),
           humanCount(double(b.pointsRendered)).c_str());
     }
+    if (stats.post)
+      std::printf(
+          "  resolve stage: point size %.3f ms, dilation %.3f ms, compose%s %.3f ms (median GPU time)\n",
+          stats.post->splatMs, stats.post->dilateMs, settings.post.edlStrength > 0 ? " + EDL" : "",
+          stats.post->composeMs);
   }
   return 0;
 }
@@ -366,6 +567,8 @@ Command addRender(CLI::App& app) {
       "  pointrast render autzen.las -o a.png --eye 636000,848900,700 --target 636600,849200,450\n"
       "  pointrast render terrain --points 100M --order morton -o t.png --frames 50\n"
       "  pointrast render terrain --points 1G --order morton --method batch-prefetch -o t.png --json\n"
+      "  pointrast render autzen.las -o a.png --color classification --point-size 3 --edl\n"
+      "  pointrast render autzen.las -o a.png --color elevation --dilate 2\n"
       "  pointrast render autzen.las --path path.json --video fly.mp4 --fps 60 --width 3840 --height 2160\n"
       "Spheres (particles): a sphere method with an MMPLD file, a particle scene (" +
       std::string(kParticleSceneNames) + ") or points and --radius.\nSphere methods (--method):\n" +
@@ -404,6 +607,22 @@ Command addRender(CLI::App& app) {
                   "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
                   "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
       ->capture_default_str();
+  auto lodOption = [a](const std::string&) { a->lodOptionsGiven = true; };
+  cmd->add_option(
+         "--min-node-px", a->minNodePx,
+         "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
+         "sphere) is smaller, with their subtrees; 0 draws every point")
+      ->capture_default_str()
+      ->each(lodOption);
+  cmd->add_option("--point-budget", a->pointBudget,
+                  "LOD methods: most points drawn, largest nodes first (e.g. 100M; 0: no limit)")
+      ->capture_default_str()
+      ->each(lodOption);
+  cmd->add_option(
+         "--gpu-memory", a->gpuMemory,
+         "LOD methods: GPU memory for the node cache (e.g. 8G; default: half the device's); a larger "
+         "selection is drawn in several passes")
+      ->each(lodOption);
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
       ->capture_default_str();
@@ -429,6 +648,37 @@ Command addRender(CLI::App& app) {
   cmd->add_flag("--task-cull", a->taskCull,
                 "sphere-mesh-points, sphere-mesh-tris: a task shader culls spheres outside the view first "
                 "and launches mesh workgroups only for the rest");
+  cmd->add_option("--color", a->color,
+                  "Point colors: auto (RGB if the file has it, else intensity, else elevation), rgb, "
+                  "intensity, classification (ASPRS classes), elevation, return (return number), source "
+                  "(point source id)")
+      ->capture_default_str();
+  cmd->add_option(
+      "--color-range", a->colorRange,
+      "lo,hi mapped to the ends of the intensity or elevation ramp (default: the 0.5 % and 99.5 % "
+      "percentiles)");
+  cmd->add_option("--point-size", a->pointSize,
+                  "Point size in pixels (1..32); the closest point still wins every pixel")
+      ->capture_default_str();
+  cmd->add_option("--point-shape", a->pointShape, "Shape of points larger than a pixel: square or disc")
+      ->capture_default_str();
+  cmd->add_option(
+         "--point-size-mode", a->pointSizeMode,
+         "fixed (every point --point-size pixels) or attenuated (--point-size pixels at the target's "
+         "distance, larger nearer and smaller farther, at most --point-size-max)")
+      ->capture_default_str();
+  cmd->add_option("--point-size-max", a->pointSizeMax, "Attenuated point sizes: the largest, pixels (1..32)")
+      ->capture_default_str();
+  cmd->add_option("--dilate", a->dilate,
+                  "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
+                  "point never covers a near one, and convex outlines do not grow")
+      ->capture_default_str();
+  cmd->add_flag("--edl", a->edl,
+                "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
+                "its neighbours");
+  cmd->add_option("--edl-strength", a->edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
+  cmd->add_option("--edl-radius", a->edlRadius,
+                  "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

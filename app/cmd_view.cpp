@@ -40,6 +40,8 @@ int runView(const ViewArgs& a) {
   options.events = a.events;
   options.fovY = a.fov;
   options.settings.method = parseMethod(a.method);
+  if (methodInfo(options.settings.method).layout == SceneLayout::Octree)
+    throw InputError("view draws a loaded cloud; " + a.method + " draws octrees, with `pointrast render`");
   options.settings.background = parseRgb(a.background, "--background");
   options.pathFile = a.path;
   options.screenshotDir = a.screenshots;

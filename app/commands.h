@@ -21,7 +21,9 @@ Command addRender(CLI::App& app);
 Command addConvert(CLI::App& app);
 Command addGenerate(CLI::App& app);
 Command addBench(CLI::App& app);
+Command addBenchIo(CLI::App& app, int argc, char** argv); // argv: the command line for the report
 Command addView(CLI::App& app);
+Command addLod(CLI::App& app);
 
 // LAS 1.2 PF3, or 1.4 PF7 when the count needs 64-bit counts; InputError for a non-.las name.
 io::LasFlavor lasFlavorFor(const std::string& output, uint64_t points);

@@ -56,7 +56,9 @@ int runCommand(int argc, char** argv) {
   app::Command convert = app::addConvert(app);
   app::Command generate = app::addGenerate(app);
   app::Command bench = app::addBench(app);
+  app::Command benchIo = app::addBenchIo(app, argc, argv);
   app::Command view = app::addView(app);
+  app::Command lod = app::addLod(app);
 
   try {
     app.parse(argc, argv);
@@ -79,7 +81,9 @@ int runCommand(int argc, char** argv) {
       if (sub->get_name() == "convert") return convert();
       if (sub->get_name() == "generate") return generate();
       if (sub->get_name() == "bench") return bench();
+      if (sub->get_name() == "bench-io") return benchIo();
       if (sub->get_name() == "view") return view();
+      if (sub->get_name() == "lod") return lod();
     }
     return 1;
   } catch (const InputError& e) {

@@ -13,6 +13,8 @@
 #include <tuple>
 
 #include "base/error.h"
+#include "bench/lod_report.h"
+#include "bench/report_parts.h"
 #include "bench/suites.h"
 
 namespace pointrast::bench {
@@ -93,6 +95,10 @@ std::string mdCell(std::string_view text) {
   }
   return out;
 }
+
+} // namespace
+
+// The parts every report writer shares (bench/report_parts.h).
 
 void writeAtomically(const std::filesystem::path& path, const std::string& content) {
   std::filesystem::path partial = path;
@@ -195,18 +201,6 @@ void markdownNotMeasured(std::ostringstream& md, const std::set<std::string>& re
   for (const std::string& why : reasons)
     md << "- " << why << "\n";
 }
-
-// A grouped bar chart of milliseconds: one group per x label, one bar per series (colored as in the
-// legend); log scale when values span more than 20x.
-struct BarChart {
-  std::string title;               // "<title>: median GPU ms per frame (lower is better)" is drawn from it
-  std::string subtitle;            // device, image, what the bars show
-  std::vector<std::string> groups; // labels; " (" starts a second line
-  std::vector<std::string> series;
-  // values[group][series]: milliseconds; kNoBar draws nothing, kNotMeasured "n/a".
-  std::vector<std::vector<double>> values;
-};
-constexpr double kNoBar = -1, kNotMeasured = -2;
 
 std::string svgBars(const BarChart& chart) {
   double lo = INFINITY, hi = 0;
@@ -316,8 +310,6 @@ std::string svgBars(const BarChart& chart) {
   return s.str();
 }
 
-// Writes the three files of a report through ".partial" files renamed into place; everything is rendered
-// by the caller before the first file is written, so a failure leaves no mixed set.
 WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::string& name,
                               const std::string& json, const std::string& markdown, const std::string& svg) {
   std::error_code ec;
@@ -330,8 +322,6 @@ WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::strin
   writeAtomically(files.svg, svg);
   return files;
 }
-
-} // namespace
 
 std::string sanitizeName(std::string_view text) {
   std::string out;
@@ -397,6 +387,7 @@ nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   if (!run.stopped.empty()) j["stopped"] = run.stopped;
   j["copy_fraction"] = r.copyFraction;
   if (r.stats.batch) j["batch_stats"] = batchStatsJson(*r.stats.batch);
+  if (r.stats.lod) j["lod_stats"] = lodStatsJson(*r.stats.lod);
   j["camera"] = r.camera;
   return j;
 }
@@ -426,6 +417,7 @@ nlohmann::json runJson(const BenchRun& run, const ReportInfo& info) {
   j["results"] = nlohmann::json::array();
   for (const Result& r : run.results)
     j["results"].push_back(resultJson(run, r));
+  if (!run.octrees.empty()) j["octrees"] = octreesJson(run.octrees);
   return j;
 }
 
@@ -505,15 +497,16 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
     bool batched = false;
     for (size_t k = 0; k < c.methods.size(); ++k) {
       const MethodInfo& m = methodInfo(c.methods[k]);
-      md << (k ? ", " : " ") << m.name << " "
-         << (m.layout == SceneLayout::Batched ? "*" : std::to_string(m.bytesPerPoint));
-      batched = batched || m.layout == SceneLayout::Batched;
+      const bool counted = m.layout == SceneLayout::Batched || m.layout == SceneLayout::Octree;
+      md << (k ? ", " : " ") << m.name << " " << (counted ? "*" : std::to_string(m.bytesPerPoint));
+      batched = batched || counted;
     }
     md << ".";
     if (batched)
       md << " *: the bytes the frame read, from the batch statistics: 4 per coordinate word of each point "
-            "processed, 32 per batch's bounds; batch-hqs reads both twice (depth and blending pass) and the "
-            "color of each blended point.";
+            "processed, 32 per batch's (or octree node's) bounds; batch-hqs and lod-hqs read both twice "
+            "(depth "
+            "and blending pass) and the color of each blended point.";
     md << "\n\n";
     table(bandwidthView, [](const Result& r) { return printf1("%.0f%%", r.copyFraction * 100); });
   }
@@ -521,7 +514,7 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
   // The 2022 paper's Table 2: what the batch methods processed and rendered, per frame.
   bool batchStats = false;
   for (const Result& r : run.results)
-    batchStats = batchStats || (r.ok() && r.stats.batch);
+    batchStats = batchStats || (r.ok() && r.stats.batch && !r.stats.lod);
   if (batchStats) {
     md << "## Batch statistics per frame (the 2022 paper's Table 2)\n\n";
     md << "Batches of 10,240 points: processed (all), rendered (not culled); points processed (in rendered "
@@ -536,7 +529,7 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
         for (View v : c.views)
           for (Method m : c.methods) {
             const Result* r = index.find(d->dataset.name, o, v, m);
-            if (!r || !r->ok() || !r->stats.batch) continue;
+            if (!r || !r->ok() || !r->stats.batch || r->stats.lod) continue; // LOD rows: their own table
             const BatchStats& b = *r->stats.batch;
             auto share = [&](uint64_t n) {
               return b.pointsProcessed ? printf1("%.0f%%", 100.0 * double(n) / double(b.pointsProcessed))
@@ -553,6 +546,7 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
     md << "\n";
   }
 
+  markdownLodStatistics(md, run);
   markdownDatasets(md, run.datasets);
   std::set<std::string> reasons;
   for (const Result& r : run.results)

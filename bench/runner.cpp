@@ -11,6 +11,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "bench/lod_runner.h"
 #include "cloud/generate.h"
 #include "io/reader.h"
 #include "render/scene.h"
@@ -39,17 +40,6 @@ const std::vector<View>& viewsOf(const Dataset& d, const BenchConfig& c) {
 constexpr uint64_t kGatherBlock = uint64_t(1) << 16;
 
 } // namespace
-
-std::string bytesText(uint64_t bytes) {
-  char text[32];
-  if (bytes >= (uint64_t(1) << 30))
-    std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t(1) << 30));
-  else if (bytes >= (uint64_t(1) << 20))
-    std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(uint64_t(1) << 20));
-  else
-    std::snprintf(text, sizeof text, "%.0f KiB", double(bytes) / 1024.0);
-  return text;
-}
 
 std::string printf1(const char* format, double value) {
   char text[64];
@@ -162,6 +152,7 @@ PointCloud loadDataset(const Dataset& dataset, bool progress) {
   cloud.intensity = {};
   cloud.classification = {};
   cloud.returnNumber = {};
+  cloud.pointSourceId = {};
   return cloud;
 }
 
@@ -188,6 +179,15 @@ PointCloud reorderedCopy(const PointCloud& src, Order order, uint64_t seed) {
   return dst;
 }
 
+void completeRates(Result& r, const gpu::CopyBandwidth& copy) {
+  if (!r.ok() || !(r.stats.medianMs > 0)) return;
+  const double seconds = r.stats.medianMs * 1e-3;
+  r.pointsPerSecond = double(r.stats.points) / seconds;
+  r.effectiveBytesPerSecond =
+      (r.stats.batch ? double(r.stats.batch->bytesRead) : double(r.stats.points) * r.bytesPerPoint) / seconds;
+  r.copyFraction = copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / copy.bytesPerSecond : 0;
+}
+
 BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchCallbacks& callbacks) {
   const auto start = std::chrono::steady_clock::now();
   auto note = [&](const std::string& line) {
@@ -201,6 +201,9 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
 
   // Every data set is sized before anything runs, so what will be skipped is said up front.
   size_t total = 0;
+  const size_t octrees = size_t(std::count_if(config.methods.begin(), config.methods.end(), [](Method m) {
+    return methodInfo(m).layout == SceneLayout::Octree;
+  }));
   for (const Dataset& d : config.datasets) {
     DatasetOutcome outcome;
     outcome.dataset = d;
@@ -214,8 +217,9 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       outcome.reason = "it does not fit: " + outcome.memory.describe();
     }
     note(d.label + ": " + (outcome.skipped ? "skipped, " + outcome.reason : outcome.memory.describe()));
-    if (!outcome.skipped)
-      total += ordersOf(d, config).size() * viewsOf(d, config).size() * config.methods.size();
+    if (!outcome.skipped) // the LOD methods draw the data set's octree, once whatever the orders
+      total += viewsOf(d, config).size() *
+               (ordersOf(d, config).size() * (config.methods.size() - octrees) + octrees);
     run.datasets.push_back(std::move(outcome));
   }
 
@@ -266,7 +270,8 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
         // Clocks up again after the host's work, with the first supported method on the first view.
         for (Method method : config.methods) {
           const SceneLayout layout = methodInfo(method).layout;
-          if (!scenes[layout] || !Renderer::supports(context, method)) continue;
+          if (layout == SceneLayout::Octree || !scenes[layout] || !Renderer::supports(context, method))
+            continue;
           const Camera camera = viewCamera(viewsOf(d, config).front(), cloud.bounds, aspect, config.fovY);
           try {
             settleClocks([&](uint32_t frames) {
@@ -285,6 +290,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
         for (View view : viewsOf(d, config)) {
           const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
           for (Method method : config.methods) {
+            if (methodInfo(method).layout == SceneLayout::Octree) continue; // after the orders, on the octree
             checkTimeLimit(start, config.timeLimitSeconds, done, total);
             Result r;
             r.dataset = d.name;
@@ -328,21 +334,20 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
                     if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
                   });
             }
-            if (r.ok() && r.stats.medianMs > 0) {
-              const double seconds = r.stats.medianMs * 1e-3;
-              r.pointsPerSecond = double(r.stats.points) / seconds;
-              r.effectiveBytesPerSecond = (r.stats.batch ? double(r.stats.batch->bytesRead)
-                                                         : double(r.stats.points) * r.bytesPerPoint) /
-                                          seconds;
-              r.copyFraction =
-                  run.copy.bytesPerSecond > 0 ? r.effectiveBytesPerSecond / run.copy.bytesPerSecond : 0;
-            }
+            completeRates(r, run.copy);
             run.results.push_back(r);
             ++done;
             if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
           }
         }
       }
+      checkTimeLimit(start, config.timeLimitSeconds, done, total);
+      measureOctreeMethods(context, renderer, config, d, cloud, ordersOf(d, config).front(),
+                           viewsOf(d, config), run, [&](const Result& r) {
+                             run.results.push_back(r);
+                             ++done;
+                             if (callbacks.onResult) callbacks.onResult(run, run.results.back(), done, total);
+                           });
     }
   } catch (const DeviceFault& e) {
     run.stopped = deviceFaultText(e);

@@ -17,6 +17,8 @@
 #include <vector>
 
 #include "base/error.h"
+#include "base/text.h" // bytesText
+#include "bench/octree_cache.h"
 #include "bench/views.h"
 #include "cloud/order.h"
 #include "gpu/bandwidth.h"
@@ -57,10 +59,10 @@ struct BenchConfig {
   uint64_t copyBytes = uint64_t(1) << 30;
   int copyRepeats = 10;
   bool progress = true; // generation, reading and upload progress (drawn only on a terminal)
+  // The octrees the LOD methods draw (bench/lod_runner.h); without one, their results say so.
+  OctreeProvider octrees;
 };
 
-// "512 KiB", "3.1 MiB", "12.7 GiB": memory sizes in messages and reports.
-std::string bytesText(uint64_t bytes);
 // One number through a printf format: printf1("%.1f s", 2.34) = "2.3 s" (at most 63 characters).
 std::string printf1(const char* format, double value);
 // The line both runners log once the copy bandwidth is measured: "copy bandwidth: 4305.4 GB/s (read +
@@ -140,7 +142,8 @@ struct BenchRun {
   uint32_t warmup = 0;
   std::vector<DatasetOutcome> datasets;
   std::vector<Result> results;
-  double seconds = 0; // wall time of the whole run (not a GPU figure)
+  std::vector<std::pair<std::string, DatasetOctree>> octrees; // by Dataset::name: the LOD methods' octrees
+  double seconds = 0;                                         // wall time of the whole run (not a GPU figure)
   // Why the run ended before its last combination: the GPU stopped making progress (every later submission
   // would wait on the stuck one) or the time limit passed. The reports hold what was measured before.
   std::string stopped;
@@ -175,6 +178,9 @@ void measureGuarded(R& result, Measure&& measure, Record&& record) {
     throw;
   }
 }
+
+// Points per second, effective bandwidth and its fraction of the copy bandwidth of a measured result.
+void completeRates(Result& result, const gpu::CopyBandwidth& copy);
 
 // The line a run that met a device fault ends with (BenchRun::stopped).
 std::string deviceFaultText(const DeviceFault& fault);

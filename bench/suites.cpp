@@ -35,6 +35,13 @@ constexpr SuiteEntry kPaper2022[] = {
      true},
 };
 
+// The lod suite's data set: the 1,000 M point aerial stand-in of paper2022 (same name, size and seed, so both
+// suites share its octree): the LOD methods' sweeps, and the streaming run with 1/8 of its octree in GPU
+// memory (a cloud 8x larger than the node cache).
+constexpr SuiteEntry kLod[] = {
+    {"aerial1g", Scene::Terrain, 1'000'000'000, "a 1,000 M point aerial survey, as an octree"},
+};
+
 // The four particle data sets of the 2023 sphere study, at the sizes the issue gives for them (306 M, 4 M,
 // 30 M, 200 M particles, in this order), each drawn by the particle scene closest to what it shows:
 // laser ablation of a metal (a crystal slab with a molten crater and ejected clusters), a Riemann shock tube
@@ -52,9 +59,10 @@ constexpr uint64_t kMinScaledPoints = 1000;
 std::span<const SuiteEntry> entriesOf(std::string_view suite) {
   if (suite == "paper2021") return kPaper2021;
   if (suite == "paper2022") return kPaper2022;
+  if (suite == "lod") return kLod;
   if (suite == "spheres2023")
     throw InputError("spheres2023 is a particle suite: it has no point data sets or methods");
-  throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021, paper2022 or spheres2023");
+  throw InputError("unknown suite '" + std::string(suite) + "'; choose paper2021, paper2022, lod or spheres2023");
 }
 
 uint64_t scaled(uint64_t size, double scale) {
@@ -80,11 +88,15 @@ std::span<const SuiteEntry> paper2022Suite() {
 }
 
 std::vector<std::string> suiteNames() {
-  return {"paper2021", "paper2022", "spheres2023"};
+  return {"paper2021", "paper2022", "lod", "spheres2023"};
 }
 
 std::span<const SphereSuiteEntry> spheres2023Suite() {
   return kSpheres2023;
+}
+
+bool isLodSuite(std::string_view suite) {
+  return suite == "lod";
 }
 
 bool isSphereSuite(std::string_view suite) {
@@ -116,10 +128,18 @@ SuiteDefaults suiteDefaults(std::string_view suite) {
     for (Method m : allMethods())
       if (m.info().layout == SceneLayout::Float) d.methods.push_back(m);
   }
+  if (suite == "lod") {
+    d.methods = {pointMethod("lod")};
+    d.views = {View::Overview, View::Closeup};
+    d.width = 2560;
+    d.height = 1140;
+  }
   if (suite == "paper2022") {
-    // The paper's comparison: the hardware baseline, its three methods, and the best 2021 methods.
-    d.methods = {pointMethod("hw-points"), pointMethod("batch"), pointMethod("batch-prefetch"),
-                 pointMethod("batch-hqs"), pointMethod("dedup"), pointMethod("hqs")};
+    // The paper's comparison: the hardware baseline, its three batch methods and its two LOD methods on the
+    // octrees of the same data, and the best 2021 methods.
+    d.methods = {pointMethod("hw-points"), pointMethod("batch"),   pointMethod("batch-prefetch"),
+                 pointMethod("batch-hqs"), pointMethod("dedup"),   pointMethod("hqs"),
+                 pointMethod("lod"),       pointMethod("lod-hqs")};
     d.orders = {Order::Morton, Order::Original};
     d.views = {View::Overview, View::Closeup};
     d.width = 2560;

@@ -42,6 +42,8 @@ struct SphereSuiteEntry {
   const char* resembles; // what the original holds, the reason for the generator
 };
 std::span<const SphereSuiteEntry> spheres2023Suite();
+// Whether `suite` is the lod suite (bench/lod_suite.h: sweeps and streaming on octrees, its own runner).
+bool isLodSuite(std::string_view suite);
 // Whether `suite` is a sphere suite (its data sets are particle sets, its runner the sphere runner).
 bool isSphereSuite(std::string_view suite);
 // The particle data sets of a sphere suite with every size multiplied by `scale` (at least 1000 particles

@@ -54,6 +54,11 @@ for what in "$@"; do
     .gpu/bin/cli_tests --gtest_brief=1 || status=1
     .gpu/bin/bench_tests --gtest_brief=1 || status=1
     ;;
+  lod)
+    echo "== octree build: pointrast lod on generated terrain (scripts/bench-lod.sh), ${LOD_SIZES:-100M 1G} points"
+    # shellcheck disable=SC2086
+    { POINTRAST_BIN=$pr OUT=$OUT scripts/bench-lod.sh run ${LOD_SIZES:-100M 1G} && OUT=$OUT scripts/bench-lod.sh report; } || status=1
+    ;;
   autzen)
     echo "== autzen_trim.las"
     $pr render .gpu/data/las/autzen_trim.las -o "$OUT/autzen.png" --json --frames 50 | tee "$OUT/autzen.json" || status=1

@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libvulkan-dev glslc spirv-tools mesa-vulkan-drivers vulkan-validationlayers
-  libglm-dev libcli11-dev nlohmann-json3-dev libstb-dev libgtest-dev
+  libglm-dev libcli11-dev nlohmann-json3-dev libstb-dev libgtest-dev libzstd-dev
   libbrotli-dev
   # the desktop viewer (GLFW is loaded at run time, the panel is Dear ImGui), its tests on a virtual X
   # server driven by xdotool, and video output of camera paths

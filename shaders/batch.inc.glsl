@@ -1,22 +1,19 @@
 // The 2022 batched rasterizer (Schuetz, Kerbl, Wimmer, "Software Rasterization of 2 Billion Points in Real
-// Time", sections 4-5), shared by its passes. One workgroup of 128 threads draws one batch of 10240
-// consecutive points of a part (BatchPush pc): it frustum-culls the batch's box, chooses how many of the
-// three coordinate words its points need (cloud/batch_words.h has the bit layout), and decodes points
-// relative to the batch's min corner. Points are projected by project.inc.glsl, like the 2021 methods.
+// Time", sections 4-5): what every pass of a box of quantized points shares, whatever holds the box. A batch
+// of 10240 consecutive points of a part (batch_part.inc.glsl) is one such box, an octree node of the LOD
+// methods (lod.inc.glsl) another. The box is frustum-culled, its points load as many of the three
+// coordinate words as its projected size needs (cloud/batch_words.h has the bit layout) and are decoded
+// relative to its min corner. Points are projected by project.inc.glsl, like the 2021 methods.
 //
-// Every thread computes the batch decision from the same loads with the same instructions, so the decision
-// is uniform over the workgroup without shared memory or a barrier.
+// A box decision (viewBox) depends only on the box and the camera: computed by every thread of a workgroup
+// from the same loads with the same instructions it is uniform over the workgroup without shared memory or
+// a barrier, and computed once per node and stored (the LOD methods) it is the same bits.
 #include "common.inc.glsl"
 #include "project.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
-layout(push_constant) uniform Push { BatchPush pc; };
 
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BoundsArray {
-  BatchBounds v[];
-};
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer FrameRef { BatchFrame f; };
 
 const uint kNoPixel = 0xFFFFFFFFu;
 
@@ -49,10 +46,19 @@ struct BatchView {
   vec3 lo, step; // the batch's min corner (relative to the scene origin) and 2^30 quantization steps
 };
 
-BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool culling) {
-  BatchBounds bounds = BoundsArray(pc.bounds).v[batch];
-  vec3 lo = bounds.min.xyz, hi = bounds.max.xyz, size = hi - lo;
-  mat4 m = pc.viewProj;
+// The camera of a batch pass: view-projection relative to the scene origin, near plane, image size.
+struct BatchCamera {
+  mat4 viewProj; // only rows x, y, w are used
+  float nearW;   // points with c.w <= nearW are dropped
+  uint width;
+  uint height;
+};
+
+// The decision for the box [lo, hi] (relative to the scene origin): forcedWords 1..3 overrides the
+// adaptive precision; without culling no box is culled.
+BatchView viewBox(vec3 lo, vec3 hi, BatchCamera cam, uint forcedWords, bool culling) {
+  vec3 size = hi - lo;
+  mat4 m = cam.viewProj;
   // Clip coordinates of the eight corners: the min corner plus any of the three edge vectors.
   vec4 c0 = m * vec4(lo, 1.0), ex = m[0] * size.x, ey = m[1] * size.y, ez = m[2] * size.z;
   vec3 a = max(abs(lo), abs(hi));
@@ -73,8 +79,8 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
     right = right && c.x - c.w > e.x + e.w;
     below = below && c.y + c.w < -(e.y + e.w);
     above = above && c.y - c.w > e.y + e.w;
-    behind = behind && c.w + e.w < pc.nearW;
-    nearOrBehind = nearOrBehind || c.w - e.w <= pc.nearW;
+    behind = behind && c.w + e.w < cam.nearW;
+    nearOrBehind = nearOrBehind || c.w - e.w <= cam.nearW;
     inside = inside && c.x + c.w > e.x + e.w && c.w - c.x > e.x + e.w && c.y + c.w > e.y + e.w &&
              c.w - c.y > e.y + e.w;
     wMin = min(wMin, c.w - e.w);
@@ -94,8 +100,8 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
     vec3 rx = vec3(m[0].x, m[1].x, m[2].x), ry = vec3(m[0].y, m[1].y, m[2].y);
     vec3 rw = vec3(m[0].w, m[1].w, m[2].w);
     vec2 slope = min(ndcMax, vec2(1.0));
-    float perUnit = max(0.5 * float(width) * (length(rx) + slope.x * length(rw)),
-                        0.5 * float(height) * (length(ry) + slope.y * length(rw))) / wMin;
+    float perUnit = max(0.5 * float(cam.width) * (length(rx) + slope.x * length(rw)),
+                        0.5 * float(cam.height) * (length(ry) + slope.y * length(rw))) / wMin;
     float pixels = perUnit * length(size) * 1.001; // 1.001: the 30-bit rounding (2^-31) and float slack
     v.words = pixels * (1.0 / 2048.0) < 0.5 ? 1u : pixels * (1.0 / 2097152.0) < 0.5 ? 2u : 3u;
   }
@@ -109,8 +115,8 @@ BatchView viewBatch(uint batch, uint width, uint height, uint forcedWords, bool 
   vec4 origin = vec4(lo + centre * scale - k * step, 1.0);
   // Screen rows of the map; X and Y lose Z/2 so that X/Z is the pixel's x - 1/2.
   vec4 rowW = vec4(m[0].w, m[1].w, m[2].w, m[3].w);
-  vec4 rowX = 0.5 * float(width) * (vec4(m[0].x, m[1].x, m[2].x, m[3].x) + rowW) - 0.5 * rowW;
-  vec4 rowY = 0.5 * float(height) * (rowW - vec4(m[0].y, m[1].y, m[2].y, m[3].y)) - 0.5 * rowW;
+  vec4 rowX = 0.5 * float(cam.width) * (vec4(m[0].x, m[1].x, m[2].x, m[3].x) + rowW) - 0.5 * rowW;
+  vec4 rowY = 0.5 * float(cam.height) * (rowW - vec4(m[0].y, m[1].y, m[2].y, m[3].y)) - 0.5 * rowW;
   v.cx = rowX.xyz * step;
   v.cy = rowY.xyz * step;
   v.cz = rowW.xyz * step;
@@ -160,10 +166,11 @@ void projectInside(vec3 s, uint width, uint height, out uint pixel, out uint dep
 }
 
 // The same with project.inc.glsl's tests: false for a point behind the near plane or outside the image.
-bool projectChecked(vec3 s, uint width, uint height, out uint pixel, out uint depthBits) {
+bool projectChecked(vec3 s, BatchCamera cam, out uint pixel, out uint depthBits) {
   pixel = kNoPixel; // out parameters are written on every path (see projectPoint)
   depthBits = 0xFFFFFFFFu;
-  if (!(s.z > pc.nearW)) return false; // also drops NaN
+  if (!(s.z > cam.nearW)) return false; // also drops NaN
+  uint width = cam.width, height = cam.height;
   float r = 1.0 / s.z;
   float x = s.x * r, y = s.y * r;
   // Compare as floats before rounding (x, y are the pixel's coordinates less 1/2): a huge or NaN
@@ -183,23 +190,32 @@ vec3 fullPrecisionPosition(BatchView v, uint high, uint medium, uint low) {
 
 // The pixel and depth bits of a point of batch v decoded from `words` words (a constant where the caller
 // can make it one). `checked`: with the near-plane and image tests (false only for an `inside` batch).
-bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint medium, uint low, uint width,
-                       uint height, out uint pixel, out uint depthBits) {
+bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint medium, uint low, BatchCamera cam,
+                       out uint pixel, out uint depthBits) {
   if (words == 3u)
-    return projectPoint(pc.viewProj, fullPrecisionPosition(v, high, medium, low), width, height, pc.nearW,
-                        pixel, depthBits);
+    return projectPoint(cam.viewProj, fullPrecisionPosition(v, high, medium, low), cam.width, cam.height,
+                        cam.nearW, pixel, depthBits);
   vec3 s = screenOf(v, pointFields(words, high, medium, low));
-  if (checked) return projectChecked(s, width, height, pixel, depthBits);
-  projectInside(s, width, height, pixel, depthBits);
+  if (checked) return projectChecked(s, cam, pixel, depthBits);
+  projectInside(s, cam.width, cam.height, pixel, depthBits);
   return true;
 }
 
-// The words of points 4g .. 4g + 3 of the part (uvec4 g of each word buffer), the first `words` of them;
+// Where the points of a box are: the addresses of its first point's word in each word buffer (16-byte
+// aligned, padded to a multiple of 4 points) and of its first point's RGBA8 color.
+struct BatchWords {
+  uint64_t high;   // bits 29..20 of x | y << 10 | z << 20
+  uint64_t medium; // bits 19..10
+  uint64_t low;    // bits 9..0
+  uint64_t colors;
+};
+
+// The words of the box's points 4g .. 4g + 3 (uvec4 g of each word buffer), the first `words` of them;
 // zeros for the others.
-void loadQuad(uint g, uint words, out uvec4 high, out uvec4 medium, out uvec4 low) {
-  high = Uvec4Array(pc.high).v[g];
-  medium = words >= 2u ? Uvec4Array(pc.medium).v[g] : uvec4(0u);
-  low = words >= 3u ? Uvec4Array(pc.low).v[g] : uvec4(0u);
+void loadQuad(BatchWords at, uint g, uint words, out uvec4 high, out uvec4 medium, out uvec4 low) {
+  high = Uvec4Array(at.high).v[g];
+  medium = words >= 2u ? Uvec4Array(at.medium).v[g] : uvec4(0u);
+  low = words >= 3u ? Uvec4Array(at.low).v[g] : uvec4(0u);
 }
 
 // Statistics (shared.h, kStat*): a thread counts in a register, the workgroup sums in shared memory, and

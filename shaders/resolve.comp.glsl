@@ -2,7 +2,8 @@
 // Framebuffer -> RGBA8 image (background where no point landed), and optionally the canonical words
 // (depth << 32 | color) that equivalence tests compare across methods.
 //   LAYOUT 0: uint64 words, float depth << 32 | RGBA8 (atomicMin family)
-//   LAYOUT 1: uint64 words, int40 depth << 24 | RGB24 (alpha restored as 255)
+//   LAYOUT 1: uint64 words, int40 depth << 24 | RGB24 (alpha restored as 255); words in float depth for
+//             the resolve stage when pc.int40Scale > 0
 //   LAYOUT 2: busy-loop arrays: uint depth[pixels], then uint color[pixels]
 #include "common.inc.glsl"
 #include "grid.inc.glsl"
@@ -30,5 +31,7 @@ void main() {
     color = LAYOUT == 1 ? (uint(word) & 0xFFFFFFu) | 0xFF000000u : uint(word);
   }
   UintArray(pc.image).v[i] = empty ? pc.background : color;
+  if (LAYOUT == 1 && pc.int40Scale > 0.0 && !empty)
+    word = uint64_t(floatBitsToUint(float(word >> kInt40ColorBits) / pc.int40Scale)) << 32 | uint64_t(color);
   if (pc.words != 0ul) Uint64Array(pc.words).v[i] = word;
 }

@@ -1,6 +1,7 @@
 #version 460
 // HQS resolve: average color = rounded sum / count, from the two-atomic sums (ONE_ROUND 0) or from the
-// packed 16-bit sums plus the 32-bit fallback sums (ONE_ROUND 1). Both give the same integers.
+// packed 16-bit sums plus the 32-bit fallback sums (ONE_ROUND 1). Both give the same integers. Words, on
+// request, pair the closest depth of the depth pass (pc.framebuffer) with the average.
 #include "common.inc.glsl"
 #include "grid.inc.glsl"
 
@@ -33,4 +34,8 @@ void main() {
     color = uint((r + half_) / n) | (uint((g + half_) / n) << 8) | (uint((b + half_) / n) << 16) | 0xFF000000u;
   }
   UintArray(pc.image).v[i] = color;
+  if (pc.words != 0ul) {
+    uint64_t depth = Uint64Array(pc.framebuffer).v[i] & 0xFFFFFFFF00000000ul;
+    Uint64Array(pc.words).v[i] = n > 0ul ? depth | uint64_t(color) : kEmptyPixel;
+  }
 }

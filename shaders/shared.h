@@ -68,6 +68,59 @@ struct ResolvePush {
   uint height;
   uint background;      // RGBA8 written where no point landed
   uint groupsX;         // workgroups per row of the 2D dispatch
+  float int40Scale;     // int40 depth: if > 0, words carry floatBits(steps / int40Scale) << 32 | RGBA8, the
+                        // float-depth words the resolve stage reads; 0: the method's canonical words
+  uint reserved;
+};
+
+// ------------------------------------------------------------------------------------------------------
+// The resolve stage (src/render/post): passes that run after any point method's raster and resolve, on
+// one float-depth word per pixel (floatBits(linear depth) << 32 | RGBA8, kEmptyPixel where empty) that
+// every method's resolve writes (ResolvePush::words).
+//   splat   points larger than one pixel: each pixel takes the smallest word among the pixels whose
+//           point's square or disc covers it (the same image as rasterizing the shapes with atomicMin)
+//   dilate  depth-aware hole filling: a pixel that is empty, or farther than the closer points of its
+//           window, takes the closest of them when it lies within their convex hull
+//   compose eye-dome lighting (optional), background, RGBA8 image and the final words
+// ------------------------------------------------------------------------------------------------------
+
+// Workgroups of the post passes are 16 x 16 pixel tiles (256 threads, like kPixelGroupSize), so a window
+// of neighbours is mostly shared between the threads of a tile.
+PR_CONST kPostTile = 16;
+// Largest point side in pixels (fixed or attenuated): the splat pass reads up to 33 x 33 words a pixel.
+PR_CONST kMaxPointSize = 32;
+// Largest dilation radius: a 17 x 17 window (the 2022 paper's periphery uses 7 x 7, radius 3).
+PR_CONST kMaxDilateRadius = 8;
+// Splat shapes (specialization constant SHAPE of post_splat.comp).
+PR_CONST kPointShapeSquare = 0; // side n: offsets -((n - 1) / 2) .. n / 2 from the point's pixel
+PR_CONST kPointShapeDisc = 1;   // diameter s: pixels whose center is within s / 2 of the point's pixel center
+// A pixel counts as a hole the dilation fills when the closer point is nearer by more than this factor
+// (1 %, the HQS tolerance): surfaces seen at a slant differ less than that from one pixel to the next.
+#define PR_DILATE_DEPTH_FACTOR 1.01
+// Eye-dome lighting as Potree computes it (edl.fs): for a pixel with a point, response = the sum over 8
+// neighbours at `radius` pixels (directions k * 45 degrees, nearest pixel) that hold a point of
+// max(0, log2(depth) - log2(neighbour depth)), divided by 8; the color is scaled by
+// shade = exp(-response * PR_EDL_EXPONENT * strength). Empty pixels keep the background.
+#define PR_EDL_EXPONENT 300.0
+PR_CONST kEdlNeighbours = 8;
+
+// Push constants of the post passes. Buffers are addressed by device address and may be strided (an eye
+// of a side-by-side stereo image is a window of a wider buffer: pitch > width).
+struct PostPush {
+  uint64_t source;  // uint64_t words, sourcePitch per row
+  uint64_t target;  // splat, dilate: uint64_t words; compose: RGBA8 image; targetPitch per row
+  uint64_t words;   // compose: if not 0, receives the final words (targetPitch per row)
+  uint width;
+  uint height;
+  uint sourcePitch; // elements per row
+  uint targetPitch;
+  uint radius;      // splat: the window's reach, pixels; dilate: the window radius
+  uint background;  // compose: RGBA8 where no point landed
+  float pointSize;  // splat fixed: side (square) or diameter (disc) in pixels; attenuated: the same at
+                    // linear depth 1 (the size at depth d is pointSize / d, clamped to [1, maxPointSize])
+  float maxPointSize;
+  float edlStrength; // compose: 0 = no eye-dome lighting
+  float edlRadius;   // pixels
 };
 
 // Push constants of the shader copy that measures the device's copy bandwidth (src/gpu/bandwidth.cpp).
@@ -164,6 +217,85 @@ struct BatchPush {
   float nearW;     // points with c.w <= nearW are dropped
   uint part;       // visibility part number of this part
   uint reserved;
+};
+
+// ------------------------------------------------------------------------------------------------------
+// Level of detail (the 2022 paper, sections 3.5-3.6): octree nodes drawn by the batch rasterizer. The GPU
+// node cache (render/lod/) keeps nodes in pages of kLodPagePoints points; a frame draws a list of nodes (one
+// LodNode each, ordered by node key) and one workgroup per page of them. A node's points are quantized to
+// 30 bits per axis in its tight bounds exactly as a batch's are (cloud/batch_words.h).
+// ------------------------------------------------------------------------------------------------------
+
+// 128 threads x 32 points = 4096 points per page: a node of n points takes ceil(n / 4096) pages, so a node
+// wastes half a page on average (6 % of a 16 k-point node) while a workgroup still has 8 steps of 4 points
+// per thread to spread the load of its page's descriptor over.
+PR_CONST kLodPagePoints = 4096;
+PR_CONST kLodPageSteps = kLodPagePoints / (4 * kPointGroupSize); // steps of 4 points per thread: 8
+// A page in GPU memory: four sections of kLodPagePoints uints: high, medium and low coordinate words
+// (batch layout), then RGBA8 colors. 64 KiB.
+PR_CONST kLodPageSectionBytes = kLodPagePoints * 4;
+PR_CONST kLodPageBytes = 4 * kLodPageSectionBytes;
+
+// One node of a pass, in the pass's node order (node keys ascending).
+struct LodNode {
+  vec4 min;        // tight bounds relative to the scene origin (w unused), rounded once to float from the
+  vec4 max;        // exact bounds its points were quantized in
+  uint firstIndex; // visibility index of the node's first point: points of the pass numbered in node order
+  uint pointCount;
+  uint firstPage;  // its first page in the pass's page list (a node's pages are consecutive there)
+  uint rank;       // its position in the whole selection of the frame (the order across passes)
+};
+
+// One page of a pass: one workgroup of the drawing passes.
+struct LodPage {
+  uint64_t address; // the page in GPU memory (kLodPageBytes, sections as above)
+  uint node;        // index of its node in the pass's node list
+  uint first;       // index of its first point in the node (a multiple of kLodPagePoints)
+};
+
+// A node's box decision (batch.inc.glsl's BatchView), computed once per node and pass by lod_nodes.comp and
+// read by every page of the node: the screen map's rows (cx, cy, cz, offset), the min corner and the steps
+// of the 30-bit quantization. cx.w holds the coordinate words (0: culled), cy.w 1 when every point of the
+// box is inside the image (as float bits).
+struct LodNodeView {
+  vec4 cx;
+  vec4 cy;
+  vec4 cz;
+  vec4 offset;
+  vec4 lo;
+  vec4 step;
+};
+
+// Per-pixel composition of several passes (a selection larger than the node cache, drawn in passes):
+// uvec4 (depth bits, node rank, index in node, RGBA8), all ones = empty. The lexicographic minimum over the
+// passes is the word one pass over the whole selection would have kept, whatever the split into passes.
+PR_CONST kLodCompositeBytes = 16;
+
+// What every LOD pass reads about the frame (a device buffer, like BatchFrame).
+struct LodFrame {
+  uint64_t framebuffer;  // uint64_t per pixel: floatBits(depth) << 32 | visibility index; ones = empty
+  uint64_t stats;        // uint64_t[kBatchStatSlots][kBatchStatCount], batches meaning nodes
+  uint64_t accumulators; // lod-hqs: hqs1r's layout
+  uint64_t nodes;        // LodNode[nodeCount]
+  uint64_t views;        // LodNodeView[nodeCount]
+  uint64_t pages;        // LodPage[pageCount]
+  uint64_t composite;    // uvec4 per pixel (kLodCompositeBytes)
+  uint width;
+  uint height;
+  uint forcedWords; // 0: adaptive precision; 1..3: every node decodes from this many words
+  uint culling;     // 1: frustum culling of nodes; 0 (a debug setting): every node is drawn
+  uint nodeCount;
+  uint pageCount;
+  uint nodeStats; // 1: the node pass counts nodes and points (0 when a pass's nodes are viewed again)
+  uint reserved;
+};
+
+// Push constants of the LOD passes (a frame's matrix and near plane; the rest is in LodFrame).
+struct LodPush {
+  mat4 viewProj;  // world-relative-to-origin -> clip; only rows x, y, w are used
+  uint64_t frame; // LodFrame
+  float nearW;    // points with c.w <= nearW are dropped
+  uint groupsX;   // workgroups per row of the 2D grid (pages or nodes may exceed 65535 workgroups)
 };
 
 // ------------------------------------------------------------------------------------------------------

@@ -26,4 +26,10 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+// The user interrupted long work (Ctrl-C): unwinding removes what was half written; the CLI exits 130.
+class Interrupted : public std::runtime_error {
+public:
+  Interrupted() : std::runtime_error("interrupted") {}
+};
+
 } // namespace pointrast

@@ -19,11 +19,14 @@ inline unsigned hardwareThreads() {
 }
 
 // Calls body(blockIndex, begin, end) for consecutive blocks [begin, end) of at most blockSize indices
-// covering [0, count), on all hardware threads. The first exception thrown by a body is rethrown.
-template <class Body> void parallelBlocks(uint64_t count, uint64_t blockSize, Body&& body) {
+// covering [0, count), on at most maxThreads threads (0: all hardware threads). The first exception
+// thrown by a body is rethrown.
+template <class Body>
+void parallelBlocksOn(unsigned maxThreads, uint64_t count, uint64_t blockSize, Body&& body) {
   if (count == 0) return;
   uint64_t blocks = (count + blockSize - 1) / blockSize;
-  unsigned threads = static_cast<unsigned>(std::min<uint64_t>(hardwareThreads(), blocks));
+  unsigned threads =
+      static_cast<unsigned>(std::min<uint64_t>(maxThreads ? maxThreads : hardwareThreads(), blocks));
   std::atomic<uint64_t> next{0};
   std::exception_ptr error;
   std::mutex errorMutex;
@@ -54,6 +57,11 @@ template <class Body> void parallelBlocks(uint64_t count, uint64_t blockSize, Bo
       t.join();
   }
   if (error) std::rethrow_exception(error);
+}
+
+// The same on all hardware threads.
+template <class Body> void parallelBlocks(uint64_t count, uint64_t blockSize, Body&& body) {
+  parallelBlocksOn(0, count, blockSize, body);
 }
 
 } // namespace pointrast

@@ -5,7 +5,9 @@
 #include <cassert>
 #include <cmath>
 
+#include "base/error.h"
 #include "base/parallel.h"
+#include "cloud/attribute_colors.h"
 #include "cloud/detail.h"
 
 namespace pointrast {
@@ -139,9 +141,7 @@ namespace {
 // one ramp step.
 constexpr uint64_t kModeSamples = uint64_t(1) << 20;
 
-struct Range {
-  double lo = 0, hi = 0;
-};
+using Range = ColorRange;
 
 // The 0.5% and 99.5% percentiles of value(k) over k in [0, n), from a histogram of 4096 bins between
 // min and max (bin edges, so at most 1/4096 of the range off). Falls back to [min, max] when the
@@ -168,27 +168,52 @@ template <class Value> Range robustRange(uint64_t n, double min, double max, Val
   return {std::max(r.lo, min), std::min(r.hi, max)};
 }
 
+// Sample k of a mode's range is point k * stride.
+struct Sampling {
+  uint64_t stride = 1, samples = 0;
+  explicit Sampling(uint64_t n)
+      : stride(std::max<uint64_t>(1, (n + kModeSamples - 1) / kModeSamples)),
+        samples((n + stride - 1) / stride) {}
+};
+
+// Robust range of the intensity sample; lo == hi when the sample shows one value.
+Range intensityRange(const PointCloud& cloud) {
+  const Sampling s(cloud.size());
+  const uint16_t* v = cloud.intensity.data();
+  uint16_t lo = 65535, hi = 0;
+  for (uint64_t k = 0; k < s.samples; ++k) {
+    lo = std::min(lo, v[k * s.stride]);
+    hi = std::max(hi, v[k * s.stride]);
+  }
+  if (!(hi > lo)) return {double(lo), double(lo)};
+  return robustRange(s.samples, lo, hi, [=](uint64_t k) { return double(v[k * s.stride]); });
+}
+
+// Robust range of world z over the sample; {0, 1} for a cloud without points.
+Range elevationRange(const PointCloud& cloud) {
+  const uint64_t n = cloud.size();
+  Bounds b = cloud.bounds;
+  if (b.empty() && n > 0)
+    b = detail::worldBounds(detail::quantBox(cloud.positions.data(), 0, n), cloud.scale, cloud.offset);
+  if (b.empty()) return {0.0, 1.0};
+  const Sampling s(n);
+  const int32_t* p = cloud.positions.data();
+  const double sz = cloud.scale.z, oz = cloud.offset.z;
+  return robustRange(s.samples, b.min.z, b.max.z,
+                     [=](uint64_t k) { return p[3 * k * s.stride + 2] * sz + oz; });
+}
+
 } // namespace
 
 DisplayColorMode displayColorMode(const PointCloud& cloud) {
   DisplayColorMode mode;
-  const uint64_t n = cloud.size();
   if (hasUsableColor(cloud)) {
     mode.source = DisplayColorMode::Source::Rgb;
     return mode;
   }
-  // Sample k is point k * stride.
-  const uint64_t stride = std::max<uint64_t>(1, (n + kModeSamples - 1) / kModeSamples);
-  const uint64_t samples = (n + stride - 1) / stride;
   if (!cloud.intensity.empty()) {
-    const uint16_t* v = cloud.intensity.data();
-    uint16_t lo = 65535, hi = 0;
-    for (uint64_t k = 0; k < samples; ++k) {
-      lo = std::min(lo, v[k * stride]);
-      hi = std::max(hi, v[k * stride]);
-    }
-    if (hi > lo) { // a constant intensity carries no picture: use elevation instead
-      Range r = robustRange(samples, lo, hi, [=](uint64_t k) { return double(v[k * stride]); });
+    Range r = intensityRange(cloud);
+    if (r.hi > r.lo) { // a constant intensity carries no picture: use elevation instead
       mode.source = DisplayColorMode::Source::Intensity;
       mode.lo = r.lo;
       mode.hi = r.hi;
@@ -196,43 +221,86 @@ DisplayColorMode displayColorMode(const PointCloud& cloud) {
     }
   }
   mode.source = DisplayColorMode::Source::Elevation;
-  Bounds b = cloud.bounds;
-  if (b.empty() && n > 0)
-    b = detail::worldBounds(detail::quantBox(cloud.positions.data(), 0, n), cloud.scale, cloud.offset);
-  if (b.empty()) return mode;
-  const int32_t* p = cloud.positions.data();
-  const double sz = cloud.scale.z, oz = cloud.offset.z;
-  Range r =
-      robustRange(samples, b.min.z, b.max.z, [=](uint64_t k) { return p[3 * k * stride + 2] * sz + oz; });
+  Range r = elevationRange(cloud);
   mode.lo = r.lo;
   mode.hi = r.hi;
+  return mode;
+}
+
+DisplayColorMode displayColorMode(const PointCloud& cloud, DisplayColorMode::Source source,
+                                  std::optional<ColorRange> range) {
+  using Source = DisplayColorMode::Source;
+  auto lacks = [&](const char* what) {
+    return InputError(cloud.source + " has no " + what + " to color by (--color " + colorSourceName(source) +
+                      ")");
+  };
+  DisplayColorMode mode;
+  mode.source = source;
+  const uint64_t n = cloud.size();
+  switch (source) {
+  case Source::Rgb:
+    if (cloud.colors.size() != n) throw lacks("RGB colors");
+    break;
+  case Source::Intensity:
+  case Source::Elevation: {
+    if (source == Source::Intensity && cloud.intensity.size() != n) throw lacks("intensity");
+    Range r = range                         ? Range{range->lo, range->hi}
+              : source == Source::Intensity ? intensityRange(cloud)
+                                            : elevationRange(cloud);
+    mode.lo = r.lo;
+    mode.hi = r.hi;
+    break;
+  }
+  case Source::Classification:
+    if (cloud.classification.size() != n) throw lacks("classification");
+    break;
+  case Source::ReturnNumber:
+    if (cloud.returnNumber.size() != n) throw lacks("return numbers");
+    break;
+  case Source::PointSource:
+    if (cloud.pointSourceId.size() != n) throw lacks("point source ids");
+    break;
+  }
   return mode;
 }
 
 void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
                    const DisplayColorMode& mode) {
   assert(first + count <= cloud.size());
-  const double span = mode.hi - mode.lo;
-  const double inv = span > 0 ? 1.0 / span : 0.0;
+  using Source = DisplayColorMode::Source;
+  // An explicit mode was checked against the cloud (displayColorMode(cloud, source)); a mode handed in
+  // for a cloud without the attribute is a caller's mistake.
+  assert(mode.source != Source::Rgb || cloud.colors.size() == cloud.size());
+  assert(mode.source != Source::Intensity || cloud.intensity.size() == cloud.size());
+  assert(mode.source != Source::Classification || cloud.classification.size() == cloud.size());
+  assert(mode.source != Source::ReturnNumber || cloud.returnNumber.size() == cloud.size());
+  assert(mode.source != Source::PointSource || cloud.pointSourceId.size() == cloud.size());
   auto fill = [&](uint64_t begin, uint64_t end) {
-    switch (mode.source) {
-    case DisplayColorMode::Source::Rgb:
-      for (uint64_t k = begin; k < end; ++k)
-        dst[k] = cloud.colors[first + k] | 0xFF000000u;
-      break;
-    case DisplayColorMode::Source::Intensity:
-      for (uint64_t k = begin; k < end; ++k)
-        dst[k] = span > 0 ? detail::rampColor((cloud.intensity[first + k] - mode.lo) * inv)
-                          : detail::rampColor(0.5);
-      break;
-    case DisplayColorMode::Source::Elevation: {
-      const int32_t* p = cloud.positions.data();
-      const double sz = cloud.scale.z, oz = cloud.offset.z;
-      for (uint64_t k = begin; k < end; ++k)
-        dst[k] = span > 0 ? detail::rampColor((p[3 * (first + k) + 2] * sz + oz - mode.lo) * inv)
-                          : detail::rampColor(0.5);
-      break;
-    }
+    const int32_t* p = cloud.positions.data();
+    const double sz = cloud.scale.z, oz = cloud.offset.z;
+    // Each case reads only its own attribute array: the others may be empty.
+    for (uint64_t k = begin; k < end; ++k) {
+      const uint64_t i = first + k;
+      switch (mode.source) {
+      case Source::Rgb:
+        dst[k] = cloud.colors[i] | 0xFF000000u;
+        break;
+      case Source::Intensity:
+        dst[k] = attributeColor(mode, 0, cloud.intensity[i], 0, 0, 0, 0);
+        break;
+      case Source::Elevation:
+        dst[k] = attributeColor(mode, 0, 0, p[3 * i + 2] * sz + oz, 0, 0, 0);
+        break;
+      case Source::Classification:
+        dst[k] = classificationColor(cloud.classification[i]);
+        break;
+      case Source::ReturnNumber:
+        dst[k] = returnNumberColor(cloud.returnNumber[i]);
+        break;
+      case Source::PointSource:
+        dst[k] = pointSourceColor(cloud.pointSourceId[i]);
+        break;
+      }
     }
   };
   constexpr uint64_t kParallelFrom = uint64_t(1) << 18;

@@ -4,12 +4,14 @@
 // coordinates do not lose their low digits.
 //
 // Attributes are parallel arrays; an empty array means the source has no such attribute.
-// Memory per point: 12 B positions + 4 B color (+ 2 B intensity + 1 B classification + 1 B return).
+// Memory per point: 12 B positions + 4 B color (+ 2 B intensity + 1 B classification + 1 B return + 2 B
+// point source id).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +39,7 @@ struct Bounds {
 };
 
 // Packed color: r | g << 8 | b << 16 | a << 24 (RGBA8, the byte order of a PNG row).
-inline uint32_t packRgba(uint32_t r, uint32_t g, uint32_t b, uint32_t a = 255) {
+constexpr uint32_t packRgba(uint32_t r, uint32_t g, uint32_t b, uint32_t a = 255) {
   return r | (g << 8) | (b << 16) | (a << 24);
 }
 
@@ -49,6 +51,7 @@ struct PointCloud {
   std::vector<uint16_t> intensity;   // empty if none
   std::vector<uint8_t> classification; // empty if none
   std::vector<uint8_t> returnNumber; // empty if none
+  std::vector<uint16_t> pointSourceId; // empty if none (LAS: the flight line or scan a point came from)
   Bounds bounds;                     // of world positions, exact (computed from the points)
   std::string source;                // file name or scene description, for messages
 
@@ -81,15 +84,25 @@ void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint6
 // ramp. Deciding costs a few milliseconds (ranges come from a regular sample of at most 2^20 points;
 // only an all-black color array is scanned in full), so a caller converting a large cloud in many chunks
 // should compute it once and pass it to the overload below rather than call the four-argument form.
+// The palettes and ramps of each source are in cloud/attribute_colors.h.
 struct DisplayColorMode {
-  enum class Source { Rgb, Intensity, Elevation };
+  enum class Source { Rgb, Intensity, Elevation, Classification, ReturnNumber, PointSource };
   Source source = Source::Elevation;
   // Values mapped to the two ends of the ramp (intensity units or world z): the 0.5% and 99.5%
   // percentiles rather than min and max, so a few outliers (birds, noise) do not flatten the ramp.
   // Intensity counts as constant (elevation is used) when the sample shows one value.
   double lo = 0.0, hi = 1.0;
 };
+// The automatic choice: RGB where usable, else intensity where not constant, else elevation.
 DisplayColorMode displayColorMode(const PointCloud& cloud);
+// An explicit choice (render --color): throws InputError naming cloud.source when the cloud lacks the
+// attribute. Intensity and elevation map [lo, hi] = `range` when given (lo < hi), else the robust
+// percentiles above; the other sources ignore the range.
+struct ColorRange {
+  double lo = 0.0, hi = 0.0;
+};
+DisplayColorMode displayColorMode(const PointCloud& cloud, DisplayColorMode::Source source,
+                                  std::optional<ColorRange> range = std::nullopt);
 void displayColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
                    const DisplayColorMode& mode);
 

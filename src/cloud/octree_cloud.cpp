@@ -34,6 +34,7 @@ void compact(PointCloud& cloud, const std::vector<uint64_t>& first, const std::v
     moveRange(cloud.intensity, first[b], cursor, actual[b], 1);
     moveRange(cloud.classification, first[b], cursor, actual[b], 1);
     moveRange(cloud.returnNumber, first[b], cursor, actual[b], 1);
+    moveRange(cloud.pointSourceId, first[b], cursor, actual[b], 1);
     cursor += actual[b];
   }
   cloud.positions.resize(3 * cursor);
@@ -44,6 +45,7 @@ void compact(PointCloud& cloud, const std::vector<uint64_t>& first, const std::v
   shrink(cloud.intensity);
   shrink(cloud.classification);
   shrink(cloud.returnNumber);
+  shrink(cloud.pointSourceId);
 }
 
 } // namespace
@@ -61,7 +63,8 @@ PointCloud readOctreeCloud(NodeSource& source, const OctreeCloudOptions& options
   const uint64_t listed = first.back();
 
   RecordFields fields = meta.fields;
-  if (!options.keepAttributes) fields.intensity = fields.classification = fields.returnNumber = false;
+  if (!options.keepAttributes)
+    fields.intensity = fields.classification = fields.returnNumber = fields.pointSourceId = false;
   PointCloud cloud;
   cloud.scale = meta.scale;
   cloud.offset = meta.offset;
@@ -71,6 +74,7 @@ PointCloud readOctreeCloud(NodeSource& source, const OctreeCloudOptions& options
   if (fields.intensity) cloud.intensity.resize(listed);
   if (fields.classification) cloud.classification.resize(listed);
   if (fields.returnNumber) cloud.returnNumber.resize(listed);
+  if (fields.pointSourceId) cloud.pointSourceId.resize(listed);
 
   std::optional<Progress> progress;
   if (options.progress) progress.emplace("reading " + meta.source, listed);

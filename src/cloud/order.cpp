@@ -33,35 +33,9 @@ namespace {
 
 constexpr const char* kOrderNames[] = {"original", "morton", "shuffled", "shuffled-morton"};
 
+using detail::compactBits3;
 using detail::splitmixAt;
-
-// Spreads the low 21 bits of v so that bit k lands on bit 3k. Each step halves the group width:
-//   0x1f00000000ffff   groups of 16 bits, 48 apart   ---- ---- ---1 1111 (x32)  ...  1111 1111 1111 1111
-//   0x1f0000ff0000ff   groups of  8 bits, 24 apart
-//   0x100f00f00f00f00f groups of  4 bits, 12 apart
-//   0x10c30c30c30c30c3 groups of  2 bits,  6 apart
-//   0x1249249249249249 single bits,        3 apart   ...1 0010 0100 1001 = bit 0, 3, 6, 9, ...
-inline uint64_t spreadBits3(uint32_t v) {
-  uint64_t x = v & 0x1fffffu;
-  x = (x | x << 32) & 0x1f00000000ffffull;
-  x = (x | x << 16) & 0x1f0000ff0000ffull;
-  x = (x | x << 8) & 0x100f00f00f00f00full;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
-}
-
-// The inverse of spreadBits3: gathers bits 0, 3, 6, ... of x into its low 21 bits, the same masks in
-// reverse order.
-inline uint32_t compactBits3(uint64_t x) {
-  x &= 0x1249249249249249ull;
-  x = (x | x >> 2) & 0x10c30c30c30c30c3ull;
-  x = (x | x >> 4) & 0x100f00f00f00f00full;
-  x = (x | x >> 8) & 0x1f0000ff0000ffull;
-  x = (x | x >> 16) & 0x1f00000000ffffull;
-  x = (x | x >> 32) & 0x1fffffull;
-  return static_cast<uint32_t>(x);
-}
+using detail::spreadBits3;
 
 // ---- parallel sample sort of indices by (key(i), i) --------------------------------------------------
 
@@ -388,6 +362,7 @@ void applyOrder(PointCloud& cloud, const std::vector<uint64_t>& order) {
   gather<uint16_t, 1>(cloud.intensity, order);
   gather<uint8_t, 1>(cloud.classification, order);
   gather<uint8_t, 1>(cloud.returnNumber, order);
+  gather<uint16_t, 1>(cloud.pointSourceId, order);
 }
 
 void reorder(PointCloud& cloud, Order kind, uint64_t seed) {

@@ -12,6 +12,7 @@ void appendRecords(PointCloud& cloud, const PointRecord* records, size_t count, 
   if (fields.intensity) cloud.intensity.resize(first + count);
   if (fields.classification) cloud.classification.resize(first + count);
   if (fields.returnNumber) cloud.returnNumber.resize(first + count);
+  if (fields.pointSourceId) cloud.pointSourceId.resize(first + count);
   storeRecords(cloud, first, records, count, fields, colorShift);
 }
 
@@ -29,6 +30,7 @@ void storeRecords(PointCloud& cloud, uint64_t first, const PointRecord* records,
     if (fields.intensity) cloud.intensity[first + i] = r.intensity;
     if (fields.classification) cloud.classification[first + i] = r.classification;
     if (fields.returnNumber) cloud.returnNumber[first + i] = r.returnNumber;
+    if (fields.pointSourceId) cloud.pointSourceId[first + i] = r.pointSourceId;
   }
 }
 

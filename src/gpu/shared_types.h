@@ -14,7 +14,10 @@ static_assert(offsetof(RasterPush, framebuffer) == 80);
 static_assert(offsetof(RasterPush, viewProjD) == 96);
 static_assert(offsetof(RasterPush, pointCount) == 104);
 static_assert(offsetof(RasterPush, groupsX) == 120);
-static_assert(sizeof(ResolvePush) == 48);
+static_assert(sizeof(ResolvePush) == 56);
+static_assert(offsetof(ResolvePush, int40Scale) == 48);
+static_assert(sizeof(PostPush) == 64);
+static_assert(offsetof(PostPush, width) == 24 && offsetof(PostPush, pointSize) == 48);
 static_assert(offsetof(ResolvePush, width) == 32);
 static_assert(sizeof(CopyPush) == 24);
 
@@ -33,6 +36,16 @@ static_assert(sizeof(BatchFrame) == 40 + 8 * kMaxVisibilityParts);
 static_assert(kBatchPoints == 10240 && kBatchPrefetchSteps * 4 == kBatchPointsPerThread);
 static_assert(uint64_t(kMaxPartBatches) * kBatchPoints <= kVisibilityLocalMask + 1ull);
 static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 32);
+
+// The LOD passes: LodNode, LodPage, LodNodeView and LodFrame live in buffers read with std430 rules; LodPush
+// is a push-constant block.
+static_assert(sizeof(LodNode) == 48 && offsetof(LodNode, firstIndex) == 32 && offsetof(LodNode, rank) == 44);
+static_assert(sizeof(LodPage) == 16 && offsetof(LodPage, node) == 8);
+static_assert(sizeof(LodNodeView) == 96);
+static_assert(sizeof(LodFrame) == 88 && offsetof(LodFrame, width) == 56 &&
+              offsetof(LodFrame, pageCount) == 76);
+static_assert(sizeof(LodPush) == 80 && offsetof(LodPush, frame) == 64 && offsetof(LodPush, groupsX) == 76);
+static_assert(kLodPageSteps * 4 * kPointGroupSize == kLodPagePoints && kLodPagePoints % 4 == 0);
 
 // Spheres: SphereFrame lives in a buffer read with std430 rules (struct alignment 16 for its mat4/vec4).
 static_assert(sizeof(SphereFrame) == 160);

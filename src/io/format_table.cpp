@@ -7,8 +7,12 @@
 
 #include "cloud/octree.h"
 #include "io/formats.h"
+#include "io/copc.h"
+#include "io/ept.h"
 #include "io/io_util.h"
 #include "io/las_format.h"
+#include "io/las_source.h"
+#include "io/laz_reader.h"
 #include "io/point_source.h"
 #include "io/potree.h"
 
@@ -28,6 +32,16 @@ bool isLasFile(const FormatProbe& input) {
 
 bool isLazFile(const FormatProbe& input) {
   return startsWith(input, "LASF") && lasLooksCompressed(*input.file);
+}
+
+// COPC: a LAZ file with the COPC info VLR.
+bool isCopcFile(const FormatProbe& input) {
+  return startsWith(input, "LASF") && hasCopcInfoVlr(*input.file);
+}
+
+// An EPT dataset: its folder, or the ept.json in it.
+bool isEpt(const FormatProbe& input) {
+  return looksLikeEpt(input.path);
 }
 
 // "ply" ends its own line (PLY header, first line); trailing spaces and CR LF are tolerated.
@@ -53,11 +67,13 @@ void refuseParticles(const std::filesystem::path& path) {
 // clang-format off
 constexpr FormatInfo kFormats[] = {
   // name    extensions               content                 detect       read     probe     openPoints openNodes refuse
-  {"LAS",   ".las",                   FormatContent::Points,    isLasFile,   readLas, probeLas, nullptr,   nullptr,  nullptr},
-  {"LAZ",   ".laz",                   FormatContent::Points,    isLazFile,   nullptr, nullptr,  nullptr,   nullptr,  failCompressed},
+  {"LAS",   ".las",                   FormatContent::Points,    isLasFile,   readLas, probeLas, openLasSource, nullptr, nullptr},
+  {"COPC",  ".copc.laz",              FormatContent::Points,    isCopcFile,  readLaz, probeLaz, openLazSource, openCopc, nullptr},
+  {"LAZ",   ".laz",                   FormatContent::Points,    isLazFile,   readLaz, probeLaz, openLazSource, nullptr, nullptr},
   {"PLY",   ".ply",                   FormatContent::Points,    isPlyFile,   readPly, probePly, nullptr,   nullptr,  nullptr},
   {"XYZ",   ".xyz .txt .csv .pts",    FormatContent::Points,    nullptr,     readXyz, probeXyz, nullptr,   nullptr,  nullptr},
   {"Potree 2.0", "",                  FormatContent::Points,    isPotree,    readPotree, probePotreeFolder, nullptr, openPotree, nullptr},
+  {"EPT",   "",                       FormatContent::Points,    isEpt,       readEpt, probeEpt, nullptr,   openEpt,  nullptr},
   {"MMPLD", ".mmpld",                 FormatContent::Particles, isMmpldFile, nullptr, nullptr,  nullptr,   nullptr,  refuseParticles},
 };
 // clang-format on

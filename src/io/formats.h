@@ -18,9 +18,7 @@ FileInfo probePotreeFolder(const std::filesystem::path& path);
 // "not a LAS, LAZ, ... file (unrecognised content and extension)", naming every row.
 std::string unrecognisedFormatText();
 
-// Header counts (statedPointCount()): LAS's count, checked against the file's size; PLY's vertex
-// count where the file's size can hold it.
-std::optional<uint64_t> statedCountLas(const std::filesystem::path& path);
+// The vertex count of a PLY header where the file's size can hold it (statedPointCount()).
 std::optional<uint64_t> statedCountPly(const std::filesystem::path& path);
 
 // Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to

@@ -46,6 +46,7 @@ std::vector<LasVlr> walkVlrs(const InputFile& file, uint64_t start, uint32_t cou
     vlr.length = loadLE<uint16_t>(h + 20);
     vlr.description = fixedString(h + 22, 32);
     pos += las::kVlrHeaderSize;
+    vlr.dataOffset = pos;
     if (vlr.length > limit - pos) {
       truncated = true;
       vlrs.push_back(std::move(vlr));
@@ -59,37 +60,8 @@ std::vector<LasVlr> walkVlrs(const InputFile& file, uint64_t start, uint32_t cou
 
 } // namespace
 
-namespace {
-
-// A path as one shell word, so that the suggested command can be pasted as it is: single quotes around
-// anything but plain characters, and "./" before a relative name that the tool would take for an option.
-std::string shellWord(const std::filesystem::path& path) {
-  std::string name = path.string();
-  if (!name.empty() && name[0] == '-') name = "./" + name;
-  const bool plain =
-      !name.empty() && name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                              "0123456789_./+,:=@%-") == std::string::npos;
-  if (plain) return name;
-  std::string quoted = "'";
-  for (char c : name)
-    quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
-} // namespace
-
 void failCompressed(const std::filesystem::path& path) {
-  // The decompressed copy goes beside the input, under a name that is never the input's own: a LAZ file
-  // named .las must not be suggested a command that overwrites it.
-  std::filesystem::path las = path;
-  if (lowerExtension(path) == ".las")
-    las.replace_filename(path.stem().string() + "-decompressed.las");
-  else
-    las.replace_extension(".las");
-  const std::string in = shellWord(path), out = shellWord(las);
-  fail(path, strFormat("LAZ/COPC compressed files are not supported yet; decompress with "
-                       "`pdal translate %s %s` or `laszip -i %s -o %s`",
-                       in.c_str(), out.c_str(), in.c_str(), out.c_str()));
+  fail(path, "the points are LAZ-compressed; the plain LAS reader reads uncompressed files only");
 }
 
 bool lasLooksCompressed(const InputFile& file) {
@@ -107,7 +79,7 @@ bool lasLooksCompressed(const InputFile& file) {
   return false;
 }
 
-LasHeader readLasHeader(const InputFile& file) {
+LasHeader readLasHeader(const InputFile& file, bool allowCompressed) {
   const std::filesystem::path& path = file.path();
   const uint64_t fileSize = file.size();
   if (fileSize < las::kHeaderSize12)
@@ -172,7 +144,7 @@ LasHeader readLasHeader(const InputFile& file) {
   hd.compressed = (hd.pointFormatByte & las::kCompressionBits) != 0;
   for (const LasVlr& vlr : hd.vlrs)
     hd.compressed = hd.compressed || isCompressionVlr(vlr);
-  if (hd.compressed) failCompressed(path);
+  if (hd.compressed && !allowCompressed) failCompressed(path);
 
   if (hd.pointFormat > las::kMaxPointFormat)
     fail(path, strFormat("point format %d is not a LAS point format (0 to 10)", hd.pointFormat));
@@ -188,7 +160,7 @@ LasHeader readLasHeader(const InputFile& file) {
       fail(path, strFormat("%c offset %g is not a finite number", kAxis[a], hd.offset[a]));
   }
   uint64_t available = fileSize - hd.pointOffset;
-  if (hd.pointCount > available / hd.recordLength)
+  if (!hd.compressed && hd.pointCount > available / hd.recordLength)
     fail(path, strFormat("header claims %llu points of %u bytes but the file holds %llu bytes of point data",
                          static_cast<unsigned long long>(hd.pointCount), hd.recordLength,
                          static_cast<unsigned long long>(available)));

@@ -62,6 +62,7 @@ struct LasVlr {
   uint16_t recordId = 0;
   uint16_t length = 0;
   std::string description;
+  uint64_t dataOffset = 0; // file offset of the record's payload (length bytes)
 };
 
 struct LasHeader {
@@ -96,15 +97,16 @@ bool lasLooksCompressed(const InputFile& file);
 
 // Reads and validates the header and VLR list: every size, offset and count is checked against the file
 // size, so a header that passes can be used to read point data without further bounds checks. Throws
-// InputError with one sentence; for compressed files, the "LAZ is not supported" sentence.
-LasHeader readLasHeader(const InputFile& file);
+// InputError with one sentence; for compressed files failCompressed()'s sentence unless allowCompressed,
+// in which case the point count is left for the LAZ reader to check against its chunk table.
+LasHeader readLasHeader(const InputFile& file, bool allowCompressed = false);
 
 // Bytes of point records the LAS reader reads and parses at a time (default 32 MiB). Tests lower it to
 // cross chunk boundaries with small files; 0 restores the default.
 void setLasChunkBytes(uint64_t bytes);
 uint64_t lasChunkBytes();
 
-// The sentence readers and probe give for LAZ/COPC files.
+// The sentence the plain LAS reader gives for LAZ/COPC files (readCloud sends those to the LAZ reader).
 [[noreturn]] void failCompressed(const std::filesystem::path& path);
 
 } // namespace pointrast::io::detail

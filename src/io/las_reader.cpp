@@ -10,6 +10,7 @@
 #include "base/progress.h"
 #include "io/formats.h"
 #include "io/las_format.h"
+#include "io/las_records.h"
 
 namespace pointrast::io {
 
@@ -20,20 +21,6 @@ namespace {
 constexpr uint64_t kDefaultChunkBytes = uint64_t(32) << 20;
 std::atomic<uint64_t> gChunkBytes{kDefaultChunkBytes};
 constexpr uint64_t kBlockPoints = uint64_t(1) << 16; // parallel work unit within a chunk
-
-struct BlockStats {
-  int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
-  int32_t qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-  uint16_t colorMax = 0;
-};
-
-struct Destination {
-  int32_t* positions = nullptr;
-  uint32_t* colors = nullptr;    // null: format has no color
-  uint16_t* intensity = nullptr; // these three are null unless attributes are kept
-  uint8_t* classification = nullptr;
-  uint8_t* returnNumber = nullptr;
-};
 
 // Calls fn(records, firstIndex, count) for consecutive chunks of point records (see forEachRecordChunk).
 template <class Fn> void forEachChunk(const InputFile& file, const LasHeader& hd, Fn&& fn) {
@@ -46,52 +33,6 @@ inline uint32_t packLasColor(const uint8_t* rgb, int shift) {
   uint32_t g = (loadLE<uint16_t>(rgb + 2) >> shift) & 0xFF;
   uint32_t b = (loadLE<uint16_t>(rgb + 4) >> shift) & 0xFF;
   return packRgba(r, g, b);
-}
-
-// Record layout, R15 section 2.6: X, Y, Z int32 at 0, 4, 8; intensity uint16 at 12; byte 14 holds the
-// return number in bits 0-2 (formats 0-5) or bits 0-3 (formats 6-10); the classification is bits 0-4
-// of byte 15 (formats 0-5) or all of byte 16 (formats 6-10).
-template <bool kExtended>
-void parseBlock(const uint8_t* src, uint64_t stride, uint64_t count, int rgbOffset, int colorShift,
-                const Destination& dst, BlockStats& stats) {
-  BlockStats s;
-  for (uint64_t i = 0; i < count; ++i, src += stride) {
-    int32_t q[3] = {loadLE<int32_t>(src), loadLE<int32_t>(src + 4), loadLE<int32_t>(src + 8)};
-    for (int a = 0; a < 3; ++a) {
-      dst.positions[3 * i + a] = q[a];
-      s.qmin[a] = std::min(s.qmin[a], q[a]);
-      s.qmax[a] = std::max(s.qmax[a], q[a]);
-    }
-    if (dst.colors) {
-      const uint8_t* rgb = src + rgbOffset;
-      uint16_t r = loadLE<uint16_t>(rgb), g = loadLE<uint16_t>(rgb + 2), b = loadLE<uint16_t>(rgb + 4);
-      s.colorMax = std::max({s.colorMax, r, g, b});
-      dst.colors[i] = packRgba((r >> colorShift) & 0xFF, (g >> colorShift) & 0xFF, (b >> colorShift) & 0xFF);
-    }
-    if (dst.intensity) {
-      dst.intensity[i] = loadLE<uint16_t>(src + 12);
-      if constexpr (kExtended) {
-        dst.returnNumber[i] = src[14] & 0x0F;
-        dst.classification[i] = src[16];
-      } else {
-        dst.returnNumber[i] = src[14] & 0x07;
-        dst.classification[i] = src[15] & 0x1F;
-      }
-    }
-  }
-  stats = s;
-}
-
-Destination offsetBy(const Destination& d, uint64_t i) {
-  Destination o;
-  o.positions = d.positions + 3 * i;
-  if (d.colors) o.colors = d.colors + i;
-  if (d.intensity) {
-    o.intensity = d.intensity + i;
-    o.classification = d.classification + i;
-    o.returnNumber = d.returnNumber + i;
-  }
-  return o;
 }
 
 // R15 2.4 stores the creation date as year + day of year (1 = January 1st); shown as an ISO date.
@@ -140,36 +81,38 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
     cloud.intensity.resize(n);
     cloud.classification.resize(n);
     cloud.returnNumber.resize(n);
+    cloud.pointSourceId.resize(n);
   }
-  Destination all;
+  RecordDestination all;
   all.positions = cloud.positions.data();
   all.colors = hd.hasColor() ? cloud.colors.data() : nullptr;
   if (options.keepAttributes) {
     all.intensity = cloud.intensity.data();
     all.classification = cloud.classification.data();
     all.returnNumber = cloud.returnNumber.data();
+    all.pointSourceId = cloud.pointSourceId.data();
   }
 
   std::optional<Progress> progress;
   if (options.progress) progress.emplace("reading " + path.filename().string(), n);
 
-  BlockStats total;
+  RecordStats total;
   bool colors16 = false; // decided per file: any channel above 255 means 16-bit colors
-  std::vector<BlockStats> stats;
+  std::vector<RecordStats> stats;
   forEachChunk(file, hd, [&](const uint8_t* records, uint64_t first, uint64_t count) {
-    stats.assign((count + kBlockPoints - 1) / kBlockPoints, BlockStats{});
+    stats.assign((count + kBlockPoints - 1) / kBlockPoints, RecordStats{});
     int shift = colors16 ? 8 : 0;
     parallelBlocks(count, kBlockPoints, [&](uint64_t block, uint64_t begin, uint64_t end) {
       const uint8_t* src = records + begin * hd.recordLength;
-      Destination d = offsetBy(all, first + begin);
+      RecordDestination d = offsetBy(all, first + begin);
       if (extended)
-        parseBlock<true>(src, hd.recordLength, end - begin, rgbOffset, shift, d, stats[block]);
+        parseRecords<true>(src, hd.recordLength, end - begin, rgbOffset, shift, d, stats[block]);
       else
-        parseBlock<false>(src, hd.recordLength, end - begin, rgbOffset, shift, d, stats[block]);
+        parseRecords<false>(src, hd.recordLength, end - begin, rgbOffset, shift, d, stats[block]);
       if (progress) progress->advance(end - begin);
     });
     uint16_t chunkColorMax = 0;
-    for (const BlockStats& s : stats) {
+    for (const RecordStats& s : stats) {
       for (int a = 0; a < 3; ++a) {
         total.qmin[a] = std::min(total.qmin[a], s.qmin[a]);
         total.qmax[a] = std::max(total.qmax[a], s.qmax[a]);
@@ -208,18 +151,11 @@ uint64_t lasChunkBytes() {
   return gChunkBytes;
 }
 
-std::optional<uint64_t> statedCountLas(const std::filesystem::path& path) {
-  InputFile file(path);
-  return readLasHeader(file).pointCount;
-}
-
-FileInfo probeLas(const std::filesystem::path& path) {
-  InputFile file(path);
-  const LasHeader hd = readLasHeader(file);
+FileInfo describeLasHeader(const LasHeader& hd, const char* name, uint16_t colorLo, uint16_t colorHi) {
   FileInfo info;
   uint16_t formatSize = las::kRecordSize[static_cast<size_t>(hd.pointFormat)];
-  info.formatDetail = strFormat("LAS %d.%d, point format %d (%u B records", hd.versionMajor, hd.versionMinor,
-                                hd.pointFormat, hd.recordLength);
+  info.formatDetail = strFormat("%s %d.%d, point format %d (%u B records", name, hd.versionMajor,
+                                hd.versionMinor, hd.pointFormat, hd.recordLength);
   if (hd.recordLength > formatSize)
     info.formatDetail += strFormat(": %u + %u extra bytes", formatSize, hd.recordLength - formatSize);
   info.formatDetail += ")";
@@ -232,21 +168,9 @@ FileInfo probeLas(const std::filesystem::path& path) {
 
   auto& extra = info.extra;
   if (info.hasColor) {
-    // The bit depth is a property of the values, not the header: scan the color channels.
-    const int rgbOffset = hd.rgbOffset();
-    uint16_t lo = UINT16_MAX, hi = 0;
-    forEachChunk(file, hd, [&](const uint8_t* records, uint64_t, uint64_t count) {
-      for (uint64_t i = 0; i < count; ++i) {
-        const uint8_t* rgb = records + i * hd.recordLength + rgbOffset;
-        for (int c = 0; c < 3; ++c) {
-          uint16_t v = loadLE<uint16_t>(rgb + 2 * c);
-          lo = std::min(lo, v);
-          hi = std::max(hi, v);
-        }
-      }
-    });
-    info.colorBits = hi > 255 ? 16 : 8;
-    if (hd.pointCount > 0) extra.emplace_back("color values", strFormat("%u .. %u", lo, hi));
+    // The bit depth is a property of the values, not the header.
+    info.colorBits = colorHi > 255 ? 16 : 8;
+    if (hd.pointCount > 0) extra.emplace_back("color values", strFormat("%u .. %u", colorLo, colorHi));
   }
   extra.emplace_back("system identifier", hd.systemId.empty() ? "(empty)" : hd.systemId);
   extra.emplace_back("generating software", hd.software.empty() ? "(empty)" : hd.software);
@@ -273,6 +197,26 @@ FileInfo probeLas(const std::filesystem::path& path) {
     extra.emplace_back(
         "EVLRs", strFormat("%u at offset %llu", hd.evlrCount, static_cast<unsigned long long>(hd.evlrStart)));
   return info;
+}
+
+FileInfo probeLas(const std::filesystem::path& path) {
+  InputFile file(path);
+  const LasHeader hd = readLasHeader(file);
+  uint16_t lo = UINT16_MAX, hi = 0;
+  if (hd.hasColor()) {
+    const int rgbOffset = hd.rgbOffset();
+    forEachChunk(file, hd, [&](const uint8_t* records, uint64_t, uint64_t count) {
+      for (uint64_t i = 0; i < count; ++i) {
+        const uint8_t* rgb = records + i * hd.recordLength + rgbOffset;
+        for (int c = 0; c < 3; ++c) {
+          uint16_t v = loadLE<uint16_t>(rgb + 2 * c);
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+      }
+    });
+  }
+  return describeLasHeader(hd, "LAS", lo, hi);
 }
 
 } // namespace detail

@@ -193,6 +193,7 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
   fields.intensity = cloud.intensity.size() == n && n > 0;
   fields.classification = cloud.classification.size() == n && n > 0;
   fields.returnNumber = cloud.returnNumber.size() == n && n > 0;
+  fields.pointSourceId = cloud.pointSourceId.size() == n && n > 0;
   LasRecordWriter writer(path, cloud.scale, cloud.offset, fields, flavor);
   std::vector<PointRecord> records(static_cast<size_t>(std::min(n, kChunkPoints)));
   for (uint64_t first = 0; first < n; first += kChunkPoints) {
@@ -212,6 +213,7 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFla
       if (fields.intensity) r.intensity = cloud.intensity[i];
       if (fields.classification) r.classification = cloud.classification[i];
       if (fields.returnNumber) r.returnNumber = cloud.returnNumber[i];
+      if (fields.pointSourceId) r.pointSourceId = cloud.pointSourceId[i];
     }
     writer.write(records.data(), static_cast<size_t>(count));
   }

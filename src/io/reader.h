@@ -30,7 +30,7 @@ struct FileInfo {
 
 struct ReadOptions {
   bool progress = true;       // progress line on stderr when it is a terminal
-  bool keepAttributes = true; // intensity, classification, return number
+  bool keepAttributes = true; // intensity, classification, return number, point source id
 };
 
 // Reads the whole file into a PointCloud (bounds computed from the points), through the format's row of
@@ -39,8 +39,8 @@ PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& optio
 FileInfo probeFile(const std::filesystem::path& path);
 // The point count the file's header states, read without touching the points (probeFile() may read them
 // all: LAS color depth, PLY bounds), so that a caller can refuse a file it has no room for before reading
-// it. LAS: the header's count; PLY: the vertex count. nullopt where only reading tells (XYZ text, a PLY
-// count larger than the file holds). Throws InputError as probeFile() does.
+// it. LAS, LAZ, COPC: the header's count; PLY: the vertex count. nullopt where only reading tells (XYZ
+// text, a PLY count larger than the file holds, an octree folder). Throws InputError as probeFile() does.
 std::optional<uint64_t> statedPointCount(const std::filesystem::path& path);
 
 // Per format (the rows of io/format_table.h name these).

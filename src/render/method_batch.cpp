@@ -99,7 +99,6 @@ public:
                        });
       gpu::fullBarrier(cmd);
       resolve.aux = accumulators_.address();
-      resolve.words = 0;
     } else {
       resolve.aux = frame_.address(); // the table of color buffers
     }

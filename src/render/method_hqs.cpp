@@ -58,7 +58,6 @@ public:
     shared::ResolvePush resolve =
         resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
     resolve.aux = accumulators_.address();
-    resolve.words = 0;
     resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
     gpu::fullBarrier(cmd);
   }

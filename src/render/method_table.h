@@ -34,6 +34,8 @@ enum class MethodFamily {
   Hqs,      // method_hqs.cpp: closest depth pass, `shader` accumulates, resolve divides
   HwPoints, // method_hw_points.cpp: the graphics point-list pipeline (`shader` is the vertex stage)
   Batch,    // method_batch.cpp: `shader` rasterizes batches; Blend output adds the accumulation pass
+  Lod,      // lod/lod_passes.cpp: `shader` rasterizes pages of octree nodes; Blend output adds the
+            // accumulation pass. Reads SceneLayout::Octree: Renderer::render(lod::LodScene&, ...)
 };
 
 // What the method leaves in the framebuffer, which decides what tests and reports compare.
@@ -147,6 +149,13 @@ inline constexpr MethodInfo kPointMethods[] = {
    {{/* PREFETCH= */ 0, 1}, {/* DEPTH_ONLY= */ 1, 1}},
    MethodNeeds::Subgroups, SceneLayout::Batched, MethodOutput::Blend, 8,
    "HQS on batches: prefetch depth pass, one packed atomicAdd per point with overflow fallback (2022)"},
+  {"lod", MethodFamily::Lod, "raster_lod.comp", nullptr, {{/* PREFETCH= */ 0, 1}},
+   MethodNeeds::None, SceneLayout::Octree, MethodOutput::Closest, 4,
+   "2022 LOD: octree nodes chosen by projected size, streamed into a GPU node cache, drawn as batches"},
+  {"lod-hqs", MethodFamily::Lod, "raster_lod.comp", nullptr,
+   {{/* PREFETCH= */ 0, 1}, {/* DEPTH_ONLY= */ 1, 1}},
+   MethodNeeds::Subgroups, SceneLayout::Octree, MethodOutput::Blend, 8,
+   "HQS on octree nodes: depth pass, one packed atomicAdd per point with overflow fallback (2022)"},
 };
 // clang-format on
 

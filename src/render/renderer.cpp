@@ -7,7 +7,9 @@
 #include "base/error.h"
 #include "gpu/context.h"
 #include "gpu/timer.h"
+#include "render/lod/lod_render.h"
 #include "render/method.h"
+#include "render/post/post_stage.h"
 
 namespace pointrast {
 
@@ -54,7 +56,10 @@ shared::ResolvePush resolvePush(const Frame& frame, const Targets& targets, uint
   shared::ResolvePush push{};
   push.framebuffer = framebuffer;
   push.image = targets.image.address();
-  push.words = frame.settings.captureWords ? targets.words.address() : 0;
+  const bool post = frame.settings.post.enabled();
+  push.words = frame.settings.captureWords || post ? targets.words.address() : 0;
+  // The resolve stage reads float depths: int40 words are converted for it.
+  if (post && frame.settings.depth == DepthMode::Int40) push.int40Scale = float(frame.settings.depthScale);
   push.width = targets.width;
   push.height = targets.height;
   push.background = frame.settings.background;
@@ -138,6 +143,9 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
   case MethodFamily::Batch:
     created = createBatchMethod(context_, info, targets_->width, targets_->height);
     break;
+  case MethodFamily::Lod:
+    throw InputError(std::string(info.name) +
+                     " draws octrees streamed from a node source, not uploaded scenes");
   }
   return *methods_.emplace(key, std::move(created)).first->second;
 }
@@ -160,10 +168,19 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
                      " per frame (parts of up to 67,102,720 points: 4.29 billion points, the reach of a "
                      "32-bit visibility index)");
   if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
+  const bool post = settings.post.enabled();
+  if (post) {
+    validatePostSettings(settings.post);
+    if (info.output == MethodOutput::ColorOnly)
+      throw InputError(std::string("point size, dilation and eye-dome lighting work on the depth the "
+                                   "compute methods keep per pixel; ") +
+                       info.name + " keeps none");
+  }
   PointMethod& m = method(settings);
   Targets& t = *targets_;
-  // Canonical words are for equivalence tests only: allocated on first request (8 B a pixel).
-  if (settings.captureWords && !t.words)
+  // Canonical words are for equivalence tests and the resolve stage: allocated on first request (8 B a
+  // pixel).
+  if ((settings.captureWords || post) && !t.words)
     t.words =
         gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
   // Double-precision copies of each scene's matrix, for the int40 path.
@@ -181,18 +198,36 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
     effective.depthScale = int40Scale(scenes, camera);
   uint32_t frames = std::max(1u, settings.frames);
   gpu::TimestampPool timestamps(context_, frames);
+  PostView view;
+  std::optional<gpu::TimestampPool> postTimestamps;
+  if (post) {
+    if (!post_) post_ = std::make_unique<PostStage>(context_);
+    view = {t.words.address(),
+            t.image.address(),
+            t.width,
+            t.height,
+            t.width,
+            float(glm::length(camera.target - camera.eye)),
+            settings.background,
+            settings.captureWords};
+    postTimestamps.emplace(context_, frames * kPostPasses);
+  }
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
+    if (post) postTimestamps->reset(cmd);
     Frame frame{cmd, scenes, camera, effective};
-    for (uint32_t w = 0; w < settings.warmup; ++w)
+    for (uint32_t w = 0; w < settings.warmup; ++w) {
       m.recordFrame(frame, t);
+      if (post) post_->record(cmd, view, settings.post);
+    }
     for (uint32_t f = 0; f < frames; ++f) {
       timestamps.begin(cmd, f);
       m.recordFrame(frame, t);
+      if (post) post_->record(cmd, view, settings.post, &*postTimestamps, f * kPostPasses);
       timestamps.end(cmd, f);
     }
   });
-  wordsCaptured_ = settings.captureWords && hasCanonicalWords(info);
+  wordsCaptured_ = settings.captureWords && (hasCanonicalWords(info) || post);
   std::vector<double> ms = timestamps.milliseconds();
   FrameStats stats;
   stats.frames = frames;
@@ -202,6 +237,48 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   for (const GpuScene* scene : scenes)
     stats.points += scene->pointCount();
   stats.batch = m.readStats();
+  if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), frames);
+  return stats;
+}
+
+lod::LodPasses& Renderer::lodPasses(const RenderSettings& settings) {
+  const MethodInfo& info = methodInfo(settings.method);
+  if (info.layout != SceneLayout::Octree)
+    throw InputError(std::string(info.name) + " reads scenes in the " + sceneLayoutName(info.layout) +
+                     " layout, not octrees; the LOD methods are " + methodNamesReading(SceneLayout::Octree));
+  if (settings.depth != DepthMode::Float)
+    throw InputError(std::string(info.name) + " has no int40 depth encoding, only float");
+  if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
+  std::string why;
+  if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
+  auto found = lodPasses_.find(settings.method);
+  if (found != lodPasses_.end()) return *found->second;
+  auto created = std::make_unique<lod::LodPasses>(context_, info, targets_->width, targets_->height);
+  return *lodPasses_.emplace(settings.method, std::move(created)).first->second;
+}
+
+FrameStats Renderer::render(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings) {
+  validateCamera(camera);
+  lod::LodPasses& passes = lodPasses(settings);
+  Targets& t = *targets_;
+  if (settings.captureWords && !t.words)
+    t.words =
+        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
+  FrameStats stats = lod::renderOctree(context_, octree, passes, t, camera, settings);
+  wordsCaptured_ = settings.captureWords && hasCanonicalWords(methodInfo(settings.method));
+  return stats;
+}
+
+FrameStats Renderer::renderFrame(lod::LodScene& octree, const Camera& camera,
+                                 const RenderSettings& settings) {
+  validateCamera(camera);
+  lod::LodPasses& passes = lodPasses(settings);
+  Targets& t = *targets_;
+  if (settings.captureWords && !t.words)
+    t.words =
+        gpu::Buffer(context_, t.pixels() * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "canonical words");
+  FrameStats stats = lod::renderResidentFrame(context_, octree, passes, t, camera, settings);
+  wordsCaptured_ = settings.captureWords && hasCanonicalWords(methodInfo(settings.method));
   return stats;
 }
 

@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/lod/lod_stats.h"
 #include "render/method_table.h"
+#include "render/post/post_settings.h"
 #include "render/scene.h"
 
 namespace pointrast {
@@ -44,6 +46,11 @@ struct RenderSettings {
   // the batch under half a pixel), 1..3 = forced (3 = full 30-bit precision).
   uint32_t precision = 0;
   bool batchCulling = true; // batch methods: frustum culling of batches (off only to test that it is exact)
+  PostSettings post;        // the resolve stage after the method: point size, dilation, eye-dome lighting
+  // LOD methods: nodes whose projected size (Potree's: the pixel radius of the node cube's bounding sphere)
+  // is under minNodePx are not drawn, nor their subtrees; at most pointBudget points a frame (0: no limit).
+  double minNodePx = 100;
+  uint64_t pointBudget = 0;
 };
 // "adaptive", "1", "2", "3" -> 0..3; throws InputError naming the choices.
 uint32_t parsePrecision(std::string_view text);
@@ -64,12 +71,19 @@ struct BatchStats {
 struct FrameStats {
   double medianMs = 0, minMs = 0, maxMs = 0; // GPU time of clear + draw + resolve, timestamp queries
   uint32_t frames = 0;
-  uint64_t points = 0;             // points submitted per frame
-  std::optional<BatchStats> batch; // batch methods only
+  std::optional<PostStats> post;   // when the resolve stage ran (its time is part of medianMs too)
+  uint64_t points = 0;              // points submitted per frame
+  std::optional<BatchStats> batch;  // batch and LOD methods (for LOD, batches are octree nodes)
+  std::optional<lod::LodStats> lod; // LOD methods only
 };
 
 struct Targets;
 class PointMethod;
+class PostStage;
+namespace lod {
+class LodScene;
+class LodPasses;
+} // namespace lod
 
 class Renderer {
 public:
@@ -78,8 +92,9 @@ public:
   ~Renderer();
 
   // Throws UnsupportedError if the device cannot run the method (missing extension or feature) and
-  // InputError for a combination that does not exist (hqs with int40 depth), for a scene uploaded in
-  // another layout than the method reads (MethodInfo::layout), and for more than 64 batched parts.
+  // InputError for a combination that does not exist (hqs with int40 depth, hw-points with the resolve
+  // stage), for a scene uploaded in another layout than the method reads (MethodInfo::layout), for more
+  // than 64 batched parts, and for resolve-stage settings out of range.
   FrameStats render(std::span<const GpuScene* const> scenes, const Camera& camera,
                     const RenderSettings& settings);
   FrameStats render(const GpuScene& scene, const Camera& camera, const RenderSettings& settings) {
@@ -87,10 +102,22 @@ public:
     return render(one, camera, settings);
   }
 
+  // Draws an octree with a LOD method (a row reading SceneLayout::Octree) at full detail: the whole
+  // selection for the camera is streamed into the octree's node cache before the timed frames, and drawn in
+  // passes when it is larger than the cache (render/lod/lod_render.h). Throws InputError for a method that
+  // reads uploaded scenes, and as render() above.
+  FrameStats render(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings);
+  // One frame of a viewer: the octree selects nodes for the camera, takes what its readers finished and
+  // asks them for more; this frame copies the new nodes into the cache and draws the resident part of the
+  // selection, never waiting for a reader (render/lod/lod_scene.h). One timed frame (settings.frames and
+  // warmup are ignored); FrameStats::lod says whether it changed and whether it converged.
+  FrameStats renderFrame(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings);
+
   // RGBA8 pixels of the last frame, row 0 at the top.
   std::vector<uint32_t> image();
   // Canonical words (depth << 32 | color, all ones where empty) of the last frame rendered with
-  // captureWords; for closest-point methods only.
+  // captureWords; for closest-point methods only, or for any method when the resolve stage ran (then the
+  // words it ended with, float depth also for int40).
   std::vector<uint64_t> framebufferWords();
   // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
   // reads to pick the point under the cursor.
@@ -107,9 +134,12 @@ public:
 
 private:
   PointMethod& method(const RenderSettings& settings);
+  lod::LodPasses& lodPasses(const RenderSettings& settings);
   gpu::Context& context_;
   std::unique_ptr<Targets> targets_;
   std::map<std::pair<Method, DepthMode>, std::unique_ptr<PointMethod>> methods_;
+  std::unique_ptr<PostStage> post_; // made on the first frame that uses it
+  std::map<Method, std::unique_ptr<lod::LodPasses>> lodPasses_;
   bool wordsCaptured_ = false; // the last frame wrote canonical words
 };
 

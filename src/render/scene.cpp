@@ -1,6 +1,7 @@
 #include "render/scene.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 #include <string>
 
@@ -33,7 +34,7 @@ uint64_t roundUp4(uint64_t n) {
 } // namespace
 
 const char* sceneLayoutName(SceneLayout layout) {
-  return layout == SceneLayout::Batched ? "batched" : "float";
+  return layout == SceneLayout::Batched ? "batched" : layout == SceneLayout::Octree ? "octree" : "float";
 }
 
 uint64_t ScenePart::batchCount() const {
@@ -103,13 +104,15 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
     parts_.push_back(std::move(part));
   }
   if (count == 0) return;
+  const DisplayColorMode colors = options.colors ? *options.colors : displayColorMode(cloud); // once
   if (layout_ == SceneLayout::Float)
-    uploadFloat(context, cloud, options.progress);
+    uploadFloat(context, cloud, colors, options.progress);
   else
-    uploadBatched(context, cloud, options.progress);
+    uploadBatched(context, cloud, colors, options.progress);
 }
 
-void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, bool progressShown) {
+void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
+                           bool progressShown) {
   gpu::Buffer staging(context, kStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload,
                       "upload staging");
   auto* stagingFloats = static_cast<float*>(staging.mapped());
@@ -120,7 +123,7 @@ void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, bool 
     for (uint64_t at = 0; at < part.count; at += kStagingPoints) {
       uint64_t n = std::min(kStagingPoints, part.count - at);
       toRelativeFloat(stagingFloats, cloud, part.first + at, n, origin_);
-      displayColors(stagingColors, cloud, part.first + at, n);
+      displayColors(stagingColors, cloud, part.first + at, n, colors);
       context.submitAndWait([&](VkCommandBuffer cmd) {
         VkBufferCopy pos{0, at * 12, n * 12};
         VkBufferCopy col{kStagingPoints * 12, at * 4, n * 4};
@@ -134,7 +137,8 @@ void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, bool 
 
 // Encodes whole batches into the staging buffer on all cores (bounds, three words, colors per batch, as
 // cloud/batch_words.h defines them), then copies them into the part's buffers.
-void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud, bool progressShown) {
+void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
+                             const DisplayColorMode& colorMode, bool progressShown) {
   gpu::Buffer staging(context, kStagingBatches * kBatchBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                       gpu::MemoryKind::Upload, "upload staging");
   // Staging sections: high, medium, low words, colors (kStagingBatchPoints each), then the bounds.
@@ -142,7 +146,6 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud, boo
   uint32_t* section[4] = {words, words + kStagingBatchPoints, words + 2 * kStagingBatchPoints,
                           words + 3 * kStagingBatchPoints};
   auto* bounds = reinterpret_cast<shared::BatchBounds*>(words + 4 * kStagingBatchPoints);
-  const DisplayColorMode colorMode = displayColorMode(cloud); // once, not per chunk
   Progress progress("uploading to GPU (batched)", pointCount_, " points", progressShown);
   for (const ScenePart& part : parts_) {
     for (uint64_t at = 0; at < part.count; at += kStagingBatchPoints) {
@@ -176,6 +179,25 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud, boo
         gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.batches.handle(), 1, &box);
       });
       progress.advance(n);
+    }
+  }
+}
+
+// Colors of a part are the same in both layouts: one uint per point, in point order.
+void GpuScene::recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode) {
+  assert(parts_.empty() || parts_.back().first + parts_.back().count <= cloud.size());
+  gpu::Buffer staging(context, kStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload,
+                      "recolor staging");
+  auto* colors = static_cast<uint32_t*>(staging.mapped());
+  constexpr uint64_t kChunk = kStagingBytes / 4;
+  for (const ScenePart& part : parts_) {
+    for (uint64_t at = 0; at < part.count; at += kChunk) {
+      const uint64_t n = std::min(kChunk, part.count - at);
+      displayColors(colors, cloud, part.first + at, n, mode);
+      context.submitAndWait([&](VkCommandBuffer cmd) {
+        VkBufferCopy copy{0, at * 4, n * 4};
+        gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.colors.handle(), 1, &copy);
+      });
     }
   }
 }

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@ class Context;
 enum class SceneLayout {
   Float,   // float xyz relative to the origin + RGBA8: the 2019/2021 methods and hw-points
   Batched, // the 2022 batch methods: three words of batch-relative coordinates + RGBA8, bounds per batch
+  Octree,  // the LOD methods: no GpuScene, an octree streamed into a node cache (render/lod/lod_scene.h)
 };
 const char* sceneLayoutName(SceneLayout layout);
 
@@ -52,6 +54,8 @@ struct UploadOptions {
   uint64_t maxPartPoints = 0;
   SceneLayout layout = SceneLayout::Float;
   bool progress = true;
+  // How points become colors (render --color); nullopt: displayColorMode(cloud), decided once per upload.
+  std::optional<DisplayColorMode> colors;
 };
 
 // Points per part of a layout: `requested` (0: as many as fit) bounded by the layout's maximum and by a
@@ -80,9 +84,15 @@ public:
   // Bytes of point data in GPU memory (sceneBytes()).
   uint64_t bytes() const { return sceneBytes(layout_, pointCount_); }
 
+  // Rewrites the colors of every part from `cloud` (the one uploaded, same subrange) in another mode:
+  // 4 B a point instead of a whole upload, so a viewer switches modes without uploading positions again.
+  void recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode);
+
 private:
-  void uploadFloat(gpu::Context& context, const PointCloud& cloud, bool progress);
-  void uploadBatched(gpu::Context& context, const PointCloud& cloud, bool progress);
+  void uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
+                   bool progress);
+  void uploadBatched(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
+                     bool progress);
   std::vector<ScenePart> parts_;
   SceneLayout layout_ = SceneLayout::Float;
   uint64_t pointCount_ = 0;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "base/error.h"
 #include "cloud/cloud.h"
 #include "gpu/context.h"
 #include "render/scene.h"
@@ -69,6 +70,8 @@ GpuCloud::GpuCloud(gpu::Context& context, const PointCloud& cloud, bool progress
 GpuCloud::~GpuCloud() = default;
 
 const GpuScene& GpuCloud::scene(SceneLayout layout) {
+  if (layout == SceneLayout::Octree)
+    throw InputError("the octree methods draw octrees streamed from disk, not an uploaded cloud");
   std::unique_ptr<GpuScene>& slot = scenes_[int(layout)];
   if (!slot) {
     UploadOptions upload;

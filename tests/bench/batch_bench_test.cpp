@@ -42,7 +42,8 @@ TEST(Suites, Paper2022SizesOrdersViewsAndDefaults) {
   EXPECT_EQ(defaults.height, 1140u);
   EXPECT_EQ(defaults.methods, std::vector<Method>({pointMethod("hw-points"), pointMethod("batch"),
                                                    pointMethod("batch-prefetch"), pointMethod("batch-hqs"),
-                                                   pointMethod("dedup"), pointMethod("hqs")}));
+                                                   pointMethod("dedup"), pointMethod("hqs"), pointMethod("lod"),
+                                                   pointMethod("lod-hqs")}));
   EXPECT_EQ(layoutsOf(defaults.methods),
             std::vector<SceneLayout>({SceneLayout::Float, SceneLayout::Batched}));
   const std::vector<Method> family = suiteDefaults("paper2021").methods;

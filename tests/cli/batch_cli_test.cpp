@@ -97,14 +97,16 @@ TEST(BatchCli, Paper2022SuiteSmokeScale) {
   ASSERT_EQ(j["datasets"].size(), 5u);
   EXPECT_EQ(j["datasets"][3]["points"], 100000);
   EXPECT_EQ(j["settings"]["width"], 64) << "--width overrides the suite's 2560";
-  // (3 data sets x 1 view + scan529m x 2 views + tls-order x 2 orders x 2 views) x 6 methods.
-  EXPECT_EQ(j["results"].size(), (3 + 2 + 4) * 6u);
+  // (3 data sets x 1 view + scan529m x 2 views + tls-order x 2 orders x 2 views) x 6 methods, and the 2 LOD
+  // methods once per data set and view (on its octree, whatever the orders): 7 x 2.
+  EXPECT_EQ(j["results"].size(), (3 + 2 + 4) * 6u + 7 * 2u);
   size_t withStats = 0;
   for (const auto& result : j["results"])
-    withStats += result.contains("batch_stats");
+    withStats += result.contains("batch_stats") && !result.contains("lod_stats");
   EXPECT_EQ(withStats, (3 + 2 + 4) * 3u);
   std::string md = slurp(out / "paper2022-scale0.0001.md");
-  EXPECT_NE(md.find("| data set | order | hw-points | batch | batch-prefetch | batch-hqs | dedup | hqs |"),
+  EXPECT_NE(md.find("| data set | order | hw-points | batch | batch-prefetch | batch-hqs | dedup | hqs | lod | "
+                    "lod-hqs |"),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("| tls-order (tls, 10k) | original |"), std::string::npos) << md;

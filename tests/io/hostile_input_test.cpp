@@ -2,6 +2,7 @@
 // must either succeed or throw InputError: no crash, no other exception, no huge allocation (run under
 // AddressSanitizer, see environment_test.cpp).
 #include "io/io_test_util.h"
+#include "io/laz_compose.h"
 #include "io/writer.h"
 
 using pointrast::InputError;
@@ -166,6 +167,18 @@ TEST(HostileInput, PlyPrefixes) {
   auto mugBinary = iotest::readBytes(data("ply/table_scene_mug_stereo_textured.ply"));
   mugBinary.resize(4000);
   sweepPrefixes(mugBinary, "t.ply", 0, 1, true, false); // claims 209,280 vertices: every prefix fails
+}
+
+TEST(HostileInput, LazPrefixes) {
+  // A prefix loses the chunk table (written last) or part of it. Only the table's trailing zero padding
+  // may go missing unnoticed: the decoder reads zeros there anyway, and decodes the same points.
+  auto simple = iotest::readBytes(data("laz/simple.laz"));
+  size_t refused = sweepPrefixes(simple, "t.laz", 400, 41, false);
+  EXPECT_GE(refused, (simple.size() - 400) / 41 + 400 - 1);
+  // Layered: dense through the header, VLRs, first raw point and layer table, then every 13th.
+  auto layered = composeLaz(data("laz/lone-star.copc.laz"), {0, 9}); // 212 + 318 points, 4.5 KB
+  refused = sweepPrefixes(layered, "t.laz", 1200, 13, false);
+  EXPECT_GE(refused, (layered.size() - 1200) / 13 + 1200 - 1);
 }
 
 TEST(HostileInput, PlyHeaderFlips) {

@@ -25,6 +25,7 @@ PointCloud makeCloud(uint64_t n, int maxReturn, int maxClass) {
     c.intensity.push_back(static_cast<uint16_t>(rng.next()));
     c.classification.push_back(static_cast<uint8_t>(rng.next() % (maxClass + 1)));
     c.returnNumber.push_back(static_cast<uint8_t>(1 + rng.next() % maxReturn));
+    c.pointSourceId.push_back(static_cast<uint16_t>(rng.next()));
   }
   c.bounds = pointrast::Bounds{};
   for (uint64_t i = 0; i < n; ++i)
@@ -55,6 +56,7 @@ TEST_P(LasRoundTrip, ReadBackIsIdentical) {
   EXPECT_EQ(back.intensity, cloud.intensity);
   EXPECT_EQ(back.classification, cloud.classification);
   EXPECT_EQ(back.returnNumber, cloud.returnNumber);
+  EXPECT_EQ(back.pointSourceId, cloud.pointSourceId);
   EXPECT_EQ(back.bounds.min, cloud.bounds.min);
   EXPECT_EQ(back.bounds.max, cloud.bounds.max);
 

@@ -160,8 +160,8 @@ Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Conte
   info_.input = cloud.source;
   info_.points = cloud.size();
   info_.pathFile = options.pathFile.string();
-  for (Method m : allMethods())
-    if (Renderer::supports(context, m)) info_.methods.push_back(m);
+  for (Method m : allMethods()) // the methods that draw an uploaded cloud (not the octree methods)
+    if (m.info().layout != SceneLayout::Octree && Renderer::supports(context, m)) info_.methods.push_back(m);
 }
 
 ImDrawData* Viewer::buildPanelFrame(double seconds) {

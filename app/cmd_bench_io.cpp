@@ -1,0 +1,119 @@
+// pointrast bench-io FILE... : LAZ decoding throughput with 1 and N threads (bench/io_bench.h).
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "bench/io_bench.h"
+#include "bench/report.h"
+#include "cli_util.h"
+#include "commands.h"
+#include "io/io_util.h"
+
+namespace pointrast::app {
+
+namespace {
+
+struct BenchIoArgs {
+  std::vector<std::string> inputs;
+  std::string points = "0";
+  std::vector<std::string> threads;
+  int repeats = 5;
+  bool noReadCloud = false, json = false, quiet = false;
+  std::string out, name = "io-laz";
+  std::string commandLine;
+};
+
+std::vector<unsigned> parseThreads(const std::vector<std::string>& items) {
+  std::vector<unsigned> threads;
+  for (const std::string& item : items) {
+    if (item == "all") {
+      threads.push_back(hardwareThreads());
+      continue;
+    }
+    const uint64_t n = parseCount(item, "--threads");
+    if (n < 1 || n > 4096) throw InputError("--threads: " + item + " is not a thread count (1..4096 or all)");
+    threads.push_back(unsigned(n));
+  }
+  return threads;
+}
+
+void writeFile(const std::filesystem::path& path, const std::string& text) {
+  io::detail::PartialFile file(path);
+  file.write(text.data(), text.size());
+  file.commit();
+}
+
+int runBenchIo(const BenchIoArgs& a) {
+  bench::IoBenchConfig config;
+  for (const std::string& input : a.inputs)
+    config.inputs.emplace_back(input);
+  config.minPoints = parseCount(a.points, "--points");
+  config.threads = parseThreads(a.threads);
+  if (a.repeats < 1 || a.repeats > 1000) throw InputError("--repeats must be 1 to 1000");
+  config.repeats = a.repeats;
+  config.readCloud = !a.noReadCloud;
+  config.workDir =
+      std::filesystem::temp_directory_path() / ("pointrast-bench-io-" + std::to_string(::getpid()));
+  struct Cleanup {
+    std::filesystem::path dir;
+    ~Cleanup() {
+      std::error_code ec;
+      std::filesystem::remove_all(dir, ec);
+    }
+  } cleanup{config.workDir};
+
+  const bench::IoBenchRun run = bench::runIoBench(config, !a.quiet);
+  const std::string date = bench::utcNow();
+  const nlohmann::json j = bench::ioRunJson(run, a.commandLine, date);
+  const std::filesystem::path dir = a.out.empty()
+                                        ? std::filesystem::path("bench/results") / bench::ioDeviceName(run)
+                                        : std::filesystem::path(a.out);
+  std::filesystem::create_directories(dir);
+  writeFile(dir / (a.name + ".json"), j.dump(1) + "\n");
+  writeFile(dir / (a.name + ".md"), bench::ioMarkdownReport(run, a.commandLine, date));
+  if (a.json) std::printf("%s\n", j.dump().c_str());
+  if (!a.quiet)
+    std::fprintf(a.json ? stderr : stdout, "%zu file%s in %.1f s; wrote %s and %s\n", run.results.size(),
+                 run.results.size() == 1 ? "" : "s", run.seconds, (dir / (a.name + ".json")).string().c_str(),
+                 (dir / (a.name + ".md")).string().c_str());
+  return 0;
+}
+
+} // namespace
+
+Command addBenchIo(CLI::App& app, int argc, char** argv) {
+  auto a = std::make_shared<BenchIoArgs>();
+  for (int i = 0; i < argc; ++i)
+    a->commandLine += (i ? " " : "") + std::string(argv[i]);
+  CLI::App* cmd = app.add_subcommand("bench-io", "Measure LAZ decoding throughput on 1 and on all cores");
+  cmd->footer(
+      "\nDecodes every chunk of each LAZ (or COPC) file to raw LAS records, from compressed chunks read\n"
+      "into memory first, once per thread count and --repeats times; reports the median and best\n"
+      "wall time, points/s, points/s per thread and points per CPU-second (from each thread's CPU\n"
+      "clock: what a core delivers on a shared machine; the load average is recorded), then times\n"
+      "readCloud end to end. --points replicates a file's own chunks (chunks decode on their own)\n"
+      "into a temporary LAZ of at least that many points. Writes <name>.json and <name>.md to\n"
+      "bench/results/cpu-<model>-<threads>t/.\n"
+      "Examples:\n  pointrast bench-io autzen_trim.laz --points 3M\n"
+      "  pointrast bench-io a.laz b.laz --points 3M --threads 1,4,all --repeats 9");
+  cmd->add_option("FILE", a->inputs, "LAZ or COPC files")->required();
+  cmd->add_option("--points", a->points,
+                  "Replicate each file's chunks to at least this many points (3M, 1.5G)");
+  cmd->add_option("--threads", a->threads, "Thread counts to time (default: 1,all)")->delimiter(',');
+  cmd->add_option("--repeats", a->repeats, "Timed runs per thread count")->capture_default_str();
+  cmd->add_flag("--no-read-cloud", a->noReadCloud, "Skip the readCloud timing");
+  cmd->add_option("--out", a->out, "Folder for the reports (default: bench/results/cpu-<model>-<threads>t/)");
+  cmd->add_option("--name", a->name, "Report file stem")->capture_default_str();
+  cmd->add_flag("--json", a->json, "Print the report's JSON on stdout");
+  cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  return [a] { return runBenchIo(*a); };
+}
+
+} // namespace pointrast::app

@@ -1,0 +1,216 @@
+// pointrast lod IN... -o DIR: a level-of-detail octree (Potree 2.0) from point files.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "base/progress.h"
+#include "cli_util.h"
+#include "commands.h"
+#include "io/format_table.h"
+#include "io/lod_potree.h"
+
+namespace pointrast::app {
+
+namespace {
+
+struct LodArgs {
+  std::vector<std::string> inputs;
+  std::string output, memory, leafPoints = "20k", encoding = "default", colorFilter = "average";
+  double spacing = 0;
+  unsigned threads = 0;
+  bool json = false, quiet = false;
+};
+
+// Ctrl-C (or a termination request) asks the build to stop: it unwinds, and the writer removes its
+// temporary folder with the chunk files in it. The handler only sets a flag (all a signal handler may
+// do); SA_RESETHAND makes a second Ctrl-C end the process at once, for a user who will not wait.
+std::atomic<bool> gInterrupted{false};
+extern "C" void onInterrupt(int) {
+  gInterrupted.store(true);
+}
+
+class InterruptGuard {
+public:
+  InterruptGuard() {
+    struct sigaction action {};
+    action.sa_handler = onInterrupt;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &oldInt_);
+    sigaction(SIGTERM, &action, &oldTerm_);
+  }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &oldInt_, nullptr);
+    sigaction(SIGTERM, &oldTerm_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+private:
+  struct sigaction oldInt_ {
+  }, oldTerm_{};
+};
+
+double perSecond(double count, double seconds) {
+  return seconds > 0 ? count / seconds : 0;
+}
+
+nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
+  const io::LodBuildReport& b = r.build;
+  nlohmann::json j;
+  j["command"] = "lod";
+  j["inputs"] = a.inputs;
+  j["output"] = a.output;
+  j["points"] = b.octree.points;
+  j["nodes"] = b.octree.nodes;
+  j["levels"] = b.octree.levels;
+  j["bytes"] = r.bytes;
+  j["input_bytes"] = b.inputBytes;
+  j["seconds"] = b.seconds;
+  j["points_per_second"] = perSecond(double(b.octree.points), b.seconds);
+  j["threads"] = b.threads;
+  j["memory_bytes"] = b.memoryBytes;
+  j["out_of_core"] = b.outOfCore;
+  j["spill_bytes"] = b.spillBytes;
+  j["chunks"] = b.chunks;
+  j["spacing"] = b.metadata.spacing;
+  j["encoding"] = a.encoding;
+  j["color_filter"] = a.colorFilter;
+  nlohmann::json phases = nlohmann::json::array();
+  for (const lod::LodPhase& p : b.phases) {
+    nlohmann::json q;
+    q["name"] = p.name;
+    q["seconds"] = p.seconds;
+    q["cpu_seconds"] = p.cpuSeconds;
+    q["points_per_second"] = perSecond(double(p.points), p.seconds);
+    q["bytes"] = p.bytes;
+    q["overlapped"] = p.overlapped;
+    phases.push_back(q);
+  }
+  j["phases"] = phases;
+  return j;
+}
+
+void printSummary(const LodArgs& a, const io::PotreeBuildReport& r) {
+  const io::LodBuildReport& b = r.build;
+  std::printf("%s: %s points in %s nodes, %d levels, %.1f MB, in %.2f s (%s points/s; %s, %u threads)\n",
+              a.output.c_str(), humanCount(double(b.octree.points)).c_str(),
+              humanCount(double(b.octree.nodes)).c_str(), b.octree.levels, double(r.bytes) / 1e6, b.seconds,
+              humanCount(perSecond(double(b.octree.points), b.seconds)).c_str(),
+              b.outOfCore ? "out of core" : "in memory", b.threads);
+  for (const lod::LodPhase& p : b.phases) {
+    std::printf("  %-10s %8.3f s %10s points/s", p.name.c_str(), p.seconds,
+                humanCount(perSecond(double(p.points), p.seconds)).c_str());
+    if (p.overlapped)
+      std::printf("   (during index)\n");
+    else
+      std::printf("   cpu %7.3f s\n", p.cpuSeconds);
+  }
+}
+
+int runLod(const LodArgs& a) {
+  io::LodBuildOptions options;
+  options.spacing = a.spacing;
+  options.leafPoints = parseCount(a.leafPoints, "--leaf-points");
+  if (options.leafPoints < 1) throw InputError("--leaf-points expects at least 1");
+  if (!a.memory.empty()) options.memoryBytes = parseBytes(a.memory, "--memory");
+  options.threads = a.threads;
+  options.progress = !a.quiet && !a.json;
+  if (a.colorFilter != "average" && a.colorFilter != "none")
+    throw InputError("--color-filter expects average or none, got '" + a.colorFilter + "'");
+  options.averageColors = a.colorFilter == "average";
+  io::PotreeWriteOptions write;
+  if (a.encoding == "brotli")
+    write.encoding = io::PotreeEncoding::Brotli;
+  else if (a.encoding != "default")
+    throw InputError("--encoding expects default or brotli, got '" + a.encoding + "'");
+  if (a.spacing < 0) throw InputError("--spacing expects a positive length");
+  // Refused before any point is read: a mistake in the output's name should not cost a read of the input.
+  std::error_code ec;
+  if (std::filesystem::exists(std::filesystem::symlink_status(a.output, ec)))
+    throw InputError(a.output + ": already exists (an octree is written into a new folder)");
+  const std::filesystem::path parent = std::filesystem::absolute(a.output, ec).parent_path();
+  if (!std::filesystem::is_directory(parent, ec))
+    throw InputError(a.output + ": the folder " + parent.string() + " does not exist");
+
+  std::vector<std::filesystem::path> inputs(a.inputs.begin(), a.inputs.end());
+  gInterrupted = false;
+  options.cancel = &gInterrupted;
+  InterruptGuard guard;
+  io::PotreeBuildReport report;
+  try {
+    report = io::buildPotree(inputs, a.output, options, write);
+  } catch (const Interrupted&) {
+    std::fprintf(stderr, "pointrast: interrupted; %s was not written\n", a.output.c_str());
+    return 130;
+  }
+  if (a.json)
+    std::printf("%s\n", toJson(a, report).dump().c_str());
+  else if (!a.quiet)
+    printSummary(a, report);
+  return 0;
+}
+
+} // namespace
+
+Command addLod(CLI::App& app) {
+  auto a = std::make_shared<LodArgs>();
+  CLI::App* cmd =
+      app.add_subcommand("lod", "Build a level-of-detail octree (Potree 2.0 folder) from point files");
+  cmd->footer(
+      "\nThe octree is additive, as PotreeConverter's: every input point is stored once, exactly (its\n"
+      "integer coordinates and attributes); the root holds a subsample with one point per cell of a\n"
+      "128 x 128 x 128 grid over the cube (spacing = cube edge / 128), each level below one per cell of a\n"
+      "grid twice as fine, and a node whose cube holds more than --leaf-points points is split. The\n"
+      "point kept in a cell is the one nearest its center; with --color-filter average (the default) it\n"
+      "takes the average color of the points it stands for, which removes the color noise of coarse\n"
+      "levels. Several inputs merge into one octree (the finest of their scales; 8-bit colors widened\n"
+      "next to 16-bit ones).\n"
+      "\n"
+      "Points are read once and indexed in memory when they fit --memory (about 56 bytes a point);\n"
+      "otherwise the build runs out of core, reading the input three times and keeping temporary chunk\n"
+      "files in the output's temporary folder. Either way the result is the same, byte for byte, whatever\n"
+      "--memory and --threads are. The folder appears only when complete: an error or Ctrl-C leaves\n"
+      "nothing behind (a second Ctrl-C stops at once).\n"
+      "\n"
+      "Examples:\n"
+      "  pointrast lod scan.las -o scan_octree                 # all cores, in memory if it fits\n"
+      "  pointrast lod tiles/*.las -o city --memory 8G         # many tiles, one octree, at most ~8 GiB\n"
+      "  pointrast lod big.las -o big --encoding brotli --json # compressed nodes, one JSON summary\n"
+      "  pointrast lod scan.las -o coarse --spacing 2 --leaf-points 50k\n"
+      "  pointrast info scan_octree                            # what was built\n"
+      "  pointrast render scan_octree -o view.png              # draw all its points");
+  cmd->add_option("IN", a->inputs, "Point files: LAS, PLY, XYZ/CSV (several merge into one octree)")
+      ->required();
+  cmd->add_option("-o,--output", a->output, "Folder to create (must not exist)")->required();
+  cmd->add_option("--spacing", a->spacing,
+                  "Root spacing in input units, rounded to the cube edge / 2^k (default: edge / 128)");
+  cmd->add_option("--leaf-points", a->leafPoints, "A node whose cube holds more points is split (e.g. 20k)")
+      ->capture_default_str();
+  cmd->add_option("--memory", a->memory,
+                  "Memory for the build, e.g. 8G (default: half of the physical memory)");
+  cmd->add_option("--threads", a->threads, "Threads (default: all cores)");
+  cmd->add_option("--encoding", a->encoding, "Node encoding: default (uncompressed) or brotli")
+      ->capture_default_str();
+  cmd->add_option("--color-filter", a->colorFilter,
+                  "Colors of subsampled points: average (of the points they stand for) or none (their own)")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->json,
+                "Print one JSON object: points, nodes, levels, bytes, phases with seconds");
+  cmd->add_flag("-q,--quiet", a->quiet, "No progress lines or summary");
+  return [a] {
+    Progress::setEnabled(!a->quiet && !a->json);
+    return runLod(*a);
+  };
+}
+
+} // namespace pointrast::app

@@ -1,0 +1,287 @@
+#include "bench/io_bench.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "base/parallel.h"
+#include "bench/report.h"
+#include "io/io_util.h"
+#include "io/laz_chunk.h"
+#include "io/laz_compose.h"
+#include "io/laz_reader.h"
+
+namespace pointrast::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
+}
+
+std::string firstLine(const char* path, const char* key) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line))
+    if (!key || line.rfind(key, 0) == 0) {
+      if (key) {
+        const size_t colon = line.find(':');
+        return colon == std::string::npos ? line : line.substr(line.find_first_not_of(" \t", colon + 1));
+      }
+      return line;
+    }
+  return "";
+}
+
+// The compressed chunks of a file, in memory.
+struct LoadedLaz {
+  io::laz::LazFile laz;
+  std::vector<std::vector<uint8_t>> chunks;
+  uint64_t points = 0, bytes = 0;
+};
+
+LoadedLaz load(const std::filesystem::path& path) {
+  io::detail::InputFile file(path);
+  LoadedLaz l;
+  l.laz = io::laz::openLaz(file);
+  for (const io::laz::Chunk& c : l.laz.chunks) {
+    l.chunks.emplace_back(c.bytes);
+    file.readAt(c.offset, l.chunks.back().data(), c.bytes);
+    l.points += c.pointCount;
+    l.bytes += c.bytes;
+  }
+  return l;
+}
+
+struct OneRun {
+  double wall = 0, cpu = 0;
+};
+
+// Every chunk decoded once on `threads` threads, chunks handed out in file order.
+OneRun decodeOnce(const LoadedLaz& l, std::vector<std::unique_ptr<io::laz::ChunkDecoder>>& decoders,
+                  unsigned threads) {
+  std::atomic<size_t> next{0};
+  std::vector<double> cpu(threads, 0.0);
+  auto work = [&](unsigned t) {
+    const double c0 = threadCpuSeconds();
+    std::vector<uint8_t> records;
+    for (size_t i = next++; i < l.chunks.size(); i = next++)
+      decoders[t]->decode(l.chunks[i].data(), l.chunks[i].size(), l.laz.chunks[i].pointCount, records);
+    cpu[t] = threadCpuSeconds() - c0;
+  };
+  const Clock::time_point start = Clock::now();
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t)
+    pool.emplace_back(work, t);
+  work(0);
+  for (std::thread& t : pool)
+    t.join();
+  OneRun r;
+  r.wall = std::chrono::duration<double>(Clock::now() - start).count();
+  for (double c : cpu)
+    r.cpu += c;
+  return r;
+}
+
+IoTiming summarize(std::vector<OneRun> runs, unsigned threads, uint64_t points) {
+  std::sort(runs.begin(), runs.end(), [](const OneRun& a, const OneRun& b) { return a.wall < b.wall; });
+  IoTiming t;
+  t.threads = threads;
+  t.points = points;
+  t.bestSeconds = runs.front().wall;
+  t.medianSeconds = runs[runs.size() / 2].wall;
+  t.cpuSeconds = runs[runs.size() / 2].cpu;
+  return t;
+}
+
+std::string layoutText(const io::laz::LazFile& laz) {
+  const io::detail::LasHeader& hd = laz.header;
+  return io::detail::strFormat("LAZ %d.%d point format %d: %s (%s)", hd.versionMajor, hd.versionMinor,
+                               hd.pointFormat, laz.layout.describeItems().c_str(),
+                               laz.layout.describeCompressor().c_str());
+}
+
+double mega(double v) {
+  return v / 1e6;
+}
+
+} // namespace
+
+double IoTiming::pointsPerSecond() const {
+  return medianSeconds > 0 ? double(points) / medianSeconds : 0;
+}
+double IoTiming::pointsPerSecondPerThread() const {
+  return threads ? pointsPerSecond() / threads : 0;
+}
+double IoTiming::pointsPerCpuSecond() const {
+  return cpuSeconds > 0 ? double(points) / cpuSeconds : 0;
+}
+
+IoBenchRun runIoBench(const IoBenchConfig& config, bool progress) {
+  const Clock::time_point begin = Clock::now();
+  IoBenchRun run;
+  run.cpu = firstLine("/proc/cpuinfo", "model name");
+  run.hardwareThreads = hardwareThreads();
+  run.loadBefore = firstLine("/proc/loadavg", nullptr);
+  std::vector<unsigned> threadCounts = config.threads;
+  if (threadCounts.empty()) threadCounts = {1, run.hardwareThreads};
+  std::sort(threadCounts.begin(), threadCounts.end());
+  threadCounts.erase(std::unique(threadCounts.begin(), threadCounts.end()), threadCounts.end());
+
+  for (const std::filesystem::path& input : config.inputs) {
+    IoResult result;
+    result.file = input.filename().string();
+    std::filesystem::path path = input;
+    {
+      io::detail::InputFile file(input);
+      const io::laz::LazFile laz = io::laz::openLaz(file);
+      const uint64_t points = laz.header.pointCount;
+      if (config.minPoints > points && points > 0) {
+        // Chunks decode on their own: the file's chunks, repeated, with a rebuilt table, are a valid LAZ.
+        result.copies = (config.minPoints + points - 1) / points;
+        std::vector<size_t> picks;
+        for (uint64_t c = 0; c < result.copies; ++c)
+          for (size_t i = 0; i < laz.chunks.size(); ++i)
+            picks.push_back(i);
+        std::filesystem::create_directories(config.workDir);
+        path = config.workDir / (input.stem().string() + "-x" + std::to_string(result.copies) + ".laz");
+        io::writeComposedLaz(input, picks, path);
+      }
+    }
+    const LoadedLaz loaded = load(path);
+    result.layout = layoutText(loaded.laz);
+    result.points = loaded.points;
+    result.chunks = loaded.chunks.size();
+    result.compressedBytes = loaded.bytes;
+    for (unsigned threads : threadCounts) {
+      std::vector<std::unique_ptr<io::laz::ChunkDecoder>> decoders;
+      for (unsigned t = 0; t < threads; ++t)
+        decoders.push_back(std::make_unique<io::laz::ChunkDecoder>(loaded.laz.layout));
+      decodeOnce(loaded, decoders, threads); // warm-up: caches, page faults of the decoders' models
+      std::vector<OneRun> runs;
+      for (int r = 0; r < std::max(1, config.repeats); ++r)
+        runs.push_back(decodeOnce(loaded, decoders, threads));
+      result.decode.push_back(summarize(runs, threads, loaded.points));
+      const IoTiming& t = result.decode.back();
+      if (progress)
+        std::fprintf(
+            stderr, "%s: %u thread%s: %.1f M points/s (%.2f M/s per thread, %.2f M per CPU-second)\n",
+            path.filename().string().c_str(), threads, threads == 1 ? "" : "s", mega(t.pointsPerSecond()),
+            mega(t.pointsPerSecondPerThread()), mega(t.pointsPerCpuSecond()));
+    }
+    if (config.readCloud) {
+      const unsigned threads = threadCounts.back();
+      io::detail::setLazThreads(threads);
+      io::ReadOptions options;
+      options.progress = false;
+      std::vector<OneRun> runs;
+      for (int r = 0; r < std::max(1, config.repeats); ++r) {
+        const Clock::time_point start = Clock::now();
+        const PointCloud cloud = io::readCloud(path, options);
+        runs.push_back({std::chrono::duration<double>(Clock::now() - start).count(), 0});
+      }
+      io::detail::setLazThreads(0);
+      result.readCloud = summarize(runs, threads, loaded.points);
+    }
+    if (path != input) std::filesystem::remove(path);
+    run.results.push_back(std::move(result));
+  }
+  run.loadAfter = firstLine("/proc/loadavg", nullptr);
+  run.seconds = std::chrono::duration<double>(Clock::now() - begin).count();
+  return run;
+}
+
+std::string ioDeviceName(const IoBenchRun& run) {
+  return "cpu-" + sanitizeName(run.cpu) + "-" + std::to_string(run.hardwareThreads) + "t";
+}
+
+nlohmann::json ioRunJson(const IoBenchRun& run, const std::string& commandLine, const std::string& date) {
+  nlohmann::json j;
+  j["suite"] = "io";
+  j["cpu"] = run.cpu;
+  j["hardware_threads"] = run.hardwareThreads;
+  j["load_average_before"] = run.loadBefore;
+  j["load_average_after"] = run.loadAfter;
+  j["command"] = commandLine;
+  j["date"] = date;
+  j["seconds"] = run.seconds;
+  j["results"] = nlohmann::json::array();
+  for (const IoResult& r : run.results) {
+    nlohmann::json jr = {{"file", r.file},
+                         {"layout", r.layout},
+                         {"points", r.points},
+                         {"copies", r.copies},
+                         {"chunks", r.chunks},
+                         {"compressed_bytes", r.compressedBytes},
+                         {"decode", nlohmann::json::array()}};
+    auto timing = [](const IoTiming& t) {
+      return nlohmann::json{{"threads", t.threads},
+                            {"median_s", t.medianSeconds},
+                            {"best_s", t.bestSeconds},
+                            {"cpu_s", t.cpuSeconds},
+                            {"points_per_s", t.pointsPerSecond()},
+                            {"points_per_s_per_thread", t.pointsPerSecondPerThread()},
+                            {"points_per_cpu_s", t.pointsPerCpuSecond()}};
+    };
+    for (const IoTiming& t : r.decode)
+      jr["decode"].push_back(timing(t));
+    if (r.readCloud.threads) jr["read_cloud"] = timing(r.readCloud);
+    j["results"].push_back(jr);
+  }
+  return j;
+}
+
+std::string ioMarkdownReport(const IoBenchRun& run, const std::string& commandLine, const std::string& date) {
+  std::ostringstream md;
+  md << "# LAZ decoding throughput\n\n";
+  md << "CPU: " << run.cpu << ", " << run.hardwareThreads
+     << " hardware threads. Load average before: " << run.loadBefore << "; after: " << run.loadAfter
+     << ".\n\n";
+  md << "Decoding to raw LAS records from compressed chunks in memory; each row the median of the runs (best "
+        "in "
+        "parentheses). Per CPU-second: points over the decoding threads' CPU time, what one core delivers "
+        "whatever else the machine runs.\n\n";
+  md << "| file | points | threads | median s (best) | M points/s | M points/s per thread | M points per "
+        "CPU-s |\n";
+  md << "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  char line[512];
+  for (const IoResult& r : run.results) {
+    for (const IoTiming& t : r.decode) {
+      std::snprintf(line, sizeof line, "| %s | %llu | %u | %.3f (%.3f) | %.2f | %.2f | %.2f |\n",
+                    r.file.c_str(), static_cast<unsigned long long>(r.points), t.threads, t.medianSeconds,
+                    t.bestSeconds, mega(t.pointsPerSecond()), mega(t.pointsPerSecondPerThread()),
+                    mega(t.pointsPerCpuSecond()));
+      md << line;
+    }
+  }
+  md << "\nreadCloud (records into the renderer's cloud, all stages) at the highest thread count:\n\n";
+  md << "| file | threads | median s (best) | M points/s |\n| --- | ---: | ---: | ---: |\n";
+  for (const IoResult& r : run.results)
+    if (r.readCloud.threads) {
+      std::snprintf(line, sizeof line, "| %s | %u | %.3f (%.3f) | %.2f |\n", r.file.c_str(),
+                    r.readCloud.threads, r.readCloud.medianSeconds, r.readCloud.bestSeconds,
+                    mega(r.readCloud.pointsPerSecond()));
+      md << line;
+    }
+  md << "\nFiles:\n\n";
+  for (const IoResult& r : run.results) {
+    std::snprintf(line, sizeof line, "- %s x %llu: %s, %llu chunks, %.1f MB compressed (%.2f B per point)\n",
+                  r.file.c_str(), static_cast<unsigned long long>(r.copies), r.layout.c_str(),
+                  static_cast<unsigned long long>(r.chunks), double(r.compressedBytes) / 1e6,
+                  r.points ? double(r.compressedBytes) / double(r.points) : 0.0);
+    md << line;
+  }
+  md << "\nCommand: `" << commandLine << "`, " << date << ", " << run.seconds << " s.\n";
+  return md.str();
+}
+
+} // namespace pointrast::bench

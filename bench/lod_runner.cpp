@@ -1,0 +1,123 @@
+#include "bench/lod_runner.h"
+
+#include <filesystem>
+#include <memory>
+
+#include "bench/suites.h"
+#include "io/format_table.h"
+#include "render/lod/lod_scene.h"
+
+namespace pointrast::bench {
+
+namespace {
+
+std::vector<Method> octreeMethods(const std::vector<Method>& methods) {
+  std::vector<Method> out;
+  for (Method m : methods)
+    if (methodInfo(m).layout == SceneLayout::Octree) out.push_back(m);
+  return out;
+}
+
+// The data set's octree opened as a LodScene with the default node cache, or why not.
+struct OpenOctree {
+  std::unique_ptr<lod::NodeSource> source;
+  std::unique_ptr<lod::LodScene> scene;
+  std::string failure;
+};
+
+OpenOctree openOctree(gpu::Context& context, const BenchConfig& config, const Dataset& dataset,
+                      const PointCloud& cloud, BenchRun& run) {
+  OpenOctree o;
+  try {
+    if (!config.octrees) throw InputError("no octree: this run has no octree builder or cache");
+    DatasetOctree octree =
+        config.octrees(octreeKey(dataset), [&]() -> const PointCloud& { return cloud; });
+    o.source = io::openNodeSource(octree.path);
+    o.scene = std::make_unique<lod::LodScene>(context, *o.source);
+    run.octrees.emplace_back(dataset.name, std::move(octree));
+  } catch (const InputError& e) {
+    o.failure = e.what();
+  } catch (const UnsupportedError& e) {
+    o.failure = e.what();
+  }
+  return o;
+}
+
+} // namespace
+
+std::string octreeKey(const Dataset& dataset) {
+  if (dataset.file) return dataset.name + "-" + std::filesystem::path(dataset.source).stem().string();
+  return dataset.name + "-" + std::to_string(dataset.points) + "-seed" + std::to_string(dataset.seed);
+}
+
+void measureOctreeMethods(gpu::Context& context, Renderer& renderer, const BenchConfig& config,
+                          const Dataset& dataset, const PointCloud& cloud, Order order,
+                          const std::vector<View>& views, BenchRun& run,
+                          const std::function<void(const Result&)>& record) {
+  const std::vector<Method> methods = octreeMethods(config.methods);
+  if (methods.empty() || views.empty()) return;
+  OpenOctree octree = openOctree(context, config, dataset, cloud, run);
+  const double aspect = double(config.width) / double(config.height);
+  // Clocks up again after the build, with the first method the device runs.
+  for (Method method : methods) {
+    if (!octree.scene || !Renderer::supports(context, method)) continue;
+    const Camera camera = viewCamera(views.front(), cloud.bounds, aspect, config.fovY);
+    try {
+      settleClocks([&](uint32_t frames) {
+        RenderSettings settle;
+        settle.method = method;
+        settle.frames = frames;
+        settle.warmup = 0;
+        return renderer.render(*octree.scene, camera, settle).medianMs;
+      });
+    } catch (const UnsupportedError&) {
+    } catch (const InputError&) {
+    }
+    break;
+  }
+  for (View view : views) {
+    const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
+    for (Method method : methods) {
+      Result r;
+      r.dataset = dataset.name;
+      r.order = order;
+      r.view = view;
+      r.method = method;
+      r.points = cloud.size();
+      r.bytesPerPoint = methodInfo(method).bytesPerPoint;
+      r.camera = describeCamera(camera);
+      std::string why;
+      if (!octree.scene) {
+        r.status = "unsupported";
+        r.reason = octree.failure;
+      } else if (!Renderer::supports(context, method, &why)) {
+        r.status = "unsupported";
+        r.reason = why;
+      } else {
+        RenderSettings settings;
+        settings.method = method;
+        settings.frames = config.frames;
+        settings.warmup = run.warmup;
+        measureGuarded(
+            r,
+            [&] {
+              if (config.secondsPerCombination > 0) {
+                RenderSettings probe = settings;
+                probe.frames = 1;
+                probe.warmup = 0;
+                const double seconds = renderer.render(*octree.scene, camera, probe).medianMs * 1e-3;
+                settings.frames =
+                    budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
+                if (settings.frames < config.frames) settings.warmup = 1;
+              }
+              r.stats = renderer.render(*octree.scene, camera, settings);
+            },
+            record);
+      }
+      completeRates(r, run.copy);
+      record(r);
+    }
+  }
+}
+
+} // namespace pointrast::bench

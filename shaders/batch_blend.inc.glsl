@@ -1,0 +1,67 @@
+// The accumulation loop of the HQS batch passes, for any box of quantized points (batch.inc.glsl): a batch
+// of a part (raster_batch_hqs.comp) or a page of an octree node (raster_lod_hqs.comp). After a depth pass
+// left each pixel's closest depth in the framebuffer's high word, every point of a box that is not culled
+// and lies within 1 % of its pixel's closest depth adds its color with one packed atomicAdd (hqs1r's
+// layout, resolved by resolve_hqs.comp). Same culling, precision and 128-bit loads as the depth pass, so
+// both passes decode every point to the same position; colors are read for blended points only. Needs
+// hqs_accumulate.inc.glsl and its subgroup extensions.
+
+// Blends the box's `count` points; `steps` steps of 4 points per thread cover the largest box of the pass.
+// Returns the points this thread blended. Call in uniform control flow (hqsBlend's subgroup operations
+// need every lane; v is uniform).
+uint blendBox(BatchView v, BatchWords at, uint count, uint steps, BatchCamera cam, uint64_t framebuffer,
+              uint64_t accumulators) {
+  Uint64Array fb = Uint64Array(framebuffer);
+  Uint64Array acc = Uint64Array(accumulators);
+  uint pixels = cam.width * cam.height;
+  uint blended = 0u;
+  // No early exit from the loops: hqsBlend's subgroup operations need every lane.
+  if (v.words == 0u) return 0u;
+  for (uint j = 0u; j < steps; ++j) {
+    uint local = 4u * (gl_LocalInvocationIndex + j * kPointGroupSize);
+    uvec4 h = uvec4(0u), m = uvec4(0u), l = uvec4(0u);
+    if (local < count) loadQuad(at, local / 4u, v.words, h, m, l);
+    // Four points in flight: project all, then their pixels' closest depths and the colors of those that
+    // blend are read together, then they blend.
+    uint pixel[4];
+    float depth[4];
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+      uint p, depthBits;
+      pixel[k] = kNoPixel;
+      depth[k] = 0.0;
+      if (local + k < count && projectBatchPoint(v, v.words, true, h[k], m[k], l[k], cam, p, depthBits)) {
+        pixel[k] = p;
+        depth[k] = uintBitsToFloat(depthBits);
+      }
+    }
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+      if (pixel[k] == kNoPixel) continue;
+      float closest = uintBitsToFloat(uint(fb.v[pixel[k]] >> 32));
+      if (depth[k] > closest * float(PR_HQS_DEPTH_FACTOR)) pixel[k] = kNoPixel; // hidden: not blended
+    }
+    // Colors of the points that blend; a thread's four points are consecutive and often share a pixel, so
+    // the sums of a shared pixel go with its first point (fewer lanes for the subgroup to combine).
+    uint r[4], g[4], b[4], n[4];
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+      r[k] = g[k] = b[k] = n[k] = 0u;
+      if (pixel[k] == kNoPixel) continue;
+      hqsChannels(UintArray(at.colors).v[local + k], r[k], g[k], b[k]);
+      n[k] = 1u;
+      ++blended;
+    }
+    [[unroll]] for (uint k = 1u; k < 4u; ++k) {
+      [[unroll]] for (uint e = 0u; e < k; ++e) {
+        if (pixel[k] != kNoPixel && pixel[k] == pixel[e]) {
+          r[e] += r[k];
+          g[e] += g[k];
+          b[e] += b[k];
+          n[e] += n[k];
+          pixel[k] = kNoPixel;
+        }
+      }
+    }
+    [[unroll]] for (uint k = 0u; k < 4u; ++k)
+      hqsBlend(acc, pixels, true, pixel[k], r[k], g[k], b[k], n[k]);
+  }
+  return blended;
+}

@@ -1,0 +1,21 @@
+#version 460
+// LOD, node pass: one thread per node of the pass computes the node's box decision (frustum culling,
+// coordinate words, screen map: batch.inc.glsl's viewBox on the node's tight bounds) once, for every page
+// of the node to read; and counts nodes processed and rendered and their points by coordinate words.
+#include "lod.inc.glsl"
+
+void main() {
+  LodFrame f = LodFrameRef(pc.frame).f;
+  uint i = lodWorkgroup() * kPointGroupSize + gl_LocalInvocationIndex;
+  if (i >= f.nodeCount) return;
+  LodNode node = LodNodes(f.nodes).v[i];
+  BatchView v = viewBox(node.min.xyz, node.max.xyz, lodCamera(f), f.forcedWords, f.culling != 0u);
+  LodViews(f.views).v[i] = storeView(v);
+  if (f.nodeStats == 0u) return;
+  Uint64Array stats = Uint64Array(f.stats);
+  uint row = (i % kBatchStatSlots) * kBatchStatCount;
+  atomicAdd(stats.v[row + kStatBatchesProcessed], 1ul);
+  if (v.words == 0u) return;
+  atomicAdd(stats.v[row + kStatBatchesRendered], 1ul);
+  atomicAdd(stats.v[row + kStatPointsOneWord + v.words - 1u], uint64_t(node.pointCount));
+}

@@ -1,0 +1,234 @@
+// The adaptive arithmetic coder of LASzip: Amir Said's FastAC ("Fast arithmetic coding implementation:
+// 32-bit variables, 32-bit product, periodic updates, table decoding", 2004) as LASzip uses it, with its
+// exact constants and model-update schedule, because a LAZ stream decodes correctly only when every model
+// adapts exactly as the encoder's did.
+//
+// The decoder keeps the interval [0, length) and the code value; each symbol narrows the interval by
+// the symbol's share of the model's cumulative distribution (15-bit precision for symbol models, 13-bit
+// for bit models) and renormalizes by whole bytes when length falls below 2^24.
+//
+// Hostile input: a decoder never reads outside [begin, end): past the end it reads zero bytes and counts
+// them (pastEnd()), which the chunk decoders check against a small slack. Corrupt bytes give wrong
+// symbols, never an out-of-range table index or an endless loop (length stays > 0 by construction).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace pointrast::io::laz {
+
+inline constexpr uint32_t kMinLength = 0x01000000u; // renormalize below 2^24
+inline constexpr uint32_t kMaxLength = 0xFFFFFFFFu;
+inline constexpr uint32_t kBitLengthShift = 13; // bit models: probabilities in 1/8192
+inline constexpr uint32_t kBitMaxCount = 1u << kBitLengthShift;
+inline constexpr uint32_t kLengthShift = 15; // symbol models: distributions in 1/32768
+inline constexpr uint32_t kMaxCount = 1u << kLengthShift;
+
+// Probability of a 0 bit, re-estimated every `updateCycle` bits (4, growing by 5/4 up to 64).
+struct BitModel {
+  uint32_t bit0Prob = 1u << (kBitLengthShift - 1);
+  uint32_t bit0Count = 1;
+  uint32_t bitCount = 2;
+  uint32_t updateCycle = 4;
+  uint32_t bitsUntilUpdate = 4;
+
+  void reset() { *this = BitModel{}; }
+  void update();
+};
+
+// An adaptive model of `symbols` symbols (2..2048). Alphabets above 16 symbols get a lookup table that
+// maps the top bits of value / length to a first guess, refined by bisection (FastAC's table decoding).
+class SymbolModel {
+public:
+  SymbolModel() = default;
+  explicit SymbolModel(uint32_t symbols) { create(symbols); }
+  SymbolModel(SymbolModel&&) = default;
+  SymbolModel& operator=(SymbolModel&&) = default;
+
+  // Allocates the tables for an alphabet of `symbols` (2..2048) and leaves the model not ready.
+  void create(uint32_t symbols);
+  // Back to the uniform start state (every count 1), as LASzip's initSymbolModel.
+  void reset();
+  // Marks the model for a reset before its next use: models that a chunk never touches are not reset.
+  void invalidate() { ready_ = false; }
+  void ensureReady() {
+    if (!ready_) reset();
+  }
+  bool created() const { return symbols_ != 0; }
+  uint32_t symbols() const { return symbols_; }
+
+private:
+  friend class ArithmeticDecoder;
+  friend class ArithmeticEncoder;
+  void update();
+
+  uint32_t* distribution_ = nullptr; // symbols_ entries: cumulative probability, 15-bit scale
+  uint32_t* symbolCount_ = nullptr;  // symbols_ entries
+  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries, or null for small alphabets
+  uint32_t symbols_ = 0, lastSymbol_ = 0, tableSize_ = 0, tableShift_ = 0;
+  uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
+  bool ready_ = false;
+  std::unique_ptr<uint32_t[]> storage_;
+};
+
+class ArithmeticDecoder {
+public:
+  // Starts decoding the bytes [begin, end) (reads the first four as the code value).
+  void init(const uint8_t* begin, const uint8_t* end) {
+    ptr_ = begin;
+    end_ = end;
+    pastEnd_ = 0;
+    length_ = kMaxLength;
+    value_ = uint32_t(nextByte()) << 24;
+    value_ |= uint32_t(nextByte()) << 16;
+    value_ |= uint32_t(nextByte()) << 8;
+    value_ |= uint32_t(nextByte());
+  }
+
+  [[gnu::always_inline]] uint32_t decodeBit(BitModel& m) {
+    const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
+    uint32_t bit;
+    if (value_ < x) {
+      bit = 0;
+      length_ = x;
+      ++m.bit0Count;
+    } else {
+      bit = 1;
+      value_ -= x;
+      length_ -= x;
+    }
+    normalize();
+    if (--m.bitsUntilUpdate == 0) m.update();
+    return bit;
+  }
+
+  [[gnu::always_inline]] uint32_t decodeSymbol(SymbolModel& m) {
+    uint32_t sym, x, y = length_;
+    if (m.decoderTable_) {
+      const uint32_t dv = value_ / (length_ >>= kLengthShift);
+      // value < length holds for every stream an encoder wrote, which keeps t <= tableSize; corrupt
+      // bytes can break it, so the index is clamped rather than trusted.
+      uint32_t t = dv >> m.tableShift_;
+      if (t > m.tableSize_) t = m.tableSize_;
+      sym = m.decoderTable_[t];
+      uint32_t n = m.decoderTable_[t + 1] + 1;
+      while (n > sym + 1) {
+        const uint32_t k = (sym + n) >> 1;
+        if (m.distribution_[k] > dv)
+          n = k;
+        else
+          sym = k;
+      }
+      x = m.distribution_[sym] * length_;
+      if (sym != m.lastSymbol_) y = m.distribution_[sym + 1] * length_;
+    } else {
+      x = sym = 0;
+      length_ >>= kLengthShift;
+      uint32_t n = m.symbols_;
+      uint32_t k = n >> 1;
+      do {
+        const uint32_t z = length_ * m.distribution_[k];
+        if (z > value_) {
+          n = k;
+          y = z;
+        } else {
+          sym = k;
+          x = z;
+        }
+      } while ((k = (sym + n) >> 1) != sym);
+    }
+    value_ -= x;
+    length_ = y - x;
+    normalize();
+    ++m.symbolCount_[sym];
+    if (--m.symbolsUntilUpdate_ == 0) m.update();
+    return sym;
+  }
+
+  // Raw bits, equiprobable (LASzip readBits: at most 32, values above 19 bits in two steps).
+  uint32_t readBits(uint32_t bits) {
+    if (bits > 19) {
+      const uint32_t low = readShort();
+      return (readBits(bits - 16) << 16) | low;
+    }
+    const uint32_t sym = value_ / (length_ >>= bits);
+    value_ -= length_ * sym;
+    normalize();
+    return sym;
+  }
+  uint32_t readShort() {
+    const uint32_t sym = value_ / (length_ >>= 16);
+    value_ -= length_ * sym;
+    normalize();
+    return sym & 0xFFFF;
+  }
+  uint32_t readInt() {
+    const uint32_t low = readShort();
+    return (readShort() << 16) | low;
+  }
+  uint64_t readInt64() {
+    const uint64_t low = readInt();
+    return (uint64_t(readInt()) << 32) | low;
+  }
+
+  // Bytes read past the end of the input (as zeros).
+  size_t pastEnd() const { return pastEnd_; }
+  const uint8_t* position() const { return ptr_; }
+
+private:
+  [[gnu::always_inline]] uint8_t nextByte() {
+    if (ptr_ < end_) return *ptr_++;
+    ++pastEnd_;
+    return 0;
+  }
+  // After every symbol: shift in the bytes that bring length back to 2^24 or more (clz(length) / 8 of
+  // them, 0 to 3) without a branch on length, which mispredicts about every third symbol; near the end
+  // of the input, byte by byte.
+  [[gnu::always_inline]] void normalize() {
+    if (end_ - ptr_ >= 4) [[likely]] {
+      const uint32_t n = uint32_t(__builtin_clz(length_ | 1)) >> 3;
+      uint32_t next;
+      std::memcpy(&next, ptr_, 4);
+      const uint64_t v = ((uint64_t(value_) << 32) | __builtin_bswap32(next)) << (8 * n);
+      value_ = uint32_t(v >> 32);
+      length_ <<= 8 * n;
+      ptr_ += n;
+    } else if (length_ < kMinLength) {
+      renormalize();
+    }
+  }
+  [[gnu::always_inline]] void renormalize() {
+    do {
+      value_ = (value_ << 8) | nextByte();
+    } while ((length_ <<= 8) < kMinLength);
+  }
+
+  const uint8_t* ptr_ = nullptr;
+  const uint8_t* end_ = nullptr;
+  size_t pastEnd_ = 0;
+  uint32_t value_ = 0, length_ = kMaxLength;
+};
+
+// The matching encoder. pointrast writes no compressed points; it encodes LAZ chunk tables (the bench's
+// replicated files, test files with rebuilt or damaged tables), which use the same coder.
+class ArithmeticEncoder {
+public:
+  ArithmeticEncoder() = default;
+  void encodeBit(BitModel& m, uint32_t bit);
+  void encodeSymbol(SymbolModel& m, uint32_t sym);
+  void writeBits(uint32_t bits, uint32_t value);
+  // Flushes the interval (with the trailing zero bytes FastAC writes so a decoder never reads past the
+  // end) and returns the bytes.
+  std::vector<uint8_t> finish();
+
+private:
+  void propagateCarry();
+  void renormalize();
+  std::vector<uint8_t> out_;
+  uint32_t base_ = 0, length_ = kMaxLength;
+};
+
+} // namespace pointrast::io::laz

@@ -1,0 +1,149 @@
+// `pointrast lod` as a user meets it: a JSON summary with every phase, the same folder bytes from one
+// and two threads and out of core, one-line errors with exit 1 and nothing written, Ctrl-C leaving
+// nothing behind, and the octree readable by `info` and `convert`.
+#include <algorithm>
+#include <csignal>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "cli_harness.h"
+#include "test_data.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using pointrast::test::runPointrast;
+
+const fs::path kAutzen = pointrast::test::dataDir() / "las" / "autzen_trim.las";
+
+fs::path fresh(const std::string& name) {
+  fs::path p = pointrast::test::cliTempDir() / name;
+  fs::remove_all(p);
+  return p;
+}
+
+std::string bytesOf(const fs::path& p) {
+  return pointrast::test::slurp(p);
+}
+
+bool onlyEntry(const fs::path& dir, const std::string& name) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename() != name) {
+      ADD_FAILURE() << "left behind: " << e.path();
+      return false;
+    }
+  return true;
+}
+
+TEST(LodBuildCli, JsonSummaryHasEveryPhase) {
+  const fs::path out = fresh("lod_json");
+  const auto r = runPointrast("lod " + kAutzen.string() + " -o " + out.string() + " --json --leaf-points 5k");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["points"], 110000);
+  EXPECT_GT(j["nodes"].get<int>(), 4);
+  EXPECT_GE(j["levels"].get<int>(), 3);
+  EXPECT_EQ(j["bytes"].get<uint64_t>(), fs::file_size(out / "octree.bin") +
+                                            fs::file_size(out / "hierarchy.bin") +
+                                            fs::file_size(out / "metadata.json"));
+  EXPECT_GT(j["points_per_second"].get<double>(), 0);
+  std::vector<std::string> names;
+  for (const auto& p : j["phases"]) {
+    names.push_back(p["name"]);
+    EXPECT_GE(p["seconds"].get<double>(), 0);
+    EXPECT_TRUE(p.contains("points_per_second") && p.contains("cpu_seconds"));
+  }
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"read", "count", "chunk", "distribute", "index", "write", "commit"}));
+  EXPECT_TRUE(r.err.empty()) << r.err; // --json: no progress or summary lines
+
+  const auto info = runPointrast("info " + out.string());
+  EXPECT_EQ(info.exitCode, 0) << info.err;
+  EXPECT_NE(info.out.find("110000"), std::string::npos) << info.out;
+}
+
+TEST(LodBuildCli, SameBytesFromOneAndTwoThreadsAndWithLittleMemory) {
+  const fs::path terrain = fresh("lod_terrain.las");
+  ASSERT_EQ(runPointrast("generate terrain --points 300k -q -o " + terrain.string()).exitCode, 0);
+  const fs::path a = fresh("lod_a"), b = fresh("lod_b"), c = fresh("lod_c");
+  fs::create_directories(a);
+  fs::create_directories(b);
+  fs::create_directories(c);
+  const std::string common = " --leaf-points 5k -q ";
+  ASSERT_EQ(
+      runPointrast("lod " + terrain.string() + common + "--threads 1 -o " + (a / "o").string()).exitCode, 0);
+  ASSERT_EQ(
+      runPointrast("lod " + terrain.string() + common + "--threads 2 -o " + (b / "o").string()).exitCode, 0);
+  const auto spilled =
+      runPointrast("lod " + terrain.string() + common + "--memory 2M --json -o " + (c / "o").string());
+  ASSERT_EQ(spilled.exitCode, 0) << spilled.err;
+  EXPECT_TRUE(nlohmann::json::parse(spilled.out)["out_of_core"].get<bool>());
+  for (const char* file : {"octree.bin", "hierarchy.bin", "metadata.json"}) {
+    EXPECT_EQ(bytesOf(a / "o" / file), bytesOf(b / "o" / file)) << file;
+    EXPECT_EQ(bytesOf(a / "o" / file), bytesOf(c / "o" / file)) << file;
+  }
+  EXPECT_TRUE(onlyEntry(c, "o"));
+  // Every point comes back out of the octree.
+  const fs::path back = fresh("lod_back.las");
+  const auto convert = runPointrast("convert " + (a / "o").string() + " " + back.string() + " -q");
+  ASSERT_EQ(convert.exitCode, 0) << convert.err;
+  const auto info = runPointrast("info " + back.string() + " --json");
+  EXPECT_EQ(nlohmann::json::parse(info.out)["points"], 300000) << info.out;
+}
+
+TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
+  const fs::path dir = fresh("lod_errors");
+  fs::create_directories(dir / "exists");
+  const std::string out = " -o " + (dir / "o").string();
+  const std::string cases[] = {
+      "lod " + (dir / "missing.las").string() + out,
+      "lod " + kAutzen.string() + " -o " + (dir / "exists").string(),
+      "lod " + kAutzen.string() + out + " --memory lots",
+      "lod " + kAutzen.string() + out + " --encoding zip",
+      "lod " + kAutzen.string() + out + " --color-filter median",
+      "lod " + kAutzen.string() + out + " --leaf-points 0",
+      "lod " + (pointrast::test::dataDir() / "las" / "no-points.las").string() + out,
+      "lod " + (pointrast::test::dataDir() / "mmpld" / "test_xyz_float_none.mmpld").string() + out,
+      "lod " + kAutzen.string(),
+  };
+  for (const std::string& args : cases) {
+    const auto r = runPointrast(args);
+    EXPECT_FALSE(r.signaled) << args;
+    EXPECT_EQ(r.exitCode, 1) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_TRUE(onlyEntry(dir, "exists")) << args;
+  }
+}
+
+TEST(LodBuildCli, InterruptLeavesNothingBehind) {
+  const fs::path dir = fresh("lod_interrupt");
+  fs::create_directories(dir);
+  const fs::path input = dir / "t.las";
+  ASSERT_EQ(runPointrast("generate terrain --points 3M -q -o " + input.string()).exitCode, 0);
+  // Out of core on one thread: long enough to be interrupted while temporary chunk files exist.
+  const std::string command = pointrast::test::pointrastBinary() + " lod " + input.string() + " -o " +
+                              (dir / "o").string() + " --threads 1 --memory 4M -q";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + command + " 2>/dev/null").c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  usleep(700'000);
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the build finished before the interrupt";
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  fs::remove(input);
+  for (const auto& e : fs::directory_iterator(dir))
+    ADD_FAILURE() << "left behind: " << e.path();
+}
+
+} // namespace
