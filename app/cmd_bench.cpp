@@ -1,5 +1,6 @@
 // pointrast bench FILE|SCENE... | --suite paper2021: the method x order x view matrix, timed on the GPU;
-// --suite spheres2023: the sphere method x layout x billboard x conservative x orbit matrix.
+// --suite spheres2023: the sphere method x layout x billboard x conservative x orbit matrix; --suite lod:
+// the LOD method's sweeps and streaming on octrees from the octree cache (bench/octree_cache.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,9 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "bench/lod_report.h"
+#include "bench/lod_suite.h"
+#include "bench/octree_cache.h"
 #include "bench/report.h"
 #include "bench/runner.h"
 #include "bench/sphere_runner.h"
@@ -38,7 +42,10 @@ const std::vector<Order> kAllOrders = {Order::Original, Order::Morton, Order::Sh
 struct BenchArgs {
   std::vector<std::string> inputs;
   std::string suite, methods = "all", orders = "all", views = "all", points = "1M", copySize = "1G";
-  std::string out, name;
+  std::string out, name, datasets = "all";
+  // Octree methods and the lod suite: the octree cache, the streaming run's flight frames and jumps.
+  std::string octreeCache;
+  uint32_t flightFrames = bench::LodSuiteConfig{}.flightFrames, jumps = bench::LodSuiteConfig{}.jumps;
   // Sphere suites: the layouts, billboards, conservative settings and orbits measured, cameras per orbit.
   std::string layouts = "all", billboards = "all", conservative = "all", orbits = "all";
   uint32_t cameras = 10;
@@ -52,7 +59,7 @@ struct BenchArgs {
   bool scaleGiven = false, pointsGiven = false;
   // Options given on the command line (a suite brings its own methods, orders, views and image size).
   bool methodsGiven = false, ordersGiven = false, viewsGiven = false, widthGiven = false, heightGiven = false;
-  bool framesGiven = false, sphereOptionsGiven = false;
+  bool framesGiven = false, sphereOptionsGiven = false, streamOptionsGiven = false, datasetsGiven = false;
 };
 
 // Timed frames per camera of the sphere suites unless --frames says otherwise: 5 x 10 cameras = 50 frames
@@ -234,6 +241,40 @@ bool parseOnOff(const std::string& item) {
   throw InputError("--conservative '" + item + "': choose off, on, or all");
 }
 
+// --datasets: the suite's data sets named (by the paper's name, "aerial1g", or the stand-in's,
+// "aerial1g-like"), in the suite's order.
+std::vector<bench::Dataset> pickDatasets(const BenchArgs& a, std::vector<bench::Dataset> all) {
+  if (!a.datasetsGiven || a.datasets == "all") return all;
+  auto baseName = [](const std::string& name) {
+    const std::string like = "-like";
+    return name.size() > like.size() && name.ends_with(like) ? name.substr(0, name.size() - like.size())
+                                                             : name;
+  };
+  std::string names;
+  for (const bench::Dataset& d : all)
+    names += (names.empty() ? "" : ", ") + baseName(d.name);
+  const std::vector<std::string> wanted =
+      parseList(a.datasets, "--datasets", std::vector<std::string>{}, [&](const std::string& item) {
+        for (const bench::Dataset& d : all)
+          if (item == d.name || item == baseName(d.name)) return d.name;
+        throw InputError("--datasets: '" + item + "' is no data set of suite " + a.suite + " (" + names +
+                         ")");
+      });
+  std::vector<bench::Dataset> out;
+  for (const bench::Dataset& d : all)
+    if (std::find(wanted.begin(), wanted.end(), d.name) != wanted.end()) out.push_back(d);
+  return out;
+}
+
+// The octrees of the LOD methods: the cache folder of --octree-cache, built there when missing.
+bench::OctreeProvider octreeProvider(const BenchArgs& a, ProgressLines& lines) {
+  bench::OctreeCacheOptions options;
+  options.dir = a.octreeCache.empty() ? bench::defaultOctreeCacheDir() : std::filesystem::path(a.octreeCache);
+  options.progress = !a.quiet;
+  options.onNote = [&lines](const std::string& line) { lines.note(line); };
+  return bench::octreeCache(std::move(options));
+}
+
 // --suite spheres2023: particle stand-ins, sphere methods of the method table.
 int runSphereSuite(const BenchArgs& a) {
   if (!a.inputs.empty())
@@ -244,7 +285,7 @@ int runSphereSuite(const BenchArgs& a) {
                      " takes --orbits short,long");
   if (a.cameras == 0) throw InputError("--cameras must be at least 1");
   bench::SphereBenchConfig config;
-  config.datasets = bench::sphereSuiteDatasets(a.suite, a.scale, a.seed);
+  config.datasets = pickDatasets(a, bench::sphereSuiteDatasets(a.suite, a.scale, a.seed));
   std::vector<SphereMethod> allMethods;
   for (const SphereMethodInfo& m : sphereMethodTable())
     allMethods.push_back(m.method);
@@ -296,6 +337,73 @@ int runSphereSuite(const BenchArgs& a) {
   return 0;
 }
 
+// --suite lod: the LOD method's sweeps (point budget, --min-node-px) and streaming on the stand-ins' octrees.
+int runLodSuite(const BenchArgs& a) {
+  if (a.ordersGiven)
+    throw InputError(
+        "--orders do not apply to --suite lod: an octree is the same whatever the points' order");
+  bench::LodSuiteConfig config;
+  config.datasets = pickDatasets(a, bench::suiteDatasets(a.suite, a.scale, a.seed, a.inputs));
+  const bench::SuiteDefaults defaults = bench::suiteDefaults(a.suite);
+  if (a.methodsGiven && parseList(a.methods, "--methods", allMethods(), parseMethod) != defaults.methods)
+    throw InputError("--suite lod measures the method lod; use --suite paper2022 --methods ... for others");
+  if (a.viewsGiven) {
+    std::vector<bench::View> all(bench::allViews().begin(), bench::allViews().end());
+    config.views = parseList(a.views, "--views", all, bench::parseView);
+  } else {
+    config.views = defaults.views;
+  }
+  config.width = a.widthGiven ? a.width : defaults.width;
+  config.height = a.heightGiven ? a.height : defaults.height;
+  config.frames = a.framesGiven ? a.frames : config.frames;
+  config.fovY = a.fov;
+  // The budgets shrink with the data set, so that a smoke run still sweeps from coarse to complete.
+  for (uint64_t& budget : config.pointBudgets)
+    budget = std::max<uint64_t>(uint64_t(std::llround(double(budget) * a.scale)), 1);
+  if (a.flightFrames == 0) throw InputError("--flight-frames must be at least 1");
+  config.flightFrames = a.flightFrames;
+  config.jumps = a.jumps;
+  config.timeLimitSeconds = timeLimitSeconds(a);
+  config.copyBytes = parseCount(a.copySize, "--copy-size");
+  if (config.copyBytes == 0) throw InputError("--copy-size must be at least 1");
+  config.progress = !a.quiet;
+  const bench::ReportInfo info = suiteReportInfo(a);
+
+  gpu::Context context(contextOptions(a));
+  ProgressLines lines(a.quiet);
+  config.octrees = octreeProvider(a, lines);
+  bench::LodSuiteCallbacks callbacks;
+  callbacks.onNote = [&](const std::string& line) { lines.note(line); };
+  size_t done = 0;
+  const size_t total = config.datasets.size() *
+                       (config.views.size() * (config.pointBudgets.size() + config.minNodePx.size()) + 1);
+  callbacks.onSweep = [&](const bench::LodSuiteRun&, const bench::LodSweepResult& r) {
+    std::string what = r.dataset + " / " + bench::viewName(r.view) + " / min-node-px " +
+                       bench::printf1("%g", r.minNodePx) + " / budget " +
+                       (r.pointBudget ? bench::shortCount(r.pointBudget) : std::string("none"));
+    lines.result(++done, total,
+                 what + ": " + (r.ok() ? bench::formatMs(r.stats.medianMs) + " ms" : std::string("n/a")));
+  };
+  callbacks.onStream = [&](const bench::LodSuiteRun&, const bench::LodStreamResult& r) {
+    if (a.json) printJsonLine(bench::lodStreamJson(r), context);
+    uint32_t converged = 0;
+    for (const bench::LodJumpResult& jump : r.jumps)
+      converged += jump.converged ? 1 : 0;
+    lines.result(++done, total,
+                 r.dataset + " / streaming: " +
+                     (r.ok()
+                          ? std::to_string(r.flight.size()) + " flight frames, " + std::to_string(converged) +
+                                " of " + std::to_string(r.jumps.size()) + " jumps converged"
+                          : "n/a, " + r.reason));
+  };
+  bench::LodSuiteRun run = bench::runLodSuite(context, config, callbacks);
+  lines.end();
+  checkRun(context, run.datasets);
+  bench::WrittenFiles files = bench::writeLodSuiteReports(run, info, reportDir(a, context));
+  printWritten(a, run.sweeps.size() + run.streams.size(), run.seconds, files);
+  return 0;
+}
+
 int runBench(const BenchArgs& a) {
   Progress::setEnabled(!a.quiet);
   if (a.frames == 0) throw InputError("--frames must be at least 1");
@@ -306,10 +414,15 @@ int runBench(const BenchArgs& a) {
   if (a.pointsGiven && !a.suite.empty()) throw InputError("--points does not apply to --suite; use --scale");
   if (!a.name.empty() && (a.name.find('/') != std::string::npos || a.name == "." || a.name == ".."))
     throw InputError("--name '" + a.name + "': give a plain file name without '/'");
+  if (a.datasetsGiven && a.suite.empty())
+    throw InputError("--datasets picks data sets of a --suite; without one, name files or scenes");
+  if (a.streamOptionsGiven && !bench::isLodSuite(a.suite))
+    throw InputError("--flight-frames and --jumps apply to --suite lod");
   if (bench::isSphereSuite(a.suite)) return runSphereSuite(a);
   if (a.sphereOptionsGiven)
     throw InputError("--layouts, --billboards, --conservative, --orbits and --cameras apply to --suite "
                      "spheres2023");
+  if (bench::isLodSuite(a.suite)) return runLodSuite(a);
 
   bench::BenchConfig config;
   config.methods = parseList(a.methods, "--methods", allMethods(), parseMethod);
@@ -329,7 +442,7 @@ int runBench(const BenchArgs& a) {
 
   bench::ReportInfo info;
   if (!a.suite.empty()) {
-    config.datasets = bench::suiteDatasets(a.suite, a.scale, a.seed, a.inputs);
+    config.datasets = pickDatasets(a, bench::suiteDatasets(a.suite, a.scale, a.seed, a.inputs));
     const bench::SuiteDefaults defaults = bench::suiteDefaults(a.suite);
     if (!a.methodsGiven && !defaults.methods.empty()) config.methods = defaults.methods;
     if (!a.ordersGiven && !defaults.orders.empty()) config.orders = defaults.orders;
@@ -354,6 +467,10 @@ int runBench(const BenchArgs& a) {
 
   gpu::Context context(contextOptions(a));
   ProgressLines lines(a.quiet);
+  // The cache folder is only looked at when a method draws octrees.
+  if (std::any_of(config.methods.begin(), config.methods.end(),
+                  [](Method m) { return methodInfo(m).layout == SceneLayout::Octree; }))
+    config.octrees = octreeProvider(a, lines);
   bench::BenchCallbacks callbacks;
   callbacks.onNote = [&](const std::string& line) { lines.note(line); };
   callbacks.onResult = [&](const bench::BenchRun& run, const bench::Result& r, size_t done, size_t total) {
@@ -400,11 +517,29 @@ Command addBench(CLI::App& app) {
       "--suite paper2022 stands in for the 2022 paper (Software Rasterization of 2 Billion Points): scan69m\n"
       "(tls, 69 M), aerial279m (terrain, 279 M), scan529m (tls, 529 M, overview and closeup) and aerial1g\n"
       "(terrain, 1,000 M) in Morton order, plus tls-order (tls, 100 M) in scan (original) and Morton order,\n"
-      "overview and closeup; methods hw-points, batch, batch-prefetch, batch-hqs, dedup, hqs at 2560x1140.\n"
-      "Its report adds the batch statistics of the paper's Table 2 (batches and points processed/rendered,\n"
-      "points per coordinate precision). Each data set is uploaded once per scene layout its methods read\n"
-      "(float and batched, 16 B/point each); the memory estimate counts both. --methods, --orders, --views,\n"
-      "--width and --height override the suite's.\n\n"
+      "overview and closeup; methods hw-points, batch, batch-prefetch, batch-hqs, dedup, hqs, and the LOD\n"
+      "methods lod and lod-hqs at 2560x1140. Its report adds the batch statistics of the paper's Table 2\n"
+      "(batches and points processed/rendered, points per coordinate precision) and the LOD half of it\n"
+      "(nodes and points selected, processed, rendered; the speed-up over batch-prefetch). Each data set is\n"
+      "uploaded once per scene layout its methods read (float and batched, 16 B/point each); the memory\n"
+      "estimate counts both. --methods, --orders, --views, --width and --height override the suite's;\n"
+      "--datasets aerial1g,... measures only the data sets named.\n\n"
+      "The LOD methods draw each data set's octree (Potree 2.0), built once from its points with the octree\n"
+      "builder of `pointrast lod` (in memory, on all cores) into the octree cache (--octree-cache, by\n"
+      "default ~/.cache/pointrast/octrees) and reused by later runs and by the other suite: KEY/ is the\n"
+      "octree of the data set, size and seed KEY names, KEY.json its build's time and phases, which the\n"
+      "reports give whether the octree was built or reused. A damaged entry is built again. The 1,000 M\n"
+      "stand-in's octree takes about 18 GB of disk, and its build about 56 GB of memory beside the "
+      "points.\n\n"
+      "--suite lod measures the method lod on the octree of aerial1g (the 1,000 M stand-in of paper2022,\n"
+      "the same octree) at 2560x1140: the full-detail frame time against the point budget (1 M .. 300 M,\n"
+      "times --scale) and against --min-node-px (1000 .. 10), from the overview and the closeup; then\n"
+      "streaming with a GPU node cache of an eighth of the octree: --flight-frames frames (600) of a\n"
+      "flight low across the cloud and --jumps jumps (8) between far-apart views, each frame one viewer\n"
+      "frame paced at 60 Hz, with the octree's files dropped from the page cache first where the system\n"
+      "allows. It reports each frame's GPU and wall time against 60 fps, the frames until each jump\n"
+      "converges (target: 30) and the rate nodes stream from disk. --views, --frames, --width and --height\n"
+      "override the suite's.\n\n"
       "--suite spheres2023 stands in for the particle data sets of \"Efficient Sphere Rendering Revisited\"\n"
       "(2023) with generated particle scenes at the sizes issue 5 gives them: laser (particles-laser, 306 "
       "M:\n"
@@ -428,13 +563,30 @@ Command addBench(CLI::App& app) {
       "  pointrast bench --suite paper2021 retz=/data/retz.las\n"
       "  pointrast bench --suite paper2022\n"
       "  pointrast bench --suite paper2022 --scale 0.001 --frames 5 --out /tmp/smoke\n"
+      "  pointrast bench --suite paper2022 --datasets aerial1g --methods batch-prefetch,lod,lod-hqs\n"
+      "  pointrast bench --suite lod --octree-cache /scratch/octrees\n"
+      "  pointrast bench --suite lod --scale 0.001 --frames 2 --flight-frames 60 --jumps 2 --out /tmp/smoke\n"
       "  pointrast bench --suite spheres2023\n"
       "  pointrast bench --suite spheres2023 --scale 0.0001 --cameras 2 --frames 1 --out /tmp/smoke\n"
       "  pointrast bench --suite spheres2023 --methods sphere-compute,sphere-points --orbits long");
   cmd->add_option("INPUT", a->inputs,
                   "Point cloud files (" + io::formatList(io::FormatUse::Cloud) +
                       ") or scene names (terrain, tls); with --suite, NAME=PATH");
-  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022 or spheres2023");
+  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022, lod or spheres2023");
+  cmd->add_option("--datasets", a->datasets,
+                  "With --suite: its data sets to measure, comma-separated, or all")
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->datasetsGiven = true; });
+  cmd->add_option("--octree-cache", a->octreeCache,
+                  "Folder of the octrees the LOD methods draw, built there when missing (default: "
+                  "~/.cache/pointrast/octrees)");
+  auto streamOption = [a](const std::string&) { a->streamOptionsGiven = true; };
+  cmd->add_option("--flight-frames", a->flightFrames, "lod: frames of the streaming run's flight")
+      ->capture_default_str()
+      ->each(streamOption);
+  cmd->add_option("--jumps", a->jumps, "lod: jumps between far-apart views after the flight")
+      ->capture_default_str()
+      ->each(streamOption);
   cmd->add_option("--scale", a->scale, "Multiply every size of the suite (e.g. 0.001 for a smoke run)")
       ->each([a](const std::string&) { a->scaleGiven = true; });
   cmd->add_option("--methods", a->methods, "Methods, comma-separated, or all (see `pointrast render --help`)")

@@ -5,6 +5,7 @@
 # combination starts; the process is killed 90 s later if it still runs), SUITE_FRAMES,
 # SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS;
 # BIG4G_METHOD (default batch).
+# OCTREE_CACHE: the octree cache of lodsuite and lod2022 (default /tmp/octrees: on the machine's disk).
 #   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -63,6 +64,24 @@ for what in "$@"; do
     echo "== autzen_trim.las"
     $pr render .gpu/data/las/autzen_trim.las -o "$OUT/autzen.png" --json --frames 50 | tee "$OUT/autzen.json" || status=1
     ;;
+  lazio)
+    # LAZ decoding on 1 and all cores: autzen_trim.laz (point format 3) and lone-star.copc.laz (point format 7),
+    # each replicated from its own chunks to IO_POINTS points.
+    echo "== LAZ decoding (bench-io), ${IO_POINTS:-50M} points per file"
+    $pr bench-io .gpu/data/laz/autzen_trim.laz .gpu/data/laz/lone-star.copc.laz --points "${IO_POINTS:-50M}" \
+      --threads "1,$(nproc)" --repeats 5 --out "$OUT" --name laz-decode --quiet || status=1
+    ;;
+  post)
+    # GPU time of each pass of the resolve stage at 1920x1080 and one VR eye (2478x2740).
+    scripts/time-post.sh "$pr" "$OUT/post-passes.jsonl" 20M 50 || status=1
+    ;;
+  viewpath)
+    # The 5 s orbit at 60 fps (300 frames) over a 1 G-point cloud into MP4 (PNG frames where no ffmpeg).
+    echo "== render --path, 1 G points, 300 frames at 1920x1080"
+    if command -v ffmpeg >/dev/null || [ -n "${POINTRAST_FFMPEG:-}" ]; then dst=(--video /tmp/orbit-1g.mp4); else dst=(--frames-dir /tmp/orbit-1g); fi
+    POINTRAST_VALIDATION=0 $pr render terrain --points 1G --order morton --method batch-prefetch --path orbit \
+      --fps 60 --width 1920 --height 1080 "${dst[@]}" --json | tee "$OUT/view-path-1g.json" || status=1
+    ;;
   big)
     # 1.2 billion generated points (float32 xyz alone: 14.4 GB) drawn as one upload and as 12 separately
     # uploaded scenes of 100 M points; the two images must be identical.
@@ -86,9 +105,11 @@ for what in "$@"; do
       --budget "${SUITE_BUDGET:-2}" ${SUITE_METHODS:+--methods "$SUITE_METHODS"} --out "$OUT" --name paper2021 --json > "$OUT/paper2021.jsonl" || status=1
     ;;
   paper2022)
-    # The 2022 evaluation: 69 M .. 1,000 M stand-ins at 2560x1140, batch methods vs hw-points, dedup, hqs.
+    # The 2022 evaluation: 69 M .. 1,000 M stand-ins at 2560x1140, batch methods vs hw-points, dedup, hqs, and
+    # lod, lod-hqs on the stand-ins' octrees (built into OCTREE_CACHE when missing: ~34 GB, ~2 min, once).
     POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite paper2022 --frames "${SUITE_FRAMES:-15}" \
-      --budget "${SUITE_BUDGET:-2}" ${SUITE_METHODS:+--methods "$SUITE_METHODS"} --out "$OUT" --name paper2022 --json > "$OUT/paper2022.jsonl" || status=1
+      --budget "${SUITE_BUDGET:-2}" ${SUITE_METHODS:+--methods "$SUITE_METHODS"} --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" \
+      --out "$OUT" --name paper2022 --json > "$OUT/paper2022.jsonl" || status=1
     ;;
   spheres2023)
     # The 2023 sphere study: every sphere pipeline x layout x billboard x conservative on four particle
@@ -112,8 +133,27 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 $pr render terrain --points 4G --method "${BIG4G_METHOD:-batch}" --width 2560 \
       --height 1140 -o "$OUT/big4g.png" --json --frames 20 | tee "$OUT/big4g.json" || status=1
     ;;
+  lodsuite)
+    # The lod suite on the 1,000 M stand-in's octree: sweeps of point budget and --min-node-px, then streaming
+    # with 1/8 of the octree in GPU memory (a flight and jumps). The octree is built into OCTREE_CACHE on the
+    # machine's disk (about 18 GB; generation + build about 1-2 min on 16 cores) unless a run before built it;
+    # lod2022 reuses it. df says which filesystem it is on (the page cache drop needs a real disk).
+    mkdir -p "${OCTREE_CACHE:-/tmp/octrees}" && df -hT "${OCTREE_CACHE:-/tmp/octrees}"
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite lod \
+      --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" ${SUITE_FRAMES:+--frames "$SUITE_FRAMES"} ${SUITE_ARGS:-} --out "$OUT" --name lod \
+      --json > "$OUT/lod.jsonl" || status=1
+    ls -l "${OCTREE_CACHE:-/tmp/octrees}"
+    ;;
+  lod2022)
+    # paper2022's LOD columns on the 1,000 M stand-in only: batch-prefetch against lod and lod-hqs at
+    # 2560x1140, the octree from OCTREE_CACHE (built there first when lodsuite did not run before).
+    mkdir -p "${OCTREE_CACHE:-/tmp/octrees}" && df -hT "${OCTREE_CACHE:-/tmp/octrees}"
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench --time-limit "${SUITE_LIMIT:-470}" --suite paper2022 \
+      --datasets aerial1g --methods batch-prefetch,lod,lod-hqs --frames "${SUITE_FRAMES:-15}" --budget "${SUITE_BUDGET:-2}" \
+      --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" --out "$OUT" --name lod2022 --json > "$OUT/lod2022.jsonl" || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

@@ -34,4 +34,34 @@ void storeRecords(PointCloud& cloud, uint64_t first, const PointRecord* records,
   }
 }
 
+RecordFields recordFieldsOf(const PointCloud& cloud) {
+  RecordFields f;
+  f.color = cloud.hasColor();
+  f.colorMax = f.color ? 255 : 0;
+  f.intensity = !cloud.intensity.empty();
+  f.classification = !cloud.classification.empty();
+  f.returnNumber = !cloud.returnNumber.empty();
+  f.pointSourceId = !cloud.pointSourceId.empty();
+  return f;
+}
+
+void loadRecords(const PointCloud& cloud, uint64_t first, size_t count, PointRecord* out) {
+  const RecordFields f = recordFieldsOf(cloud);
+  for (size_t i = 0; i < count; ++i) {
+    const uint64_t k = first + i;
+    PointRecord r;
+    r.x = cloud.positions[3 * k];
+    r.y = cloud.positions[3 * k + 1];
+    r.z = cloud.positions[3 * k + 2];
+    if (f.color)
+      for (int c = 0; c < 3; ++c)
+        r.rgb[c] = uint16_t((cloud.colors[k] >> (8 * c)) & 0xFF);
+    if (f.intensity) r.intensity = cloud.intensity[k];
+    if (f.classification) r.classification = cloud.classification[k];
+    if (f.returnNumber) r.returnNumber = cloud.returnNumber[k];
+    if (f.pointSourceId) r.pointSourceId = cloud.pointSourceId[k];
+    out[i] = r;
+  }
+}
+
 } // namespace pointrast

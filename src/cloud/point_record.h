@@ -57,4 +57,10 @@ void appendRecords(PointCloud& cloud, const PointRecord* records, size_t count, 
 void storeRecords(PointCloud& cloud, uint64_t first, const PointRecord* records, size_t count,
                   const RecordFields& fields, int colorShift);
 
+// The record fields a cloud carries (its colors are 8-bit: colorMax 255 when it has any).
+RecordFields recordFieldsOf(const PointCloud& cloud);
+// The inverse of storeRecords with colorShift 0: points [first, first + count) of a cloud as records, in
+// the cloud's scale/offset, for building an octree from points in memory. Fields the cloud lacks are 0.
+void loadRecords(const PointCloud& cloud, uint64_t first, size_t count, PointRecord* out);
+
 } // namespace pointrast
