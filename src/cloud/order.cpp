@@ -250,7 +250,9 @@ struct MortonKey {
     uint32_t c[3];
     for (int a = 0; a < 3; ++a) {
       double cell = double(p[a] - ref[a]) * mul[a];
-      c[a] = static_cast<uint32_t>(std::min(cell, double((1 << 21) - 1))); // the far face maps to 2^21
+      // The far face maps to 2^21 - 1. NaN (0 x infinity: an axis of zero extent whose scale is huge
+      // next to the cube) to 0, as no integer holds it.
+      c[a] = cell > 0 ? static_cast<uint32_t>(std::min(cell, double((1 << 21) - 1))) : 0;
     }
     return spreadBits3(c[0]) | spreadBits3(c[1]) << 1 | spreadBits3(c[2]) << 2; // = mortonCode()
   }
