@@ -44,7 +44,6 @@ std::optional<uint64_t> statedPointCount(const std::filesystem::path& path) {
   if (format.openPoints) return format.openPoints(path)->info().pointCount;
   if (format.read == readPly) return statedCountPly(path);
   return std::nullopt; // text, or a format whose count only reading tells
-
 }
 
 } // namespace pointrast::io
