@@ -136,8 +136,7 @@ std::vector<bench::Dataset> inputDatasets(const BenchArgs& a) {
     bench::Dataset d;
     d.source = input;
     d.seed = a.seed;
-    std::error_code ec;
-    if (std::filesystem::exists(input, ec)) {
+    if (pathExists(input)) {
       d.file = true;
       d.name = std::filesystem::path(input).stem().string();
       d.label = std::filesystem::path(input).filename().string();

@@ -81,7 +81,7 @@ Command addConvert(CLI::App& app) {
     if (a->lasVersion != "auto" && a->lasVersion != "1.2" && a->lasVersion != "1.4")
       throw InputError("--las expects auto, 1.2 or 1.4");
     lasFlavorFor(a->output, 0);
-    if (!std::filesystem::exists(a->input)) throw InputError(a->input + ": no such file or folder");
+    if (!pathExists(a->input)) throw InputError(a->input + ": no such file or folder");
     const io::FormatInfo* format = io::detectFormat(a->input);
     if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
     InputSpec spec;

@@ -9,8 +9,10 @@
 
 #include "base/error.h"
 #include "cli_util.h"
+#include "base/text.h"
 #include "commands.h"
 #include "gpu/context.h"
+#include "input.h"
 #include "io/format_table.h"
 #include "io/particles_io.h"
 #include "io/reader.h"
@@ -102,7 +104,7 @@ int mmpldInfo(const InfoArgs& a, const io::FormatInfo& format) {
     std::printf("%s\n", jsonText(j).c_str());
     return 0;
   }
-  std::printf("file:    %s\n", a.input.c_str());
+  std::printf("file:    %s\n", printableLine(a.input).c_str()); // one line whatever the name
   std::printf("format:  MMPLD %s (%u), %u frame%s\n", version.c_str(), info.version, info.frames,
               info.frames == 1 ? "" : "s");
   std::printf("frame:   %u, %zu list%s", info.frame, info.lists.size(), info.lists.size() == 1 ? "" : "s");
@@ -152,7 +154,7 @@ int mmpldInfo(const InfoArgs& a, const io::FormatInfo& format) {
 int runInfo(const InfoArgs& a) {
   if (a.devices) return listDevicesCommand(a.json);
   if (a.input.empty()) throw InputError("info needs a FILE (or --devices)");
-  if (!std::filesystem::exists(a.input)) throw InputError(a.input + ": no such file or folder");
+  if (!pathExists(a.input)) throw InputError(a.input + ": no such file or folder");
   const io::FormatInfo* format = io::detectFormat(a.input);
   if (format && format->content == io::FormatContent::Particles) return mmpldInfo(a, *format);
   io::FileInfo info = io::probeFile(a.input);
@@ -178,7 +180,7 @@ int runInfo(const InfoArgs& a) {
     std::printf("%s\n", jsonText(j).c_str());
     return 0;
   }
-  std::printf("file:    %s\n", a.input.c_str());
+  std::printf("file:    %s\n", printableLine(a.input).c_str()); // one line whatever the name
   std::printf("format:  %s\n", info.formatDetail.c_str());
   std::printf("points:  %llu\n", static_cast<unsigned long long>(info.pointCount));
   if (!info.bounds.empty()) {

@@ -405,13 +405,18 @@ int runRenderSpheres(const RenderArgs& a) {
   spec.particles = parseCount(a.points, "--points");
   spec.seed = a.seed;
   spec.progress = !a.quiet;
-  const ParticleSet set = loadParticles(spec);
+  // Header counts first (a bad file is refused before the device starts), then the device's memory: a
+  // file too large for it is refused before its particles are read.
+  const std::optional<uint64_t> stated = statedParticles(spec);
+  gpu::Context context(contextOptions(a));
   std::string why;
+  if (stated && !particlesFit(context, upload.layout, *stated, &why))
+    throw UnsupportedError((a.input.empty() ? kDemoParticleScene : a.input) + ": " + why);
+  if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the read
+  ParticleSet set = loadParticles(spec);
   if (upload.layout && !layoutHolds(*upload.layout, set, &why)) throw InputError(why);
   const Camera camera = renderCamera(a, sphereBounds(set), set.source);
 
-  gpu::Context context(contextOptions(a));
-  if (!SphereRenderer::supports(context, settings, &why)) throw UnsupportedError(why); // before the upload
   SphereRenderer renderer(context, a.width, a.height);
   GpuParticles particles(context, set, upload);
   const SphereStats stats = renderer.render(particles, camera, settings);
@@ -659,10 +664,15 @@ int runRender(const RenderArgs& a) {
   spec.order = parseOrder(a.order);
   spec.progress = !a.quiet;
 
+  // The header's count before the device starts, the device's memory before the read.
+  const std::optional<uint64_t> stated = statedPoints(spec);
+  gpu::Context context(contextOptions(a));
+  std::string why;
+  if (stated && !sceneFits(context, settings.method.info().layout, *stated, &why))
+    throw UnsupportedError((a.input.empty() ? kDemoScene : a.input) + ": " + why);
   const PointCloud cloud = loadInput(spec);
   const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
   const Camera camera = renderCamera(a, cloud.bounds, cloud.source);
-  gpu::Context context(contextOptions(a));
   Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
   const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
   std::vector<const GpuScene*> drawn;

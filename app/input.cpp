@@ -12,11 +12,17 @@
 
 namespace pointrast::app {
 
+bool pathExists(const std::string& path) {
+  std::error_code ec;
+  const bool found = std::filesystem::exists(path, ec);
+  if (ec) throw InputError(path + ": cannot open: " + ec.message());
+  return found;
+}
+
 PointCloud loadInput(const InputSpec& spec) {
   PointCloud cloud;
   std::string source = spec.source.empty() ? kDemoScene : spec.source;
-  std::error_code ec;
-  if (std::filesystem::exists(source, ec)) {
+  if (pathExists(source)) {
     io::ReadOptions options;
     options.progress = spec.progress;
     cloud = io::readCloud(source, options);
@@ -33,6 +39,13 @@ PointCloud loadInput(const InputSpec& spec) {
   return cloud;
 }
 
+std::optional<uint64_t> statedPoints(const InputSpec& spec) {
+  const std::string source = spec.source.empty() ? kDemoScene : spec.source;
+  if (pathExists(source)) return io::statedPointCount(source);
+  if (isSceneName(source)) return spec.source.empty() ? kDemoPoints : spec.points;
+  return std::nullopt;
+}
+
 ParticleSet loadParticles(const ParticleInputSpec& spec) {
   if (!(spec.radius >= 0) || !std::isfinite(spec.radius))
     throw InputError("--radius expects a positive number, got " + std::to_string(spec.radius));
@@ -43,8 +56,7 @@ ParticleSet loadParticles(const ParticleInputSpec& spec) {
       throw InputError(source + ": points drawn as spheres need a radius (--radius R, in the cloud's units)");
     return particlesFromCloud(cloud, spec.radius);
   };
-  std::error_code ec;
-  if (std::filesystem::exists(source, ec)) {
+  if (pathExists(source)) {
     const io::FormatInfo* format = io::detectFormat(source);
     if (!format || format->content != io::FormatContent::Particles) {
       io::ReadOptions options;
@@ -79,6 +91,19 @@ ParticleSet loadParticles(const ParticleInputSpec& spec) {
   }
   throw InputError(source + ": no such file, and not a scene name (particle scenes: " + kParticleSceneNames +
                    "; point scenes, with --radius: terrain, tls)");
+}
+
+std::optional<uint64_t> statedParticles(const ParticleInputSpec& spec) {
+  const std::string source = spec.source.empty() ? kDemoParticleScene : spec.source;
+  if (pathExists(source)) {
+    const io::FormatInfo* format = io::detectFormat(source);
+    if (format && format->content == io::FormatContent::Particles)
+      return io::probeMmpld(source, spec.frame).particles();
+    return io::statedPointCount(source);
+  }
+  if (isParticleSceneName(source)) return spec.source.empty() ? kDemoPoints : spec.particles;
+  if (isSceneName(source)) return spec.particles;
+  return std::nullopt;
 }
 
 } // namespace pointrast::app

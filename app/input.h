@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "cloud/cloud.h"
@@ -23,9 +24,18 @@ struct InputSpec {
 constexpr const char* kDemoScene = "terrain";
 constexpr uint64_t kDemoPoints = 1'000'000;
 
+// Whether something exists at `path`: false when nothing does (the name may be a scene's), InputError
+// naming the path when the question has no answer (a symbolic link loop, a name too long, a folder that
+// may not be searched).
+bool pathExists(const std::string& path);
+
 // Reads the file or generates the scene, then applies the order. Throws InputError for a source that is
 // neither an existing file nor a scene name.
 PointCloud loadInput(const InputSpec& spec);
+// The points loadInput will return, known without reading them: a file's header count, a scene's size;
+// nullopt where only reading tells (XYZ text) or loadInput will refuse the source. Throws InputError for
+// an unreadable file, as loadInput would.
+std::optional<uint64_t> statedPoints(const InputSpec& spec);
 
 struct ParticleInputSpec {
   // An MMPLD file; a point cloud file or a point scene name (terrain, tls), drawn as spheres of `radius`;
@@ -47,5 +57,7 @@ constexpr const char* kDemoParticleScene = "particles-block";
 // Reads or generates the particles (for the sphere renderers). Throws InputError for a source that is
 // neither an existing file nor a scene name, a point input without a radius, or a negative radius.
 ParticleSet loadParticles(const ParticleInputSpec& spec);
+// The particles loadParticles will return, as statedPoints() does for points (MMPLD: the frame's lists).
+std::optional<uint64_t> statedParticles(const ParticleInputSpec& spec);
 
 } // namespace pointrast::app

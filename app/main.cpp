@@ -1,7 +1,10 @@
 // pointrast: render huge point clouds by software rasterization in compute shaders.
 // Thin on purpose: parsing and wiring only; the work lives in src/.
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <new>
 #include <string>
 
@@ -9,10 +12,31 @@
 
 #include "base/build_info.h"
 #include "base/error.h"
+#include "base/text.h"
 #include "commands.h"
 #include "gpu/vulkan_api.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+// The one error line: control characters escaped, so a file name holding a newline cannot split it.
+void printError(const std::string& message) {
+  std::fprintf(stderr, "pointrast: %s\n", pointrast::printableLine(message).c_str());
+}
+
+// What a command printed must have reached stdout (a full disk, /dev/full, a failing device): a lost
+// write is an error like any other, exit 1 with one line, unless the command already failed and said so.
+int checkStdout(int status) {
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  const int error = errno;
+  if (flushed && !std::ferror(stdout)) return status;
+  if (status == 0)
+    printError(std::string("cannot write to standard output") +
+               (error ? ": " + std::string(std::strerror(error)) : ""));
+  return 1;
+}
+
+int runCommand(int argc, char** argv) {
   using namespace pointrast;
   CLI::App app{"pointrast: renders billions of points and particles by software rasterization in compute "
                "shaders (Vulkan 1.3; any GPU, or the CPU through lavapipe).\n\n"
@@ -48,7 +72,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string which = app.get_subcommands().empty() ? "" : " " + app.get_subcommands().front()->get_name();
-    std::fprintf(stderr, "pointrast: %s (see `pointrast%s --help`)\n", e.what(), which.c_str());
+    printError(std::string(e.what()) + " (see `pointrast" + which + " --help`)");
     return 1;
   }
 
@@ -66,17 +90,26 @@ int main(int argc, char** argv) {
     }
     return 1;
   } catch (const InputError& e) {
-    std::fprintf(stderr, "pointrast: %s\n", e.what());
+    printError(e.what());
   } catch (const UnsupportedError& e) {
-    std::fprintf(stderr, "pointrast: %s\n", e.what());
+    printError(e.what());
   } catch (const DeviceFault& e) {
-    std::fprintf(stderr, "pointrast: %s\n", e.what());
+    printError(e.what());
   } catch (const gpu::VulkanError& e) {
-    std::fprintf(stderr, "pointrast: %s\n", e.what());
+    printError(e.what());
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "pointrast: out of host memory\n");
+    printError("out of host memory");
+  } catch (const std::filesystem::filesystem_error& e) {
+    // The library's text ("filesystem error: status: ... [path]") as our line: the path, then the reason.
+    printError((e.path1().empty() ? "" : e.path1().string() + ": ") + e.code().message());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pointrast: %s\n", e.what());
+    printError(e.what());
   }
   return 1;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return checkStdout(runCommand(argc, argv));
 }

@@ -21,9 +21,12 @@ namespace pointrast::bench {
 namespace {
 
 // Points a data set will have, known before it is loaded: generated scenes have exactly the count
-// asked for; files state theirs in the header (counted for XYZ).
+// asked for; files state theirs in the header (counted for XYZ). Not probeFile() where the header
+// suffices: it reads every LAS color to tell the color depth.
 uint64_t expectedPoints(const Dataset& d) {
-  return d.file ? io::probeFile(d.source).pointCount : d.points;
+  if (!d.file) return d.points;
+  std::optional<uint64_t> stated = io::statedPointCount(d.source);
+  return stated ? *stated : io::probeFile(d.source).pointCount;
 }
 
 const std::vector<Order>& ordersOf(const Dataset& d, const BenchConfig& c) {

@@ -14,6 +14,7 @@ packages=(
   # the browser viewer (civetweb is loaded at run time, TurboJPEG linked statically) and its tests in a
   # headless chromium
   libcivetweb-dev libturbojpeg0-dev chromium
+  clang libclang-rt-dev llvm # libFuzzer targets (scripts/fuzz.sh): the fuzzer runtime and llvm-symbolizer
 )
 
 missing=()

@@ -3,7 +3,9 @@
 # with the Khronos validation layer on, then the parser and data-preparation tests again under
 # AddressSanitizer + UBSan (truncation sweeps must never read out of bounds), and last the sphere tests
 # on a newer lavapipe (Mesa 25, Debian 12 backports, unpacked privately) that has mesh shaders and ray
-# tracing, which the system's Mesa 22.3 lacks: there those pipelines are only skipped.
+# tracing, which the system's Mesa 22.3 lacks: there those pipelines are only skipped. Then the libFuzzer
+# targets (tests/fuzz), built with clang in build-fuzz, run for $POINTRAST_FUZZ_SECONDS (180) seconds of
+# wall time in all, shared between them, as many at once as there are cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -32,3 +34,6 @@ echo "== sphere pipelines on Mesa 25 lavapipe (mesh shaders, ray tracing)"
   eval "$(scripts/lavapipe-mesh-rt.sh "$PWD/build-test/lavapipe25")"
   POINTRAST_VALIDATION=1 build-test/tests/gpu_tests --gtest_brief=1 --gtest_filter='*Sphere*'
 )
+
+echo "== parsers under libFuzzer (clang, ASan, UBSan), ${POINTRAST_FUZZ_SECONDS:-180} s in all"
+scripts/fuzz.sh --total "${POINTRAST_FUZZ_SECONDS:-180}"

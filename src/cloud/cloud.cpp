@@ -151,8 +151,12 @@ template <class Value> Range robustRange(uint64_t n, double min, double max, Val
   constexpr int kBins = 4096;
   std::vector<uint64_t> hist(kBins, 0);
   const double toBin = kBins / (max - min);
-  for (uint64_t k = 0; k < n; ++k)
-    ++hist[std::clamp(static_cast<int>((value(k) - min) * toBin), 0, kBins - 1)];
+  for (uint64_t k = 0; k < n; ++k) {
+    // Clamped in double first: a span at the limits of double makes toBin infinite or zero, and the
+    // product NaN or infinite, which no int holds. NaN falls into bin 0.
+    const double bin = (value(k) - min) * toBin;
+    ++hist[bin > 0 ? static_cast<int>(std::min(bin, double(kBins - 1))) : 0];
+  }
   const uint64_t cut = n / 200; // 0.5%
   int loBin = 0, hiBin = kBins - 1;
   for (uint64_t acc = 0; loBin < kBins - 1 && acc + hist[loBin] <= cut; ++loBin)

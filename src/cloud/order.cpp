@@ -240,7 +240,9 @@ struct MortonKey {
     const double cellsPerUnit = cube > 0 ? double(1 << 21) / cube : 0.0;
     for (int a = 0; a < 3; ++a) {
       ref[a] = s[a] >= 0 ? box.min[a] : box.max[a];
-      mul[a] = s[a] * cellsPerUnit; // with a negative scale, (q - max) * negative >= 0
+      // With a negative scale, (q - max) * negative >= 0. A subnormal cube (a file's subnormal scale)
+      // makes cellsPerUnit infinite and (q - ref) * mul NaN at the corner: then divide by the cube first.
+      mul[a] = std::isfinite(cellsPerUnit) ? s[a] * cellsPerUnit : s[a] / cube * double(1 << 21);
     }
   }
   uint64_t operator()(uint64_t i) const {
@@ -248,7 +250,9 @@ struct MortonKey {
     uint32_t c[3];
     for (int a = 0; a < 3; ++a) {
       double cell = double(p[a] - ref[a]) * mul[a];
-      c[a] = static_cast<uint32_t>(std::min(cell, double((1 << 21) - 1))); // the far face maps to 2^21
+      // The far face maps to 2^21 - 1. NaN (0 x infinity: an axis of zero extent whose scale is huge
+      // next to the cube) to 0, as no integer holds it.
+      c[a] = cell > 0 ? static_cast<uint32_t>(std::min(cell, double((1 << 21) - 1))) : 0;
     }
     return spreadBits3(c[0]) | spreadBits3(c[1]) << 1 | spreadBits3(c[2]) << 2; // = mortonCode()
   }

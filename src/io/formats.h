@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "io/reader.h"
@@ -16,6 +17,9 @@ FileInfo probePotreeFolder(const std::filesystem::path& path);
 
 // "not a LAS, LAZ, ... file (unrecognised content and extension)", naming every row.
 std::string unrecognisedFormatText();
+
+// The vertex count of a PLY header where the file's size can hold it (statedPointCount()).
+std::optional<uint64_t> statedCountPly(const std::filesystem::path& path);
 
 // Bytes of MMPLD particle data the reader reads and decodes at a time (default 32 MiB). Tests lower it to
 // cross chunk boundaries with small files; 0 restores the default.

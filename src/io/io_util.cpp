@@ -7,6 +7,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/text.h"
+
 namespace pointrast::io::detail {
 
 std::string strFormat(const char* fmt, ...) {
@@ -27,7 +29,8 @@ void fail(const std::filesystem::path& path, const std::string& message) {
 }
 
 void warn(const std::filesystem::path& path, const std::string& message) {
-  std::fprintf(stderr, "%s: warning: %s\n", path.string().c_str(), message.c_str());
+  std::fprintf(stderr, "%s: warning: %s\n", printableLine(path.string()).c_str(),
+               printableLine(message).c_str());
 }
 
 std::string lowerExtension(const std::filesystem::path& path) {
@@ -39,14 +42,34 @@ std::string lowerExtension(const std::filesystem::path& path) {
 
 // ---- InputFile -------------------------------------------------------------------------------------
 
+namespace {
+
+// What a path is when it is not a regular file, for the refusal.
+const char* fileTypeName(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a named pipe (FIFO)";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  return "a special file";
+}
+
+} // namespace
+
 InputFile::InputFile(const std::filesystem::path& path) : path_(path) {
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: a blocking open of a FIFO waits for a writer, forever. The type is then checked on the
+  // open descriptor, so nothing can swap the file between the check and the reads; for a regular file
+  // the flag changes nothing. O_NOCTTY: a terminal given as input must not become our controlling one.
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
   if (fd_ < 0) fail(path, strFormat("cannot open: %s", std::strerror(errno)));
   struct stat st {};
-  if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+  const bool statted = ::fstat(fd_, &st) == 0;
+  const int error = errno;
+  if (!statted || !S_ISREG(st.st_mode)) {
     ::close(fd_);
     fd_ = -1;
-    fail(path, "not a regular file");
+    if (!statted) fail(path, strFormat("cannot open: %s", std::strerror(error)));
+    fail(path, strFormat("is %s, not a regular file", fileTypeName(st.st_mode)));
   }
   size_ = static_cast<uint64_t>(st.st_size);
 }

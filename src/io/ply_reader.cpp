@@ -672,6 +672,20 @@ PointCloud readPly(const std::filesystem::path& path, const ReadOptions& options
 
 namespace detail {
 
+std::optional<uint64_t> statedCountPly(const std::filesystem::path& path) {
+  InputFile file(path);
+  const PlyHeader h = readPlyHeader(file);
+  // Only a count the data could hold is stated: a vertex takes at least one byte per binary list count
+  // and the bytes of each scalar, or in ASCII a character and a separator per property. A larger count is
+  // a lie the reader names when it meets the end of the file.
+  const PlyElement& vertex = h.vertexElement();
+  uint64_t minBytes = 0;
+  for (const PlyProperty& p : vertex.properties)
+    minBytes += h.encoding == PlyEncoding::Ascii ? 2 : typeSize(p.isList ? p.countType : p.type);
+  if (minBytes == 0 || vertex.count > (file.size() - h.dataOffset) / minBytes) return std::nullopt;
+  return vertex.count;
+}
+
 FileInfo probePly(const std::filesystem::path& path) {
   InputFile file(path);
   const PlyHeader h = readPlyHeader(file);

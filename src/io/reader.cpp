@@ -4,6 +4,7 @@
 #include "io/format_table.h"
 #include "io/formats.h"
 #include "io/io_util.h"
+#include "io/point_source.h"
 
 namespace pointrast::io {
 
@@ -35,6 +36,14 @@ FileInfo probeFile(const std::filesystem::path& path) {
   FileInfo info = format.probe(path);
   info.format = &format;
   return info;
+}
+
+std::optional<uint64_t> statedPointCount(const std::filesystem::path& path) {
+  const FormatInfo& format = cloudFormat(path);
+  // A streaming source opens from the header (LAS, LAZ, COPC: counts checked against the file there).
+  if (format.openPoints) return format.openPoints(path)->info().pointCount;
+  if (format.read == readPly) return statedCountPly(path);
+  return std::nullopt; // text, or a format whose count only reading tells
 }
 
 } // namespace pointrast::io

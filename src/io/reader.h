@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,11 @@ struct ReadOptions {
 // io/format_table.h. Throws InputError, for a format that cannot be read as a cloud too.
 PointCloud readCloud(const std::filesystem::path& path, const ReadOptions& options = {});
 FileInfo probeFile(const std::filesystem::path& path);
+// The point count the file's header states, read without touching the points (probeFile() may read them
+// all: LAS color depth, PLY bounds), so that a caller can refuse a file it has no room for before reading
+// it. LAS, LAZ, COPC: the header's count; PLY: the vertex count. nullopt where only reading tells (XYZ
+// text, a PLY count larger than the file holds, an octree folder). Throws InputError as probeFile() does.
+std::optional<uint64_t> statedPointCount(const std::filesystem::path& path);
 
 // Per format (the rows of io/format_table.h name these).
 PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options = {});

@@ -233,9 +233,11 @@ PointCloud readXyz(const std::filesystem::path& path, const ReadOptions& options
   if (d.intensityColumn >= 0 && options.keepAttributes) {
     cloud.intensity.resize(n);
     const double shift = d.negativeIntensity ? 2048.0 : 0.0;
-    for (uint64_t i = 0; i < n; ++i)
-      cloud.intensity[i] =
-          static_cast<uint16_t>(std::clamp(std::nearbyint(d.intensity[i] + shift), 0.0, 65535.0));
+    for (uint64_t i = 0; i < n; ++i) {
+      // NaN (which std::clamp passes through and no integer holds) and values below 0 read as 0.
+      const double value = std::nearbyint(d.intensity[i] + shift);
+      cloud.intensity[i] = value > 0 ? static_cast<uint16_t>(std::min(value, 65535.0)) : 0;
+    }
   }
   return cloud;
 }

@@ -59,6 +59,18 @@ uint64_t sceneBytes(SceneLayout layout, uint64_t points) {
   return bytes;
 }
 
+bool sceneFits(const gpu::Context& context, SceneLayout layout, uint64_t points, std::string* why) {
+  const uint64_t have = context.deviceLocalBytes();
+  // The first test keeps a hostile count from wrapping sceneBytes() around to a size that fits.
+  if (points <= have / 16 && sceneBytes(layout, points) <= have) return true;
+  if (why)
+    *why = std::to_string(points) + " points need " +
+           std::to_string(uint64_t(double(points) * 16 / 1048576)) + " MiB of GPU memory (the " +
+           sceneLayoutName(layout) + " layout, 16 B a point) but device '" + context.info().name + "' has " +
+           std::to_string(have >> 20) + " MiB";
+  return false;
+}
+
 GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadOptions& options)
     : layout_(options.layout), origin_(cloud.origin()), bounds_(cloud.bounds) {
   uint64_t first = std::min(options.first, cloud.size());
@@ -69,11 +81,8 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
   if (partPoints == 0)
     throw UnsupportedError("device buffers are too small to hold even one batch of points");
 
-  uint64_t needed = sceneBytes(layout_, count);
-  if (needed > context.deviceLocalBytes())
-    throw UnsupportedError("the cloud needs " + std::to_string(needed >> 20) +
-                           " MiB of GPU memory but device '" + context.info().name + "' has " +
-                           std::to_string(context.deviceLocalBytes() >> 20) + " MiB");
+  std::string why;
+  if (!sceneFits(context, layout_, count, &why)) throw UnsupportedError("the cloud does not fit: " + why);
 
   for (uint64_t at = 0; at < count; at += partPoints) {
     ScenePart part;

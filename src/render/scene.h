@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "cloud/cloud.h"
@@ -62,6 +63,10 @@ struct UploadOptions {
 uint64_t partCapacity(SceneLayout layout, uint64_t requested, uint64_t bufferLimit);
 // GPU bytes of `points` points in a layout (both 16 B a point; Batched adds 32 B a batch of bounds).
 uint64_t sceneBytes(SceneLayout layout, uint64_t points);
+// Whether `points` points in `layout` fit the device's memory; when not, *why says so in one sentence.
+// GpuScene refuses what this refuses; a caller that knows the count early (a file's header, a scene's
+// size) asks first, so that nothing is read or generated for a cloud the device cannot hold.
+bool sceneFits(const gpu::Context& context, SceneLayout layout, uint64_t points, std::string* why = nullptr);
 
 class GpuScene {
 public:

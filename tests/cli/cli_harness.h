@@ -35,10 +35,24 @@ inline std::string slurp(const std::filesystem::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-inline CliResult runPointrast(const std::string& args) {
+struct CliOptions {
+  // > 0: the command is stopped after this many seconds (exit code 124), so a hang fails its test
+  // instead of stalling the suite.
+  int timeoutSeconds = 0;
+  // Where stdout goes instead of being captured (e.g. /dev/full); out is then empty.
+  std::string stdoutPath;
+};
+
+inline CliResult runPointrast(const std::string& args, const CliOptions& options = {}) {
   auto out = cliTempDir() / "stdout.txt", err = cliTempDir() / "stderr.txt";
-  std::string command = "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
-                        pointrastBinary() + " " + args + " >" + out.string() + " 2>" + err.string();
+  std::filesystem::remove(out);
+  std::string prefix = options.timeoutSeconds > 0
+                           ? "timeout -k 5 " + std::to_string(options.timeoutSeconds) + " env "
+                           : std::string();
+  std::string command = prefix + "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
+                        pointrastBinary() + " " + args + " >" +
+                        (options.stdoutPath.empty() ? out.string() : options.stdoutPath) + " 2>" +
+                        err.string();
   int status = std::system(command.c_str());
   CliResult r;
   r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) > 128);

@@ -156,5 +156,24 @@ TEST(DisplayColorMode, FlatCloudDoesNotDivideByZero) {
   EXPECT_EQ(out[0], out[1]);
 }
 
+// Elevation spans at the limits of double (a subnormal scale; values of opposite sign near 1e308 whose
+// difference overflows) make the histogram's bins infinitely narrow or wide: the bin of each value must
+// still be found without converting NaN or infinity to an integer (undefined behaviour; the sanitized
+// test build aborts on it).
+TEST(DisplayColorMode, ExtremeElevationSpansStayDefined) {
+  for (double scale : {1e-310, 8e298}) {
+    SCOPED_TRACE(scale);
+    PointCloud cloud;
+    cloud.scale = glm::dvec3(1, 1, scale);
+    cloud.positions = {0, 0, -2000000000, 1, 1, 0, 2, 2, 2000000000};
+    computeBounds(cloud);
+    uint32_t out[3];
+    displayColors(out, cloud, 0, 3);
+    if (scale < 1) {
+      EXPECT_NE(out[0], out[2]); // the span itself is an ordinary number
+    }
+  }
+}
+
 } // namespace
 } // namespace pointrast

@@ -160,6 +160,19 @@ TEST(MortonOrderTest, CubicCellsForAFlatCloud) {
     ASSERT_LE(codes[order[i - 1]], codes[order[i]]);
 }
 
+// Scales a file's header may state: a subnormal one makes the cube subnormal and the cells per unit
+// infinite; a huge one on an axis of zero extent then makes that axis's cell 0 x infinity = NaN, which no
+// integer holds (undefined behaviour; the sanitized test build aborts on it). Cells at the limits of
+// double must still order the points along the axis that varies.
+TEST(MortonOrderTest, ScalesAtTheLimitsOfDouble) {
+  PointCloud cloud;
+  cloud.scale = glm::dvec3(1e-310, -6.7e97, 3.9e-313);
+  cloud.positions = {0, 0, 1281517824, 0, 0, 0, 0, 0, 640000000};
+  std::vector<uint64_t> order;
+  computeOrder(order, cloud, Order::Morton, 1);
+  EXPECT_EQ(order, (std::vector<uint64_t>{1, 2, 0}));
+}
+
 TEST(MortonOrderTest, IdenticalPointsKeepTheirOrder) {
   // Half the points on one spot (duplicates in a scan): the order must stay stable and complete.
   PointCloud cloud = dyadicCloud(200'000);

@@ -1,4 +1,5 @@
 // libFuzzer target for the Xyz reader: readXyz and its probe on arbitrary bytes.
+// Seeds: xyz
 #include "fuzz_input.h"
 #include "io/formats.h"
 

@@ -137,6 +137,17 @@ TEST(XyzReader, NonFiniteRowsAreDropped) {
   EXPECT_TRUE(listed);
 }
 
+// A NaN intensity has no integer value: converting it was undefined behaviour (UBSan float-cast-overflow;
+// tests/fuzz/regressions/xyz holds the fuzzer's input). NaN and -inf read as 0, +inf as the largest value.
+TEST(XyzReader, NonFiniteIntensitiesStayInRange) {
+  PointCloud cloud = readText("1 2 3 NaN\n4 5 6 inf\n7 8 9 -inf\n1 1 1 70000\n");
+  ASSERT_EQ(cloud.intensity.size(), 4u);
+  EXPECT_EQ(cloud.intensity[0], 0);
+  EXPECT_EQ(cloud.intensity[1], 65535);
+  EXPECT_EQ(cloud.intensity[2], 0);
+  EXPECT_EQ(cloud.intensity[3], 65535);
+}
+
 TEST(XyzReader, OnlyTextExtensionsAreTriedAsText) {
   iotest::TempDir dir;
   for (const char* name : {"a.xyz", "a.TXT", "a.csv", "a.pts"}) {

@@ -141,6 +141,26 @@ ParticleLayout compactLayout(const ParticleSet& set) {
   return ParticleLayout::Xyz;
 }
 
+bool particlesFit(const gpu::Context& context, std::optional<ParticleLayout> layout, uint64_t count,
+                  std::string* why) {
+  uint32_t perParticle = UINT32_MAX;
+  const char* name = "";
+  for (const ParticleLayoutInfo& info : particleLayoutTable())
+    if ((!layout || info.layout == *layout) && info.bytesPerParticle < perParticle) {
+      perParticle = info.bytesPerParticle;
+      name = info.name;
+    }
+  // Computed in double: a hostile count times the bytes per particle must not wrap around to "fits".
+  const double needed = double(count) * perParticle;
+  if (needed <= double(context.deviceLocalBytes())) return true;
+  if (why)
+    *why = std::to_string(count) + " particles need " + std::to_string(uint64_t(needed / 1048576.0)) +
+           " MiB of GPU memory (layout " + name + ", " + std::to_string(perParticle) +
+           " B a particle) but device '" + context.info().name + "' has " +
+           std::to_string(context.deviceLocalBytes() >> 20) + " MiB";
+  return false;
+}
+
 GpuParticles::GpuParticles(gpu::Context& context, const ParticleSet& set,
                            const ParticleUploadOptions& options)
     : count_(set.size()), origin_(set.origin), bounds_(sphereBounds(set)), globalRadius_(set.globalRadius),
@@ -156,11 +176,8 @@ GpuParticles::GpuParticles(gpu::Context& context, const ParticleSet& set,
                            std::to_string(kMaxParticles) + " particles, this set has " +
                            std::to_string(count_));
   const ParticleLayoutInfo& info = particleLayoutInfo(layout_);
-  uint64_t needed = count_ * info.bytesPerParticle;
-  if (needed > context.deviceLocalBytes())
-    throw UnsupportedError("the particles need " + std::to_string(needed >> 20) + " MiB of GPU memory as " +
-                           info.name + " but device '" + context.info().name + "' has " +
-                           std::to_string(context.deviceLocalBytes() >> 20) + " MiB");
+  if (!particlesFit(context, layout_, count_, &why))
+    throw UnsupportedError("the particles do not fit: " + why);
   uint64_t limit = std::min(context.maxAllocationSize(), context.maxBufferSize());
   partCapacity_ = options.maxPartParticles;
   if (partCapacity_ == 0)

@@ -49,6 +49,12 @@ bool layoutHolds(ParticleLayout layout, const ParticleSet& set, std::string* why
 // The most compact layout that holds the set exactly: xyz, else aos, else vec4x2.
 ParticleLayout compactLayout(const ParticleSet& set);
 
+// Whether `count` particles fit the device's memory in `layout` (nullopt: the most compact layout, the
+// least any set of that count needs); when not, *why says so in one sentence. GpuParticles refuses what
+// this refuses; a caller that knows the count early (a file's header) asks before reading anything.
+bool particlesFit(const gpu::Context& context, std::optional<ParticleLayout> layout, uint64_t count,
+                  std::string* why = nullptr);
+
 struct ParticlePart {
   gpu::Buffer data;   // the part's particles in the layout (one buffer, streams at fixed offsets)
   uint64_t first = 0; // index of the part's first particle in the set

@@ -1,0 +1,146 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (the list in tests/fuzz/CMakeLists.txt) in their own tree with clang, ASan
+# and UBSan, and runs each for a bounded time, JOBS of them at once. A target is seeded from the shared
+# test data (the folders its "// Seeds:" line names, else the folder NAME; a target that generates its
+# seeds reads the folder to write them to from NAME_FUZZ_SEEDS, e.g. POTREE_FUZZ_SEEDS) and from its
+# regression inputs (tests/fuzz/regressions/NAME/), with the dictionary tests/fuzz/NAME.dict where there
+# is one. Exits 1 if any target finds a crash, a leak, undefined behaviour, an input that takes over 10 s,
+# or an allocation over 256 MiB (an input is at most 64 KiB: a reader allocating that much trusts a count
+# it should have checked); the input that did it is kept under BUILD/findings/DATE-TIME/ and the command
+# that replays it is printed.
+#
+#   scripts/fuzz.sh [SECONDS] [NAME...]          SECONDS per target (default 25), NAME: las, ply...
+#   scripts/fuzz.sh --total SECONDS [NAME...]    the running of all targets takes about SECONDS of wall
+#                                                time: each gets SECONDS x JOBS / targets (at least 10)
+#   POINTRAST_FUZZ_JOBS     targets run at once (default: the number of cores); 1 for long runs on a
+#                           shared machine
+#   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
+#                           found, so a later run starts from there.
+#   POINTRAST_DATA_DIR      the shared test data (default ../shared/data beside the checkout)
+#   POINTRAST_FUZZ_FLAGS    more libFuzzer flags, e.g. "-use_value_profile=1" for long runs
+set -euo pipefail
+cd "$(dirname "$0")/.."
+total=""
+if [ "${1:-}" = "--total" ]; then
+  total="${2:?--total needs SECONDS}"
+  shift 2
+fi
+seconds=25
+if [ -z "$total" ] && [ $# -gt 0 ]; then
+  seconds="$1"
+  shift
+fi
+build="${POINTRAST_FUZZ_BUILD:-build-fuzz}"
+data="${POINTRAST_DATA_DIR:-$PWD/../shared/data}"
+jobs="${POINTRAST_FUZZ_JOBS:-$(nproc)}"
+
+names=("$@")
+if [ ${#names[@]} -eq 0 ]; then
+  # The targets CMake builds: the names of the foreach() line.
+  read -r -a names <<<"$(sed -n 's/^foreach(name \(.*\))[[:space:]]*$/\1/p' tests/fuzz/CMakeLists.txt)"
+fi
+[ ${#names[@]} -gt 0 ] || { echo "fuzz: no targets in tests/fuzz/CMakeLists.txt" >&2; exit 1; }
+if [ -n "$total" ]; then
+  seconds=$((total * jobs / ${#names[@]}))
+  if [ "$seconds" -lt 10 ]; then seconds=10; fi
+fi
+
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+# -O1 -g without -DNDEBUG: the asserts stay on (a file must never reach one), the stacks stay readable.
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DPOINTRAST_FUZZ=ON -DPOINTRAST_TESTS=OFF "${launcher[@]}" >/dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzz
+
+if [ -z "${ASAN_SYMBOLIZER_PATH:-}" ] && ! command -v llvm-symbolizer >/dev/null; then
+  for s in /usr/lib/llvm-*/bin/llvm-symbolizer; do
+    if [ -x "$s" ]; then export ASAN_SYMBOLIZER_PATH="$s"; fi
+  done
+fi
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
+
+findings="$build/findings/$(date +%Y%m%d-%H%M%S)"
+mkdir -p "$findings" "$build/logs"
+
+# Runs target $1; its outcome goes to $build/logs/NAME.result (the lines to print, "failed" first if it
+# found something).
+fuzzTarget() {
+  local name="$1"
+  local binary="$build/fuzz/${name}_fuzz"
+  local result="$build/logs/$name.result"
+  local seeds=() generator=() dict=()
+  # A target that writes its own seeds (valid inputs of a layout no data file has) reads NAME_FUZZ_SEEDS:
+  # it fills that folder when it starts, before the corpus is loaded.
+  local variable
+  variable="$(echo "$name" | tr '[:lower:]' '[:upper:]')_FUZZ_SEEDS"
+  if grep -q "$variable" "tests/fuzz/${name}_fuzz.cpp"; then
+    mkdir -p "$build/seeds/$name"
+    generator=(env "$variable=$build/seeds/$name")
+    seeds+=("$build/seeds/$name")
+  else
+    local folders folder
+    folders="$(sed -n 's|^// Seeds:[[:space:]]*||p' "tests/fuzz/${name}_fuzz.cpp" | head -n 1)"
+    for folder in ${folders:-$name}; do
+      if [ -d "$data/$folder" ]; then seeds+=("$data/$folder"); else echo "fuzz: $name: no seed folder $data/$folder"; fi
+    done
+  fi
+  if [ -d "tests/fuzz/regressions/$name" ]; then seeds+=("tests/fuzz/regressions/$name"); fi
+  if [ -f "tests/fuzz/$name.dict" ]; then dict=(-dict="tests/fuzz/$name.dict"); fi
+  local corpus="$build/corpus/$name"
+  local log="$build/logs/$name.log"
+  mkdir -p "$corpus"
+  echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
+  if "${generator[@]}" "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 \
+    -malloc_limit_mb=256 -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" \
+    ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" >"$log" 2>&1; then
+    {
+      echo "== $name"
+      # "#123456 DONE cov: 812 ft: 2931 corp: 401/1873Kb ..." and the executions from the final stats.
+      grep -E '^#[0-9]+[[:space:]]+DONE' "$log" | tail -n 1 || true
+      grep -E '^stat::(number_of_executed_units|average_exec_per_sec):' "$log" | tr '\n' ' ' || true
+      echo
+    } >"$result"
+  else
+    {
+      echo "failed"
+      echo "== $name: FINDING"
+      tail -n 80 "$log"
+      local input
+      for input in "$findings/$name-"*; do
+        [ -e "$input" ] && echo "fuzz: $name: finding kept in $input; replay: $binary $input"
+      done
+    } >"$result"
+  fi
+}
+
+for name in "${names[@]}"; do
+  [ -x "$build/fuzz/${name}_fuzz" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
+  rm -f "$build/logs/$name.result"
+done
+running=0
+for name in "${names[@]}"; do
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || true # a target's outcome is in its result file
+    running=$((running - 1))
+  fi
+  fuzzTarget "$name" &
+  running=$((running + 1))
+done
+wait || true
+
+failed=()
+for name in "${names[@]}"; do
+  result="$build/logs/$name.result"
+  if [ ! -f "$result" ] || [ "$(head -n 1 "$result")" = "failed" ]; then
+    failed+=("$name")
+    tail -n +2 "$result" 2>/dev/null || echo "fuzz: $name: no result (see $build/logs/$name.log)"
+  else
+    cat "$result"
+  fi
+done
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "fuzz: findings in ${failed[*]} (logs in $build/logs)" >&2
+  exit 1
+fi
+echo "fuzz: ${#names[@]} targets, no findings"
