@@ -457,7 +457,7 @@ int runVrSuite(const BenchArgs& a) {
   lines.end();
   checkRun(context, run.datasets);
   bench::WrittenFiles files = bench::writeVrSuiteReports(run, info, reportDir(a, context));
-  printWritten(a, run.results.size(), run.seconds, files);
+  printWritten(a, run, run.results.size(), files);
   return 0;
 }
 

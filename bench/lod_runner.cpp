@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "bench/suites.h"
 #include "io/format_table.h"
@@ -30,8 +31,7 @@ OpenOctree openOctree(gpu::Context& context, const BenchConfig& config, const Da
   OpenOctree o;
   try {
     if (!config.octrees) throw InputError("no octree: this run has no octree builder or cache");
-    DatasetOctree octree =
-        config.octrees(octreeKey(dataset), [&]() -> const PointCloud& { return cloud; });
+    DatasetOctree octree = config.octrees(octreeKey(dataset), [&]() -> const PointCloud& { return cloud; });
     o.source = io::openNodeSource(octree.path);
     o.scene = std::make_unique<lod::LodScene>(context, *o.source);
     run.octrees.emplace_back(dataset.name, std::move(octree));
@@ -119,6 +119,33 @@ void measureOctreeMethods(gpu::Context& context, Renderer& renderer, const Bench
       record(r);
     }
   }
+}
+
+DatasetSource openDatasetOctree(const Dataset& dataset, const OctreeProvider& octrees, bool progress,
+                                DatasetOutcome& outcome) {
+  outcome.dataset = dataset;
+  std::optional<PointCloud> cloud; // the build's input, released when this returns
+  auto points = [&]() -> const PointCloud& {
+    if (!cloud) cloud = loadDataset(dataset, progress);
+    return *cloud;
+  };
+  DatasetSource d;
+  try {
+    if (!octrees) throw InputError("no octree: this run has no octree builder or cache");
+    d.octree = octrees(octreeKey(dataset), points);
+    d.source = io::openNodeSource(d.octree.path);
+  } catch (const InputError& e) {
+    outcome.skipped = true;
+    outcome.reason = e.what();
+  } catch (const UnsupportedError& e) {
+    outcome.skipped = true;
+    outcome.reason = e.what();
+  }
+  if (d.source) {
+    outcome.points = d.source->metadata().pointCount;
+    outcome.description = d.source->metadata().source + " (" + d.source->metadata().format + ")";
+  }
+  return d;
 }
 
 } // namespace pointrast::bench

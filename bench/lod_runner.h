@@ -7,15 +7,27 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bench/runner.h"
+#include "cloud/octree.h"
 
 namespace pointrast::bench {
 
 // The cache key of a data set's octree: its name, size and seed (a file: its name and file name).
 std::string octreeKey(const Dataset& dataset);
+
+// A suite's data set as an octree: `octrees` finds it or builds it from the data set's points (generated
+// only when a build needs them), then it is opened. Without one, `outcome` is marked skipped with the reason
+// and the source is null. `outcome.points` and `description` come from the octree.
+struct DatasetSource {
+  std::unique_ptr<lod::NodeSource> source;
+  DatasetOctree octree;
+};
+DatasetSource openDatasetOctree(const Dataset& dataset, const OctreeProvider& octrees, bool progress,
+                                DatasetOutcome& outcome);
 
 // Measures config's LOD methods on the octree of `dataset` (whose points are `cloud`) from each of `views`,
 // each result filed under `order` (an octree is built from the points whatever their order) and handed to

@@ -240,34 +240,13 @@ LodSuiteRun runLodSuite(gpu::Context& context, const LodSuiteConfig& config,
     for (const Dataset& d : config.datasets) {
       checkTimeLimit(start, config.timeLimitSeconds, done, total);
       DatasetOutcome outcome;
-      outcome.dataset = d;
-      std::optional<PointCloud> cloud;
-      auto points = [&]() -> const PointCloud& {
-        if (!cloud) cloud = loadDataset(d, config.progress);
-        return *cloud;
-      };
-      std::unique_ptr<lod::NodeSource> source;
-      DatasetOctree octree;
-      try {
-        if (!config.octrees) throw InputError("no octree: this run has no octree builder or cache");
-        octree = config.octrees(octreeKey(d), points);
-        source = io::openNodeSource(octree.path);
-      } catch (const InputError& e) {
-        outcome.skipped = true;
-        outcome.reason = e.what();
-      } catch (const UnsupportedError& e) {
-        outcome.skipped = true;
-        outcome.reason = e.what();
-      }
-      cloud.reset(); // the build's input: the octree is on disk now
+      auto [source, octree] = openDatasetOctree(d, config.octrees, config.progress, outcome);
       ++done;
       if (outcome.skipped) {
         note(d.label + ": skipped, " + outcome.reason);
         run.datasets.push_back(outcome);
         continue;
       }
-      outcome.points = source->metadata().pointCount;
-      outcome.description = source->metadata().source + " (" + source->metadata().format + ")";
       run.datasets.push_back(outcome);
       run.octrees.emplace_back(d.name, octree);
       note(d.label + ": octree " + octree.path.string() +

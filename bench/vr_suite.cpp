@@ -108,53 +108,28 @@ double stereoSpeedup(const VrSuiteRun& run, const VrResult& stereo) {
 
 VrSuiteRun runVrSuite(gpu::Context& context, const VrSuiteConfig& config, const VrSuiteCallbacks& callbacks) {
   const auto start = Clock::now();
-  auto note = [&](const std::string& line) {
+  const Note note = [&](const std::string& line) {
     if (callbacks.onNote) callbacks.onNote(line);
   };
   VrSuiteRun run;
-  run.device = context.info();
-  run.deviceLocalBytes = context.deviceLocalBytes();
   run.config = config;
   run.warmup = warmupFrames(config.frames);
-  run.copy = gpu::measureCopy(context, config.copyBytes, config.copyRepeats);
-  note(copyBandwidthText(run.copy));
-  Renderer stereo(context, config.width, config.height, 2);
-  Renderer mono(context, config.width, config.height);
-  const size_t perDataset = config.views.size() * (2 * vrCases().size() - 1);
-  const size_t total = config.datasets.size() * perDataset;
-  size_t done = 0;
-  try {
+  runRecorded(context, run, config.copyBytes, config.copyRepeats, start, note, [&] {
+    Renderer stereo(context, config.width, config.height, 2);
+    Renderer mono(context, config.width, config.height);
+    const size_t perDataset = config.views.size() * (2 * vrCases().size() - 1);
+    const size_t total = config.datasets.size() * perDataset;
+    size_t done = 0;
     for (const Dataset& d : config.datasets) {
       checkTimeLimit(start, config.timeLimitSeconds, done, total);
       DatasetOutcome outcome;
-      outcome.dataset = d;
-      std::optional<PointCloud> cloud;
-      auto points = [&]() -> const PointCloud& {
-        if (!cloud) cloud = loadDataset(d, config.progress);
-        return *cloud;
-      };
-      std::unique_ptr<lod::NodeSource> source;
-      DatasetOctree octree;
-      try {
-        if (!config.octrees) throw InputError("no octree: this run has no octree builder or cache");
-        octree = config.octrees(octreeKey(d), points);
-        source = io::openNodeSource(octree.path);
-      } catch (const InputError& e) {
-        outcome.skipped = true;
-        outcome.reason = e.what();
-      } catch (const UnsupportedError& e) {
-        outcome.skipped = true;
-        outcome.reason = e.what();
-      }
-      cloud.reset(); // the build's input: the octree is on disk now
+      auto [source, octree] = openDatasetOctree(d, config.octrees, config.progress, outcome);
       if (outcome.skipped) {
         note(d.label + ": skipped, " + outcome.reason);
         run.datasets.push_back(outcome);
         done += perDataset;
         continue;
       }
-      outcome.points = source->metadata().pointCount;
-      outcome.description = source->metadata().source + " (" + source->metadata().format + ")";
       run.datasets.push_back(outcome);
       run.octrees.emplace_back(d.name, octree);
       note(d.label + ": octree " + octree.path.string() +
@@ -167,14 +142,7 @@ VrSuiteRun runVrSuite(gpu::Context& context, const VrSuiteConfig& config, const 
         note(d.label + ": stopped, " + e.what());
       }
     }
-  } catch (const DeviceFault& e) {
-    run.stopped = deviceFaultText(e);
-    note("stopped: " + run.stopped);
-  } catch (const TimeLimitReached& e) {
-    run.stopped = e.what();
-    note("stopped: " + run.stopped);
-  }
-  run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  });
   return run;
 }
 

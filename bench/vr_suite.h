@@ -59,17 +59,10 @@ struct VrResult {
   bool ok() const { return status == "ok"; }
 };
 
-struct VrSuiteRun {
-  gpu::DeviceInfo device;
-  uint64_t deviceLocalBytes = 0;
-  gpu::CopyBandwidth copy;
+struct VrSuiteRun : RunRecord {
   VrSuiteConfig config;
-  uint32_t warmup = 0;
-  std::vector<DatasetOutcome> datasets;
   std::vector<std::pair<std::string, DatasetOctree>> octrees;
   std::vector<VrResult> results;
-  double seconds = 0;
-  std::string stopped; // as BenchRun::stopped
 };
 
 struct VrSuiteCallbacks {
