@@ -79,7 +79,8 @@ StereoSettings stereoSettings(const RenderArgs& a) {
   StereoSettings s;
   if (!a.stereo) return s;
   if (a.stereoLayout != "side-by-side" && a.stereoLayout != "cross-eyed" && a.stereoLayout != "separate")
-    throw InputError("unknown --stereo-layout '" + a.stereoLayout + "'; choose side-by-side, cross-eyed or separate");
+    throw InputError("unknown --stereo-layout '" + a.stereoLayout +
+                     "'; choose side-by-side, cross-eyed or separate");
   if (a.ipd) {
     if (!(*a.ipd > 0) || !std::isfinite(*a.ipd))
       throw InputError("--ipd must be a distance > 0 in scene units");
@@ -453,8 +454,9 @@ void printLodStats(const lod::LodStats& s, const BatchStats& b) {
 
 // The JSON line of an octree render.
 nlohmann::json octreeJson(const gpu::Context& context, const RenderSettings& settings,
-                          const lod::OctreeMetadata& octree, const ColorChoice& colors, const FrameStats& stats,
-                          const Camera& camera, const RenderArgs& a, const std::vector<uint32_t>& pixels) {
+                          const lod::OctreeMetadata& octree, const ColorChoice& colors,
+                          const FrameStats& stats, const Camera& camera, const RenderArgs& a,
+                          const std::vector<uint32_t>& pixels) {
   nlohmann::json j;
   j["device"] = context.info().name;
   j["device_type"] = context.info().typeName;
@@ -515,7 +517,8 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   const FrameStats stats = renderer.render(scene, camera, settings);
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(
-      a, context, pixels, [&] { return octreeJson(context, settings, octree, colors, stats, camera, a, pixels); },
+      a, context, pixels,
+      [&] { return octreeJson(context, settings, octree, colors, stats, camera, a, pixels); },
       [&] {
         std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), "
                     "%s points/s\n",
@@ -550,9 +553,10 @@ RenderSettings pointSettings(const RenderArgs& a) {
                      methodNamesReading(SceneLayout::Octree) + ")");
   if (a.stereo && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
     throw InputError("--stereo draws both eyes in one pass with the batch and LOD methods (" +
-                     methodNamesReading(SceneLayout::Batched) + ", " + methodNamesReading(SceneLayout::Octree) +
-                     "), not " + a.method);
-  if (a.stereo && !a.path.path.empty()) throw InputError("--stereo renders one frame with -o, not a camera path");
+                     methodNamesReading(SceneLayout::Batched) + ", " +
+                     methodNamesReading(SceneLayout::Octree) + "), not " + a.method);
+  if (a.stereo && !a.path.path.empty())
+    throw InputError("--stereo renders one frame with -o, not a camera path");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   if (layout == SceneLayout::Octree) return settings; // runRenderOctree checks the octree's own options
@@ -657,12 +661,7 @@ int runRender(const RenderArgs& a) {
   if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
-  InputSpec spec;
-  spec.source = a.input;
-  spec.points = parseCount(a.points, "--points");
-  spec.seed = a.seed;
-  spec.order = parseOrder(a.order);
-  spec.progress = !a.quiet;
+  const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
 
   // The header's count before the device starts, the device's memory before the read.
   const std::optional<uint64_t> stated = statedPoints(spec);
@@ -849,15 +848,17 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--edl-strength", a->edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
   cmd->add_option("--edl-radius", a->edlRadius,
                   "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
-  cmd->add_flag("--stereo", a->stereo,
-                "Batch and LOD methods: render both eyes in one pass, each --width x --height, into one "
-                "side-by-side image (left eye on the left); each point is read once and drawn into both eyes");
+  cmd->add_flag(
+      "--stereo", a->stereo,
+      "Batch and LOD methods: render both eyes in one pass, each --width x --height, into one "
+      "side-by-side image (left eye on the left); each point is read once and drawn into both eyes");
   cmd->add_option("--ipd", a->ipd,
                   "Stereo: distance between the eyes in scene units (default: the convergence distance / 30, "
                   "comfortable whatever the units; 0.064 is life-size for a cloud in metres)");
-  cmd->add_option("--convergence", a->convergence,
-                  "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
-                  "the target's distance), or inf for parallel eyes as a VR headset renders");
+  cmd->add_option(
+      "--convergence", a->convergence,
+      "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
+      "the target's distance), or inf for parallel eyes as a VR headset renders");
   cmd->add_option("--stereo-layout", a->stereoLayout,
                   "Stereo output: side-by-side (one PNG, left eye left), cross-eyed (right eye left, for "
                   "cross-eyed viewing) or separate (OUT-left.png and OUT-right.png)")
@@ -868,9 +869,10 @@ Command addRender(CLI::App& app) {
   cmd->add_option("--fovea-radius", a->foveaRadius,
                   "Foveated LOD: radius of the fovea in half-diagonals of the image (0..1, default 0.3); "
                   "inside it --min-node-px holds");
-  cmd->add_option("--fovea-periphery", a->foveaPeriphery,
-                  "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
-                  "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
+  cmd->add_option(
+      "--fovea-periphery", a->foveaPeriphery,
+      "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
+      "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

@@ -60,22 +60,8 @@ int runServe(const ServeArgs& a) {
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
   view::web::checkServerOptions(o);
 
-  InputSpec spec;
-  spec.source = a.input;
-  spec.points = parseCount(a.points, "--points");
-  spec.seed = a.seed;
-  spec.order = parseOrder(a.order);
-  spec.progress = !a.quiet;
-  PointCloud cloud = loadInput(spec);
-  if (!a.eye.empty()) {
-    Camera camera;
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
-    camera.up = parseVec3(a.up, "--up");
-    camera.fovY = a.fov;
-    validateCamera(camera);
-    o.camera = camera;
-  }
+  PointCloud cloud = loadInput(inputSpec(a.input, a.points, a.seed, a.order, a.quiet));
+  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, cloud.bounds.center())) o.camera = camera;
   return view::web::runServer(cloud, o);
 }
 

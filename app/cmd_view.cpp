@@ -48,22 +48,9 @@ int runView(const ViewArgs& a) {
   options.device = a.device;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
 
-  InputSpec spec;
-  spec.source = a.input;
-  spec.points = parseCount(a.points, "--points");
-  spec.seed = a.seed;
-  spec.order = parseOrder(a.order);
-  spec.progress = !a.quiet;
-  PointCloud cloud = loadInput(spec);
-  if (!a.eye.empty()) {
-    Camera camera;
-    camera.eye = parseVec3(a.eye, "--eye");
-    camera.target = a.target.empty() ? cloud.bounds.center() : parseVec3(a.target, "--target");
-    camera.up = parseVec3(a.up, "--up");
-    camera.fovY = a.fov;
-    validateCamera(camera);
+  PointCloud cloud = loadInput(inputSpec(a.input, a.points, a.seed, a.order, a.quiet));
+  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, cloud.bounds.center()))
     options.camera = camera;
-  }
   options.title = "pointrast - " + cloud.source;
   return view::runViewer(cloud, options);
 }

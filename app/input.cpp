@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "base/error.h"
+#include "cli_util.h"
 #include "cloud/generate.h"
 #include "cloud/particles_generate.h"
 #include "io/format_table.h"
@@ -104,6 +105,30 @@ std::optional<uint64_t> statedParticles(const ParticleInputSpec& spec) {
   if (isParticleSceneName(source)) return spec.source.empty() ? kDemoPoints : spec.particles;
   if (isSceneName(source)) return spec.particles;
   return std::nullopt;
+}
+
+InputSpec inputSpec(const std::string& source, const std::string& points, uint64_t seed,
+                    const std::string& order, bool quiet) {
+  InputSpec spec;
+  spec.source = source;
+  spec.points = parseCount(points, "--points");
+  spec.seed = seed;
+  spec.order = parseOrder(order);
+  spec.progress = !quiet;
+  return spec;
+}
+
+std::optional<Camera> cameraFromOptions(const std::string& eye, const std::string& target,
+                                        const std::string& up, double fov, const glm::dvec3& center) {
+  if (!target.empty() && eye.empty()) throw InputError("--target needs --eye");
+  if (eye.empty()) return std::nullopt;
+  Camera camera;
+  camera.eye = parseVec3(eye, "--eye");
+  camera.target = target.empty() ? center : parseVec3(target, "--target");
+  camera.up = parseVec3(up, "--up");
+  camera.fovY = fov;
+  validateCamera(camera);
+  return camera;
 }
 
 } // namespace pointrast::app

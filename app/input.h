@@ -9,6 +9,7 @@
 #include "cloud/cloud.h"
 #include "cloud/order.h"
 #include "cloud/particles.h"
+#include "render/camera.h"
 
 namespace pointrast::app {
 
@@ -19,6 +20,16 @@ struct InputSpec {
   Order order = Order::Original;
   bool progress = true;
 };
+
+// The input of the commands that take a point cloud (render, view, serve) from their shared options: FILE or
+// a scene name, --points, --seed, --order; progress unless quiet. Throws InputError naming a bad option.
+InputSpec inputSpec(const std::string& source, const std::string& points, uint64_t seed,
+                    const std::string& order, bool quiet);
+
+// --eye, --target and --up with --fov as the starting camera of a viewer (--target defaults to `center`);
+// nullopt without --eye. Throws InputError for a bad vector or a camera that cannot look.
+std::optional<Camera> cameraFromOptions(const std::string& eye, const std::string& target,
+                                        const std::string& up, double fov, const glm::dvec3& center);
 
 // The built-in demo: the terrain scene, 1 M points, seed 1.
 constexpr const char* kDemoScene = "terrain";

@@ -122,7 +122,7 @@ void measureOctreeMethods(gpu::Context& context, Renderer& renderer, const Bench
 }
 
 DatasetSource openDatasetOctree(const Dataset& dataset, const OctreeProvider& octrees, bool progress,
-                                DatasetOutcome& outcome) {
+                                DatasetOutcome& outcome, const Note& note) {
   outcome.dataset = dataset;
   std::optional<PointCloud> cloud; // the build's input, released when this returns
   auto points = [&]() -> const PointCloud& {
@@ -141,11 +141,25 @@ DatasetSource openDatasetOctree(const Dataset& dataset, const OctreeProvider& oc
     outcome.skipped = true;
     outcome.reason = e.what();
   }
-  if (d.source) {
-    outcome.points = d.source->metadata().pointCount;
-    outcome.description = d.source->metadata().source + " (" + d.source->metadata().format + ")";
+  if (!d.source) {
+    note(dataset.label + ": skipped, " + outcome.reason);
+    return d;
   }
+  outcome.points = d.source->metadata().pointCount;
+  outcome.description = d.source->metadata().source + " (" + d.source->metadata().format + ")";
+  note(dataset.label + ": octree " + d.octree.path.string() +
+       (d.octree.reused ? " (from the cache)" : " built in " + printf1("%.1f s", d.octree.buildSeconds)));
   return d;
+}
+
+void measureDataset(const Dataset& dataset, const Note& note, const std::function<void()>& measure) {
+  try {
+    measure();
+  } catch (const InputError& e) {
+    note(dataset.label + ": stopped, " + e.what());
+  } catch (const UnsupportedError& e) {
+    note(dataset.label + ": stopped, " + e.what());
+  }
 }
 
 } // namespace pointrast::bench

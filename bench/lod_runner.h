@@ -26,8 +26,13 @@ struct DatasetSource {
   std::unique_ptr<lod::NodeSource> source;
   DatasetOctree octree;
 };
+// Notes where the octree came from, or why the data set is skipped.
 DatasetSource openDatasetOctree(const Dataset& dataset, const OctreeProvider& octrees, bool progress,
-                                DatasetOutcome& outcome);
+                                DatasetOutcome& outcome, const Note& note);
+
+// Runs a data set's measurements: a damaged octree found while streaming (InputError) or a step the device
+// cannot take (UnsupportedError) stops this data set with a note, not the run.
+void measureDataset(const Dataset& dataset, const Note& note, const std::function<void()>& measure);
 
 // Measures config's LOD methods on the octree of `dataset` (whose points are `cloud`) from each of `views`,
 // each result filed under `order` (an octree is built from the points whatever their order) and handed to

@@ -240,26 +240,19 @@ LodSuiteRun runLodSuite(gpu::Context& context, const LodSuiteConfig& config,
     for (const Dataset& d : config.datasets) {
       checkTimeLimit(start, config.timeLimitSeconds, done, total);
       DatasetOutcome outcome;
-      auto [source, octree] = openDatasetOctree(d, config.octrees, config.progress, outcome);
+      auto [source, octree] = openDatasetOctree(d, config.octrees, config.progress, outcome, note);
       ++done;
       if (outcome.skipped) {
-        note(d.label + ": skipped, " + outcome.reason);
         run.datasets.push_back(outcome);
         continue;
       }
       run.datasets.push_back(outcome);
       run.octrees.emplace_back(d.name, octree);
-      note(d.label + ": octree " + octree.path.string() +
-           (octree.reused ? " (from the cache)" : " built in " + printf1("%.1f s", octree.buildSeconds)));
-      try {
+      measureDataset(d, note, [&] {
         runSweeps(context, renderer, config, d, *source, run, callbacks);
         checkTimeLimit(start, config.timeLimitSeconds, done, total);
         runStreaming(context, renderer, config, d, octree, *source, run, callbacks);
-      } catch (const InputError& e) { // a damaged octree found while streaming
-        note(d.label + ": stopped, " + e.what());
-      } catch (const UnsupportedError& e) {
-        note(d.label + ": stopped, " + e.what());
-      }
+      });
     }
   });
   return run;
