@@ -46,6 +46,17 @@ nlohmann::json lodStatsJson(const lod::LodStats& s) {
           {"cache_bytes", s.cacheBytes}};
 }
 
+void markdownOctrees(std::ostream& md,
+                     const std::vector<std::pair<std::string, DatasetOctree>>& octrees) {
+  md << "| data set | points | bytes | build s | reused | phases |\n| --- | ---: | ---: | ---: | --- | --- "
+        "|\n";
+  for (const auto& [dataset, o] : octrees)
+    md << "| " << dataset << " | " << shortCount(o.points) << " | " << bytesText(o.bytes) << " | "
+       << printf1("%.1f", o.buildSeconds) << " | " << (o.reused ? "yes" : "no") << " | " << o.phases
+       << " |\n";
+  md << "\n";
+}
+
 nlohmann::json octreesJson(const std::vector<std::pair<std::string, DatasetOctree>>& octrees) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [dataset, o] : octrees)
@@ -101,13 +112,7 @@ void markdownLodStatistics(std::ostream& md, const BenchRun& run) {
   md << "### Octrees\n\n";
   md << "Built once from each data set's points with the octree builder (`pointrast lod`) and kept in the "
         "octree cache; a reused octree shows the time of its build.\n\n";
-  md << "| data set | points | bytes | build s | reused | phases |\n| --- | ---: | ---: | ---: | --- | --- "
-        "|\n";
-  for (const auto& [dataset, o] : run.octrees)
-    md << "| " << dataset << " | " << shortCount(o.points) << " | " << bytesText(o.bytes) << " | "
-       << printf1("%.1f", o.buildSeconds) << " | " << (o.reused ? "yes" : "no") << " | " << o.phases
-       << " |\n";
-  md << "\n";
+  markdownOctrees(md, run.octrees);
 }
 
 } // namespace pointrast::bench
@@ -366,13 +371,8 @@ std::string lodSuiteMarkdown(const LodSuiteRun& run, const ReportInfo& info) {
   for (const LodStreamResult& s : run.streams)
     streamMarkdown(md, run, s);
   if (!run.octrees.empty()) {
-    md << "## Octrees\n\n| data set | points | bytes | build s | reused | phases |\n| --- | ---: | ---: | "
-          "---: | --- | --- |\n";
-    for (const auto& [dataset, o] : run.octrees)
-      md << "| " << dataset << " | " << shortCount(o.points) << " | " << bytesText(o.bytes) << " | "
-         << printf1("%.1f", o.buildSeconds) << " | " << (o.reused ? "yes" : "no") << " | " << o.phases
-         << " |\n";
-    md << "\n";
+    md << "## Octrees\n\n";
+    markdownOctrees(md, run.octrees);
   }
   markdownDatasets(md, run.datasets);
   std::set<std::string> reasons;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,10 @@
 namespace pointrast::bench {
 
 nlohmann::json lodStatsJson(const lod::LodStats& stats);
+// The octrees' table (data set, points, bytes, build time, reused, phases) for a Markdown report.
+void markdownOctrees(std::ostream& md,
+                     const std::vector<std::pair<std::string, DatasetOctree>>& octrees);
+
 nlohmann::json octreesJson(const std::vector<std::pair<std::string, DatasetOctree>>& octrees);
 
 // The LOD rows of a run: per data set, view and LOD method, the nodes and points the CPU selected, what

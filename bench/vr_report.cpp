@@ -157,13 +157,8 @@ std::string vrSuiteMarkdown(const VrSuiteRun& run, const ReportInfo& info) {
     }
   }
   if (!run.octrees.empty()) {
-    md << "## Octrees\n\n| data set | points | bytes | build s | reused | phases |\n| --- | ---: | ---: | "
-          "---: | --- | --- |\n";
-    for (const auto& [dataset, o] : run.octrees)
-      md << "| " << dataset << " | " << shortCount(o.points) << " | " << bytesText(o.bytes) << " | "
-         << printf1("%.1f", o.buildSeconds) << " | " << (o.reused ? "yes" : "no") << " | " << o.phases
-         << " |\n";
-    md << "\n";
+    md << "## Octrees\n\n";
+    markdownOctrees(md, run.octrees);
   }
   markdownDatasets(md, run.datasets);
   std::set<std::string> reasons;

@@ -6,6 +6,7 @@
 
 #include "base/error.h"
 #include "gpu/context.h"
+#include "render/batch_stats.h"
 #include "render/method.h"
 
 namespace pointrast {
@@ -119,25 +120,7 @@ public:
   std::optional<BatchStats> readStats() override {
     uint64_t rows[shared::kBatchStatSlots][shared::kBatchStatCount];
     gpu::readBuffer(context_, stats_, 0, rows, sizeof rows);
-    uint64_t sum[shared::kBatchStatCount] = {};
-    for (const auto& row : rows)
-      for (uint32_t k = 0; k < shared::kBatchStatCount; ++k)
-        sum[k] += row[k];
-    BatchStats s;
-    s.batchesProcessed = sum[shared::kStatBatchesProcessed];
-    s.batchesRendered = sum[shared::kStatBatchesRendered];
-    s.pointsRendered = sum[shared::kStatPointsRendered];
-    s.pointsBlended = sum[shared::kStatPointsBlended];
-    for (int w = 0; w < 3; ++w) {
-      s.pointsByWords[w] = sum[shared::kStatPointsOneWord + w];
-      s.pointsProcessed += s.pointsByWords[w];
-    }
-    // Every batch reads its bounds, every point of a drawn batch its words; batch-hqs does both twice and
-    // reads the color of each blended point.
-    uint64_t once = s.batchesProcessed * sizeof(shared::BatchBounds) +
-                    4 * (s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2]);
-    s.bytesRead = hqs_ ? 2 * once + 4 * s.pointsBlended : once;
-    return s;
+    return batchStatsFromRows(rows, hqs_);
   }
 
 private:

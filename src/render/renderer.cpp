@@ -1,4 +1,5 @@
 #include "render/renderer.h"
+#include "render/batch_stats.h"
 
 #include <algorithm>
 #include <cassert>
@@ -142,9 +143,10 @@ PointMethod& Renderer::method(const RenderSettings& settings) {
   std::string why;
   if (!supports(context_, settings.method, &why)) throw UnsupportedError(why);
   if (targets_->eyes == 2 && info.family != MethodFamily::Batch)
-    throw InputError(std::string("stereo frames draw both eyes in one pass with the batch and LOD methods (") +
-                     methodNamesReading(SceneLayout::Batched) + ", " + methodNamesReading(SceneLayout::Octree) +
-                     "), not " + info.name);
+    throw InputError(
+        std::string("stereo frames draw both eyes in one pass with the batch and LOD methods (") +
+        methodNamesReading(SceneLayout::Batched) + ", " + methodNamesReading(SceneLayout::Octree) +
+        "), not " + info.name);
   auto key = std::make_pair(settings.method, settings.depth);
   auto found = methods_.find(key);
   if (found != methods_.end()) return *found->second;
@@ -318,8 +320,9 @@ FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, cons
     };
   }
   const std::vector<Camera> eyes = views(camera, settings);
-  FrameStats stats = resident ? lod::renderResidentFrame(context_, octree, passes, t, eyes, settings, epilogue)
-                              : lod::renderOctree(context_, octree, passes, t, eyes, settings, epilogue);
+  FrameStats stats = resident
+                         ? lod::renderResidentFrame(context_, octree, passes, t, eyes, settings, epilogue)
+                         : lod::renderOctree(context_, octree, passes, t, eyes, settings, epilogue);
   if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), postFrames);
   wordsCaptured_ = settings.captureWords && (hasCanonicalWords(methodInfo(settings.method)) || post);
   return stats;
@@ -363,6 +366,28 @@ std::vector<uint64_t> Renderer::framebufferWords(uint32_t x, uint32_t y, uint32_
 
 uint64_t Renderer::imageAddress() const {
   return targets_->image.address();
+}
+
+BatchStats batchStatsFromRows(const uint64_t (&rows)[shared::kBatchStatSlots][shared::kBatchStatCount],
+                              bool hqs) {
+  uint64_t sum[shared::kBatchStatCount] = {};
+  for (const auto& row : rows)
+    for (uint32_t k = 0; k < shared::kBatchStatCount; ++k)
+      sum[k] += row[k];
+  BatchStats s;
+  s.batchesProcessed = sum[shared::kStatBatchesProcessed];
+  s.batchesRendered = sum[shared::kStatBatchesRendered];
+  s.pointsRendered = sum[shared::kStatPointsRendered];
+  s.pointsBlended = sum[shared::kStatPointsBlended];
+  for (int w = 0; w < 3; ++w) {
+    s.pointsByWords[w] = sum[shared::kStatPointsOneWord + w];
+    s.pointsProcessed += s.pointsByWords[w];
+  }
+  // Every batch (or octree node) reads its bounds, every point of a drawn one its words.
+  const uint64_t once = s.batchesProcessed * sizeof(shared::BatchBounds) +
+                        4 * (s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2]);
+  s.bytesRead = hqs ? 2 * once + 4 * s.pointsBlended : once;
+  return s;
 }
 
 } // namespace pointrast

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "gpu/context.h"
+#include "render/batch_stats.h"
 
 namespace pointrast::lod {
 
@@ -225,25 +226,7 @@ BatchStats LodPasses::readStats() const {
   uint64_t rows[shared::kBatchStatSlots][shared::kBatchStatCount];
   statsReadback_.invalidate();
   std::memcpy(rows, statsReadback_.mapped(), sizeof rows);
-  uint64_t sum[shared::kBatchStatCount] = {};
-  for (const auto& row : rows)
-    for (uint32_t k = 0; k < shared::kBatchStatCount; ++k)
-      sum[k] += row[k];
-  BatchStats s;
-  s.batchesProcessed = sum[shared::kStatBatchesProcessed];
-  s.batchesRendered = sum[shared::kStatBatchesRendered];
-  s.pointsRendered = sum[shared::kStatPointsRendered];
-  s.pointsBlended = sum[shared::kStatPointsBlended];
-  for (int w = 0; w < 3; ++w) {
-    s.pointsByWords[w] = sum[shared::kStatPointsOneWord + w];
-    s.pointsProcessed += s.pointsByWords[w];
-  }
-  // As the batch methods count it: each node's bounds, each processed point's words; lod-hqs reads them in
-  // both passes and the color of each blended point.
-  const uint64_t once = s.batchesProcessed * sizeof(shared::BatchBounds) +
-                        4 * (s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2]);
-  s.bytesRead = hqs_ ? 2 * once + 4 * s.pointsBlended : once;
-  return s;
+  return batchStatsFromRows(rows, hqs_);
 }
 
 } // namespace pointrast::lod
