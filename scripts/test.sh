@@ -31,7 +31,9 @@ cd ..
 
 echo "== sphere pipelines on Mesa 25 lavapipe (mesh shaders, ray tracing)"
 (
-  eval "$(scripts/lavapipe-mesh-rt.sh "$PWD/build-test/lavapipe25")"
+  # Assigned first: a failing eval "$(...)" would not stop the script and the tests would run on Mesa 22.3.
+  lavapipe25=$(scripts/lavapipe-mesh-rt.sh "$PWD/build-test/lavapipe25")
+  eval "$lavapipe25"
   POINTRAST_VALIDATION=1 build-test/tests/gpu_tests --gtest_brief=1 --gtest_filter='*Sphere*'
 )
 
