@@ -3,7 +3,9 @@
 # with the Khronos validation layer on, then the parser and data-preparation tests again under
 # AddressSanitizer + UBSan (truncation sweeps must never read out of bounds), and last the sphere tests
 # on a newer lavapipe (Mesa 25, Debian 12 backports, unpacked privately) that has mesh shaders and ray
-# tracing, which the system's Mesa 22.3 lacks: there those pipelines are only skipped. Then the libFuzzer
+# tracing, which the system's Mesa 22.3 lacks: there those pipelines are only skipped. Then a tree built
+# with the test-only point method of tests/methods (one table row, one shader) checks that the method
+# appears in every generated name list and renders like atomicmin. Then the libFuzzer
 # targets (tests/fuzz), built with clang in build-fuzz, run for $POINTRAST_FUZZ_SECONDS (180) seconds of
 # wall time in all, shared between them, as many at once as there are cores.
 set -euo pipefail
@@ -36,6 +38,13 @@ echo "== sphere pipelines on Mesa 25 lavapipe (mesh shaders, ray tracing)"
   eval "$lavapipe25"
   POINTRAST_VALIDATION=1 build-test/tests/gpu_tests --gtest_brief=1 --gtest_filter='*Sphere*'
 )
+
+echo "== a test-only point method (tests/methods: one table row, one shader) in the lists and on lavapipe"
+cmake -S . -B build-method -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g" \
+  -DPOINTRAST_WERROR=ON -DPOINTRAST_TEST_METHODS=ON
+cmake --build build-method -j"$jobs" --target pointrast gpu_tests cli_tests
+POINTRAST_VALIDATION=1 build-method/tests/gpu_tests --gtest_brief=1 --gtest_filter='MethodTable.*:Table/*closest_variant*'
+POINTRAST_VALIDATION=1 build-method/tests/cli_tests --gtest_brief=1 --gtest_filter='TestMethodCli.*'
 
 echo "== parsers under libFuzzer (clang, ASan, UBSan), ${POINTRAST_FUZZ_SECONDS:-180} s in all"
 scripts/fuzz.sh --total "${POINTRAST_FUZZ_SECONDS:-180}"

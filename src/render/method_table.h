@@ -10,6 +10,8 @@
 //   src/render (method.h) and the factory case in renderer.cpp, then rows as above;
 // - a method that reads another kind of GPU input (an octree streamed through a node cache instead of an
 //   uploaded scene) adds its value to SceneLayout (render/scene.h) and says so in its rows.
+// A test build configured with POINTRAST_TEST_METHODS=ON adds the rows of tests/methods/method_rows.inc
+// (shaders in tests/methods): the proof that the above holds, run by scripts/test.sh.
 // Code outside src/render asks rows for properties (layout, output, needs), never for a method by name;
 // pointMethod("name") names one at compile time where a default or a test needs a particular one.
 #pragma once
@@ -156,6 +158,9 @@ inline constexpr MethodInfo kPointMethods[] = {
    {{/* PREFETCH= */ 0, 1}, {/* DEPTH_ONLY= */ 1, 1}},
    MethodNeeds::Subgroups, SceneLayout::Octree, MethodOutput::Blend, 8,
    "HQS on octree nodes: depth pass, one packed atomicAdd per point with overflow fallback (2022)"},
+#ifdef POINTRAST_TEST_METHOD_ROWS
+#include POINTRAST_TEST_METHOD_ROWS // test builds only (CMake POINTRAST_TEST_METHODS)
+#endif
 };
 // clang-format on
 
