@@ -546,13 +546,9 @@ int runBench(const BenchArgs& a) {
   return 0;
 }
 
-} // namespace
-
-Command addBench(CLI::App& app) {
-  auto a = std::make_shared<BenchArgs>();
-  CLI::App* cmd =
-      app.add_subcommand("bench", "Time every method x vertex order x view on the GPU; JSON, Markdown, SVG");
-  cmd->footer(
+// `bench --help`'s text after the options: what is timed and reported, each suite, examples.
+std::string benchFooter() {
+  const std::string text =
       "\nFor each data set, order, view and method: a warm-up (a tenth of --frames, at least 2), then "
       "--frames\n"
       "frames timed with timestamp queries (clear + render + resolve): median, min, max ms, points/s, and "
@@ -603,7 +599,8 @@ Command addBench(CLI::App& app) {
       "converges (target: 30) and the rate nodes stream from disk. --views, --frames, --width and --height\n"
       "override the suite's.\n\n"
       "--suite vr2022 measures the VR frame of the 2022 paper on the octree of scan529m (tls, 529 M, the\n"
-      "octree cache's, shared with paper2022): both eyes at 2478x2740 each, lod-hqs, foveated LOD (100 px in\n"
+      "octree cache's, shared with paper2022): both eyes at 2478x2740 each, lod-hqs, foveated LOD (100 px "
+      "in\n"
       "the fovea, 300 px at the corners), dilation, parallel eyes 6.4 cm apart, from the closeup and\n"
       "overview views; each configuration as one stereo pass and as two mono renders of the same eyes.\n"
       "--views, --frames, --width and --height (each eye's) override the suite's.\n\n"
@@ -636,73 +633,98 @@ Command addBench(CLI::App& app) {
       "  pointrast bench --suite vr2022 --octree-cache /scratch/octrees\n"
       "  pointrast bench --suite spheres2023\n"
       "  pointrast bench --suite spheres2023 --scale 0.0001 --cameras 2 --frames 1 --out /tmp/smoke\n"
-      "  pointrast bench --suite spheres2023 --methods sphere-compute,sphere-points --orbits long");
-  cmd->add_option("INPUT", a->inputs,
-                  "Point cloud files (" + io::formatList(io::FormatUse::Cloud) +
-                      ") or scene names (terrain, tls); with --suite, NAME=PATH");
-  cmd->add_option("--suite", a->suite, "Run a named suite: paper2021, paper2022, lod, vr2022 or spheres2023");
-  cmd->add_option("--datasets", a->datasets,
-                  "With --suite: its data sets to measure, comma-separated, or all")
+      "  pointrast bench --suite spheres2023 --methods sphere-compute,sphere-points --orbits long";
+  return text;
+}
+
+// Options bind to members of the BenchArgs that the command's closure keeps alive with the app.
+// What is measured: inputs, a suite and its data sets, the octree cache, the lod suite's streaming.
+void addSuiteOptions(CLI::App& cmd, BenchArgs& a) {
+  cmd.add_option("INPUT", a.inputs,
+                 "Point cloud files (" + io::formatList(io::FormatUse::Cloud) +
+                     ") or scene names (terrain, tls); with --suite, NAME=PATH");
+  cmd.add_option("--suite", a.suite, "Run a named suite: paper2021, paper2022, lod, vr2022 or spheres2023");
+  cmd.add_option("--datasets", a.datasets, "With --suite: its data sets to measure, comma-separated, or all")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->datasetsGiven = true; });
-  cmd->add_option("--octree-cache", a->octreeCache,
-                  "Folder of the octrees the LOD methods draw, built there when missing (default: "
-                  "~/.cache/pointrast/octrees)");
-  auto streamOption = [a](const std::string&) { a->streamOptionsGiven = true; };
-  cmd->add_option("--flight-frames", a->flightFrames, "lod: frames of the streaming run's flight")
+      ->each([&a](const std::string&) { a.datasetsGiven = true; });
+  cmd.add_option("--octree-cache", a.octreeCache,
+                 "Folder of the octrees the LOD methods draw, built there when missing (default: "
+                 "~/.cache/pointrast/octrees)");
+  auto streamOption = [&a](const std::string&) { a.streamOptionsGiven = true; };
+  cmd.add_option("--flight-frames", a.flightFrames, "lod: frames of the streaming run's flight")
       ->capture_default_str()
       ->each(streamOption);
-  cmd->add_option("--jumps", a->jumps, "lod: jumps between far-apart views after the flight")
+  cmd.add_option("--jumps", a.jumps, "lod: jumps between far-apart views after the flight")
       ->capture_default_str()
       ->each(streamOption);
-  cmd->add_option("--scale", a->scale, "Multiply every size of the suite (e.g. 0.001 for a smoke run)")
-      ->each([a](const std::string&) { a->scaleGiven = true; });
-  cmd->add_option("--methods", a->methods, "Methods, comma-separated, or all (see `pointrast render --help`)")
+  cmd.add_option("--scale", a.scale, "Multiply every size of the suite (e.g. 0.001 for a smoke run)")
+      ->each([&a](const std::string&) { a.scaleGiven = true; });
+}
+
+// The matrix of a run (methods x orders x views), the image and how long a combination is timed.
+void addMatrixOptions(CLI::App& cmd, BenchArgs& a) {
+  cmd.add_option("--methods", a.methods, "Methods, comma-separated, or all (see `pointrast render --help`)")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->methodsGiven = true; });
-  cmd->add_option("--orders", a->orders, "original, morton, shuffled, shuffled-morton, or all")
+      ->each([&a](const std::string&) { a.methodsGiven = true; });
+  cmd.add_option("--orders", a.orders, "original, morton, shuffled, shuffled-morton, or all")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->ordersGiven = true; });
-  cmd->add_option("--views", a->views, "overview, closeup, outside, or all")
+      ->each([&a](const std::string&) { a.ordersGiven = true; });
+  cmd.add_option("--views", a.views, "overview, closeup, outside, or all")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->viewsGiven = true; });
-  cmd->add_option("--width", a->width, "Image width in pixels (paper2022: 2560)")
+      ->each([&a](const std::string&) { a.viewsGiven = true; });
+  cmd.add_option("--width", a.width, "Image width in pixels (paper2022: 2560)")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->widthGiven = true; });
-  cmd->add_option("--height", a->height, "Image height in pixels (paper2022: 1140)")
+      ->each([&a](const std::string&) { a.widthGiven = true; });
+  cmd.add_option("--height", a.height, "Image height in pixels (paper2022: 1140)")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->heightGiven = true; });
-  cmd->add_option("--frames", a->frames,
-                  "Timed frames per combination (spheres2023: per camera, default 5); the median is reported")
+      ->each([&a](const std::string&) { a.heightGiven = true; });
+  cmd.add_option("--frames", a.frames,
+                 "Timed frames per combination (spheres2023: per camera, default 5); the median is reported")
       ->capture_default_str()
-      ->each([a](const std::string&) { a->framesGiven = true; });
-  cmd->add_option("--budget", a->budget,
-                  "GPU seconds per combination: a method whose first frame shows that warm-up + --frames "
-                  "would take longer is timed over as many frames as fit (at least 3 after 1 warm-up; "
-                  "spheres2023: over all cameras, at least 1 per camera); the reports list them; 0 = always "
-                  "--frames")
+      ->each([&a](const std::string&) { a.framesGiven = true; });
+  cmd.add_option("--budget", a.budget,
+                 "GPU seconds per combination: a method whose first frame shows that warm-up + --frames "
+                 "would take longer is timed over as many frames as fit (at least 3 after 1 warm-up; "
+                 "spheres2023: over all cameras, at least 1 per camera); the reports list them; 0 = always "
+                 "--frames")
       ->capture_default_str();
-  cmd->add_option("--time-limit", a->timeLimit,
-                  "Wall seconds after which no further combination starts; the reports then hold what was "
-                  "measured and say where the run stopped (0 = no limit)")
+  cmd.add_option("--time-limit", a.timeLimit,
+                 "Wall seconds after which no further combination starts; the reports then hold what was "
+                 "measured and say where the run stopped (0 = no limit)")
       ->capture_default_str();
-  auto sphereOption = [a](const std::string&) { a->sphereOptionsGiven = true; };
-  cmd->add_option("--layouts", a->layouts, "spheres2023: particle layouts soa8, vec4x2, aos, xyz, or all")
+}
+
+// The sphere suite's matrix and cameras.
+void addSphereSuiteOptions(CLI::App& cmd, BenchArgs& a) {
+  auto sphereOption = [&a](const std::string&) { a.sphereOptionsGiven = true; };
+  cmd.add_option("--layouts", a.layouts, "spheres2023: particle layouts soa8, vec4x2, aos, xyz, or all")
       ->capture_default_str()
       ->each(sphereOption);
-  cmd->add_option("--billboards", a->billboards, "spheres2023: billboards screen, camera, or all")
+  cmd.add_option("--billboards", a.billboards, "spheres2023: billboards screen, camera, or all")
       ->capture_default_str()
       ->each(sphereOption);
-  cmd->add_option("--conservative", a->conservative,
-                  "spheres2023: conservative rasterization off, on (where supported), or all")
+  cmd.add_option("--conservative", a.conservative,
+                 "spheres2023: conservative rasterization off, on (where supported), or all")
       ->capture_default_str()
       ->each(sphereOption);
-  cmd->add_option("--orbits", a->orbits, "spheres2023: camera orbits short (inside), long (outside), or all")
+  cmd.add_option("--orbits", a.orbits, "spheres2023: camera orbits short (inside), long (outside), or all")
       ->capture_default_str()
       ->each(sphereOption);
-  cmd->add_option("--cameras", a->cameras, "spheres2023: cameras per orbit")
+  cmd.add_option("--cameras", a.cameras, "spheres2023: cameras per orbit")
       ->capture_default_str()
       ->each(sphereOption);
+}
+
+} // namespace
+
+Command addBench(CLI::App& app) {
+  auto a = std::make_shared<BenchArgs>();
+  CLI::App* cmd =
+      app.add_subcommand("bench", "Time every method x vertex order x view on the GPU; JSON, Markdown, SVG");
+  cmd->footer(benchFooter());
+  addSuiteOptions(*cmd, *a);
+  addMatrixOptions(*cmd, *a);
+  addSphereSuiteOptions(*cmd, *a);
   cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
   cmd->add_option("--points", a->points, "Points of generated scenes (e.g. 20k, 10M)")
       ->capture_default_str()

@@ -710,12 +710,10 @@ std::string sphereMethodList() {
   return list;
 }
 
-} // namespace
-
-Command addRender(CLI::App& app) {
-  auto a = std::make_shared<RenderArgs>();
-  CLI::App* cmd = app.add_subcommand("render", "Render a point cloud file or a generated scene to a PNG");
-  cmd->footer(
+// `render --help`'s text after the options: the input, the camera, the methods from their tables, and
+// examples.
+std::string renderFooter() {
+  const std::string text =
       "\nWithout FILE, renders the built-in demo scene (terrain, 1 M points). FILE may also be a scene name\n"
       "(terrain, tls) generated with --points and --seed.\n"
       "Without --eye the camera is an overview: it looks at the center of the bounds from the south-west,\n"
@@ -747,132 +745,158 @@ Command addRender(CLI::App& app) {
       "is the same,\nonly the fragments spent on it differ.\n"
       "  pointrast render particles-drops --points 10M --method sphere-compute -o d.png\n"
       "  pointrast render md.mmpld --method sphere-compute --layout soa8 -o md.png --json\n"
-      "  pointrast render particles-laser --points 10M --method sphere-strip --billboard camera -o l.png");
-  cmd->add_option("FILE", a->input,
-                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + "), particle file (" +
-                      io::formatList(io::FormatUse::Particles) + ") or a scene name (terrain, tls)");
-  cmd->add_option("-o,--output", a->output, "PNG to write (required unless --path)");
-  cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
-  cmd->add_option("--height", a->height, "Image height in pixels")->capture_default_str();
-  cmd->add_option("--eye", a->eye, "Camera position x,y,z (default: overview)");
-  cmd->add_option("--target", a->target, "Point looked at x,y,z (default: center of the bounds)");
-  cmd->add_option("--up", a->up, "Up direction x,y,z")->capture_default_str();
-  cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
-  cmd->add_option("--near", a->nearW, "Drop points at linear depth <= near (0: 1e-5 x bounds diagonal)");
-  cmd->add_option("--background", a->background, "Background color r,g,b (0..255)")->capture_default_str();
-  cmd->add_option("--order", a->order, "Vertex order: original, morton, shuffled, shuffled-morton")
+      "  pointrast render particles-laser --points 10M --method sphere-strip --billboard camera -o l.png";
+  return text;
+}
+
+// Options bind to members of the RenderArgs that the command's closure keeps alive with the app.
+// The input, the image and the camera.
+void addViewOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_option("FILE", a.input,
+                 "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + "), particle file (" +
+                     io::formatList(io::FormatUse::Particles) + ") or a scene name (terrain, tls)");
+  cmd.add_option("-o,--output", a.output, "PNG to write (required unless --path)");
+  cmd.add_option("--width", a.width, "Image width in pixels")->capture_default_str();
+  cmd.add_option("--height", a.height, "Image height in pixels")->capture_default_str();
+  cmd.add_option("--eye", a.eye, "Camera position x,y,z (default: overview)");
+  cmd.add_option("--target", a.target, "Point looked at x,y,z (default: center of the bounds)");
+  cmd.add_option("--up", a.up, "Up direction x,y,z")->capture_default_str();
+  cmd.add_option("--fov", a.fov, "Vertical field of view in degrees")->capture_default_str();
+  cmd.add_option("--near", a.nearW, "Drop points at linear depth <= near (0: 1e-5 x bounds diagonal)");
+  cmd.add_option("--background", a.background, "Background color r,g,b (0..255)")->capture_default_str();
+}
+
+// The method, its variants, the level of detail and what is timed.
+void addMethodOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_option("--order", a.order, "Vertex order: original, morton, shuffled, shuffled-morton")
       ->capture_default_str();
-  cmd->add_option(
-         "--method", a->method,
+  cmd.add_option(
+         "--method", a.method,
          "Rasterization method, e.g. atomicmin (compute) or hw-points (the hardware GL_POINTS baseline); "
          "an unknown name lists them all")
       ->capture_default_str();
-  cmd->add_option(
-         "--depth", a->depth,
-         "Depth encoding of the atomic methods: float (32-bit linear depth) or int40 (40-bit integer "
-         "computed in double precision)")
+  cmd.add_option("--depth", a.depth,
+                 "Depth encoding of the atomic methods: float (32-bit linear depth) or int40 (40-bit integer "
+                 "computed in double precision)")
       ->capture_default_str();
-  cmd->add_option("--precision", a->precision,
-                  "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
-                  "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
+  cmd.add_option("--precision", a.precision,
+                 "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
+                 "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
       ->capture_default_str();
-  auto lodOption = [a](const std::string&) { a->lodOptionsGiven = true; };
-  cmd->add_option(
-         "--min-node-px", a->minNodePx,
+  auto lodOption = [&a](const std::string&) { a.lodOptionsGiven = true; };
+  cmd.add_option(
+         "--min-node-px", a.minNodePx,
          "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
          "sphere) is smaller, with their subtrees; 0 draws every point")
       ->capture_default_str()
       ->each(lodOption);
-  cmd->add_option("--point-budget", a->pointBudget,
-                  "LOD methods: most points drawn, largest nodes first (e.g. 100M; 0: no limit)")
+  cmd.add_option("--point-budget", a.pointBudget,
+                 "LOD methods: most points drawn, largest nodes first (e.g. 100M; 0: no limit)")
       ->capture_default_str()
       ->each(lodOption);
-  cmd->add_option(
-         "--gpu-memory", a->gpuMemory,
-         "LOD methods: GPU memory for the node cache (e.g. 8G; default: half the device's); a larger "
-         "selection is drawn in several passes")
+  cmd.add_option("--gpu-memory", a.gpuMemory,
+                 "LOD methods: GPU memory for the node cache (e.g. 8G; default: half the device's); a larger "
+                 "selection is drawn in several passes")
       ->each(lodOption);
-  cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
-  cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 1.2G)")
+  cmd.add_option("--seed", a.seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
+  cmd.add_option("--points", a.points, "Points of a generated scene (e.g. 1M, 1.2G)")->capture_default_str();
+  cmd.add_option("--frames", a.frames, "Timed frames; the median GPU time is reported")
       ->capture_default_str();
-  cmd->add_option("--frames", a->frames, "Timed frames; the median GPU time is reported")
+  cmd.add_option("--parts", a.parts, "Upload the cloud as N separate scenes drawn into one framebuffer")
       ->capture_default_str();
-  cmd->add_option("--parts", a->parts, "Upload the cloud as N separate scenes drawn into one framebuffer")
+}
+
+// What the sphere methods alone read.
+void addSphereOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_option("--radius", a.radius,
+                 "Sphere methods: radius of points drawn as spheres, or replacing an MMPLD file's radii");
+  cmd.add_option("--frame", a.frame, "Sphere methods: the MMPLD frame to draw")->capture_default_str();
+  cmd.add_option("--layout", a.layout, "Sphere methods: GPU particle layout soa8, vec4x2, aos, xyz, or auto")
       ->capture_default_str();
-  cmd->add_option("--radius", a->radius,
-                  "Sphere methods: radius of points drawn as spheres, or replacing an MMPLD file's radii");
-  cmd->add_option("--frame", a->frame, "Sphere methods: the MMPLD frame to draw")->capture_default_str();
-  cmd->add_option("--layout", a->layout,
-                  "Sphere methods: GPU particle layout soa8, vec4x2, aos, xyz, or auto")
+  cmd.add_option("--billboard", a.billboard,
+                 "Sphere pipelines that rasterize billboards: screen (the tight screen-space box of the "
+                 "projected sphere, the default) or camera (a camera-aligned square, side 2r enlarged to "
+                 "cover the sphere under perspective)");
+  cmd.add_flag("--conservative", a.conservative,
+               "Sphere pipelines that rasterize billboards: overestimating conservative rasterization "
+               "(VK_EXT_conservative_rasterization; refused where the device lacks it)");
+  cmd.add_option("--meshlet", a.meshlet,
+                 "sphere-mesh-points, sphere-mesh-tris: spheres per mesh workgroup, 31 (default) or 15");
+  cmd.add_flag("--task-cull", a.taskCull,
+               "sphere-mesh-points, sphere-mesh-tris: a task shader culls spheres outside the view first "
+               "and launches mesh workgroups only for the rest");
+}
+
+// Colors, point size, hole filling and eye-dome lighting.
+void addLookOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_option("--color", a.color,
+                 "Point colors: auto (RGB if the file has it, else intensity, else elevation), rgb, "
+                 "intensity, classification (ASPRS classes), elevation, return (return number), source "
+                 "(point source id)")
       ->capture_default_str();
-  cmd->add_option("--billboard", a->billboard,
-                  "Sphere pipelines that rasterize billboards: screen (the tight screen-space box of the "
-                  "projected sphere, the default) or camera (a camera-aligned square, side 2r enlarged to "
-                  "cover the sphere under perspective)");
-  cmd->add_flag("--conservative", a->conservative,
-                "Sphere pipelines that rasterize billboards: overestimating conservative rasterization "
-                "(VK_EXT_conservative_rasterization; refused where the device lacks it)");
-  cmd->add_option("--meshlet", a->meshlet,
-                  "sphere-mesh-points, sphere-mesh-tris: spheres per mesh workgroup, 31 (default) or 15");
-  cmd->add_flag("--task-cull", a->taskCull,
-                "sphere-mesh-points, sphere-mesh-tris: a task shader culls spheres outside the view first "
-                "and launches mesh workgroups only for the rest");
-  cmd->add_option("--color", a->color,
-                  "Point colors: auto (RGB if the file has it, else intensity, else elevation), rgb, "
-                  "intensity, classification (ASPRS classes), elevation, return (return number), source "
-                  "(point source id)")
+  cmd.add_option("--color-range", a.colorRange,
+                 "lo,hi mapped to the ends of the intensity or elevation ramp (default: the 0.5 % and 99.5 % "
+                 "percentiles)");
+  cmd.add_option("--point-size", a.pointSize,
+                 "Point size in pixels (1..32); the closest point still wins every pixel")
       ->capture_default_str();
-  cmd->add_option(
-      "--color-range", a->colorRange,
-      "lo,hi mapped to the ends of the intensity or elevation ramp (default: the 0.5 % and 99.5 % "
-      "percentiles)");
-  cmd->add_option("--point-size", a->pointSize,
-                  "Point size in pixels (1..32); the closest point still wins every pixel")
+  cmd.add_option("--point-shape", a.pointShape, "Shape of points larger than a pixel: square or disc")
       ->capture_default_str();
-  cmd->add_option("--point-shape", a->pointShape, "Shape of points larger than a pixel: square or disc")
+  cmd.add_option("--point-size-mode", a.pointSizeMode,
+                 "fixed (every point --point-size pixels) or attenuated (--point-size pixels at the target's "
+                 "distance, larger nearer and smaller farther, at most --point-size-max)")
       ->capture_default_str();
-  cmd->add_option(
-         "--point-size-mode", a->pointSizeMode,
-         "fixed (every point --point-size pixels) or attenuated (--point-size pixels at the target's "
-         "distance, larger nearer and smaller farther, at most --point-size-max)")
+  cmd.add_option("--point-size-max", a.pointSizeMax, "Attenuated point sizes: the largest, pixels (1..32)")
       ->capture_default_str();
-  cmd->add_option("--point-size-max", a->pointSizeMax, "Attenuated point sizes: the largest, pixels (1..32)")
+  cmd.add_option("--dilate", a.dilate,
+                 "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
+                 "point never covers a near one, and convex outlines do not grow")
       ->capture_default_str();
-  cmd->add_option("--dilate", a->dilate,
-                  "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
-                  "point never covers a near one, and convex outlines do not grow")
+  cmd.add_flag("--edl", a.edl,
+               "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
+               "its neighbours");
+  cmd.add_option("--edl-strength", a.edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
+  cmd.add_option("--edl-radius", a.edlRadius,
+                 "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
+}
+
+// Stereo and foveated level of detail.
+void addStereoOptions(CLI::App& cmd, RenderArgs& a) {
+  cmd.add_flag("--stereo", a.stereo,
+               "Batch and LOD methods: render both eyes in one pass, each --width x --height, into one "
+               "side-by-side image (left eye on the left); each point is read once and drawn into both eyes");
+  cmd.add_option("--ipd", a.ipd,
+                 "Stereo: distance between the eyes in scene units (default: the convergence distance / 30, "
+                 "comfortable whatever the units; 0.064 is life-size for a cloud in metres)");
+  cmd.add_option("--convergence", a.convergence,
+                 "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
+                 "the target's distance), or inf for parallel eyes as a VR headset renders");
+  cmd.add_option("--stereo-layout", a.stereoLayout,
+                 "Stereo output: side-by-side (one PNG, left eye left), cross-eyed (right eye left, for "
+                 "cross-eyed viewing) or separate (OUT-left.png and OUT-right.png)")
       ->capture_default_str();
-  cmd->add_flag("--edl", a->edl,
-                "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
-                "its neighbours");
-  cmd->add_option("--edl-strength", a->edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
-  cmd->add_option("--edl-radius", a->edlRadius,
-                  "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
-  cmd->add_flag(
-      "--stereo", a->stereo,
-      "Batch and LOD methods: render both eyes in one pass, each --width x --height, into one "
-      "side-by-side image (left eye on the left); each point is read once and drawn into both eyes");
-  cmd->add_option("--ipd", a->ipd,
-                  "Stereo: distance between the eyes in scene units (default: the convergence distance / 30, "
-                  "comfortable whatever the units; 0.064 is life-size for a cloud in metres)");
-  cmd->add_option(
-      "--convergence", a->convergence,
-      "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
-      "the target's distance), or inf for parallel eyes as a VR headset renders");
-  cmd->add_option("--stereo-layout", a->stereoLayout,
-                  "Stereo output: side-by-side (one PNG, left eye left), cross-eyed (right eye left, for "
-                  "cross-eyed viewing) or separate (OUT-left.png and OUT-right.png)")
-      ->capture_default_str();
-  cmd->add_flag("--foveated", a->foveated,
-                "LOD methods: foveated level of detail, nodes must look larger away from the image's centre "
-                "(each eye's centre in stereo) to be drawn");
-  cmd->add_option("--fovea-radius", a->foveaRadius,
-                  "Foveated LOD: radius of the fovea in half-diagonals of the image (0..1, default 0.3); "
-                  "inside it --min-node-px holds");
-  cmd->add_option(
-      "--fovea-periphery", a->foveaPeriphery,
-      "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
-      "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
+  cmd.add_flag("--foveated", a.foveated,
+               "LOD methods: foveated level of detail, nodes must look larger away from the image's centre "
+               "(each eye's centre in stereo) to be drawn");
+  cmd.add_option("--fovea-radius", a.foveaRadius,
+                 "Foveated LOD: radius of the fovea in half-diagonals of the image (0..1, default 0.3); "
+                 "inside it --min-node-px holds");
+  cmd.add_option("--fovea-periphery", a.foveaPeriphery,
+                 "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
+                 "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
+}
+
+} // namespace
+
+Command addRender(CLI::App& app) {
+  auto a = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a point cloud file or a generated scene to a PNG");
+  cmd->footer(renderFooter());
+  addViewOptions(*cmd, *a);
+  addMethodOptions(*cmd, *a);
+  addSphereOptions(*cmd, *a);
+  addLookOptions(*cmd, *a);
+  addStereoOptions(*cmd, *a);
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

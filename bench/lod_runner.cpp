@@ -58,24 +58,11 @@ void measureOctreeMethods(gpu::Context& context, Renderer& renderer, const Bench
   if (methods.empty() || views.empty()) return;
   OpenOctree octree = openOctree(context, config, dataset, cloud, run);
   const double aspect = double(config.width) / double(config.height);
-  // Clocks up again after the build, with the first method the device runs (GPUs only: settlesClocks).
-  for (Method method : methods) {
-    if (!settlesClocks(context)) break;
-    if (!octree.scene || !Renderer::supports(context, method)) continue;
-    const Camera camera = viewCamera(views.front(), cloud.bounds, aspect, config.fovY);
-    try {
-      settleClocks([&](uint32_t frames) {
-        RenderSettings settle;
-        settle.method = method;
-        settle.frames = frames;
-        settle.warmup = 0;
-        return renderer.render(*octree.scene, camera, settle).medianMs;
-      });
-    } catch (const UnsupportedError&) {
-    } catch (const InputError&) {
-    }
-    break;
-  }
+  // Clocks up again after the build, with the first method the device runs.
+  const Camera first = viewCamera(views.front(), cloud.bounds, aspect, config.fovY);
+  settleWithFirst(
+      context, methods, [&](Method m) { return octree.scene && Renderer::supports(context, m); },
+      [&](const RenderSettings& s) { return renderer.render(*octree.scene, first, s); });
   for (View view : views) {
     const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
     for (Method method : methods) {
@@ -95,23 +82,12 @@ void measureOctreeMethods(gpu::Context& context, Renderer& renderer, const Bench
         r.status = "unsupported";
         r.reason = why;
       } else {
-        RenderSettings settings;
-        settings.method = method;
-        settings.frames = config.frames;
-        settings.warmup = run.warmup;
         measureGuarded(
             r,
             [&] {
-              if (config.secondsPerCombination > 0) {
-                RenderSettings probe = settings;
-                probe.frames = 1;
-                probe.warmup = 0;
-                const double seconds = renderer.render(*octree.scene, camera, probe).medianMs * 1e-3;
-                settings.frames =
-                    budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
-                if (settings.frames < config.frames) settings.warmup = 1;
-              }
-              r.stats = renderer.render(*octree.scene, camera, settings);
+              r.stats = timeFrames(method, run, [&](const RenderSettings& s) {
+                return renderer.render(*octree.scene, camera, s);
+              });
             },
             record);
       }

@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,11 @@
 #include "bench/report.h"
 
 namespace pointrast::bench {
+
+// The data sets that were measured (not skipped), in run order.
+std::vector<const DatasetOutcome*> measuredDatasets(const std::vector<DatasetOutcome>& datasets);
+// Table cells must not break the row: '|' is escaped, newlines flattened.
+std::string mdCell(std::string_view text);
 
 // Writes `content` through a ".partial" file renamed into place. Throws InputError naming the file.
 void writeAtomically(const std::filesystem::path& path, const std::string& content);

@@ -218,50 +218,6 @@ OrderScenes uploadOrder(gpu::Context& context, const PointCloud& cloud, Order or
   return out;
 }
 
-// Renders with the first method the device runs until the GPU's clocks are up again after the host's work
-// (settleClocks). What goes wrong here is left to the combinations, which report it; a DeviceFault ends the
-// run as there.
-void settleFirst(gpu::Context& context, Renderer& renderer, const OrderScenes& order,
-                 const BenchConfig& config, const Camera& camera) {
-  if (!settlesClocks(context)) return;
-  for (Method method : config.methods) {
-    const GpuScene* scene = order.find(method.info().layout);
-    if (!scene || !Renderer::supports(context, method)) continue;
-    try {
-      settleClocks([&](uint32_t frames) {
-        RenderSettings settle;
-        settle.method = method;
-        settle.frames = frames;
-        settle.warmup = 0;
-        return renderer.render(*scene, camera, settle).medianMs;
-      });
-    } catch (const UnsupportedError&) {
-    } catch (const InputError&) {
-    }
-    return;
-  }
-}
-
-// Times one combination, `r` naming it: --frames frames after the warm-up, or as many as the time budget
-// allows after a probe frame.
-void timeCombination(Renderer& renderer, const GpuScene& scene, const BenchRun& run, const Camera& camera,
-                     Result& r) {
-  const BenchConfig& config = run.config;
-  RenderSettings settings;
-  settings.method = r.method;
-  settings.frames = config.frames;
-  settings.warmup = run.warmup;
-  if (config.secondsPerCombination > 0) {
-    RenderSettings probe = settings;
-    probe.frames = 1;
-    probe.warmup = 0;
-    const double seconds = renderer.render(scene, camera, probe).medianMs * 1e-3;
-    settings.frames = budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
-    if (settings.frames < config.frames) settings.warmup = 1;
-  }
-  r.stats = renderer.render(scene, camera, settings);
-}
-
 } // namespace
 
 void completeRates(Result& r, const gpu::CopyBandwidth& copy) {
@@ -280,6 +236,43 @@ double secondsSince(std::chrono::steady_clock::time_point since) {
 
 bool settlesClocks(const gpu::Context& context) {
   return !context.info().software();
+}
+
+void settleWithFirst(const gpu::Context& context, std::span<const Method> methods,
+                     const std::function<bool(Method)>& runs, const RenderFrames& render) {
+  if (!settlesClocks(context)) return;
+  for (Method method : methods) {
+    if (!runs(method)) continue;
+    try {
+      settleClocks([&](uint32_t frames) {
+        RenderSettings settle;
+        settle.method = method;
+        settle.frames = frames;
+        settle.warmup = 0;
+        return render(settle).medianMs;
+      });
+    } catch (const UnsupportedError&) {
+    } catch (const InputError&) {
+    }
+    return;
+  }
+}
+
+FrameStats timeFrames(Method method, const BenchRun& run, const RenderFrames& render) {
+  const BenchConfig& config = run.config;
+  RenderSettings settings;
+  settings.method = method;
+  settings.frames = config.frames;
+  settings.warmup = run.warmup;
+  if (config.secondsPerCombination > 0) {
+    RenderSettings probe = settings;
+    probe.frames = 1;
+    probe.warmup = 0;
+    const double seconds = render(probe).medianMs * 1e-3;
+    settings.frames = budgetedFrames(config.frames, run.warmup, seconds, config.secondsPerCombination);
+    if (settings.frames < config.frames) settings.warmup = 1;
+  }
+  return render(settings);
 }
 
 BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchCallbacks& callbacks) {
@@ -316,8 +309,13 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
         const OrderScenes scenes = uploadOrder(context, cloud, order, config);
         note(d.label + " / " + orderName(order) + ": ordered and uploaded in " +
              printf1("%.1f s", secondsSince(since)));
-        settleFirst(context, renderer, scenes, config,
-                    viewCamera(viewsOf(d, config).front(), cloud.bounds, aspect, config.fovY));
+        const Camera first = viewCamera(viewsOf(d, config).front(), cloud.bounds, aspect, config.fovY);
+        settleWithFirst(
+            context, config.methods,
+            [&](Method m) { return scenes.find(m.info().layout) && Renderer::supports(context, m); },
+            [&](const RenderSettings& s) {
+              return renderer.render(*scenes.find(s.method.info().layout), first, s);
+            });
         for (View view : viewsOf(d, config)) {
           const Camera camera = viewCamera(view, cloud.bounds, aspect, config.fovY);
           for (Method method : config.methods) {
@@ -341,7 +339,13 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
               r.reason = why;
             } else {
               measureGuarded(
-                  r, [&] { timeCombination(renderer, *scene, run, camera, r); }, record);
+                  r,
+                  [&] {
+                    r.stats = timeFrames(method, run, [&](const RenderSettings& s) {
+                      return renderer.render(*scene, camera, s);
+                    });
+                  },
+                  record);
             }
             completeRates(r, run.copy);
             record(r);

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -210,6 +211,20 @@ void runRecorded(gpu::Context& context, RunRecord& run, uint64_t copyBytes, int 
 // Whether settleClocks is worth its time before a data set's first combination: GPUs lower their clocks
 // while the host prepares data; a CPU device (lavapipe) has no GPU clocks to raise.
 bool settlesClocks(const gpu::Context& context);
+
+// Renders the combination's scene from its camera with `settings` (method, frames, warm-up) and returns
+// the frames' statistics: how the timing helpers below reach a Renderer and whatever scene it draws.
+using RenderFrames = std::function<FrameStats(const RenderSettings& settings)>;
+
+// Before a scene's first combination (GPUs only, settlesClocks): renders with the first of `methods` that
+// `runs` accepts until the GPU's clocks are up again after the host's work (settleClocks). What goes wrong
+// here is left to the combinations, which report it; a DeviceFault ends the run as there.
+void settleWithFirst(const gpu::Context& context, std::span<const Method> methods,
+                     const std::function<bool(Method)>& runs, const RenderFrames& render);
+
+// Times one combination of `method`: the run's frames after its warm-up, or as many as the time budget
+// allows after a probe frame (budgetedFrames).
+FrameStats timeFrames(Method method, const BenchRun& run, const RenderFrames& render);
 
 // Thrown by checkTimeLimit between combinations: the run ends there like after a device fault.
 struct TimeLimitReached : std::runtime_error {

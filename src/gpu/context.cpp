@@ -272,6 +272,167 @@ void Context::chooseDevice(const ContextOptions& options) {
                            std::to_string(VK_API_VERSION_MINOR(info_.apiVersion)) + "; pointrast needs 1.3");
 }
 
+namespace {
+
+// The feature structures the device reports (has*) and those given to vkCreateDevice (want*), linked
+// by pNext; the chains point into the object, so it stays where it was made.
+struct FeatureChain {
+  VkPhysicalDeviceVulkan13Features has13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &has13};
+  VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &has12};
+  VkPhysicalDeviceVulkan13Features want13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features want12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &want13};
+  VkPhysicalDeviceFeatures2 want{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &want12};
+  VkPhysicalDeviceMeshShaderFeaturesEXT wantMesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR wantAccel{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR wantRayTracing{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+
+  FeatureChain() = default;
+  FeatureChain(const FeatureChain&) = delete;
+  FeatureChain& operator=(const FeatureChain&) = delete;
+  // Adds a structure of an extension to what vkCreateDevice is given.
+  template <class T> void enable(T& feature) {
+    feature.pNext = want13.pNext;
+    want13.pNext = &feature;
+  }
+};
+
+// Throws UnsupportedError unless the device has what every method needs; then asks for that and for the
+// optional core features the device has (methods check DeviceFeatures before they use one).
+void chooseCoreFeatures(FeatureChain& c, const std::string& deviceName) {
+  auto require = [&](VkBool32 present, const char* feature) {
+    if (!present)
+      throw UnsupportedError("device '" + deviceName + "' lacks " + feature +
+                             ", which every pointrast method needs");
+  };
+  require(c.has.features.shaderInt64, "shaderInt64");
+  require(c.has12.bufferDeviceAddress, "bufferDeviceAddress");
+  require(c.has12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics (64-bit atomics on buffers)");
+  require(c.has13.synchronization2, "synchronization2");
+  c.want13.synchronization2 = VK_TRUE;
+  c.want13.dynamicRendering = c.has13.dynamicRendering; // hw-points draws without render pass objects
+  c.want13.maintenance4 = c.has13.maintenance4;
+  c.want13.subgroupSizeControl = c.has13.subgroupSizeControl;
+  c.want13.computeFullSubgroups = c.has13.computeFullSubgroups;
+  c.want12.bufferDeviceAddress = VK_TRUE;
+  c.want12.shaderBufferInt64Atomics = VK_TRUE;
+  c.want12.shaderSharedInt64Atomics = c.has12.shaderSharedInt64Atomics;
+  c.want12.scalarBlockLayout = c.has12.scalarBlockLayout;
+  c.want12.hostQueryReset = c.has12.hostQueryReset;
+  c.want12.shaderSubgroupExtendedTypes = c.has12.shaderSubgroupExtendedTypes;
+  c.want.features.shaderInt64 = VK_TRUE;
+  c.want.features.shaderFloat64 = c.has.features.shaderFloat64;
+  c.want.features.vertexPipelineStoresAndAtomics = c.has.features.vertexPipelineStoresAndAtomics;
+  c.want.features.fragmentStoresAndAtomics = c.has.features.fragmentStoresAndAtomics;
+  c.want.features.largePoints = c.has.features.largePoints;
+  c.want.features.geometryShader = c.has.features.geometryShader;
+}
+
+// The first queue family with graphics, compute and timestamps.
+uint32_t chooseQueueFamily(VkPhysicalDevice physical, const std::string& deviceName) {
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical, &familyCount, families.data());
+  constexpr VkQueueFlags kWanted = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+  for (uint32_t f = 0; f < familyCount; ++f)
+    if ((families[f].queueFlags & kWanted) == kWanted && families[f].timestampValidBits > 0) return f;
+  throw UnsupportedError("device '" + deviceName + "' has no queue with graphics, compute and timestamps");
+}
+
+// The device's extensions, by name.
+class ExtensionSet {
+public:
+  explicit ExtensionSet(VkPhysicalDevice physical) {
+    uint32_t count = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr));
+    all_.resize(count);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, all_.data()));
+  }
+  bool has(const char* name) const {
+    return std::any_of(all_.begin(), all_.end(), [&](const VkExtensionProperties& e) {
+      return std::strcmp(e.extensionName, name) == 0;
+    });
+  }
+
+private:
+  std::vector<VkExtensionProperties> all_;
+};
+
+// Mesh shaders and ray tracing: features and limits are queried only where the device lists the
+// extensions (a structure of an unsupported extension in a query or in vkCreateDevice is invalid), and
+// enabled only where the features are present. VK_KHR_spirv_1_4, which both require, is core in 1.2.
+// Fills `features`' meshShader, taskShader and rayTracing and the extensions' properties (zero where not
+// enabled).
+void enableMeshAndRayTracing(VkPhysicalDevice physical, const ExtensionSet& extensions, FeatureChain& chain,
+                             std::vector<const char*>& enabled, DeviceFeatures& features,
+                             VkPhysicalDeviceMeshShaderPropertiesEXT& meshProperties,
+                             VkPhysicalDeviceRayTracingPipelinePropertiesKHR& rayTracingProperties,
+                             VkPhysicalDeviceAccelerationStructurePropertiesKHR& accelerationProperties) {
+  VkPhysicalDeviceMeshShaderFeaturesEXT hasMesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR hasAccel{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR hasRayTracing{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  const bool meshExtension = extensions.has(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+  const bool rayTracingExtensions = extensions.has(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) &&
+                                    extensions.has(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
+                                    extensions.has(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+  if (meshExtension || rayTracingExtensions) {
+    VkPhysicalDeviceFeatures2 extensionFeatures{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    VkPhysicalDeviceProperties2 extensionProperties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    meshProperties = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_PROPERTIES_EXT};
+    rayTracingProperties = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR};
+    accelerationProperties = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+    if (meshExtension) {
+      hasMesh.pNext = extensionFeatures.pNext;
+      extensionFeatures.pNext = &hasMesh;
+      meshProperties.pNext = extensionProperties.pNext;
+      extensionProperties.pNext = &meshProperties;
+    }
+    if (rayTracingExtensions) {
+      hasAccel.pNext = extensionFeatures.pNext;
+      hasRayTracing.pNext = &hasAccel;
+      extensionFeatures.pNext = &hasRayTracing;
+      accelerationProperties.pNext = extensionProperties.pNext;
+      rayTracingProperties.pNext = &accelerationProperties;
+      extensionProperties.pNext = &rayTracingProperties;
+    }
+    vkGetPhysicalDeviceFeatures2(physical, &extensionFeatures);
+    vkGetPhysicalDeviceProperties2(physical, &extensionProperties);
+    meshProperties.pNext = nullptr;
+    rayTracingProperties.pNext = nullptr;
+    accelerationProperties.pNext = nullptr;
+  }
+  if (meshExtension && hasMesh.meshShader) {
+    enabled.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+    chain.wantMesh.meshShader = VK_TRUE;
+    chain.wantMesh.taskShader = hasMesh.taskShader;
+    chain.enable(chain.wantMesh);
+    features.meshShader = true;
+    features.taskShader = hasMesh.taskShader;
+  } else {
+    meshProperties = {};
+  }
+  if (rayTracingExtensions && hasRayTracing.rayTracingPipeline && hasAccel.accelerationStructure) {
+    enabled.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+    enabled.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+    enabled.push_back(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
+    chain.wantAccel.accelerationStructure = VK_TRUE;
+    chain.wantRayTracing.rayTracingPipeline = VK_TRUE;
+    chain.enable(chain.wantAccel);
+    chain.enable(chain.wantRayTracing);
+    features.rayTracing = true;
+  } else {
+    rayTracingProperties = {};
+    accelerationProperties = {};
+  }
+}
+
+} // namespace
+
 void Context::createDevice() {
   VkPhysicalDeviceMaintenance4Properties m4{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES};
   VkPhysicalDeviceMaintenance3Properties m3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES, &m4};
@@ -286,85 +447,27 @@ void Context::createDevice() {
       VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
   features_.subgroupCompute = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                               (subgroup.supportedOperations & kComputeOps) == kComputeOps;
-  bool partitioned = subgroup.supportedOperations & VK_SUBGROUP_FEATURE_PARTITIONED_BIT_NV;
   maxAllocation_ = m3.maxMemoryAllocationSize;
   maxBuffer_ = m4.maxBufferSize;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
   for (uint32_t h = 0; h < memory_.memoryHeapCount; ++h)
     if (memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
       deviceLocalBytes_ += memory_.memoryHeaps[h].size;
+  const bool partitioned = subgroup.supportedOperations & VK_SUBGROUP_FEATURE_PARTITIONED_BIT_NV;
 
-  VkPhysicalDeviceVulkan13Features has13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-  VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &has13};
-  VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &has12};
-  vkGetPhysicalDeviceFeatures2(physical_, &has);
-  auto require = [&](VkBool32 present, const char* feature) {
-    if (!present)
-      throw UnsupportedError("device '" + info_.name + "' lacks " + feature +
-                             ", which every pointrast method needs");
-  };
-  require(has.features.shaderInt64, "shaderInt64");
-  require(has12.bufferDeviceAddress, "bufferDeviceAddress");
-  require(has12.shaderBufferInt64Atomics, "shaderBufferInt64Atomics (64-bit atomics on buffers)");
-  require(has13.synchronization2, "synchronization2");
+  FeatureChain chain;
+  vkGetPhysicalDeviceFeatures2(physical_, &chain.has);
+  chooseCoreFeatures(chain, info_.name);
+  features_.float64 = chain.has.features.shaderFloat64;
+  features_.subgroupExtendedTypes = chain.has12.shaderSubgroupExtendedTypes;
+  features_.geometryShader = chain.has.features.geometryShader;
+  features_.largePoints = chain.has.features.largePoints;
+  features_.vertexStores = chain.has.features.vertexPipelineStoresAndAtomics;
+  queueFamily_ = chooseQueueFamily(physical_, info_.name);
 
-  uint32_t familyCount = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, nullptr);
-  std::vector<VkQueueFamilyProperties> families(familyCount);
-  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, families.data());
-  constexpr VkQueueFlags kWanted = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
-  bool found = false;
-  for (uint32_t f = 0; f < familyCount && !found; ++f)
-    if ((families[f].queueFlags & kWanted) == kWanted && families[f].timestampValidBits > 0) {
-      queueFamily_ = f;
-      found = true;
-    }
-  if (!found)
-    throw UnsupportedError("device '" + info_.name + "' has no queue with graphics, compute and timestamps");
-
-  float priority = 1.0f;
-  VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  queueInfo.queueFamilyIndex = queueFamily_;
-  queueInfo.queueCount = 1;
-  queueInfo.pQueuePriorities = &priority;
-
-  VkPhysicalDeviceVulkan13Features want13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-  want13.synchronization2 = VK_TRUE;
-  want13.dynamicRendering = has13.dynamicRendering; // hw-points draws without render pass objects
-  want13.maintenance4 = has13.maintenance4;
-  want13.subgroupSizeControl = has13.subgroupSizeControl;
-  want13.computeFullSubgroups = has13.computeFullSubgroups;
-  VkPhysicalDeviceVulkan12Features want12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &want13};
-  want12.bufferDeviceAddress = VK_TRUE;
-  want12.shaderBufferInt64Atomics = VK_TRUE;
-  want12.shaderSharedInt64Atomics = has12.shaderSharedInt64Atomics;
-  want12.scalarBlockLayout = has12.scalarBlockLayout;
-  want12.hostQueryReset = has12.hostQueryReset;
-  want12.shaderSubgroupExtendedTypes = has12.shaderSubgroupExtendedTypes;
-  VkPhysicalDeviceFeatures2 want{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &want12};
-  want.features.shaderInt64 = VK_TRUE;
-  want.features.shaderFloat64 = has.features.shaderFloat64;
-  want.features.vertexPipelineStoresAndAtomics = has.features.vertexPipelineStoresAndAtomics;
-  want.features.fragmentStoresAndAtomics = has.features.fragmentStoresAndAtomics;
-  want.features.largePoints = has.features.largePoints;
-  want.features.geometryShader = has.features.geometryShader;
-
-  uint32_t extensionCount = 0;
-  VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, nullptr));
-  std::vector<VkExtensionProperties> extensions(extensionCount);
-  VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, extensions.data()));
-  auto hasExtension = [&](const char* name) {
-    return std::any_of(extensions.begin(), extensions.end(), [&](const VkExtensionProperties& e) {
-      return std::strcmp(e.extensionName, name) == 0;
-    });
-  };
+  const ExtensionSet extensions(physical_);
   std::vector<const char*> enabled;
-  features_.float64 = has.features.shaderFloat64;
-  features_.subgroupExtendedTypes = has12.shaderSubgroupExtendedTypes;
-  features_.geometryShader = has.features.geometryShader;
-  features_.largePoints = has.features.largePoints;
-  features_.vertexStores = has.features.vertexPipelineStoresAndAtomics;
-  if (hasExtension(VK_EXT_CONSERVATIVE_RASTERIZATION_EXTENSION_NAME)) {
+  if (extensions.has(VK_EXT_CONSERVATIVE_RASTERIZATION_EXTENSION_NAME)) {
     VkPhysicalDeviceConservativeRasterizationPropertiesEXT conservative{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONSERVATIVE_RASTERIZATION_PROPERTIES_EXT};
     VkPhysicalDeviceProperties2 conservativeProps{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
@@ -374,85 +477,24 @@ void Context::createDevice() {
     features_.conservativeRasterization = true;
     features_.conservativePoints = conservative.conservativePointAndLineRasterization;
   }
-  // Mesh shaders and ray tracing: features and limits are queried only where the device lists the
-  // extensions (a structure of an unsupported extension in a query or in vkCreateDevice is invalid), and
-  // enabled only where the features are present. VK_KHR_spirv_1_4, which both require, is core in 1.2.
-  VkPhysicalDeviceMeshShaderFeaturesEXT hasMesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
-  VkPhysicalDeviceAccelerationStructureFeaturesKHR hasAccel{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
-  VkPhysicalDeviceRayTracingPipelineFeaturesKHR hasRayTracing{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
-  bool meshExtension = hasExtension(VK_EXT_MESH_SHADER_EXTENSION_NAME);
-  bool rayTracingExtensions = hasExtension(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) &&
-                              hasExtension(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
-                              hasExtension(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
-  if (meshExtension || rayTracingExtensions) {
-    VkPhysicalDeviceFeatures2 extensionFeatures{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-    VkPhysicalDeviceProperties2 extensionProperties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-    meshProperties_ = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_PROPERTIES_EXT};
-    rayTracingProperties_ = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR};
-    accelerationProperties_ = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
-    if (meshExtension) {
-      hasMesh.pNext = extensionFeatures.pNext;
-      extensionFeatures.pNext = &hasMesh;
-      meshProperties_.pNext = extensionProperties.pNext;
-      extensionProperties.pNext = &meshProperties_;
-    }
-    if (rayTracingExtensions) {
-      hasAccel.pNext = extensionFeatures.pNext;
-      hasRayTracing.pNext = &hasAccel;
-      extensionFeatures.pNext = &hasRayTracing;
-      accelerationProperties_.pNext = extensionProperties.pNext;
-      rayTracingProperties_.pNext = &accelerationProperties_;
-      extensionProperties.pNext = &rayTracingProperties_;
-    }
-    vkGetPhysicalDeviceFeatures2(physical_, &extensionFeatures);
-    vkGetPhysicalDeviceProperties2(physical_, &extensionProperties);
-    meshProperties_.pNext = nullptr;
-    rayTracingProperties_.pNext = nullptr;
-    accelerationProperties_.pNext = nullptr;
-  }
-  VkPhysicalDeviceMeshShaderFeaturesEXT wantMesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
-  VkPhysicalDeviceAccelerationStructureFeaturesKHR wantAccel{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
-  VkPhysicalDeviceRayTracingPipelineFeaturesKHR wantRayTracing{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
-  if (meshExtension && hasMesh.meshShader) {
-    enabled.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
-    wantMesh.meshShader = VK_TRUE;
-    wantMesh.taskShader = hasMesh.taskShader;
-    wantMesh.pNext = want13.pNext;
-    want13.pNext = &wantMesh;
-    features_.meshShader = true;
-    features_.taskShader = hasMesh.taskShader;
-  } else {
-    meshProperties_ = {};
-  }
-  if (rayTracingExtensions && hasRayTracing.rayTracingPipeline && hasAccel.accelerationStructure) {
-    enabled.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
-    enabled.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
-    enabled.push_back(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
-    wantAccel.accelerationStructure = VK_TRUE;
-    wantRayTracing.rayTracingPipeline = VK_TRUE;
-    wantRayTracing.pNext = &wantAccel;
-    wantAccel.pNext = want13.pNext;
-    want13.pNext = &wantRayTracing;
-    features_.rayTracing = true;
-  } else {
-    rayTracingProperties_ = {};
-    accelerationProperties_ = {};
-  }
+  enableMeshAndRayTracing(physical_, extensions, chain, enabled, features_, meshProperties_,
+                          rayTracingProperties_, accelerationProperties_);
   if (presenting_) {
-    if (!hasExtension(VK_KHR_SWAPCHAIN_EXTENSION_NAME))
+    if (!extensions.has(VK_KHR_SWAPCHAIN_EXTENSION_NAME))
       throw UnsupportedError("device '" + info_.name + "' cannot present to a window (no VK_KHR_swapchain)");
     enabled.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
   }
-  if (partitioned && hasExtension(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME)) {
+  if (partitioned && extensions.has(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME)) {
     enabled.push_back(VK_NV_SHADER_SUBGROUP_PARTITIONED_EXTENSION_NAME);
     features_.subgroupPartitionedNV = true;
   }
 
-  VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &want};
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queueInfo.queueFamilyIndex = queueFamily_;
+  queueInfo.queueCount = 1;
+  queueInfo.pQueuePriorities = &priority;
+  VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &chain.want};
   create.enabledExtensionCount = uint32_t(enabled.size());
   create.ppEnabledExtensionNames = enabled.data();
   create.queueCreateInfoCount = 1;
