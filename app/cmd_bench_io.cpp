@@ -12,6 +12,7 @@
 #include "base/parallel.h"
 #include "bench/io_bench.h"
 #include "bench/report.h"
+#include "bench/report_parts.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "io/io_util.h"
@@ -76,9 +77,9 @@ int runBenchIo(const BenchIoArgs& a) {
                                         ? std::filesystem::path("bench/results") / bench::ioDeviceName(run)
                                         : std::filesystem::path(a.out);
   std::filesystem::create_directories(dir);
-  writeFile(dir / (a.name + ".json"), j.dump(1) + "\n");
+  writeFile(dir / (a.name + ".json"), bench::jsonFileText(j));
   writeFile(dir / (a.name + ".md"), bench::ioMarkdownReport(run, a.commandLine, date));
-  if (a.json) std::printf("%s\n", j.dump().c_str());
+  if (a.json) std::printf("%s\n", jsonText(j).c_str());
   if (!a.quiet)
     std::fprintf(a.json ? stderr : stdout, "%zu file%s in %.1f s; wrote %s and %s\n", run.results.size(),
                  run.results.size() == 1 ? "" : "s", run.seconds, (dir / (a.name + ".json")).string().c_str(),

@@ -155,7 +155,7 @@ int runLod(const LodArgs& a) {
     return 130;
   }
   if (a.json)
-    std::printf("%s\n", toJson(a, report).dump().c_str());
+    std::printf("%s\n", jsonText(toJson(a, report)).c_str());
   else if (!a.quiet)
     printSummary(a, report);
   return 0;

@@ -9,6 +9,7 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "cli_util.h"
 #include "gpu/context.h"
 #include "io/video_writer.h"
 #include "view/path_render.h"
@@ -77,7 +78,7 @@ int renderCameraPath(gpu::Context& context, Renderer& renderer, std::span<const 
     j["frames_per_second"] = result.framesPerSecond;
     j["median_render_ms"] = result.medianRenderMs;
     j["output"] = output;
-    std::printf("%s\n", j.dump().c_str());
+    std::printf("%s\n", jsonText(j).c_str());
   } else if (!quiet) {
     std::printf(
         "%s: %llu frames, %ux%u at %g fps, %s: rendered and written in %.2f s (%.1f frames/s; %.3f ms "

@@ -210,7 +210,7 @@ private:
     nlohmann::json sizes;
     folderBytes(dir, &sizes);
     j["files"] = sizes;
-    writeAtomically(record, j.dump(2) + "\n");
+    writeAtomically(record, jsonFileText(j));
     note("octree cache: built " + dir.string() + " in " + printf1("%.1f s", o.buildSeconds) + " (" +
          o.phases + ")");
     return o;

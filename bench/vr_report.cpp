@@ -190,7 +190,7 @@ std::string vrSuiteSvg(const VrSuiteRun& run, const ReportInfo& info) {
 
 WrittenFiles writeVrSuiteReports(const VrSuiteRun& run, const ReportInfo& info,
                                  const std::filesystem::path& dir) {
-  return writeReportFiles(dir, info.name, vrSuiteJson(run, info).dump(2), vrSuiteMarkdown(run, info),
+  return writeReportFiles(dir, info.name, jsonFileText(vrSuiteJson(run, info)), vrSuiteMarkdown(run, info),
                           vrSuiteSvg(run, info));
 }
 

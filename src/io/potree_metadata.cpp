@@ -281,7 +281,9 @@ std::string metadataJson(const Metadata& m) {
   }
   // Not a Potree field (the viewer ignores it): tells a reader that the integers are exact.
   j["generator"] = m.generator;
-  return j.dump(2) + "\n";
+  // A name taken from a file name in another encoding than UTF-8 is replaced, not an exception after the
+  // whole build.
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 Metadata parseMetadata(const std::string& text, const std::filesystem::path& file) {
