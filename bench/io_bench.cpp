@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "base/build_info.h"
 #include "base/parallel.h"
 #include "bench/report.h"
 #include "io/io_util.h"
@@ -213,6 +214,7 @@ nlohmann::json ioRunJson(const IoBenchRun& run, const std::string& commandLine, 
   j["load_average_after"] = run.loadAfter;
   j["command"] = commandLine;
   j["date"] = date;
+  j["commit"] = buildCommit();
   j["seconds"] = run.seconds;
   j["results"] = nlohmann::json::array();
   for (const IoResult& r : run.results) {
@@ -280,7 +282,8 @@ std::string ioMarkdownReport(const IoBenchRun& run, const std::string& commandLi
                   r.points ? double(r.compressedBytes) / double(r.points) : 0.0);
     md << line;
   }
-  md << "\nCommand: `" << commandLine << "`, " << date << ", " << run.seconds << " s.\n";
+  md << "\nCommand: `" << commandLine << "`, " << date << ", " << run.seconds << " s; pointrast "
+     << buildCommit() << ".\n";
   return md.str();
 }
 
