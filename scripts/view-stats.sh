@@ -19,8 +19,8 @@ work=$(mktemp -d)
 xvfb=""
 viewer=""
 cleanup() {
-  [ -n "$viewer" ] && kill "$viewer" 2>/dev/null || true
-  [ -n "$xvfb" ] && kill "$xvfb" 2>/dev/null || true
+  if [ -n "$viewer" ]; then kill "$viewer" 2>/dev/null || true; fi
+  if [ -n "$xvfb" ]; then kill "$xvfb" 2>/dev/null || true; fi
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -31,13 +31,18 @@ xvfb=$!
 exec 3>&-
 for _ in $(seq 100); do [ -s "$work/display" ] && break; sleep 0.1; done
 [ -s "$work/display" ] || { echo "view-stats: Xvfb did not start" >&2; exit 1; }
-export DISPLAY=":$(head -n1 "$work/display")"
+DISPLAY=":$(head -n1 "$work/display")"
+export DISPLAY
 
 "$bin" view "$@" --no-vsync --events -q --stats "$out" --path "$work/path.json" \
   >"$work/events" 2>"$work/errors" &
 viewer=$!
 
-frames() { grep -c '"event":"frame"' "$work/events" || true; }
+frames() {
+  local n
+  n=$(grep -c '"event":"frame"' "$work/events" 2>/dev/null || true)
+  echo "${n:-0}"
+}
 # Waits up to $2 seconds for more than $1 frames; fails when the viewer exited.
 wait_frames() {
   local deadline=$((SECONDS + $2))
