@@ -37,6 +37,8 @@ void checkStatsFile(const std::string& stats) {
   std::error_code error;
   if (!parent.empty() && !std::filesystem::is_directory(parent, error))
     throw InputError(stats + ": --stats names a file in a folder that does not exist");
+  if (std::filesystem::is_directory(stats, error))
+    throw InputError(stats + ": --stats names a folder; give the JSON file to write");
 }
 
 // The statistics of every frame the session rendered, as one JSON document (a file written whole, or one

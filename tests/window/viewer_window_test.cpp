@@ -352,13 +352,16 @@ TEST_F(ViewerWindow, StatsGoToStdoutAsOneLineAfterTheExit) {
   EXPECT_GT((*stats)["passes"]["render"]["median_ms"].get<double>(), 0);
 }
 
-TEST_F(ViewerWindow, StatsInAFolderThatIsNotThereFailBeforeTheWindowOpens) {
-  std::string command = "DISPLAY=" + display() + " '" + pointrastBinary() + "' view '" + autzen() +
-                        "' --stats /nonexistent/folder/stats.json 2>&1; echo \"exit=$?\"";
-  std::string out = shellOutput(command);
-  EXPECT_NE(out.find("--stats"), std::string::npos) << out;
-  EXPECT_NE(out.find("exit=1"), std::string::npos) << out;
-  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 2) << "one line, then the exit status: " << out;
+TEST_F(ViewerWindow, StatsThatCannotBeWrittenFailBeforeTheWindowOpens) {
+  // A folder that is not there, and a folder where the file should be.
+  for (std::string stats : {std::string("/nonexistent/folder/stats.json"), tempDir().string()}) {
+    std::string command = "DISPLAY=" + display() + " '" + pointrastBinary() + "' view '" + autzen() +
+                          "' --stats '" + stats + "' 2>&1; echo \"exit=$?\"";
+    std::string out = shellOutput(command);
+    EXPECT_NE(out.find("--stats"), std::string::npos) << out;
+    EXPECT_NE(out.find("exit=1"), std::string::npos) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 2) << "one line, then the exit status: " << out;
+  }
 }
 
 TEST(ViewerWithoutDisplay, SaysSoInOneLineAndExits1) {
