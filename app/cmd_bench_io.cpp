@@ -28,7 +28,6 @@ struct BenchIoArgs {
   int repeats = 5;
   bool noReadCloud = false, json = false, quiet = false;
   std::string out, name = "io-laz";
-  std::string commandLine;
 };
 
 std::vector<unsigned> parseThreads(const std::vector<std::string>& items) {
@@ -72,13 +71,14 @@ int runBenchIo(const BenchIoArgs& a) {
 
   const bench::IoBenchRun run = bench::runIoBench(config, !a.quiet);
   const std::string date = bench::utcNow();
-  const nlohmann::json j = bench::ioRunJson(run, a.commandLine, date);
+  const std::string command = commandLine("pointrast bench-io");
+  const nlohmann::json j = bench::ioRunJson(run, command, date);
   const std::filesystem::path dir = a.out.empty()
                                         ? std::filesystem::path("bench/results") / bench::ioDeviceName(run)
                                         : std::filesystem::path(a.out);
   std::filesystem::create_directories(dir);
   writeFile(dir / (a.name + ".json"), bench::jsonFileText(j));
-  writeFile(dir / (a.name + ".md"), bench::ioMarkdownReport(run, a.commandLine, date));
+  writeFile(dir / (a.name + ".md"), bench::ioMarkdownReport(run, command, date));
   if (a.json) std::printf("%s\n", jsonText(j).c_str());
   if (!a.quiet)
     std::fprintf(a.json ? stderr : stdout, "%zu file%s in %.1f s; wrote %s and %s\n", run.results.size(),
@@ -89,10 +89,8 @@ int runBenchIo(const BenchIoArgs& a) {
 
 } // namespace
 
-Command addBenchIo(CLI::App& app, int argc, char** argv) {
+Command addBenchIo(CLI::App& app) {
   auto a = std::make_shared<BenchIoArgs>();
-  for (int i = 0; i < argc; ++i)
-    a->commandLine += (i ? " " : "") + std::string(argv[i]);
   CLI::App* cmd = app.add_subcommand("bench-io", "Measure LAZ decoding throughput on 1 and on all cores");
   cmd->footer(
       "\nDecodes every chunk of each LAZ (or COPC) file to raw LAS records, from compressed chunks read\n"

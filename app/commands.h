@@ -21,7 +21,7 @@ Command addRender(CLI::App& app);
 Command addConvert(CLI::App& app);
 Command addGenerate(CLI::App& app);
 Command addBench(CLI::App& app);
-Command addBenchIo(CLI::App& app, int argc, char** argv); // argv: the command line for the report
+Command addBenchIo(CLI::App& app);
 Command addView(CLI::App& app);
 Command addLod(CLI::App& app);
 Command addServe(CLI::App& app);

@@ -57,7 +57,7 @@ int runCommand(int argc, char** argv) {
   app::Command convert = app::addConvert(app);
   app::Command generate = app::addGenerate(app);
   app::Command bench = app::addBench(app);
-  app::Command benchIo = app::addBenchIo(app, argc, argv);
+  app::Command benchIo = app::addBenchIo(app);
   app::Command view = app::addView(app);
   app::Command lod = app::addLod(app);
   app::Command serve = app::addServe(app);
