@@ -24,7 +24,7 @@ protected:
 TEST_F(TestMethodCli, HelpAndErrorsListTheRowAdded) {
   CliResult help = runPointrast("render --help");
   ASSERT_EQ(help.exitCode, 0) << help.err;
-  EXPECT_NE(help.out.find("  closest-variant  "), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("\n  closest-variant "), std::string::npos) << help.out;
   EXPECT_NE(help.out.find("a closest-point variant from one table row and one shader"), std::string::npos);
   CliResult unknown = runPointrast("render terrain --points 1000 --method no-such-method -o " +
                                    (cliTempDir() / "unknown.png").string());
