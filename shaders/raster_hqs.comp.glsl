@@ -7,7 +7,8 @@
 //                        then 2 uint64 per pixel of 32-bit fallback sums for points past the 255th.
 // Like raster_closest, a thread draws POINTS_PER_THREAD points a workgroup size apart (lanes of a subgroup
 // hold consecutive points), loading all positions first; a point reads its color only once it is known to
-// blend, so hidden points cost their 12 B of position alone.
+// blend, so hidden points cost their 12 B of position alone. The workgroup's sums meet in its shared-memory
+// table and reach the accumulators once per pixel at the end.
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require
@@ -24,7 +25,8 @@ layout(constant_id = 1) const uint POINTS_PER_THREAD = 1;
 #include "point.inc.glsl"
 
 void main() {
-  // No early return anywhere: the subgroup operations of hqsBlend need every lane.
+  // No early return anywhere: the subgroup operations of hqsBlend and the table's barriers need every lane.
+  hqsTableClear();
   uint first = firstPointOfThread(POINTS_PER_THREAD);
   vec3 positions[POINTS_PER_THREAD];
   for (uint k = 0; k < POINTS_PER_THREAD; ++k)
@@ -45,4 +47,5 @@ void main() {
     }
     hqsBlend(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0, pixel, r, g, b, pixel != kNoPixel ? 1u : 0u);
   }
+  hqsTableFlush(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0);
 }
