@@ -35,6 +35,10 @@ fi
 export POINTRAST_GPU_TIMEOUT_S=${POINTRAST_GPU_TIMEOUT_S:-40}
 export POINTRAST_BIN=$PWD/.gpu/bin/pointrast POINTRAST_DATA_DIR=$PWD/.gpu/data XDG_RUNTIME_DIR=/tmp
 pr=$POINTRAST_BIN
+# The small ffmpeg gpu-bundle.sh builds, where the machine has none (video checks and the CLI video tests).
+if ! command -v ffmpeg >/dev/null && [ -x .gpu/ffmpeg/ffmpeg ]; then
+  export PATH=$PWD/.gpu/ffmpeg:$PATH LD_LIBRARY_PATH=$PWD/.gpu/ffmpeg${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+fi
 
 echo "== machine"
 nvidia-smi -L 2>/dev/null || true
@@ -86,6 +90,11 @@ for what in "$@"; do
     if command -v ffmpeg >/dev/null || [ -n "${POINTRAST_FFMPEG:-}" ]; then dst=(--video /tmp/orbit-1g.mp4); else dst=(--frames-dir /tmp/orbit-1g); fi
     POINTRAST_VALIDATION=0 $pr render terrain --points 1G --order morton --method batch-prefetch --path orbit \
       --fps 60 --width 1920 --height 1080 "${dst[@]}" --json | tee "$OUT/view-path-1g.json" || status=1
+    if [ -f /tmp/orbit-1g.mp4 ] && command -v ffprobe >/dev/null; then
+      echo "== ffprobe of the video (frames counted by decoding)"
+      ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=codec_name,width,height,nb_read_frames \
+        -of json /tmp/orbit-1g.mp4 | tee "$OUT/view-path-1g-ffprobe.json" || status=1
+    fi
     ;;
   big)
     # 1.2 billion generated points (float32 xyz alone: 14.4 GB) drawn as one upload and as 12 separately
