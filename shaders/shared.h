@@ -373,7 +373,9 @@ struct SphereFrame {
   uint chunkCapacity;   // entries the chunk list holds
   uint background;      // RGBA8 written where no sphere covers the pixel center
   uint64_t counters;    // uint[4] statistics of the frame: [0] spheres whose point size was clamped;
-                        // sphere-compute counting its work: [1] pixels ray-tested, [2] depth atomics,
+                        // sphere-compute counting its work: [0] pixels of large-sphere chunks drawn,
+                        // [1] pixels tested (a visibility-word read each, before early-z; all passes),
+                        // [2] depth atomics,
                         // [3] large-sphere chunks skipped by their tile's depth bound
   float maxPointSize;   // sphere-points: the device's largest point size
   uint tilesX;          // sphere-compute: tiles per row of tileBounds, ceil(width / kSphereTileSide)

@@ -29,10 +29,10 @@ void countWork(uint counter) {
 // already holding something nearer than the sphere's front (center depth - radius) skips the ray test,
 // and the atomic runs only if the word can still win.
 void coverPixel(vec3 center, float radius, uint index, ivec2 p) {
+  countWork(1);
   uint pixel = uint(p.y) * frame.width + uint(p.x);
   Uint64Array fb = Uint64Array(frame.framebuffer);
   if (uint(fb.v[pixel] >> 32) < floatBitsToUint(-center.z - radius)) return;
-  countWork(1);
   float depth;
   if (!intersectSphere(center, radius, sphereRay(frame.pixelToRay, vec2(p) + 0.5), depth)) return;
   uint64_t word = (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(index);

@@ -10,6 +10,18 @@
 layout(local_size_x = kSphereChunkPixels) in;
 layout(push_constant) uniform Push { SpherePush pc; };
 
+// This invocation's pixel of the chunk, if the chunk has it.
+void drawChunkPixel(uint index, ivec4 chunk) {
+  ivec2 p = chunk.xy + ivec2(gl_LocalInvocationIndex % kSphereTileSide,
+                             gl_LocalInvocationIndex / kSphereTileSide);
+  if (p.x > chunk.z || p.y > chunk.w) return;
+  countWork(0);
+  Sphere s = sphereByIndex(index);
+  vec3 center;
+  // Always true for a listed sphere (the same call as in pass 1).
+  if (viewSphere(s, center)) coverPixel(center, s.radius, index, p);
+}
+
 void main() {
   frame = SphereFrameRef(pc.frame).f;
   SphereChunks list = SphereChunks(frame.chunks);
@@ -19,14 +31,8 @@ void main() {
     ivec4 chunk = unpackChunk(entry.yz);
     if (TILE_BOUND != 0 && entry.w > UintArray(frame.tileBounds).v[tileOf(chunk.xy)]) {
       if (gl_LocalInvocationIndex == 0) countWork(3);
-      continue;
+    } else {
+      drawChunkPixel(entry.x, chunk);
     }
-    ivec2 p = chunk.xy + ivec2(gl_LocalInvocationIndex % kSphereTileSide,
-                               gl_LocalInvocationIndex / kSphereTileSide);
-    if (p.x > chunk.z || p.y > chunk.w) continue;
-    Sphere s = sphereByIndex(entry.x);
-    vec3 center;
-    // Always true for a listed sphere (the same call as in pass 1).
-    if (viewSphere(s, center)) coverPixel(center, s.radius, entry.x, p);
   }
 }

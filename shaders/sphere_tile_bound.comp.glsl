@@ -8,8 +8,9 @@
 //     centers of the tile are convex combinations of its corners on the plane z = -1: every one is hit;
 //   - over that cone 1 / (nearest-hit depth) is concave (a projective map of the convex sphere), so the
 //     nearest-hit depth is largest at a corner;
-//   - the bound is widened by 2^-12 of itself against the rounding of both spheres' depths, so a skipped
-//     sphere would have lost every pixel of the tile: the image is the same with and without the bounds.
+//   - the bound is widened by 2048 units in the last place (2^-12 to 2^-11 of itself, an integer add on
+//     its bits) against the rounding of both spheres' depths, so a skipped sphere would have lost every
+//     pixel of the tile: the image is the same with and without the bounds.
 // The spilled chunks (drawn by pass 1) set no bound; a tile without a bound skips nothing.
 #include "sphere_raster.inc.glsl"
 
@@ -47,6 +48,6 @@ void main() {
     float depth = coveredDepth(center, s.radius, chunk);
     if (depth > 0.0)
       atomicMin(UintArray(frame.tileBounds).v[tileOf(chunk.xy)],
-                floatBitsToUint(depth * (1.0 + 1.0 / 4096.0)));
+                floatBitsToUint(depth) + 2048u);
   }
 }
