@@ -3,6 +3,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -121,6 +124,30 @@ uint64_t imageHash(const uint32_t* pixels, uint64_t count) {
   for (uint64_t i = 0; i < count * 4; ++i)
     h = (h ^ bytes[i]) * 0x100000001b3ull;
   return h;
+}
+
+// The command as typed, for the report (the Linux kernel keeps it NUL-separated).
+std::string commandLine(std::string_view fallback) {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string raw{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string line;
+  size_t at = 0;
+  bool first = true;
+  while (at < raw.size()) {
+    size_t end = raw.find('\0', at);
+    std::string arg = raw.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    if (first) arg = std::filesystem::path(arg).filename().string();
+    if (arg.empty() || arg.find_first_of(" \t'\"$\\") != std::string::npos) {
+      std::string quoted = "'";
+      for (char c : arg)
+        quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      arg = quoted + "'";
+    }
+    line += (first ? "" : " ") + arg;
+    first = false;
+    at = end == std::string::npos ? raw.size() : end + 1;
+  }
+  return line.empty() ? std::string(fallback) : line;
 }
 
 } // namespace pointrast::app

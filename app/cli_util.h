@@ -31,4 +31,8 @@ uint64_t parseBytes(std::string_view text, std::string_view option);
 // 64-bit FNV-1a of the image bytes: lets two renders be compared without keeping both images.
 uint64_t imageHash(const uint32_t* pixels, uint64_t count);
 
+// The command as typed (from /proc/self/cmdline; arguments with spaces or quotes quoted for a shell),
+// for a report to say how to reproduce it; `fallback` where the kernel does not tell.
+std::string commandLine(std::string_view fallback);
+
 } // namespace pointrast::app

@@ -103,30 +103,6 @@ std::vector<T> parseList(const std::string& text, const std::string& option, con
   return out;
 }
 
-// The command as typed, for the report (the Linux kernel keeps it NUL-separated).
-std::string commandLine() {
-  std::ifstream in("/proc/self/cmdline", std::ios::binary);
-  std::string raw{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  std::string line;
-  size_t at = 0;
-  bool first = true;
-  while (at < raw.size()) {
-    size_t end = raw.find('\0', at);
-    std::string arg = raw.substr(at, end == std::string::npos ? std::string::npos : end - at);
-    if (first) arg = std::filesystem::path(arg).filename().string();
-    if (arg.empty() || arg.find_first_of(" \t'\"$\\") != std::string::npos) {
-      std::string quoted = "'";
-      for (char c : arg)
-        quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-      arg = quoted + "'";
-    }
-    line += (first ? "" : " ") + arg;
-    first = false;
-    at = end == std::string::npos ? raw.size() : end + 1;
-  }
-  return line.empty() ? "pointrast bench" : line;
-}
-
 std::vector<bench::Dataset> inputDatasets(const BenchArgs& a) {
   std::vector<std::string> inputs = a.inputs;
   if (inputs.empty()) inputs.push_back(kDemoScene);
@@ -236,7 +212,7 @@ bench::ReportInfo suiteReportInfo(const BenchArgs& a) {
     info.title += std::string(" (scale ") + text + ")";
   }
   if (!a.name.empty()) info.name = a.name;
-  info.commandLine = commandLine();
+  info.commandLine = commandLine("pointrast bench");
   info.date = bench::utcNow();
   return info;
 }
@@ -520,7 +496,7 @@ int runBench(const BenchArgs& a) {
     info.title = info.name;
   }
   if (!a.name.empty()) info.name = a.name;
-  info.commandLine = commandLine();
+  info.commandLine = commandLine("pointrast bench");
   info.date = bench::utcNow();
 
   gpu::Context context(contextOptions(a));

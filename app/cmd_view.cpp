@@ -1,4 +1,6 @@
 // pointrast view [FILE|SCENE]: the desktop viewer.
+#include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -7,6 +9,8 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "bench/report_parts.h"
+#include "bench/view_report.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "input.h"
@@ -18,13 +22,42 @@ namespace {
 
 struct ViewArgs {
   std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
-  std::string method = "atomicmin", points = "1M", path = "path.json", screenshots = ".";
+  std::string method = "atomicmin", points = "1M", path = "path.json", screenshots = ".", stats;
   uint32_t width = 1280, height = 720;
   double fov = 60;
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool noPanel = false, noVsync = false, events = false, quiet = false;
 };
+
+// Said before the window opens, so a session's statistics are not lost to a folder that is not there.
+void checkStatsFile(const std::string& stats) {
+  if (stats.empty() || stats == "-") return;
+  std::filesystem::path parent = std::filesystem::path(stats).parent_path();
+  std::error_code error;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, error))
+    throw InputError(stats + ": --stats names a file in a folder that does not exist");
+  if (std::filesystem::is_directory(stats, error))
+    throw InputError(stats + ": --stats names a folder; give the JSON file to write");
+}
+
+// The statistics of every frame the session rendered, as one JSON document (a file written whole, or one
+// line on stdout for `-`).
+void writeStats(const ViewArgs& a, const PointCloud& cloud, const view::FrameLog& log,
+                const view::ViewerOptions& options) {
+  bench::ReportInfo info;
+  std::filesystem::path file(a.stats);
+  info.name = a.stats == "-" ? "view" : file.stem().string();
+  info.title = "pointrast view: " + cloud.source;
+  info.commandLine = commandLine("pointrast view");
+  info.date = bench::utcNow();
+  const nlohmann::json j =
+      bench::viewStatsJson(log, {cloud.source, cloud.size(), options.vsync, options.panel}, info);
+  if (a.stats == "-")
+    std::printf("%s\n", jsonText(j).c_str());
+  else
+    bench::writeAtomically(file, bench::jsonFileText(j));
+}
 
 int runView(const ViewArgs& a) {
   // Said before anything is loaded: there is no window to show it in.
@@ -47,12 +80,17 @@ int runView(const ViewArgs& a) {
   options.screenshotDir = a.screenshots;
   options.device = a.device;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  checkStatsFile(a.stats);
+  view::FrameLog log;
+  if (!a.stats.empty()) options.frameLog = &log;
 
   PointCloud cloud = loadInput(inputSpec(a.input, a.points, a.seed, a.order, a.quiet));
   if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, cloud.bounds.center()))
     options.camera = camera;
   options.title = "pointrast - " + cloud.source;
-  return view::runViewer(cloud, options);
+  const int status = view::runViewer(cloud, options);
+  if (!a.stats.empty()) writeStats(a, cloud, log, options);
+  return status;
 }
 
 } // namespace
@@ -69,11 +107,15 @@ Command addView(CLI::App& app) {
       "once);\n"
       "C prints the camera as render options; F12 writes a screenshot; H hides the panel; Escape quits.\n"
       "Keyframes render to a video with `pointrast render FILE --path path.json --video out.mp4`.\n"
+      "--stats writes, as the window closes, the median and 95th percentile GPU time of each pass\n"
+      "(render: clear + draw + resolve; present: the image into the window, and the panel) and of the\n"
+      "frame over every frame rendered, the host's frame time, the device and the commit (JSON).\n"
       "Without a display, use `pointrast serve` (a browser) or `pointrast render` (images).\n\n"
       "Examples:\n"
       "  pointrast view autzen.las\n"
       "  pointrast view terrain --points 10M --method batch-prefetch\n"
-      "  pointrast view autzen.las --eye 636000,848900,700 --target 636600,849200,450 --no-panel");
+      "  pointrast view autzen.las --eye 636000,848900,700 --target 636600,849200,450 --no-panel\n"
+      "  pointrast view terrain --points 10M --no-vsync --stats view.json  # then drag, and Escape");
   cmd->add_option("FILE", a->input,
                   "LAS/PLY/XYZ file, or a scene name (terrain, tls); default: the demo scene");
   cmd->add_option("--width", a->width, "Window width in pixels")->capture_default_str();
@@ -99,6 +141,9 @@ Command addView(CLI::App& app) {
   cmd->add_flag(
       "--events", a->events,
       "Print one JSON object a line on stdout for every frame shown and every action (for scripts)");
+  cmd->add_option("--stats", a->stats,
+                  "At the close, write the GPU time per pass and per frame over the frames rendered to "
+                  "this JSON file (- for one line on stdout)");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
   return [a] { return runView(*a); };

@@ -122,9 +122,8 @@ void writeAtomically(const std::filesystem::path& path, const std::string& conte
   }
 }
 
-// What every report's JSON starts with: the run's identity, the device and the copy bandwidth.
-nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
-                             const gpu::CopyBandwidth& copy, double seconds) {
+nlohmann::json identityJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
+                            double seconds) {
   nlohmann::json j;
   j["name"] = info.name;
   j["title"] = info.title;
@@ -135,6 +134,13 @@ nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& devi
   j["device"] = {{"name", device.name},          {"type", device.typeName},
                  {"driver", device.driver},      {"vulkan", apiVersion(device.apiVersion)},
                  {"vendor_id", device.vendorId}, {"device_local_bytes", deviceLocalBytes}};
+  return j;
+}
+
+// What every report's JSON starts with: the run's identity, the device and the copy bandwidth.
+nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
+                             const gpu::CopyBandwidth& copy, double seconds) {
+  nlohmann::json j = identityJson(info, device, deviceLocalBytes, seconds);
   j["copy_bandwidth"] = {
       {"bytes", copy.bytes},
       {"repeats", copy.repeats},
@@ -369,6 +375,7 @@ nlohmann::json batchStatsJson(const BatchStats& b) {
           {"points_processed", b.pointsProcessed},
           {"points_rendered", b.pointsRendered},
           {"points_blended", b.pointsBlended},
+          {"blend_atomics", b.blendAtomics},
           {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
           {"bytes_read", b.bytesRead}};
 }

@@ -17,6 +17,10 @@ namespace pointrast::bench {
 // Writes `content` through a ".partial" file renamed into place. Throws InputError naming the file.
 void writeAtomically(const std::filesystem::path& path, const std::string& content);
 
+// The run's identity (name, title, command line, date, commit, wall seconds) and the device: the start of
+// every report's JSON, also of reports that measure no copy bandwidth (the viewer's statistics).
+nlohmann::json identityJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
+                            double seconds);
 // What every report's JSON starts with: the run's identity, the device and the copy bandwidth.
 nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
                              const gpu::CopyBandwidth& copy, double seconds);

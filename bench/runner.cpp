@@ -76,14 +76,19 @@ double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
   const std::function<double()> now = clock ? clock : [&] { return secondsSince(steadyStart); };
   const double start = now();
   auto elapsed = [&] { return now() - start; };
+  // Round 0 is one frame that only sizes the rounds; the rounds after it are compared with the fastest of
+  // them so far. Two rounds that agree with each other but not with a faster earlier one are clocks that fell
+  // again, not the device's speed (bench/NOTES.md, session 4).
   uint32_t frames = 1;
-  double last = 0;
-  for (int round = 0; elapsed() < 3.0; ++round) {
+  double best = 0, previous = 0;
+  for (int round = 0; round < kSettleMaxRounds && elapsed() < kSettleMaxSeconds; ++round) {
     const double ms = renderMs(frames);
     if (!(ms > 0)) break; // nothing measurable to settle on
-    if (round >= 2 && std::abs(ms - last) <= 0.03 * last && elapsed() >= 0.2) break;
-    last = ms;
-    frames = uint32_t(std::clamp(std::ceil(30.0 / ms), 1.0, 200.0));
+    if (round >= 1) best = round == 1 ? ms : std::min(best, ms);
+    const double near = best * (1 + kSettleTolerance);
+    if (round >= 2 && previous <= near && ms <= near && elapsed() >= kSettleMinSeconds) break;
+    previous = ms;
+    frames = uint32_t(std::clamp(std::ceil(kSettleRoundMs / ms), 1.0, 200.0));
   }
   return elapsed();
 }

@@ -73,9 +73,16 @@ std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 // boosts to 1980), and they may stay there through a whole submission: on the H200, a method timed first
 // after such a pause ran 5.7x slow in all 17 frames of its one submission (bench/NOTES.md). So before the
 // first combination of each scene, renderMs(frames) (which renders that many frames in one submission and
-// returns their median ms) is called in rounds of about 30 ms of GPU work until two rounds agree within 3 %
-// after at least 0.2 s, or 3 s have passed. Returns the wall seconds it took. `clock` (seconds, monotonic)
-// is the steady clock unless a test passes its own, so that its rounds do not depend on the machine's load.
+// returns their median ms) is called in rounds of about 30 ms of GPU work until the last two rounds are both
+// within 3 % of the fastest round so far, after at least 0.2 s; or until 3 s or 100 rounds have passed. Two
+// equally slow rounds after a faster one do not settle it. Returns the wall seconds it took. `clock`
+// (seconds, monotonic) is the steady clock unless a test passes its own, so that its rounds do not depend on
+// the machine's load.
+constexpr double kSettleRoundMs = 30;
+constexpr double kSettleTolerance = 0.03;
+constexpr double kSettleMinSeconds = 0.2;
+constexpr double kSettleMaxSeconds = 3;
+constexpr int kSettleMaxRounds = 100; // also where rounds are short (200 frames of under 0.15 ms)
 double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
                     const std::function<double()>& clock = {});
 

@@ -2,6 +2,7 @@
 # Prepares what a GPU machine needs, in folders git ignores (.gpu/, .vkrt/):
 #   .gpu/bin   Release pointrast + GPU/CLI test binaries, statically linked C++ runtime
 #   .gpu/data  the few shared data files the GPU and CLI tests read
+#   .gpu/ffmpeg a small ffmpeg/ffprobe for machines without one (scripts/device-ffmpeg.sh)
 #   .vkrt      Vulkan loader (+ validation layer) packages for a machine that lacks them
 # Then run on that machine: scripts/gpu-check.sh (carry .gpu and .vkrt).
 set -euo pipefail
@@ -21,6 +22,7 @@ cp $data/las/autzen_trim.las .gpu/data/las/
 cp $data/las/permutations/1.2-no-points.las .gpu/data/las/permutations/
 cp $data/laz/*.laz .gpu/data/laz/
 cp $data/mmpld/*.mmpld .gpu/data/mmpld/ # 72 KiB: the particle CLI tests read every one
+bash scripts/device-ffmpeg.sh .gpu/ffmpeg
 mkdir -p .vkrt/layers
 cp ../shared/vulkan-runtime/*.deb .vkrt/ 2>/dev/null || true
 if ! ls .vkrt/layers/vulkan-validationlayers_*.deb >/dev/null 2>&1; then

@@ -5,9 +5,9 @@
 // coordinate words as its projected size needs (cloud/batch_words.h has the bit layout) and are decoded
 // relative to its min corner. Points are projected by project.inc.glsl, like the 2021 methods.
 //
-// A box decision (viewBox) depends only on the box and the camera: computed by every thread of a workgroup
-// from the same loads with the same instructions it is uniform over the workgroup without shared memory or
-// a barrier, and computed once per node and stored (the LOD methods) it is the same bits.
+// A box decision (viewBox) depends only on the box and the camera, so it is computed once per box: by one
+// thread of the workgroup and shared (a batch, batch_part.inc.glsl) or by the node pass and stored (an
+// octree node, lod.inc.glsl). Either way every thread draws with the same bits.
 #include "common.inc.glsl"
 #include "project.inc.glsl"
 
@@ -155,19 +155,24 @@ vec3 screenOf(BatchView v, vec3 g) {
               fma(g.z, v.cz.z, fma(g.y, v.cz.y, fma(g.x, v.cz.x, v.offset.z))));
 }
 
-// The pixel column or row of X/Z - 1/2, for a value known to lie in the image: 1.5 x 2^23 keeps the sum in
-// [2^23, 2^24), where floats are the integers, for any s in (-2^22, 2^22) (2^23 alone would put s in
-// (-1/2, 0) below 2^23, where the step is 1/2).
-uint pixelCoordinate(float s) {
-  return floatBitsToUint(s + 12582912.0) - 0x4B400000u;
+// The pixel column or row of X/Z - 1/2 = s, for a value known to lie in the image, plus kRoundingBias: the
+// bits of s + 1.5 x 2^23. That sum lies in [2^23, 2^24), where floats are the integers, for any s in
+// (-2^22, 2^22) (2^23 alone would put s in (-1/2, 0) below 2^23, where the step is 1/2), and its bits are
+// kRoundingBias + the rounded s.
+const uint kRoundingBias = 0x4B400000u; // floatBitsToUint(12582912.0)
+uint biasedPixelCoordinate(float s) {
+  return floatBitsToUint(s + 12582912.0);
 }
 
 // The pixel and depth bits of a point of an `inside` batch: no test can fail. The clamp only keeps a
 // rounding surprise inside the framebuffer (whatever the coordinates, the index stays in it).
 void projectInside(vec3 s, BatchCamera cam, out uint pixel, out uint depthBits) {
   float r = 1.0 / s.z;
-  pixel = cam.offset + min(pixelCoordinate(s.y * r) * cam.pitch + pixelCoordinate(s.x * r),
-                           cam.pitch * (cam.height - 1u) + cam.width - 1u);
+  // (row - bias) pitch + (column - bias) = row pitch + column - bias (pitch + 1), mod 2^32 like the index
+  // itself: the camera's constant replaces a subtraction per coordinate (the same bits, clamp included).
+  uint index = biasedPixelCoordinate(s.y * r) * cam.pitch + biasedPixelCoordinate(s.x * r) -
+               kRoundingBias * (cam.pitch + 1u);
+  pixel = cam.offset + min(index, cam.pitch * (cam.height - 1u) + cam.width - 1u);
   depthBits = floatBitsToUint(s.z);
 }
 

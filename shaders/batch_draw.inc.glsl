@@ -16,8 +16,10 @@
 
 const uint GROUP = 4u; // points in flight per thread
 
-// The framebuffer word's high half (the depth) of pixel p is word 2p + 1 of this view (little-endian).
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer DepthHalves { uint v[]; };
+// The framebuffer word's high half (the depth) of pixel p is v[p].y of this view (little-endian): the same
+// address as the atomic's on word p plus an immediate 4, where indexing a uint view at 2p + 1 (32-bit
+// arithmetic that may wrap) made the compiler compute a second address per point.
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer DepthHalves { uvec2 v[]; };
 
 // Index in the box of point u (< GROUP) of a thread's step `step`.
 uint pointOfStep(uint step, uint u) {
@@ -79,7 +81,7 @@ uint drawStep(BatchView v, uint words, bool checked, uint h[GROUP], uint m[GROUP
   }
   uint seen[GROUP];
   [[unroll]] for (uint u = 0u; u < GROUP; ++u)
-    seen[u] = pixel[u] != kNoPixel ? depths.v[2u * pixel[u] + 1u] : 0u;
+    seen[u] = pixel[u] != kNoPixel ? depths.v[pixel[u]].y : 0u;
   uint rendered = 0u;
   [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
     // Early-z on the depth half: a point not farther than the pixel's closest may still win (equal

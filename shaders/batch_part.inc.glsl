@@ -23,10 +23,20 @@ BatchCamera batchCamera(FrameRef frame, uint eye) {
   return cam;
 }
 
-// The decision for batch `batch` of the part.
+// The decision of the batch being drawn, handed from thread 0 to the workgroup.
+shared BatchView sharedBatchView;
+
+// The decision for batch `batch` of the part, the same bits in every thread. Thread 0 alone loads the bounds
+// and runs viewBox (~300 instructions, ~3.7 a point when all 128 threads ran it: bench/NOTES.md, session 6);
+// the others wait at the barrier, so every thread of the workgroup must call it, in uniform control flow.
 BatchView viewBatch(uint batch, BatchCamera cam, uint forcedWords, bool culling) {
-  BatchBounds bounds = BoundsArray(pc.bounds).v[batch];
-  return viewBox(bounds.min.xyz, bounds.max.xyz, cam, forcedWords, culling);
+  barrier(); // a previous call's readers are done with sharedBatchView (the stereo passes call it twice)
+  if (gl_LocalInvocationIndex == 0u) {
+    BatchBounds bounds = BoundsArray(pc.bounds).v[batch];
+    sharedBatchView = viewBox(bounds.min.xyz, bounds.max.xyz, cam, forcedWords, culling);
+  }
+  barrier();
+  return sharedBatchView;
 }
 
 // Where the points of the batch starting at point `first` of the part are (a multiple of 10240, so the

@@ -194,4 +194,54 @@ TEST(BenchClocks, SettlesOnceTwoRoundsAgreeAfterAFifthOfASecond) {
   EXPECT_EQ(calls, 1) << "nothing to time: no settling";
 }
 
+// A device that takes times[i] ms a frame in round i (the last one from then on), on a clock that each round
+// moves by secondsPerRound (binary fractions, so that the elapsed times are exact).
+struct SettleRun {
+  size_t rounds = 0; // calls of renderMs
+  double seconds = 0;
+};
+SettleRun settleOn(const std::vector<double>& times, double secondsPerRound) {
+  SettleRun run;
+  double now = 100;
+  run.seconds = bench::settleClocks(
+      [&](uint32_t) {
+        now += secondsPerRound;
+        return times[std::min(run.rounds++, times.size() - 1)];
+      },
+      [&] { return now; });
+  return run;
+}
+
+TEST(BenchClocks, TwoEquallySlowRoundsAfterAFasterOneDoNotSettle) {
+  // Clocks that fall again after a fast round: the slow rounds agree with one another, not with the best.
+  EXPECT_EQ(settleOn({1.0, 1.0, 5.7, 5.7, 5.7, 1.02, 1.0, 1.0}, 0.125).rounds, 7u)
+      << "on the fast pair (rounds 5 and 6), not on 5.7 ms";
+  // Slow, slow, fast, fast: not on the first two, though 0.2 s have passed after them.
+  EXPECT_EQ(settleOn({5.7, 5.7, 1.0, 1.0}, 0.125).rounds, 4u);
+}
+
+TEST(BenchClocks, SteadyRoundsSettleAfterTheMinimumTime) {
+  EXPECT_EQ(settleOn({2.0}, 1.0 / 64).rounds, 13u) << "0.2 s of rounds of 1/64 s";
+  EXPECT_EQ(settleOn({2.0}, 0.25).rounds, 3u) << "the probe round and two rounds that agree";
+}
+
+TEST(BenchClocks, NoisyRoundsSettleWhenTwoInARowAreWithinThreePercentOfTheBest) {
+  // 1.00 is the best from round 1: 1.05 and 1.04 are not within 3 % of it (1.05 and 1.02 are within 3 % of
+  // each other), 1.02 and 1.01 are.
+  EXPECT_EQ(settleOn({1.3, 1.0, 1.05, 1.02, 1.04, 1.02, 1.01, 1.2}, 0.125).rounds, 7u);
+  // A new best moves the bar: 1.0 and 1.01 agree with each other, not with 0.9.
+  EXPECT_EQ(settleOn({1.3, 1.0, 0.9, 1.0, 1.01, 0.91, 0.9}, 0.125).rounds, 7u);
+}
+
+TEST(BenchClocks, RoundsThatNeverSettleStopAtTheCap) {
+  // Alternating speeds never have two rounds in a row near the best.
+  std::vector<double> alternating;
+  for (int i = 0; i < 400; ++i)
+    alternating.push_back(i % 2 == 0 ? 1.0 : 2.0);
+  const SettleRun timed = settleOn(alternating, 0.125);
+  EXPECT_EQ(timed.rounds, 24u) << "3 s of rounds of 1/8 s";
+  EXPECT_EQ(timed.seconds, 3.0);
+  EXPECT_EQ(settleOn(alternating, 0).rounds, size_t(bench::kSettleMaxRounds)) << "a clock that stands still";
+}
+
 } // namespace

@@ -98,6 +98,25 @@ TEST(RenderPath, FailuresLeaveNoVideo) {
   }
 }
 
+TEST(RenderPath, FfmpegMissingFromThePathSaysSoInOneLine) {
+  auto video = cliTempDir() / "no-ffmpeg.mp4";
+  std::filesystem::remove(video);
+  std::string path = writePath().string();
+  // The default lookup of "ffmpeg" on a PATH that has none (a GPU server without the package).
+  const std::string saved = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", cliTempDir().c_str(), 1); // inherited by the command runPointrast starts
+  CliResult r = runPointrast("render '" + autzen() + "' --path '" + path + "' --video '" + video.string() +
+                             "' --fps 24 --width 320 --height 240 -q");
+  setenv("PATH", saved.c_str(), 1);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_FALSE(r.signaled);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("ffmpeg"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--frames-dir"), std::string::npos) << "the way out without ffmpeg: " << r.err;
+  EXPECT_FALSE(std::filesystem::exists(video));
+  EXPECT_FALSE(std::filesystem::exists(video.string() + ".partial"));
+}
+
 TEST(RenderPath, RefusesBadOptionsBeforeLoading) {
   std::string path = writePath().string();
   struct Case {

@@ -285,6 +285,85 @@ TEST_F(ViewerWindow, KeysRecordKeyframesAndScreenshots) {
   EXPECT_NE(json.find("636300"), std::string::npos) << "the first keyframe is the starting camera";
 }
 
+// Turns the camera to the top and the front view in turn (keys 8 and 5, which reach the viewer wherever the
+// panel is), each key waiting for the frame it causes, until `frames` more frames were rendered; returns
+// whether they all came.
+bool renderFrames(Viewer& viewer, int frames) {
+  viewer.xdotool("mousemove --window $W " + std::to_string(kWidth - 4) + " " + std::to_string(kHeight - 4));
+  for (int i = 1; i <= frames; ++i) {
+    size_t from = viewer.eventCount();
+    viewer.xdotool(i % 2 ? "key 8" : "key 5");
+    if (!viewer.waitEvent("frame", from, 30)) return false;
+  }
+  return true;
+}
+
+TEST_F(ViewerWindow, StatsFileHasTheGpuTimeOfEveryPassOverTheFramesRendered) {
+  constexpr int kFrames = 12;
+  std::filesystem::path stats = tempDir() / "stats.json";
+  std::filesystem::remove(stats);
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --stats '" + stats.string() + "'");
+  ASSERT_TRUE(first_);
+  ASSERT_TRUE(renderFrames(*viewer, kFrames)) << viewer->errors();
+  EXPECT_FALSE(std::filesystem::exists(stats)) << "written as the window closes, not before";
+  finish(*viewer);
+  auto exit = viewer->waitEvent("exit", 0, 5);
+  ASSERT_TRUE(exit);
+  ASSERT_TRUE(std::filesystem::exists(stats)) << viewer->errors();
+  EXPECT_FALSE(std::filesystem::exists(stats.string() + ".partial"));
+  nlohmann::json j = nlohmann::json::parse(shellOutput("cat '" + stats.string() + "'"), nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  // Every frame the session rendered: the first, one per drag step, and those the panel's look asked for.
+  EXPECT_GE(j["frames"].get<int>(), kFrames + 1);
+  EXPECT_EQ(j["frames"], (*exit)["frames"]);
+  EXPECT_EQ(j["methods"], nlohmann::json({"atomicmin"}));
+  EXPECT_EQ(j["sizes"], nlohmann::json({std::to_string(kWidth) + "x" + std::to_string(kHeight)}));
+  EXPECT_FALSE(j["device"]["name"].get<std::string>().empty());
+  EXPECT_FALSE(j["commit"].get<std::string>().empty());
+  EXPECT_GT(j["wall_seconds"].get<double>(), 0);
+  auto ms = [&](const char* group, const char* item, const char* figure) {
+    return j[group][item][figure].get<double>();
+  };
+  for (const char* pass : {"render", "present"}) {
+    EXPECT_GT(ms("passes", pass, "min_ms"), 0) << pass;
+    EXPECT_LE(ms("passes", pass, "median_ms"), ms("passes", pass, "p95_ms")) << pass;
+    EXPECT_LE(ms("passes", pass, "p95_ms"), ms("passes", pass, "max_ms")) << pass;
+    // A pass is part of the frame's GPU time, frame after frame, so its percentiles are too.
+    EXPECT_LE(ms("passes", pass, "median_ms"), ms("frame", "gpu", "median_ms")) << pass;
+  }
+  // At least half the frames take the median render time or more, plus at least the least present time.
+  EXPECT_LE(ms("passes", "render", "median_ms") + ms("passes", "present", "min_ms"),
+            ms("frame", "gpu", "median_ms"));
+  // The passes run one after the other, each waited for: their sum stays within the host's frame time.
+  EXPECT_LE(ms("frame", "gpu", "median_ms"), ms("frame", "host", "median_ms"));
+  EXPECT_LE(ms("frame", "gpu", "p95_ms"), ms("frame", "host", "p95_ms"));
+  EXPECT_LE(ms("frame", "gpu", "max_ms"), ms("frame", "host", "max_ms"));
+}
+
+TEST_F(ViewerWindow, StatsGoToStdoutAsOneLineAfterTheExit) {
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel --stats -");
+  ASSERT_TRUE(first_);
+  ASSERT_TRUE(renderFrames(*viewer, 3)) << viewer->errors();
+  finish(*viewer);
+  auto stats = viewer->waitFor([](const nlohmann::json& e) { return e.contains("passes"); }, 0, 5);
+  ASSERT_TRUE(stats) << viewer->errors();
+  EXPECT_GE((*stats)["frames"].get<int>(), 4);
+  EXPECT_EQ((*stats)["panel"], false);
+  EXPECT_GT((*stats)["passes"]["render"]["median_ms"].get<double>(), 0);
+}
+
+TEST_F(ViewerWindow, StatsThatCannotBeWrittenFailBeforeTheWindowOpens) {
+  // A folder that is not there, and a folder where the file should be.
+  for (std::string stats : {std::string("/nonexistent/folder/stats.json"), tempDir().string()}) {
+    std::string command = "DISPLAY=" + display() + " '" + pointrastBinary() + "' view '" + autzen() +
+                          "' --stats '" + stats + "' 2>&1; echo \"exit=$?\"";
+    std::string out = shellOutput(command);
+    EXPECT_NE(out.find("--stats"), std::string::npos) << out;
+    EXPECT_NE(out.find("exit=1"), std::string::npos) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 2) << "one line, then the exit status: " << out;
+  }
+}
+
 TEST(ViewerWithoutDisplay, SaysSoInOneLineAndExits1) {
   std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY '" + pointrastBinary() + "' view '" + autzen() +
                         "' 2>&1; echo \"exit=$?\"";

@@ -1,6 +1,7 @@
 #include "view/desktop/viewer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -255,6 +256,7 @@ void Viewer::handleRequests() {
 void Viewer::showFrame() {
   bool rendered = false;
   FrameReport report;
+  const auto start = std::chrono::steady_clock::now();
   if (session_.needsFrame()) {
     report = scene_.render(session_.camera(), session_.settings(), session_.viewport());
     shown_ = {scene_.renderer().imageAddress(), scene_.renderer().width(), scene_.renderer().height()};
@@ -267,7 +269,11 @@ void Viewer::showFrame() {
   presentsPending_ = std::max(0, presentsPending_ - 1);
   if (!rendered) return;
   report.presentMs = result.gpuMs;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   session_.frameRendered(report);
+  if (options_.frameLog)
+    options_.frameLog->add({report.renderMs, report.presentMs, report.seconds * 1e3},
+                           methodName(session_.settings().method), {shown_.width, shown_.height});
   if (!options_.events) return;
   nlohmann::json event = {{"event", "frame"},
                           {"frame", session_.statistics().frames},
@@ -290,7 +296,8 @@ void Viewer::showFrame() {
 }
 
 int Viewer::run() {
-  double last = glfw::glfwGetTime();
+  const double opened = glfw::glfwGetTime();
+  double last = opened;
   while (running_ && !glfw::glfwWindowShouldClose(window_)) {
     bool busy = session_.animating() || presentsPending_ > 0 || session_.needsFrame() || swapchainStale_;
     if (busy)
@@ -318,6 +325,11 @@ int Viewer::run() {
     buildPanelFrame(now - last);
     last = now;
     showFrame();
+  }
+  if (FrameLog* log = options_.frameLog) {
+    log->device = context_.info();
+    log->deviceLocalBytes = context_.deviceLocalBytes();
+    log->seconds = glfw::glfwGetTime() - opened;
   }
   uint32_t errors = context_.validationErrors();
   if (options_.events)

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "render/camera.h"
+#include "view/frame_log.h"
 #include "view/session.h"
 
 namespace pointrast {
@@ -30,6 +31,8 @@ struct ViewerOptions {
   std::filesystem::path screenshotDir = ".";    // F12 writes pointrast-NNNN.png here
   std::optional<uint32_t> device;
   std::string title = "pointrast";
+  // When set, receives every frame rendered and the device, for the statistics written at the close.
+  FrameLog* frameLog = nullptr;
 };
 
 // Whether a display is there to open a window on: X11 (DISPLAY) or Wayland (WAYLAND_DISPLAY).
