@@ -327,10 +327,13 @@ PR_CONST kSphereGroupSize = 128;
 // A sphere whose clamped pixel box has at most 64 pixels (8 x 8) is ray-tested by its own thread; a larger
 // one is cut into chunks for the large-sphere pass, so that a close-up does not serialize on one thread.
 PR_CONST kSphereSmallPixels = 64;
-// Large-sphere chunks: 256 consecutive pixels of the sphere's box in row-major order, one pixel per thread
-// of a 256-thread workgroup. Linear chunks waste at most one partial chunk per sphere (square tiles would
-// waste most of a tile on every sphere just above the small limit), and read framebuffer rows in order.
-PR_CONST kSphereChunkPixels = 256;
+// Large-sphere chunks: one screen tile of 16 x 16 pixels (tile (tx, ty) holds pixels [16 tx, 16 tx + 15] x
+// [16 ty, 16 ty + 15]) clipped to the sphere's box, one pixel per thread of a 256-thread workgroup. Tiles
+// rather than runs of box pixels, although a box just above the small limit straddles up to four of them,
+// so that one depth bound per tile (SphereFrame::tileBounds) can skip a whole chunk with one comparison.
+PR_CONST kSphereTileShift = 4;
+PR_CONST kSphereTileSide = 16;    // 1 << kSphereTileShift
+PR_CONST kSphereChunkPixels = 256; // kSphereTileSide^2
 
 // Particle index of a pixel (or impostor) without a sphere.
 PR_CONST kNoParticle = 0xFFFFFFFFu;
@@ -370,9 +373,16 @@ struct SphereFrame {
   uint partCapacity;    // particles per part; every part but the last holds exactly this many
   uint chunkCapacity;   // entries the chunk list holds
   uint background;      // RGBA8 written where no sphere covers the pixel center
-  uint64_t counters;    // uint[4] statistics of the frame: [0] spheres whose point size was clamped
+  uint64_t counters;    // uint[4] statistics of the frame: [0] spheres whose point size was clamped;
+                        // sphere-compute counting its work: [0] pixels of large-sphere chunks drawn,
+                        // [1] pixels tested (a visibility-word read each, before early-z; all passes),
+                        // [2] depth atomics,
+                        // [3] large-sphere chunks skipped by their tile's depth bound
   float maxPointSize;   // sphere-points: the device's largest point size
-  uint reserved;
+  uint tilesX;          // sphere-compute: tiles per row of tileBounds, ceil(width / kSphereTileSide)
+  uint64_t tileBounds;  // sphere-compute: uint per screen tile, floatBits of a view depth that every pixel
+                        // center of the tile is known to be covered at or nearer (ones: none known)
+  uint64_t reserved;
 };
 
 // One part of a particle set on the GPU, as the resolve and large-sphere passes find it by index.

@@ -1,9 +1,9 @@
 #version 460
 // sphere-compute, pass 1: one thread per sphere of a part. Culls the sphere (near plane, frustum, bad
 // values), then either ray-tests its whole pixel box itself (at most kSphereSmallPixels pixels: most
-// spheres of a large set) or cuts the box into chunks of 256 pixels appended to the large-sphere list for
-// sphere_raster_large.comp, so that a sphere filling the screen is spread over many workgroups instead
-// of serializing a frame on one thread.
+// spheres of a large set) or cuts the box along the screen's 16 x 16 tiles into chunks appended to the
+// large-sphere list for sphere_tile_bound.comp and sphere_raster_large.comp, so that a sphere filling the
+// screen is spread over many workgroups instead of serializing a frame on one thread.
 //
 // The list never overflows silently: chunks past its capacity are drawn here, by the sphere's own thread
 // (slow but exact), and the sphere is counted in `spilled`. Chunks are reserved with one 64-bit atomicAdd
@@ -27,21 +27,23 @@ void main() {
   if (box.z < box.x || box.w < box.y) return;
   uint index = pc.first + local;
   uvec2 size = uvec2(box.zw - box.xy + 1);
-  uint pixels = size.x * size.y;
-  if (pixels <= kSphereSmallPixels) {
+  if (size.x * size.y <= kSphereSmallPixels) {
     coverBox(center, s.radius, index, box);
     return;
   }
-  uint n = (pixels + kSphereChunkPixels - 1) / kSphereChunkPixels;
+  ivec2 firstTile = box.xy >> int(kSphereTileShift);
+  uint tilesX = uint((box.z >> int(kSphereTileShift)) - firstTile.x + 1);
+  uint n = tilesX * uint((box.w >> int(kSphereTileShift)) - firstTile.y + 1);
   SphereChunks list = SphereChunks(frame.chunks);
   uint64_t at = atomicAdd(list.count, uint64_t(n));
-  uvec4 entry = uvec4(index, uint(box.x) | (uint(box.y) << 16), size.x | (size.y << 16), 0);
+  uint front = floatBitsToUint(-center.z - s.radius);
   for (uint k = 0; k < n; ++k) {
-    entry.w = k * kSphereChunkPixels;
+    ivec4 tile = tilePixels(uvec2(firstTile) + uvec2(k % tilesX, k / tilesX));
+    ivec4 chunk = ivec4(max(tile.xy, box.xy), min(tile.zw, box.zw));
     if (at + k < uint64_t(frame.chunkCapacity))
-      list.entries[uint(at) + k] = entry;
+      list.entries[uint(at) + k] = uvec4(index, packChunk(chunk), front);
     else
-      coverChunk(center, s.radius, index, box, entry.w);
+      coverBox(center, s.radius, index, chunk);
   }
   if (at + n > uint64_t(frame.chunkCapacity)) atomicAdd(list.spilled, 1u);
 }

@@ -20,17 +20,23 @@ vec3 sphereRay(vec4 pixelToRay, vec2 pixel) {
 //     instead of b^2 - a c, which for a small sphere far away subtracts two numbers that agree in most
 //     of their digits (and says "miss" for pixels in the middle of the sphere);
 //   - the near root is c / q with q = b + sqrt(a * disc): no subtraction of nearly equal numbers either.
-bool intersectSphere(vec3 center, float radius, vec3 dir, out float depth) {
+// discFloor > 0 asks for a ray that passes at least that far inside (disc = r^2 - |v|^2 >= discFloor); 0 is
+// the plain hit test.
+bool intersectSphereWithin(vec3 center, float radius, vec3 dir, float discFloor, out float depth) {
   depth = 0.0;
   float a = dot(dir, dir);
   float b = dot(center, dir); // > 0 for every ray that hits a sphere in front of the eye
   vec3 v = center - (b / a) * dir;
   float r2 = radius * radius;
   float disc = r2 - dot(v, v);
-  if (!(disc >= 0.0 && b > 0.0)) return false;
+  if (!(disc >= discFloor && b > 0.0)) return false;
   float c = dot(center, center) - r2; // > 0: the eye is outside the sphere
   depth = c / (b + sqrt(a * disc));
   return depth > 0.0;
+}
+
+bool intersectSphere(vec3 center, float radius, vec3 dir, out float depth) {
+  return intersectSphereWithin(center, radius, dir, 0.0, depth);
 }
 
 // Exact screen bounds of a sphere's perspective projection (an ellipse) as pixel positions

@@ -51,13 +51,16 @@ static_assert(sizeof(LodPush) == 80 && offsetof(LodPush, frame) == 64 && offseto
 static_assert(kLodPageSteps * 4 * kPointGroupSize == kLodPagePoints && kLodPagePoints % 4 == 0);
 
 // Spheres: SphereFrame lives in a buffer read with std430 rules (struct alignment 16 for its mat4/vec4).
-static_assert(sizeof(SphereFrame) == 160);
+static_assert(sizeof(SphereFrame) == 176);
 static_assert(offsetof(SphereFrame, pixelToRay) == 64);
 static_assert(offsetof(SphereFrame, framebuffer) == 80);
 static_assert(offsetof(SphereFrame, image) == 104);
 static_assert(offsetof(SphereFrame, width) == 112);
 static_assert(offsetof(SphereFrame, background) == 140);
 static_assert(offsetof(SphereFrame, counters) == 144);
+static_assert(offsetof(SphereFrame, tileBounds) == 160);
+static_assert(kSphereTileSide == 1u << kSphereTileShift &&
+              kSphereChunkPixels == kSphereTileSide * kSphereTileSide);
 static_assert(sizeof(SpherePartRef) == 16);
 static_assert(sizeof(SpherePush) == 32);
 static_assert(offsetof(SpherePush, first) == 16);

@@ -9,9 +9,11 @@
 // - sphere centers land on the pixels where the point renderer puts the same positions.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "base/error.h"
+#include "cloud/particles_generate.h"
 #include "gpu/shared_types.h"
 #include "render/renderer.h"
 #include "spheres_test_util.h"
@@ -290,6 +292,65 @@ TEST_F(GpuTest, SphereCentersLandWhereThePointRendererPutsThem) {
     if (spheresFrame.index[p] == point) ++checked;
   }
   EXPECT_GE(checked, 50);
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+namespace {
+
+// The first camera of the spheres2023 suite's short orbit (bench/views.cpp): inside the bounds, at half
+// their extent along x and y from the center, a quarter of the half height above it, looking at it.
+Camera shortOrbitCamera(const Bounds& bounds) {
+  const glm::dvec3 center = bounds.center(), half = 0.5 * (bounds.max - bounds.min);
+  const double angle = 1.25 * std::numbers::pi;
+  Camera camera;
+  camera.eye =
+      center + glm::dvec3(0.5 * half.x * std::cos(angle), 0.5 * half.y * std::sin(angle), 0.25 * half.z);
+  camera.target = center;
+  camera.up = {0, 0, 1};
+  camera.fovY = 60;
+  return camera;
+}
+
+} // namespace
+
+TEST_F(GpuTest, SphereComputeTileBoundsSkipHiddenLargeSpheresAndKeepTheFrame) {
+  // A Riemann-like block seen from inside, as the suite's short orbit sees it: spheres near the eye cover
+  // whole tiles, and most large spheres behind them are hidden. The tile depth bounds must leave the frame
+  // bit for bit as it is without them, and cut the work of the large-sphere pass.
+  ParticleGenerateOptions options;
+  options.particles = 200'000;
+  options.progress = false;
+  const ParticleSet set = generateParticles(ParticleScene::Block, options);
+  const Camera camera = shortOrbitCamera(set.bounds);
+  SphereSettings settings;
+  settings.countWork = true;
+  GpuFrame bounded = renderGpu(*context, set, camera, 320, 240, {}, settings);
+  settings.tileBound = false;
+  GpuFrame unbounded = renderGpu(*context, set, camera, 320, 240, {}, settings);
+  std::printf(
+      "riemann-like short orbit, 200 k spheres, 320x240, with / without tile bounds: large chunks %llu, "
+      "skipped %llu / %llu; pixels tested in large chunks %llu / %llu, in all %llu / %llu; depth "
+      "atomics %llu / %llu\n",
+      (unsigned long long)bounded.stats.largeChunks, (unsigned long long)bounded.stats.skippedChunks,
+      (unsigned long long)unbounded.stats.skippedChunks, (unsigned long long)bounded.stats.largePixelsTested,
+      (unsigned long long)unbounded.stats.largePixelsTested, (unsigned long long)bounded.stats.pixelsTested,
+      (unsigned long long)unbounded.stats.pixelsTested, (unsigned long long)bounded.stats.depthAtomics,
+      (unsigned long long)unbounded.stats.depthAtomics);
+  EXPECT_EQ(bounded.index, unbounded.index);
+  EXPECT_EQ(bounded.depth, unbounded.depth);
+  EXPECT_EQ(bounded.image, unbounded.image);
+  EXPECT_GT(std::count_if(bounded.index.begin(), bounded.index.end(),
+                          [](uint32_t i) { return i != shared::kNoParticle; }),
+            320 * 240 * 9 / 10)
+      << "the block should fill the image";
+  EXPECT_EQ(bounded.stats.largeChunks, unbounded.stats.largeChunks);
+  EXPECT_EQ(unbounded.stats.skippedChunks, 0u);
+  EXPECT_GT(bounded.stats.skippedChunks, bounded.stats.largeChunks / 2);
+  EXPECT_LT(bounded.stats.largePixelsTested * 2, unbounded.stats.largePixelsTested);
+  EXPECT_LT(bounded.stats.pixelsTested, unbounded.stats.pixelsTested);
+  EXPECT_LE(bounded.stats.depthAtomics, unbounded.stats.depthAtomics);
 }
 
 } // namespace pointrast::test

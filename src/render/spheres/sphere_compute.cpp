@@ -1,11 +1,14 @@
 // sphere-compute: spheres rasterized in compute shaders into the visibility buffer of the 2022 point
 // renderer (Schuetz et al., "Software Rasterization of 2 Billion Points in Real Time"): per pixel the 64-bit
 // minimum of floatBits(view depth of the ray hit) << 32 | particle index, then a resolve that shades the
-// winner. Three passes per frame (shaders/sphere_*.comp.glsl):
+// winner. Four passes per frame (shaders/sphere_*.comp.glsl):
 //   1. one thread per sphere: cull, then ray-test the pixel box alone if it has at most 64 pixels, or
-//      append its chunks of 256 box pixels to the large-sphere list;
-//   2. the listed chunks, one per workgroup iteration, one pixel per thread;
-//   3. resolve: shade the winning sphere at each pixel.
+//      append its chunks (16 x 16 screen tiles clipped to the box) to the large-sphere list;
+//   2. one thread per listed chunk: a chunk whose sphere surely covers its whole tile lowers the tile's
+//      depth bound;
+//   3. the listed chunks, one per workgroup iteration, one pixel per thread; a chunk behind its tile's
+//      bound is skipped whole (the overdraw of close-ups, where most large spheres are hidden);
+//   4. resolve: shade the winning sphere at each pixel.
 #include <algorithm>
 #include <map>
 
@@ -19,14 +22,24 @@ namespace pointrast {
 
 namespace {
 
-// Default capacity of the large-sphere list: 4 M chunks of 256 pixels (64 MiB of entries), 500 screens of
-// 1080p covered by large spheres. An eye inside 10 M uniform particles overflowed 1 M chunks (H200: 108 ms,
-// 40 % of the spheres drawing chunks themselves; hardware depth testing needs 12 ms there).
-constexpr uint32_t kDefaultChunkCapacity = 4u << 20;
+// Default capacity of the large-sphere list: 8 M chunks of up to 16 x 16 pixels (128 MiB of entries). An
+// eye inside 10 M uniform particles overflowed 1 M chunks of 256 box pixels (H200: 108 ms, 40 % of the
+// spheres drawing chunks themselves; hardware depth testing needs 12 ms there), and tiles list up to ~2x
+// as many chunks as runs of 256 box pixels did (a box straddles tile borders): the riemann-like stand-in's
+// first short-orbit camera lists 3.1 M at 1920x1080, where runs listed at most 1.5 M.
+constexpr uint32_t kDefaultChunkCapacity = 8u << 20;
 constexpr uint64_t kChunkHeaderBytes = 16; // 64-bit count, spilled, reserved (entries are 16-byte aligned)
+constexpr uint64_t kCounterBytes = 16;     // SphereFrame::counters, uint[4]
 
 struct Programs {
-  gpu::ComputeProgram raster, large, resolve;
+  gpu::ComputeProgram raster, bound, large, resolve;
+};
+
+// The pipelines' variant: the particle layout and the two switches of sphere_raster.inc.glsl.
+struct Variant {
+  uint32_t layout;
+  bool countWork, tileBound;
+  auto operator<=>(const Variant&) const = default;
 };
 
 class SphereComputeMethod : public SphereMethodImpl {
@@ -37,6 +50,12 @@ public:
                                "sphere visibility buffer");
     chunks_ = gpu::Buffer(context, kChunkHeaderBytes + uint64_t(kDefaultChunkCapacity) * 16,
                           gpu::kBufferUsage, gpu::MemoryKind::Device, "large-sphere chunks");
+    tilesX_ = (width + shared::kSphereTileSide - 1) / shared::kSphereTileSide;
+    tiles_ = uint64_t(tilesX_) * ((height + shared::kSphereTileSide - 1) / shared::kSphereTileSide);
+    tileBounds_ = gpu::Buffer(context, tiles_ * 4, gpu::kBufferUsage, gpu::MemoryKind::Device,
+                              "sphere tile depth bounds");
+    counters_ = gpu::Buffer(context, kCounterBytes, gpu::kBufferUsage, gpu::MemoryKind::Device,
+                            "sphere-compute work counters");
     // The large pass strides over the list with a fixed grid: enough workgroups to fill a big GPU
     // (4096 x 256 threads), or a few per core on a CPU device, where idle workgroups are not free.
     largeGroups_ = context.info().software() ? 4 * hardwareThreads() : 4096;
@@ -48,13 +67,20 @@ public:
     chunkCapacity_ = settings.chunkCapacity ? std::min(settings.chunkCapacity, kDefaultChunkCapacity)
                                             : kDefaultChunkCapacity;
     frame.chunkCapacity = chunkCapacity_;
+    frame.tilesX = tilesX_;
+    frame.tileBounds = tileBounds_.address();
+    frame.counters = counters_.address();
+    variant_ = {0, settings.countWork, settings.tileBound};
   }
 
   void recordFrame(const SphereDraw& draw, SphereTargets& targets) override {
     VkCommandBuffer cmd = draw.cmd;
-    const Programs& p = programs(particleLayoutInfo(draw.particles.layout()).shaderId);
+    variant_.layout = particleLayoutInfo(draw.particles.layout()).shaderId;
+    const Programs& p = programs(variant_);
     gpu::vkCmdFillBuffer(cmd, framebuffer_.handle(), 0, pixels_ * 8, 0xFFFFFFFFu); // kEmptyPixel
     gpu::vkCmdFillBuffer(cmd, chunks_.handle(), 0, kChunkHeaderBytes, 0);
+    gpu::vkCmdFillBuffer(cmd, tileBounds_.handle(), 0, tiles_ * 4, 0xFFFFFFFFu); // no bound known
+    gpu::vkCmdFillBuffer(cmd, counters_.handle(), 0, kCounterBytes, 0);
     gpu::fullBarrier(cmd);
     shared::SpherePush push{};
     push.frame = targets.frame.address();
@@ -70,6 +96,10 @@ public:
     push = {};
     push.frame = targets.frame.address();
     push.groupsX = largeGroups_;
+    if (variant_.tileBound) {
+      p.bound.dispatch(cmd, largeGroups_, 1, push);
+      gpu::fullBarrier(cmd);
+    }
     p.large.dispatch(cmd, largeGroups_, 1, push);
     gpu::fullBarrier(cmd);
     recordSphereResolve(cmd, p.resolve, targets.frame.address(), pixels_);
@@ -87,27 +117,44 @@ public:
     gpu::readBuffer(context_, chunks_, 0, &header, sizeof header);
     stats.largeChunks = std::min<uint64_t>(header.count, chunkCapacity_);
     stats.spilledSpheres = header.spilled;
+    if (!variant_.countWork) return;
+    uint32_t counters[4];
+    gpu::readBuffer(context_, counters_, 0, counters, sizeof counters);
+    stats.largePixelsTested = counters[0];
+    stats.pixelsTested = counters[1];
+    stats.depthAtomics = counters[2];
+    stats.skippedChunks = counters[3];
   }
 
 private:
-  // Pipelines per particle layout (the layout is specialization constant 0 of every sphere shader).
-  const Programs& programs(uint32_t layout) {
-    auto found = programs_.find(layout);
+  // Pipelines per variant (the layout is specialization constant 0 of every sphere shader).
+  const Programs& programs(const Variant& v) {
+    auto found = programs_.find(v);
     if (found != programs_.end()) return found->second;
     Programs p;
-    p.raster = gpu::ComputeProgram(context_, "sphere_raster.comp", {{/* LAYOUT= */ 0, layout}});
-    p.large = gpu::ComputeProgram(context_, "sphere_raster_large.comp", {{/* LAYOUT= */ 0, layout}});
-    p.resolve = gpu::ComputeProgram(context_, "sphere_resolve.comp", {{/* LAYOUT= */ 0, layout}});
-    return programs_.emplace(layout, std::move(p)).first->second;
+    p.raster = gpu::ComputeProgram(context_, "sphere_raster.comp",
+                                   {{/* LAYOUT= */ 0, v.layout}, {/* COUNT_WORK= */ 3, v.countWork}});
+    p.bound = gpu::ComputeProgram(context_, "sphere_tile_bound.comp", {{/* LAYOUT= */ 0, v.layout}});
+    p.large = gpu::ComputeProgram(context_, "sphere_raster_large.comp",
+                                  {{/* LAYOUT= */ 0, v.layout},
+                                   {/* COUNT_WORK= */ 3, v.countWork},
+                                   {/* TILE_BOUND= */ 4, v.tileBound}});
+    p.resolve = gpu::ComputeProgram(context_, "sphere_resolve.comp", {{/* LAYOUT= */ 0, v.layout}});
+    return programs_.emplace(v, std::move(p)).first->second;
   }
 
   gpu::Context& context_;
   uint64_t pixels_;
   gpu::Buffer framebuffer_;
   gpu::Buffer chunks_;
+  uint32_t tilesX_;
+  uint64_t tiles_;
+  gpu::Buffer tileBounds_;
+  gpu::Buffer counters_;
   uint32_t largeGroups_;
   uint32_t chunkCapacity_ = kDefaultChunkCapacity;
-  std::map<uint32_t, Programs> programs_;
+  Variant variant_{};
+  std::map<Variant, Programs> programs_;
 };
 
 } // namespace

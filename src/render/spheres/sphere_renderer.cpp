@@ -69,7 +69,8 @@ bool pointBillboardOptions(gpu::Context& context, const SphereSettings& settings
 constexpr SphereMethodInfo kSphereMethods[] = {
     {SphereMethod::Compute, "sphere-compute",
      "compute rasterization of ray-cast spheres into a 64-bit depth|index visibility buffer; large spheres "
-     "split into 256-pixel chunks across workgroups; then a shading resolve",
+     "split into 16x16-pixel tiles across workgroups, tiles hidden behind nearer spheres skipped; then a "
+     "shading resolve",
      alwaysSupported},
     {SphereMethod::Points, "sphere-points",
      "hardware point list, gl_PointSize from the projected bounds (clamped to the largest point), ray-cast "

@@ -74,9 +74,14 @@ struct SphereSettings {
   uint32_t background = 0xFF000000u; // RGBA8
   uint32_t frames = 1;               // timed frames; the median is reported
   uint32_t warmup = 1;               // untimed frames first
-  // sphere-compute: entries of the large-sphere chunk list; 0 = the default (4 M chunks, 64 MiB). Tests
+  // sphere-compute: entries of the large-sphere chunk list; 0 = the default (8 M chunks, 128 MiB). Tests
   // set a small one to exercise the overflow path (spheres drawn by their own thread).
   uint32_t chunkCapacity = 0;
+  // sphere-compute: skip large-sphere chunks behind their tile's depth bound (off only to compare the
+  // work), and count the work (pixels tested, depth atomics, skipped chunks: one global atomic each,
+  // so the frame is slower; for tests and measurements of the work, not for timing).
+  bool tileBound = true;
+  bool countWork = false;
   // Methods that rasterize billboards (sphereMethodTakesBillboards): the impostor, and overestimating
   // conservative rasterization (VK_EXT_conservative_rasterization). Others refuse anything but the default.
   SphereBillboard billboard = SphereBillboard::Screen;
@@ -94,8 +99,12 @@ struct SphereStats {
   double medianMs = 0, minMs = 0, maxMs = 0; // GPU time of clear + draw + resolve, timestamp queries
   uint32_t frames = 0;
   uint64_t particles = 0;      // particles submitted per frame
-  uint64_t largeChunks = 0;    // sphere-compute: 256-pixel chunks of large spheres listed in the last frame
+  uint64_t largeChunks = 0;    // sphere-compute: chunks (16 x 16 tiles) of large spheres listed, last frame
   uint64_t spilledSpheres = 0; // sphere-compute: large spheres that drew chunks themselves (list full)
+  // sphere-compute with SphereSettings::countWork, the last frame: pixels tested (each one read of the
+  // visibility word, then the ray test unless early-z rejects it), of which in large-sphere chunks,
+  // 64-bit depth atomics, and large-sphere chunks skipped by their tile's depth bound.
+  uint64_t pixelsTested = 0, largePixelsTested = 0, depthAtomics = 0, skippedChunks = 0;
   uint64_t clampedSpheres = 0; // sphere-points, sphere-mesh-points: spheres larger than the largest point,
                                // drawn incomplete
   // sphere-rt: GPU time of building the acceleration structures (AABBs, bottom and top levels) before the
