@@ -168,8 +168,12 @@ void markdownDatasets(std::ostringstream& md, const std::vector<DatasetOutcome>&
     md << "- " << d.dataset.label << ": ";
     if (d.skipped)
       md << "**skipped**, " << d.reason << "\n";
-    else
-      md << (d.description.empty() ? d.dataset.source : d.description) << "; " << d.memory.describe() << "\n";
+    else {
+      md << (d.description.empty() ? d.dataset.source : d.description);
+      // Streamed data sets (an octree through the node cache) have no upload to estimate.
+      if (d.memory.gpuHave > 0) md << "; " << d.memory.describe();
+      md << "\n";
+    }
   }
 }
 
