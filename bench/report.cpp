@@ -57,7 +57,6 @@ nlohmann::json batchStatsJson(const BatchStats& b) {
           {"points_processed", b.pointsProcessed},
           {"points_rendered", b.pointsRendered},
           {"points_blended", b.pointsBlended},
-          {"blend_atomics", b.blendAtomics},
           {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
           {"bytes_read", b.bytesRead}};
 }

@@ -18,7 +18,7 @@ cp build-gpu/serve_load .gpu/bin/
 cp -L /usr/lib/x86_64-linux-gnu/libcivetweb.so.1 .gpu/bin/
 strip .gpu/bin/*
 data=../shared/data
-cp $data/las/autzen_trim.las .gpu/data/las/
+cp $data/las/{autzen_trim,1.2-with-color,no-points,test1_4}.las .gpu/data/las/ # the CLI tests' LAS files
 cp $data/las/permutations/1.2-no-points.las .gpu/data/las/permutations/
 cp $data/laz/*.laz .gpu/data/laz/
 cp $data/mmpld/*.mmpld .gpu/data/mmpld/ # 72 KiB: the particle CLI tests read every one

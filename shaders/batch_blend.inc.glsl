@@ -3,15 +3,13 @@
 // left each pixel's closest depth in the framebuffer's high word, every point of a box that is not culled
 // and lies within 1 % of its pixel's closest depth adds its color with one packed atomicAdd (hqs1r's
 // layout, resolved by resolve_hqs.comp). Same culling, precision and 128-bit loads as the depth pass, so
-// both passes decode every point to the same position; colors are read for blended points only. The sums
-// meet in the workgroup's table first (hqs_accumulate.inc.glsl): the caller clears it before the loop and
-// flushes it after (blendFlush). Needs hqs_accumulate.inc.glsl and its subgroup extensions.
+// both passes decode every point to the same position; colors are read for blended points only. Needs
+// hqs_accumulate.inc.glsl and its subgroup extensions.
 
 // Blends the loaded points of step j (their words in h, m, l, `words` of them) into one camera's image.
-// Returns the points blended and adds the accumulator atomics made to `atomics`. Call in uniform control
-// flow (hqsBlend's subgroup operations need every lane).
+// Returns the points blended. Call in uniform control flow (hqsBlend's subgroup operations need every lane).
 uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, BatchWords at, uint count,
-               BatchCamera cam, uint64_t framebuffer, uint64_t accumulators, inout uint atomics) {
+               BatchCamera cam, uint64_t framebuffer, uint64_t accumulators) {
   Uint64Array fb = Uint64Array(framebuffer);
   Uint64Array acc = Uint64Array(accumulators);
   uint pixels = cam.pitch * cam.height; // the whole framebuffer: both eyes of a stereo frame
@@ -56,15 +54,14 @@ uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, B
     }
   }
   [[unroll]] for (uint k = 0u; k < 4u; ++k)
-    atomics += hqsBlend(acc, pixels, true, pixel[k], r[k], g[k], b[k], n[k]);
+    hqsBlend(acc, pixels, true, pixel[k], r[k], g[k], b[k], n[k]);
   return blended;
 }
 
 // Blends the box's `count` points; `steps` steps of 4 points per thread cover the largest box of the pass.
-// Returns the points this thread blended, and adds its accumulator atomics to `atomics`. Call in uniform
-// control flow (v is uniform).
+// Returns the points this thread blended. Call in uniform control flow (v is uniform).
 uint blendBox(BatchView v, BatchWords at, uint count, uint steps, BatchCamera cam, uint64_t framebuffer,
-              uint64_t accumulators, inout uint atomics) {
+              uint64_t accumulators) {
   uint blended = 0u;
   // No early exit from the loops: hqsBlend's subgroup operations need every lane.
   if (v.words == 0u) return 0u;
@@ -72,7 +69,7 @@ uint blendBox(BatchView v, BatchWords at, uint count, uint steps, BatchCamera ca
     uint local = 4u * (gl_LocalInvocationIndex + j * kPointGroupSize);
     uvec4 h = uvec4(0u), m = uvec4(0u), l = uvec4(0u);
     if (local < count) loadQuad(at, local / 4u, v.words, h, m, l);
-    blended += blendStep(v, v.words, h, m, l, local, at, count, cam, framebuffer, accumulators, atomics);
+    blended += blendStep(v, v.words, h, m, l, local, at, count, cam, framebuffer, accumulators);
   }
   return blended;
 }
@@ -80,7 +77,7 @@ uint blendBox(BatchView v, BatchWords at, uint count, uint steps, BatchCamera ca
 // Stereo: each step's words loaded once (for the eye that needs more), blended into each eye not culled for
 // it with that eye's decision, as drawBoxStereo draws them. The eyes' decisions are uniform.
 uint blendBoxStereo(BatchView v0, BatchView v1, BatchWords at, uint count, uint steps, BatchCamera cam0,
-                    BatchCamera cam1, uint64_t framebuffer, uint64_t accumulators, inout uint atomics) {
+                    BatchCamera cam1, uint64_t framebuffer, uint64_t accumulators) {
   uint loaded = max(v0.words, v1.words);
   uint blended = 0u;
   if (loaded == 0u) return 0u;
@@ -89,21 +86,9 @@ uint blendBoxStereo(BatchView v0, BatchView v1, BatchWords at, uint count, uint 
     uvec4 h = uvec4(0u), m = uvec4(0u), l = uvec4(0u);
     if (local < count) loadQuad(at, local / 4u, loaded, h, m, l);
     if (v0.words != 0u)
-      blended += blendStep(v0, v0.words, h, m, l, local, at, count, cam0, framebuffer, accumulators, atomics);
+      blended += blendStep(v0, v0.words, h, m, l, local, at, count, cam0, framebuffer, accumulators);
     if (v1.words != 0u)
-      blended += blendStep(v1, v1.words, h, m, l, local, at, count, cam1, framebuffer, accumulators, atomics);
+      blended += blendStep(v1, v1.words, h, m, l, local, at, count, cam1, framebuffer, accumulators);
   }
   return blended;
-}
-
-// After the blend loops, by every thread in uniform control flow: the workgroup's table goes to the
-// accumulators, and the workgroup's accumulator atomics (`atomics`: this thread's so far) are counted in
-// kStatBlendAtomics of its statistics row, one add per subgroup.
-void blendFlush(BatchCamera cam, uint64_t accumulators, uint64_t statsAddress, uint atomics) {
-  atomics += hqsTableFlush(Uint64Array(accumulators), cam.pitch * cam.height, true);
-  uint sum = subgroupAdd(atomics);
-  if (subgroupElect() && sum != 0u) {
-    uint row = (gl_WorkGroupID.x % kBatchStatSlots) * kBatchStatCount;
-    atomicAdd(Uint64Array(statsAddress).v[row + kStatBlendAtomics], uint64_t(sum));
-  }
 }

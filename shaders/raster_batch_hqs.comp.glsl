@@ -12,23 +12,21 @@
 #include "batch_blend.inc.glsl"
 
 void main() {
-  hqsTableClear();
   beginStats();
   FrameRef frame = FrameRef(pc.frame);
   BatchCamera cam = batchCamera(frame, 0u);
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
   BatchView v = viewBatch(gl_WorkGroupID.x, cam, frame.f.forcedWords, frame.f.culling != 0u);
-  uint blended = 0u, atomics = 0u;
+  uint blended = 0u;
   if (STEREO != 0u) {
     BatchCamera right = batchCamera(frame, 1u);
     BatchView v1 = viewBatch(gl_WorkGroupID.x, right, frame.f.forcedWords, frame.f.culling != 0u);
     blended = blendBoxStereo(v, v1, batchWords(first), count, kBatchPrefetchSteps, cam, right,
-                             frame.f.framebuffer, frame.f.accumulators, atomics);
+                             frame.f.framebuffer, frame.f.accumulators);
   } else {
     blended = blendBox(v, batchWords(first), count, kBatchPrefetchSteps, cam, frame.f.framebuffer,
-                       frame.f.accumulators, atomics);
+                       frame.f.accumulators);
   }
-  blendFlush(cam, frame.f.accumulators, frame.f.stats, atomics);
   endStats(frame.f.stats, kStatPointsBlended, blended, false, v.words, count);
 }

@@ -6,9 +6,8 @@
 //   ONE_ROUND 1 (hqs1r): aux = 1 uint64 per pixel packing r, g, b, count in 16 bits each, one atomicAdd;
 //                        then 2 uint64 per pixel of 32-bit fallback sums for points past the 255th.
 // Like raster_closest, a thread draws POINTS_PER_THREAD points a workgroup size apart (lanes of a subgroup
-// hold consecutive points), loading positions four at a time; a point reads its color only once it is known
-// to blend, so hidden points cost their 12 B of position alone. The workgroup's sums meet in its shared-memory
-// table and reach the accumulators once per pixel at the end.
+// hold consecutive points), loading all positions first; a point reads its color only once it is known to
+// blend, so hidden points cost their 12 B of position alone.
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require
@@ -24,36 +23,26 @@ layout(constant_id = 1) const uint POINTS_PER_THREAD = 1;
 #define DEPTH_INT40 0
 #include "point.inc.glsl"
 
-// Positions loaded together before their points blend: enough loads in flight to hide latency while
-// POINTS_PER_THREAD, which sets how many points share the workgroup's table, may be larger.
-const uint kLoadsInFlight = 4u;
-
 void main() {
-  // No early return anywhere: the subgroup operations of hqsBlend and the table's barriers need every lane.
-  hqsTableClear();
+  // No early return anywhere: the subgroup operations of hqsBlend need every lane.
   uint first = firstPointOfThread(POINTS_PER_THREAD);
+  vec3 positions[POINTS_PER_THREAD];
+  for (uint k = 0; k < POINTS_PER_THREAD; ++k)
+    positions[k] = loadPositionOrZero(first + k * kPointGroupSize);
   Uint64Array fb = Uint64Array(pc.framebuffer);
-  for (uint k0 = 0; k0 < POINTS_PER_THREAD; k0 += kLoadsInFlight) {
-    vec3 positions[kLoadsInFlight];
-    for (uint k = 0; k < kLoadsInFlight; ++k)
-      positions[k] = k0 + k < POINTS_PER_THREAD ? loadPositionOrZero(first + (k0 + k) * kPointGroupSize)
-                                                : vec3(0.0);
-    for (uint k = 0; k < kLoadsInFlight; ++k) {
-      uint i = first + (k0 + k) * kPointGroupSize;
-      uint pixel = kNoPixel, r = 0u, g = 0u, b = 0u;
-      uint64_t word;
-      if (k0 + k < POINTS_PER_THREAD && i < pc.pointCount && depthWordOf(positions[k], pixel, word)) {
-        float closest = uintBitsToFloat(uint(fb.v[pixel] >> 32));
-        if (uintBitsToFloat(uint(word >> 32)) > closest * float(PR_HQS_DEPTH_FACTOR))
-          pixel = kNoPixel; // hidden: not blended, its color never read
-        else
-          hqsChannels(UintArray(pc.colors).v[i], r, g, b);
-      } else {
-        pixel = kNoPixel;
-      }
-      hqsBlend(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0, pixel, r, g, b,
-               pixel != kNoPixel ? 1u : 0u);
+  for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
+    uint i = first + k * kPointGroupSize;
+    uint pixel = kNoPixel, r = 0u, g = 0u, b = 0u;
+    uint64_t word;
+    if (i < pc.pointCount && depthWordOf(positions[k], pixel, word)) {
+      float closest = uintBitsToFloat(uint(fb.v[pixel] >> 32));
+      if (uintBitsToFloat(uint(word >> 32)) > closest * float(PR_HQS_DEPTH_FACTOR))
+        pixel = kNoPixel; // hidden: not blended, its color never read
+      else
+        hqsChannels(UintArray(pc.colors).v[i], r, g, b);
+    } else {
+      pixel = kNoPixel;
     }
+    hqsBlend(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0, pixel, r, g, b, pixel != kNoPixel ? 1u : 0u);
   }
-  hqsTableFlush(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0);
 }

@@ -13,11 +13,10 @@
 #include "batch_blend.inc.glsl"
 
 void main() {
-  hqsTableClear();
   beginStats();
   LodFrame f = LodFrameRef(pc.frame).f;
   uint index = lodWorkgroup();
-  uint blended = 0u, atomics = 0u;
+  uint blended = 0u;
   if (index < f.pageCount) { // uniform over the workgroup
     LodPage page = LodPages(f.pages).v[index];
     LodNode node = LodNodes(f.nodes).v[page.node];
@@ -26,12 +25,11 @@ void main() {
     if (STEREO != 0u) {
       BatchView right = loadView(LodViews(f.views).v[f.nodeCount + page.node]);
       blended = blendBoxStereo(v, right, pageWords(page.address), count, kLodPageSteps, lodCamera(f, 0u),
-                               lodCamera(f, 1u), f.framebuffer, f.accumulators, atomics);
+                               lodCamera(f, 1u), f.framebuffer, f.accumulators);
     } else {
       blended = blendBox(v, pageWords(page.address), count, kLodPageSteps, lodCamera(f, 0u), f.framebuffer,
-                         f.accumulators, atomics);
+                         f.accumulators);
     }
   }
-  blendFlush(lodCamera(f, 0u), f.accumulators, f.stats, atomics);
   endStats(f.stats, kStatPointsBlended, blended, false, 0u, 0u);
 }

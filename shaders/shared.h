@@ -183,7 +183,6 @@ PR_CONST kStatPointsBlended = 3;    // batch-hqs: points blended into their pixe
 PR_CONST kStatPointsOneWord = 4;    // points of rendered batches decoded from 1, 2, 3 words; their sum
 PR_CONST kStatPointsTwoWords = 5;   // is the number of points processed
 PR_CONST kStatPointsThreeWords = 6;
-PR_CONST kStatBlendAtomics = 7;     // HQS batch passes: atomicAdds on the accumulators (after the workgroup table)
 
 // Bounds of one batch relative to the scene origin, rounded once to float from the exact (double) bounds
 // its points were quantized in. w is unused.

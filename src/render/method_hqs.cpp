@@ -8,11 +8,6 @@ namespace pointrast {
 
 namespace {
 
-// Points a thread of the accumulation pass blends: a workgroup's 2,048 consecutive points share its
-// shared-memory table, so in Morton order each pixel reaches the accumulators about once per 2,048 points
-// instead of once per 512, and the table's clear and flush are paid once for them.
-constexpr uint32_t kAccumulatePointsPerThread = 16;
-
 // ONE_ROUND (id 0) of the row: hqs1r's packed single atomic and its accumulator layout.
 bool oneRound(const MethodInfo& method) {
   for (const gpu::SpecConstant& s : method.spec.span())
@@ -36,8 +31,8 @@ public:
                                   {/* REDUCE= */ 1, 1},
                                   {/* DEPTH_ONLY= */ 3, 1},
                                   {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
-    accumulate_ = gpu::ComputeProgram(
-        context, method.shader, method.spec.with({{/* POINTS_PER_THREAD= */ 1, kAccumulatePointsPerThread}}));
+    accumulate_ = gpu::ComputeProgram(context, method.shader,
+                                      method.spec.with({{/* POINTS_PER_THREAD= */ 1, kPointsPerThread}}));
     // The resolve reads the accumulators in the layout ONE_ROUND chose (the same constant id).
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", method.spec.span());
   }
@@ -55,7 +50,7 @@ public:
         frame, targets, depth_.groupSize() * kPointsPerThread, base,
         [&](const shared::RasterPush& push, gpu::Grid grid) { depth_.dispatch(cmd, grid.x, grid.y, push); });
     gpu::fullBarrier(cmd);
-    forEachPart(frame, targets, accumulate_.groupSize() * kAccumulatePointsPerThread, base,
+    forEachPart(frame, targets, accumulate_.groupSize() * kPointsPerThread, base,
                 [&](const shared::RasterPush& push, gpu::Grid grid) {
                   accumulate_.dispatch(cmd, grid.x, grid.y, push);
                 });

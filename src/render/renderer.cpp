@@ -379,7 +379,6 @@ BatchStats batchStatsFromRows(const uint64_t (&rows)[shared::kBatchStatSlots][sh
   s.batchesRendered = sum[shared::kStatBatchesRendered];
   s.pointsRendered = sum[shared::kStatPointsRendered];
   s.pointsBlended = sum[shared::kStatPointsBlended];
-  s.blendAtomics = sum[shared::kStatBlendAtomics];
   for (int w = 0; w < 3; ++w) {
     s.pointsByWords[w] = sum[shared::kStatPointsOneWord + w];
     s.pointsProcessed += s.pointsByWords[w];

@@ -66,7 +66,6 @@ struct BatchStats {
   uint64_t pointsProcessed = 0;          // points of rendered batches
   uint64_t pointsRendered = 0;           // points that passed early-z (did the atomicMin)
   uint64_t pointsBlended = 0;            // batch-hqs: points blended into their pixel's average
-  uint64_t blendAtomics = 0;             // batch-hqs: atomicAdds on the accumulators (after shared memory)
   uint64_t pointsByWords[3] = {0, 0, 0}; // points processed with 1, 2, 3 coordinate words
   // Bytes of point data read: 4 per coordinate word, 32 per rendered batch's bounds; batch-hqs reads the
   // words twice (depth and accumulation pass) and the color of every blended point.
