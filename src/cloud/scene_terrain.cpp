@@ -50,6 +50,22 @@ struct Tree {
   Rgb color{};
 };
 
+// Ground footprint of one pulse and its slant: the pulse moves by -t in x per metre of height.
+struct Pulse {
+  double x, y, t;
+};
+
+// The first surface a pulse meets coming down from the aircraft.
+struct PulseHit {
+  enum Kind { kGround, kRoof, kWall, kCrown };
+  double best = 0; // largest height above the ground point at which the pulse enters a surface; 0: ground
+  Kind kind = kGround;
+  glm::dvec3 normal{0, 0, 1};
+  // Copies, not pointers: a later cache lookup may evict the cell that was hit.
+  Rgb surface{};
+  Tree tree;
+};
+
 // Direct-mapped memo of per-cell parameters. Consecutive pulses of a scan line visit the same few cells,
 // so a cell's parameters (which include a ground-height evaluation) are computed about once per line.
 // It memoizes a pure function, so results never depend on what the cache held before.
@@ -116,6 +132,11 @@ private:
   Building building(int32_t bx, int32_t by) const;
   Tree tree(int32_t tx, int32_t ty) const;
   Rgb groundColor(double x, double y, double gx, double gy, uint64_t rnd, NoiseCells& cells) const;
+  // The steps of generate(): a scan line's constants, a pulse's aim, then what it meets first.
+  void startLine(uint64_t g, Line& line) const;
+  Pulse aim(const Line& line, uint64_t k, uint64_t rnd) const;
+  void hitBuildings(CellCache<Building, 4>& cache, const Pulse& p, double zg, PulseHit& hit) const;
+  void hitCrowns(CellCache<Tree, 6>& cache, const Pulse& p, double zg, PulseHit& hit) const;
 
   double side_;         // of the surveyed square (m)
   uint64_t strips_;     // K
@@ -319,11 +340,162 @@ struct TerrainScene::Line {
   bool flipY = false, flipX = false;
 };
 
+// Normal of the face a pulse entered a building by, `m` the slope of a gabled roof.
+glm::dvec3 buildingFaceNormal(int face, double m) {
+  switch (face) {
+  case 0:
+    return {-1, 0, 0};
+  case 1:
+    return {1, 0, 0};
+  case 3:
+    return glm::normalize(glm::dvec3(0, m, 1));
+  case 4:
+    return glm::normalize(glm::dvec3(0, -m, 1));
+  case 5:
+    return glm::normalize(glm::dvec3(m, 0, 1));
+  case 6:
+    return glm::normalize(glm::dvec3(-m, 0, 1));
+  default:
+    return {0, 0, 1};
+  }
+}
+
+// Records where the pulse enters building `b` when that is higher than what it met so far.
+void hitBuilding(const Building& b, const Pulse& p, double zg, PulseHit& hit) {
+  const double x = p.x, y = p.y, t = p.t;
+  if (!b.present || y < b.y0 || y > b.y1) return;
+  // Convex cross-section in the pulse's plane (y fixed): constraints coef * lambda <= rhs.
+  double hi = std::numeric_limits<double>::infinity(), lo = -hi;
+  int face = -1;
+  auto constrain = [&](double coef, double rhs, int f) {
+    if (coef > 0) {
+      if (rhs / coef < hi) hi = rhs / coef, face = f;
+    } else if (coef < 0) {
+      lo = std::max(lo, rhs / coef);
+    } else if (rhs < 0) {
+      hi = -std::numeric_limits<double>::infinity();
+    }
+  };
+  constrain(t, x - b.x0, 0);  // x >= x0: west wall
+  constrain(-t, b.x1 - x, 1); // x <= x1: east wall
+  constrain(-1, zg - b.zBase, -1);
+  double m = 0;
+  if (b.roof == 0) {
+    constrain(1, b.zEave - zg, 2);
+  } else if (b.roof == 1) {
+    const double yc = 0.5 * (b.y0 + b.y1), half = 0.5 * (b.y1 - b.y0);
+    m = b.rise / half;
+    constrain(1, b.zEave + b.rise * (1 - std::abs(y - yc) / half) - zg, y >= yc ? 3 : 4);
+  } else {
+    const double xc = 0.5 * (b.x0 + b.x1);
+    m = b.rise / (0.5 * (b.x1 - b.x0));
+    constrain(1 - m * t, b.zEave + b.rise - zg - m * (x - xc), 5); // east-facing slope
+    constrain(1 + m * t, b.zEave + b.rise - zg + m * (x - xc), 6); // west-facing slope
+  }
+  if (lo > hi || hi <= hit.best) return;
+  hit.best = hi;
+  hit.kind = face <= 1 ? PulseHit::kWall : PulseHit::kRoof;
+  hit.surface = face <= 1 ? b.wallColor * 0.9 : b.roofColor;
+  hit.normal = buildingFaceNormal(face, m);
+}
+
+// Height above the ground point at which the pulse enters crown `tr`; false when it misses.
+bool crownEntry(const Tree& tr, const Pulse& p, double zg, double* lambda) {
+  const double y = p.y, t = p.t;
+  if (!tr.present || std::abs(y - tr.cy) > tr.radius) return false;
+  const double a = p.x - tr.cx, b = y - tr.cy;
+  if (tr.conifer) {
+    // Cone, apex at zTop: horizontal distance <= k (zTop - z).
+    const double kk = tr.radius / (tr.zTop - tr.zBottom), c = tr.zTop - zg;
+    const double qa = t * t - kk * kk, qb = -2 * a * t + 2 * kk * kk * c,
+                 qc = a * a + b * b - kk * kk * c * c;
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc < 0) return false;
+    const double sq = std::sqrt(disc), r1 = (-qb + sq) / (2 * qa), r2 = (-qb - sq) / (2 * qa);
+    *lambda = -std::numeric_limits<double>::infinity();
+    if (r1 <= c) *lambda = r1;
+    if (r2 <= c) *lambda = std::max(*lambda, r2);
+    return !(zg + *lambda < tr.zBottom); // not >=: a NaN entry stays a hit
+  }
+  const double rz = 0.5 * (tr.zTop - tr.zBottom), e = zg - 0.5 * (tr.zTop + tr.zBottom);
+  const double ir2 = 1.0 / (tr.radius * tr.radius), irz2 = 1.0 / (rz * rz);
+  const double qa = t * t * ir2 + irz2, qb = -2 * a * t * ir2 + 2 * e * irz2;
+  const double qc = (a * a + b * b) * ir2 + e * e * irz2 - 1;
+  const double disc = qb * qb - 4 * qa * qc;
+  if (disc < 0) return false;
+  *lambda = (-qb + std::sqrt(disc)) / (2 * qa);
+  return true;
+}
+
+// Color of a crown return at (px, y, pz): shaded by the crown's normal there, inner and lower parts darker.
+Rgb crownColor(const Tree& tr, double px, double y, double pz, uint64_t rnd) {
+  const double h = (pz - tr.zBottom) / (tr.zTop - tr.zBottom);
+  glm::dvec3 nr(px - tr.cx, y - tr.cy, 0);
+  if (tr.conifer) {
+    nr = glm::length(nr) > 0 ? glm::normalize(nr) : glm::dvec3(0);
+    nr.z = tr.radius / (tr.zTop - tr.zBottom);
+  } else {
+    const double rz = 0.5 * (tr.zTop - tr.zBottom);
+    nr /= tr.radius * tr.radius;
+    nr.z = (pz - 0.5 * (tr.zTop + tr.zBottom)) / (rz * rz);
+  }
+  return tr.color * ((0.7 + 0.35 * std::clamp(h, 0.0, 1.0)) * shade(glm::normalize(nr)) *
+                     (0.85 + 0.3 * unit16(rnd, 40)));
+}
+
+void TerrainScene::startLine(uint64_t g, Line& line) const {
+  // Strip s holds lines [floor(s G / K), floor((s + 1) G / K)): strips differ by at most one line.
+  const uint64_t s = ((g + 1) * strips_ - 1) / lines_;
+  const uint64_t g0 = s * lines_ / strips_, g1 = (s + 1) * lines_ / strips_;
+  const uint64_t l = g - g0;
+  line.index = g;
+  line.xCenter = (double(s) + 0.5) * stripSpacing_;
+  line.dy = side_ / double(g1 - g0);
+  line.y = (double(l) + 0.5) * line.dy;
+  line.flipY = s & 1; // alternate headings
+  line.flipX = l & 1; // zig-zag mirror
+}
+
+Pulse TerrainScene::aim(const Line& line, uint64_t k, uint64_t rnd) const {
+  // Pulse footprint on the ground, jittered by up to 30% of the spacing so no grid pattern shows.
+  double u = ((double(k) + 0.2 + 0.6 * unit16(rnd, 0)) / double(samples_) - 0.5) * stripWidth_;
+  if (line.flipX) u = -u;
+  double y = line.y + (unit16(rnd, 16) - 0.5) * 0.6 * line.dy;
+  if (line.flipY) y = side_ - y;
+  return {line.xCenter + u, y, u / flightHeight_};
+}
+
+void TerrainScene::hitBuildings(CellCache<Building, 4>& cache, const Pulse& p, double zg,
+                                PulseHit& hit) const {
+  auto buildingAt = [this](int32_t x, int32_t y) { return building(x, y); };
+  const double xa = std::min(p.x, p.x - p.t * kMaxRoofTop), xb = std::max(p.x, p.x - p.t * kMaxRoofTop);
+  const int32_t by = floorInt(p.y / kBuildingCell);
+  for (int32_t bx = floorInt(xa / kBuildingCell); bx <= floorInt(xb / kBuildingCell); ++bx)
+    hitBuilding(cache.get(bx, by, buildingAt), p, zg, hit);
+}
+
+void TerrainScene::hitCrowns(CellCache<Tree, 6>& cache, const Pulse& p, double zg, PulseHit& hit) const {
+  auto treeAt = [this](int32_t x, int32_t y) { return tree(x, y); };
+  const double xa = std::min(p.x, p.x - p.t * kMaxTreeTop), xb = std::max(p.x, p.x - p.t * kMaxTreeTop);
+  const int32_t tx0 = -floorInt((kCrownReach[1] - xa) / kTreeCell);
+  const int32_t tx1 = floorInt((xb - kCrownReach[0]) / kTreeCell);
+  const int32_t ty0 = -floorInt((kCrownReach[1] - p.y) / kTreeCell);
+  const int32_t ty1 = floorInt((p.y - kCrownReach[0]) / kTreeCell);
+  for (int32_t ty = ty0; ty <= ty1; ++ty) {
+    for (int32_t tx = tx0; tx <= tx1; ++tx) {
+      const Tree& tr = cache.get(tx, ty, treeAt);
+      double lambda;
+      if (!crownEntry(tr, p, zg, &lambda) || lambda <= hit.best) continue;
+      hit.best = lambda;
+      hit.kind = PulseHit::kCrown;
+      hit.tree = tr;
+    }
+  }
+}
+
 void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors) const {
   CellCache<Building, 4> buildings;
   CellCache<Tree, 6> trees;
-  auto buildingAt = [this](int32_t x, int32_t y) { return building(x, y); };
-  auto treeAt = [this](int32_t x, int32_t y) { return tree(x, y); };
   NoiseCells cells;
 
   uint64_t g = first / samples_, k = first % samples_;
@@ -333,176 +505,38 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
       k = 0;
       ++g;
     }
-    if (line.index != g) {
-      // Strip s holds lines [floor(s G / K), floor((s + 1) G / K)): strips differ by at most one line.
-      const uint64_t s = ((g + 1) * strips_ - 1) / lines_;
-      const uint64_t g0 = s * lines_ / strips_, g1 = (s + 1) * lines_ / strips_;
-      const uint64_t l = g - g0;
-      line.index = g;
-      line.xCenter = (double(s) + 0.5) * stripSpacing_;
-      line.dy = side_ / double(g1 - g0);
-      line.y = (double(l) + 0.5) * line.dy;
-      line.flipY = s & 1; // alternate headings
-      line.flipX = l & 1; // zig-zag mirror
-    }
+    if (line.index != g) startLine(g, line);
     const uint64_t i = first + n;
     const uint64_t rnd = splitmixAt(seedKey_, i);
-    // Pulse footprint on the ground, jittered by up to 30% of the spacing so no grid pattern shows.
-    double u = ((double(k) + 0.2 + 0.6 * unit16(rnd, 0)) / double(samples_) - 0.5) * stripWidth_;
-    if (line.flipX) u = -u;
-    double y = line.y + (unit16(rnd, 16) - 0.5) * 0.6 * line.dy;
-    if (line.flipY) y = side_ - y;
-    const double x = line.xCenter + u;
-    const double t = u / flightHeight_; // the pulse moves by -t in x per metre of height
+    const Pulse p = aim(line, k, rnd);
+    const double x = p.x, y = p.y;
 
     double gx, gy;
     const double zg = ground(x, y, &gx, &gy, cells);
 
-    // Largest height above the ground point at which the pulse enters a building or a crown: that is
-    // the first surface coming down from the aircraft. 0 means the ground itself.
-    double best = 0;
-    enum { kGround, kRoof, kWall, kCrown } kind = kGround;
-    glm::dvec3 normal(0, 0, 1);
-    // Copies, not pointers: a later cache lookup may evict the cell that was hit.
-    Rgb surface{};
-    Tree hitTree;
+    PulseHit hit;
+    hitBuildings(buildings, p, zg, hit);
+    if (unit16(rnd, 32) >= kCrownPassThrough) hitCrowns(trees, p, zg, hit);
 
-    {
-      const double xa = std::min(x, x - t * kMaxRoofTop), xb = std::max(x, x - t * kMaxRoofTop);
-      const int32_t by = floorInt(y / kBuildingCell);
-      for (int32_t bx = floorInt(xa / kBuildingCell); bx <= floorInt(xb / kBuildingCell); ++bx) {
-        const Building& b = buildings.get(bx, by, buildingAt);
-        if (!b.present || y < b.y0 || y > b.y1) continue;
-        // Convex cross-section in the pulse's plane (y fixed): constraints coef * lambda <= rhs.
-        double hi = std::numeric_limits<double>::infinity(), lo = -hi;
-        int face = -1;
-        auto constrain = [&](double coef, double rhs, int f) {
-          if (coef > 0) {
-            if (rhs / coef < hi) hi = rhs / coef, face = f;
-          } else if (coef < 0) {
-            lo = std::max(lo, rhs / coef);
-          } else if (rhs < 0) {
-            hi = -std::numeric_limits<double>::infinity();
-          }
-        };
-        constrain(t, x - b.x0, 0);  // x >= x0: west wall
-        constrain(-t, b.x1 - x, 1); // x <= x1: east wall
-        constrain(-1, zg - b.zBase, -1);
-        double m = 0;
-        if (b.roof == 0) {
-          constrain(1, b.zEave - zg, 2);
-        } else if (b.roof == 1) {
-          const double yc = 0.5 * (b.y0 + b.y1), half = 0.5 * (b.y1 - b.y0);
-          m = b.rise / half;
-          constrain(1, b.zEave + b.rise * (1 - std::abs(y - yc) / half) - zg, y >= yc ? 3 : 4);
-        } else {
-          const double xc = 0.5 * (b.x0 + b.x1);
-          m = b.rise / (0.5 * (b.x1 - b.x0));
-          constrain(1 - m * t, b.zEave + b.rise - zg - m * (x - xc), 5); // east-facing slope
-          constrain(1 + m * t, b.zEave + b.rise - zg + m * (x - xc), 6); // west-facing slope
-        }
-        if (lo > hi || hi <= best) continue;
-        best = hi;
-        kind = face <= 1 ? kWall : kRoof;
-        surface = face <= 1 ? b.wallColor * 0.9 : b.roofColor;
-        switch (face) {
-        case 0:
-          normal = {-1, 0, 0};
-          break;
-        case 1:
-          normal = {1, 0, 0};
-          break;
-        case 3:
-          normal = glm::normalize(glm::dvec3(0, m, 1));
-          break;
-        case 4:
-          normal = glm::normalize(glm::dvec3(0, -m, 1));
-          break;
-        case 5:
-          normal = glm::normalize(glm::dvec3(m, 0, 1));
-          break;
-        case 6:
-          normal = glm::normalize(glm::dvec3(-m, 0, 1));
-          break;
-        default:
-          normal = {0, 0, 1};
-          break;
-        }
-      }
-    }
-
-    if (unit16(rnd, 32) >= kCrownPassThrough) {
-      const double xa = std::min(x, x - t * kMaxTreeTop), xb = std::max(x, x - t * kMaxTreeTop);
-      const int32_t tx0 = -floorInt((kCrownReach[1] - xa) / kTreeCell);
-      const int32_t tx1 = floorInt((xb - kCrownReach[0]) / kTreeCell);
-      const int32_t ty0 = -floorInt((kCrownReach[1] - y) / kTreeCell);
-      const int32_t ty1 = floorInt((y - kCrownReach[0]) / kTreeCell);
-      for (int32_t ty = ty0; ty <= ty1; ++ty) {
-        for (int32_t tx = tx0; tx <= tx1; ++tx) {
-          const Tree& tr = trees.get(tx, ty, treeAt);
-          if (!tr.present || std::abs(y - tr.cy) > tr.radius) continue;
-          const double a = x - tr.cx, b = y - tr.cy;
-          double lambda;
-          if (tr.conifer) {
-            // Cone, apex at zTop: horizontal distance <= k (zTop - z).
-            const double kk = tr.radius / (tr.zTop - tr.zBottom), c = tr.zTop - zg;
-            const double qa = t * t - kk * kk, qb = -2 * a * t + 2 * kk * kk * c,
-                         qc = a * a + b * b - kk * kk * c * c;
-            const double disc = qb * qb - 4 * qa * qc;
-            if (disc < 0) continue;
-            const double sq = std::sqrt(disc), r1 = (-qb + sq) / (2 * qa), r2 = (-qb - sq) / (2 * qa);
-            lambda = -std::numeric_limits<double>::infinity();
-            if (r1 <= c) lambda = r1;
-            if (r2 <= c) lambda = std::max(lambda, r2);
-            if (zg + lambda < tr.zBottom) continue;
-          } else {
-            const double rz = 0.5 * (tr.zTop - tr.zBottom), e = zg - 0.5 * (tr.zTop + tr.zBottom);
-            const double ir2 = 1.0 / (tr.radius * tr.radius), irz2 = 1.0 / (rz * rz);
-            const double qa = t * t * ir2 + irz2, qb = -2 * a * t * ir2 + 2 * e * irz2;
-            const double qc = (a * a + b * b) * ir2 + e * e * irz2 - 1;
-            const double disc = qb * qb - 4 * qa * qc;
-            if (disc < 0) continue;
-            lambda = (-qb + std::sqrt(disc)) / (2 * qa);
-          }
-          if (lambda <= best) continue;
-          best = lambda;
-          kind = kCrown;
-          hitTree = tr;
-        }
-      }
-    }
-
-    const double px = x - t * best, pz = zg + best + (unit16(rnd, 48) - 0.5) * 0.03; // ~1 cm ranging noise
+    const double px = x - p.t * hit.best;
+    const double pz = zg + hit.best + (unit16(rnd, 48) - 0.5) * 0.03; // ~1 cm ranging noise
     positions[3 * n + 0] = quantize(px);
     positions[3 * n + 1] = quantize(y);
     positions[3 * n + 2] = quantize(pz);
 
     Rgb c;
     const double grain = 0.93 + 0.14 * unit16(rnd, 40);
-    switch (kind) {
-    case kGround:
+    switch (hit.kind) {
+    case PulseHit::kGround:
       c = groundColor(x, y, gx, gy, rnd, cells);
       break;
-    case kRoof:
-    case kWall:
-      c = surface * (shade(normal) * grain);
+    case PulseHit::kRoof:
+    case PulseHit::kWall:
+      c = hit.surface * (shade(hit.normal) * grain);
       break;
-    case kCrown: {
-      const Tree& tr = hitTree;
-      const double h = (pz - tr.zBottom) / (tr.zTop - tr.zBottom); // inner, lower parts darker
-      glm::dvec3 nr(px - tr.cx, y - tr.cy, 0);
-      if (tr.conifer) {
-        nr = glm::length(nr) > 0 ? glm::normalize(nr) : glm::dvec3(0);
-        nr.z = tr.radius / (tr.zTop - tr.zBottom);
-      } else {
-        const double rz = 0.5 * (tr.zTop - tr.zBottom);
-        nr /= tr.radius * tr.radius;
-        nr.z = (pz - 0.5 * (tr.zTop + tr.zBottom)) / (rz * rz);
-      }
-      c = tr.color * ((0.7 + 0.35 * std::clamp(h, 0.0, 1.0)) * shade(glm::normalize(nr)) *
-                      (0.85 + 0.3 * unit16(rnd, 40)));
+    case PulseHit::kCrown:
+      c = crownColor(hit.tree, px, y, pz, rnd);
       break;
-    }
     }
     colors[n] = toRgba(c);
   }

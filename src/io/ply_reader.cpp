@@ -168,11 +168,10 @@ std::string printable(std::string_view s, size_t max = 40) {
   return out;
 }
 
-PlyHeader readPlyHeader(const InputFile& file) {
+// Reads a growing prefix of the file into `text` until it holds the end_header line; returns the offset
+// just past that line, where the data starts.
+size_t readHeaderText(const InputFile& file, std::string& text) {
   const auto& path = file.path();
-  // Read a growing prefix until it holds the end_header line.
-  std::string text;
-  size_t headerEnd = std::string::npos;
   for (size_t want = 4096;; want *= 4) {
     want = static_cast<size_t>(std::min<uint64_t>({want, file.size(), kMaxHeaderBytes}));
     text.resize(want);
@@ -183,94 +182,121 @@ PlyHeader readPlyHeader(const InputFile& file) {
       size_t after = at + 10;
       while (after < text.size() && (text[after] == ' ' || text[after] == '\t' || text[after] == '\r'))
         ++after;
-      if (at > 0 && text[at - 1] == '\n' && after < text.size() && text[after] == '\n') {
-        headerEnd = after + 1;
-        break;
-      }
+      if (at > 0 && text[at - 1] == '\n' && after < text.size() && text[after] == '\n') return after + 1;
       at = after;
     }
-    if (headerEnd != std::string::npos) break;
     if (want >= file.size() || want >= kMaxHeaderBytes)
       fail(path, want >= kMaxHeaderBytes ? "no end_header line in the first 16 MiB"
                                          : "the PLY header has no end_header line (file truncated?)");
   }
+}
 
-  PlyHeader h;
-  h.dataOffset = headerEnd;
-  std::string_view all(text.data(), headerEnd);
+// One header line split into words; bad() refuses the file, naming the line by its number.
+struct HeaderLine {
+  const std::filesystem::path& path;
+  size_t number;
+  std::string_view text;
+  std::vector<std::string_view> words;
+
+  [[noreturn]] void bad(const std::string& what) const {
+    fail(path, strFormat("line %zu of the PLY header: %s", number, what.c_str()));
+  }
+};
+
+// The text of a comment or obj_info line after its keyword, trimmed and made printable.
+std::string commentText(const HeaderLine& l) {
+  const std::string_view key = l.words[0], line = l.text;
+  size_t start = line.find(key) + key.size();
+  while (start < line.size() && isBlank(line[start]))
+    ++start;
+  std::string_view rest = line.substr(start);
+  while (!rest.empty() && isBlank(rest.back()))
+    rest.remove_suffix(1);
+  return printable(rest, 200) + (rest.size() > 200 ? "..." : "");
+}
+
+void parseFormat(const HeaderLine& l, PlyHeader& h) {
+  const auto& words = l.words;
+  if (words[1] == "ascii")
+    h.encoding = PlyEncoding::Ascii;
+  else if (words[1] == "binary_little_endian")
+    h.encoding = PlyEncoding::BinaryLE;
+  else if (words[1] == "binary_big_endian")
+    h.encoding = PlyEncoding::BinaryBE;
+  else
+    l.bad("unknown encoding '" + printable(words[1]) + "'");
+  h.formatLine = std::string(words[1]) + " " + printable(words[2]);
+}
+
+PlyElement parseElement(const HeaderLine& l) {
+  PlyElement e;
+  if (l.words.size() != 3 || !parseUint(l.words[2], e.count)) l.bad("expected 'element <name> <count>'");
+  e.name = printable(l.words[1]);
+  return e;
+}
+
+PlyProperty parseProperty(const HeaderLine& l) {
+  const auto& words = l.words;
+  PlyProperty p;
+  if (words.size() == 5 && words[1] == "list") {
+    auto countType = parseType(words[2]);
+    auto itemType = parseType(words[3]);
+    if (!countType || !itemType || isFloatType(*countType))
+      l.bad("bad list property types '" + printable(words[2]) + " " + printable(words[3]) + "'");
+    p.isList = true;
+    p.countType = *countType;
+    p.type = *itemType;
+    p.name = printable(words[4]);
+  } else if (words.size() == 3) {
+    auto type = parseType(words[1]);
+    if (!type) l.bad("unknown property type '" + printable(words[1]) + "'");
+    p.type = *type;
+    p.name = printable(words[2]);
+  } else {
+    l.bad("expected 'property <type> <name>' or 'property list <type> <type> <name>'");
+  }
+  return p;
+}
+
+// Parses the header lines in `all` (which ends with the end_header line) into h's encoding, comments and
+// elements.
+void parseHeaderLines(const std::filesystem::path& path, std::string_view all, PlyHeader& h) {
   bool haveFormat = false;
   size_t lineNo = 0;
   size_t pos = 0;
   while (pos < all.size()) {
     size_t nl = all.find('\n', pos);
-    std::string_view line = all.substr(pos, nl - pos);
+    std::string_view text = all.substr(pos, nl - pos);
     pos = nl + 1;
-    ++lineNo;
-    auto words = splitWords(line);
-    auto bad = [&](const std::string& what) {
-      fail(path, strFormat("line %zu of the PLY header: %s", lineNo, what.c_str()));
-    };
+    const HeaderLine l{path, ++lineNo, text, splitWords(text)};
     if (lineNo == 1) {
-      if (words.size() != 1 || words[0] != "ply") bad("expected 'ply'");
+      if (l.words.size() != 1 || l.words[0] != "ply") l.bad("expected 'ply'");
       continue;
     }
-    if (words.empty()) continue;
-    std::string_view key = words[0];
+    if (l.words.empty()) continue;
+    std::string_view key = l.words[0];
     if (key == "comment" || key == "obj_info") {
-      size_t start = line.find(key) + key.size();
-      while (start < line.size() && isBlank(line[start]))
-        ++start;
-      std::string_view rest = line.substr(start);
-      while (!rest.empty() && isBlank(rest.back()))
-        rest.remove_suffix(1);
-      if (h.comments.size() < 16)
-        h.comments.push_back(printable(rest, 200) + (rest.size() > 200 ? "..." : ""));
+      if (h.comments.size() < 16) h.comments.push_back(commentText(l));
     } else if (key == "format") {
-      if (haveFormat || words.size() != 3) bad("expected one 'format <encoding> 1.0' line");
-      if (words[1] == "ascii")
-        h.encoding = PlyEncoding::Ascii;
-      else if (words[1] == "binary_little_endian")
-        h.encoding = PlyEncoding::BinaryLE;
-      else if (words[1] == "binary_big_endian")
-        h.encoding = PlyEncoding::BinaryBE;
-      else
-        bad("unknown encoding '" + printable(words[1]) + "'");
-      h.formatLine = std::string(words[1]) + " " + printable(words[2]);
+      if (haveFormat || l.words.size() != 3) l.bad("expected one 'format <encoding> 1.0' line");
+      parseFormat(l, h);
       haveFormat = true;
     } else if (key == "element") {
-      PlyElement e;
-      if (words.size() != 3 || !parseUint(words[2], e.count)) bad("expected 'element <name> <count>'");
-      e.name = printable(words[1]);
-      h.elements.push_back(std::move(e));
+      h.elements.push_back(parseElement(l));
     } else if (key == "property") {
-      if (h.elements.empty()) bad("property before any element");
-      PlyProperty p;
-      if (words.size() == 5 && words[1] == "list") {
-        auto countType = parseType(words[2]);
-        auto itemType = parseType(words[3]);
-        if (!countType || !itemType || isFloatType(*countType))
-          bad("bad list property types '" + printable(words[2]) + " " + printable(words[3]) + "'");
-        p.isList = true;
-        p.countType = *countType;
-        p.type = *itemType;
-        p.name = printable(words[4]);
-      } else if (words.size() == 3) {
-        auto type = parseType(words[1]);
-        if (!type) bad("unknown property type '" + printable(words[1]) + "'");
-        p.type = *type;
-        p.name = printable(words[2]);
-      } else {
-        bad("expected 'property <type> <name>' or 'property list <type> <type> <name>'");
-      }
-      h.elements.back().properties.push_back(std::move(p));
+      if (h.elements.empty()) l.bad("property before any element");
+      h.elements.back().properties.push_back(parseProperty(l));
     } else if (key == "end_header") {
       break;
     } else {
-      bad("unknown keyword '" + printable(key) + "'");
+      l.bad("unknown keyword '" + printable(key) + "'");
     }
   }
   if (!haveFormat) fail(path, "the PLY header has no format line");
+}
 
+// Finds the vertex element and, within it, the x, y, z properties and the color ones if all three are there.
+void findVertexProperties(const std::filesystem::path& path, PlyHeader& h) {
   bool found = false;
   for (size_t i = 0; i < h.elements.size(); ++i)
     if (h.elements[i].name == "vertex") {
@@ -296,6 +322,14 @@ PlyHeader readPlyHeader(const InputFile& file) {
   if (h.xyz[0] < 0 || h.xyz[1] < 0 || h.xyz[2] < 0)
     fail(path, "the vertex element lacks an x, y or z property");
   if (h.rgb[0] < 0 || h.rgb[1] < 0 || h.rgb[2] < 0) h.rgb[0] = h.rgb[1] = h.rgb[2] = -1;
+}
+
+PlyHeader readPlyHeader(const InputFile& file) {
+  std::string text;
+  PlyHeader h;
+  h.dataOffset = readHeaderText(file, text);
+  parseHeaderLines(file.path(), std::string_view(text.data(), h.dataOffset), h);
+  findVertexProperties(file.path(), h);
   return h;
 }
 
