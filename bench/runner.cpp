@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -241,10 +240,9 @@ double secondsSince(std::chrono::steady_clock::time_point since) {
 }
 
 bool settlesClocks(const gpu::Context& context) {
-  // A run with an injected device fault (POINTRAST_INJECT_DEVICE_LOST, tests) counts submissions to place
-  // the fault; settling takes a number of them that depends on the device's clocks, so it is left out.
-  const char* injected = std::getenv("POINTRAST_INJECT_DEVICE_LOST");
-  return !context.info().software() && !(injected && *injected);
+  // An injected device fault is placed by counting submissions; settling takes a number of them that
+  // depends on the device's clocks, so it is left out of such runs.
+  return !context.info().software() && !gpu::deviceLossInjected();
 }
 
 void settleWithFirst(const gpu::Context& context, std::span<const Method> methods,

@@ -26,12 +26,17 @@ double submitTimeoutSeconds() {
 // Test hook: POINTRAST_INJECT_DEVICE_LOST=N makes the Nth submission of the process (counting from 1) and
 // every later one fail with VK_ERROR_DEVICE_LOST instead of reaching the driver, so tests can show what a
 // lost device leaves behind (a benchmark's reports, one line from the CLI).
-bool injectedDeviceLoss() {
+uint64_t injectedLossFrom() {
   static const uint64_t from = [] {
     const char* env = std::getenv("POINTRAST_INJECT_DEVICE_LOST");
     return env && *env ? std::strtoull(env, nullptr, 10) : 0ull;
   }();
+  return from;
+}
+
+bool injectedDeviceLoss() {
   static std::atomic<uint64_t> submissions{0};
+  const uint64_t from = injectedLossFrom();
   return from > 0 && ++submissions >= from;
 }
 
@@ -159,6 +164,10 @@ std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
 }
 
 } // namespace
+
+bool deviceLossInjected() {
+  return injectedLossFrom() > 0;
+}
 
 std::vector<DeviceInfo> listDevices() {
   Instance instance = createInstance(false);

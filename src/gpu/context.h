@@ -58,6 +58,10 @@ struct DeviceFeatures {
   bool rayTracing = false;
 };
 
+// Whether the test hook POINTRAST_INJECT_DEVICE_LOST is set: the process's submissions, counted, are to fail
+// from a given one on. Work whose number of submissions depends on the device (clock settling) stays out.
+bool deviceLossInjected();
+
 class Context {
 public:
   explicit Context(const ContextOptions& options = {});
