@@ -86,6 +86,9 @@ uint drawStep(BatchView v, uint words, bool checked, uint h[GROUP], uint m[GROUP
   Uint64Array fb = Uint64Array(framebuffer);
   DepthHalves depths = DepthHalves(framebuffer);
   uint pixel[GROUP], depth[GROUP], payload[GROUP];
+  // Whether every point projects to a pixel: no test can drop one (projectInside), so the merge below need
+  // not ask whether point u was dropped (a compare a point, on the path of every point of the overview).
+  const bool allProjected = !checked && words != 3u;
   [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
     uint local = pointOfStep(step, u);
     payload[u] = DEPTH_ONLY != 0u ? 0u : payloadBase + local;
@@ -94,7 +97,7 @@ uint drawStep(BatchView v, uint words, bool checked, uint h[GROUP], uint m[GROUP
       pixel[u] = kNoPixel;
       depth[u] = 0xFFFFFFFFu; // above any seen value: no atomic
     }
-    if (u > 0u && pixel[u] == pixel[u - 1u] && pixel[u] != kNoPixel) {
+    if (u > 0u && pixel[u] == pixel[u - 1u] && (allProjected || pixel[u] != kNoPixel)) {
       // Keep the smaller word: the closer point, or on equal depth the lower index (u - 1).
       if (depth[u - 1u] <= depth[u]) {
         depth[u] = depth[u - 1u];
