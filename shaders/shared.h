@@ -261,9 +261,9 @@ struct LodPage {
 };
 
 // A node's box decision (batch.inc.glsl's BatchView), computed once per node and pass by lod_nodes.comp and
-// read by every page of the node (and a batch's, by batch_views.comp for the batch passes): the screen map's rows (cx, cy, cz, offset), the min corner and the steps
-// of the 30-bit quantization. cx.w holds the coordinate words (0: culled), cy.w 1 when every point of the
-// box is inside the image (as float bits).
+// read by every page of the node (a batch's likewise: batch_views.comp, BatchFrame::views): the screen map's
+// rows (cx, cy, cz, offset), the min corner and the steps of the 30-bit quantization. cx.w holds the
+// coordinate words (0: culled), cy.w 1 when every point of the box is inside the image (as float bits).
 struct LodNodeView {
   vec4 cx;
   vec4 cy;
