@@ -240,18 +240,12 @@ struct BatchWords {
   uint64_t colors;
 };
 
-// The medium and low words of points 4g .. 4g + 3, as loadQuad (whose high words a pass may have loaded
-// already).
-void loadLowerQuads(BatchWords at, uint g, uint words, out uvec4 medium, out uvec4 low) {
-  medium = words >= 2u ? Uvec4Array(at.medium).v[g] : uvec4(0u);
-  low = words >= 3u ? Uvec4Array(at.low).v[g] : uvec4(0u);
-}
-
 // The words of the box's points 4g .. 4g + 3 (uvec4 g of each word buffer), the first `words` of them;
 // zeros for the others.
 void loadQuad(BatchWords at, uint g, uint words, out uvec4 high, out uvec4 medium, out uvec4 low) {
   high = Uvec4Array(at.high).v[g];
-  loadLowerQuads(at, g, words, medium, low);
+  medium = words >= 2u ? Uvec4Array(at.medium).v[g] : uvec4(0u);
+  low = words >= 3u ? Uvec4Array(at.low).v[g] : uvec4(0u);
 }
 
 // Statistics (shared.h, kStat*): a thread counts in a register, the workgroup sums in shared memory, and

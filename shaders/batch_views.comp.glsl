@@ -1,7 +1,7 @@
 #version 460
 // The box decisions of a part's batches (batch.inc.glsl's viewBox), one thread per batch and eye, into
 // BatchFrame::views before the frame's drawing passes: a drawing workgroup then reads its batch's decision
-// with one load (batch_part.inc.glsl, VIEW_PASS) instead of waiting at two barriers while one of its threads
+// with one load (batch_part.inc.glsl, viewBatch) instead of waiting at two barriers while one of its threads
 // runs the decision's long dependent chain.
 #include "batch_part.inc.glsl"
 

@@ -17,11 +17,11 @@ void main() {
   BatchCamera cam = batchCamera(frame, 0u);
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
-  BatchView v = viewBatch(gl_WorkGroupID.x, cam, frame.f.forcedWords, frame.f.culling != 0u);
+  BatchView v = viewBatch(gl_WorkGroupID.x, 0u);
   uint blended = 0u;
   if (STEREO != 0u) {
     BatchCamera right = batchCamera(frame, 1u);
-    BatchView v1 = viewBatch(gl_WorkGroupID.x, right, frame.f.forcedWords, frame.f.culling != 0u);
+    BatchView v1 = viewBatch(gl_WorkGroupID.x, 1u);
     blended = blendBoxStereo(v, v1, batchWords(first), count, kBatchPrefetchSteps, cam, right,
                              frame.f.framebuffer, frame.f.accumulators);
   } else {

@@ -54,27 +54,17 @@ uint64_t frameBatches(const Frame& frame) {
   return batches;
 }
 
-// The value the row gives specialization constant `id`, or the shader's default.
-uint32_t specValue(const MethodInfo& method, uint32_t id, uint32_t shaderDefault) {
-  for (const gpu::SpecConstant& s : method.spec.span())
-    if (s.id == id) return s.value;
-  return shaderDefault;
-}
-
 class BatchMethod : public PointMethod {
 public:
   BatchMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height, uint32_t eyes)
-      : context_(context), hqs_(method.output == MethodOutput::Blend),
-        viewPass_(specValue(method, kViewPassId, 1) != 0), eyes_(eyes) {
+      : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
     // The row's constants: PREFETCH (one 128-bit load of 4 consecutive points) and, for the blending
-    // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes. EARLY_HIGH and
-    // VIEW_PASS (batch_draw.inc.glsl, batch_part.inc.glsl) are left on except by the timing references.
+    // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes.
     const gpu::SpecConstant stereo{/* STEREO= */ 2, eyes == 2 ? 1u : 0u};
-    const gpu::SpecConstant viewPass{kViewPassId, viewPass_ ? 1u : 0u};
     raster_ = gpu::ComputeProgram(context, method.shader, method.spec.with({stereo}));
-    if (viewPass_) views_ = gpu::ComputeProgram(context, "batch_views.comp");
+    views_ = gpu::ComputeProgram(context, "batch_views.comp");
     if (hqs_) {
-      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo, viewPass});
+      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo});
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
       // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
       accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
@@ -106,7 +96,7 @@ public:
     f.culling = frame.settings.batchCulling ? 1 : 0;
     f.pitch = targets.width;
     f.eyes = eyes_;
-    if (viewPass_) f.views = viewBuffer(frame).address();
+    f.views = viewBuffer(frame).address();
     const double aspect = double(targets.eyeWidth()) / double(targets.height);
     uint32_t part = 0;
     for (const GpuScene* scene : frame.scenes) {
@@ -124,13 +114,10 @@ public:
     gpu::vkCmdFillBuffer(cmd, stats_.handle(), 0, VK_WHOLE_SIZE, 0);
     if (hqs_) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
     gpu::fullBarrier(cmd);
-    if (viewPass_) {
-      forEachBatchPart(
-          frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
-            views_.dispatch(cmd, (batches + views_.groupSize() - 1) / views_.groupSize(), 1, push);
-          });
-      gpu::fullBarrier(cmd);
-    }
+    forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
+      views_.dispatch(cmd, (batches + views_.groupSize() - 1) / views_.groupSize(), 1, push);
+    });
+    gpu::fullBarrier(cmd);
     forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
       raster_.dispatch(cmd, batches, 1, push);
     });
@@ -158,8 +145,6 @@ public:
   }
 
 private:
-  static constexpr uint32_t kViewPassId = 4; // VIEW_PASS
-
   // BatchFrame::views, grown to the frame's batches. The frames of one submission draw the same scenes, so
   // it never changes under a recorded frame.
   const gpu::Buffer& viewBuffer(const Frame& frame) {
@@ -173,7 +158,6 @@ private:
   static constexpr uint64_t kStatsBytes = uint64_t(shared::kBatchStatSlots) * shared::kBatchStatCount * 8;
   gpu::Context& context_;
   bool hqs_;
-  bool viewPass_; // batch_views.comp computes the box decisions (VIEW_PASS)
   uint32_t eyes_;
   gpu::ComputeProgram raster_;     // batch / batch-prefetch, or batch-hqs's depth pass
   gpu::ComputeProgram views_;      // batch_views.comp
