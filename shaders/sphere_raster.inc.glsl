@@ -4,14 +4,18 @@
 
 // COUNT_WORK: count pixels tested, depth atomics and skipped chunks in frame.counters (one global atomic
 // each: for tests and measurements of the work, never for timing). TILE_BOUND: skip large-sphere chunks
-// behind their tile's depth bound (off only to compare the work with and without it).
+// behind their tile's depth bound (off only to compare the work with and without it). TILE_CUT_PIXELS:
+// the box size (pixels) above which a large sphere is cut along screen tiles rather than into bands of
+// whole box rows (kSphereTileCutPixels; other values only to count the work of other choices).
 layout(constant_id = 3) const uint COUNT_WORK = 0;
 layout(constant_id = 4) const uint TILE_BOUND = 1;
+layout(constant_id = 5) const uint TILE_CUT_PIXELS = kSphereTileCutPixels;
 
 // The large-sphere list: chunks asked for (64 bits: it keeps counting past the capacity and must never
 // wrap), spheres that drew some of their chunks themselves because the list was full, then entries
-// (global particle index, chunk x0 | y0 << 16, chunk x1 | y1 << 16 (inclusive pixel bounds: one tile
-// clipped to the sphere's box), floatBits of the sphere's front depth: center depth - radius).
+// (global particle index, chunk x0 | y0 << 16, chunk x1 | y1 << 16 (inclusive pixel bounds of at most
+// kSphereChunkPixels pixels: a screen tile or a band of whole box rows, clipped to the sphere's box),
+// floatBits of the sphere's front depth: center depth - radius).
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer SphereChunks {
   uint64_t count;
   uint spilled;
