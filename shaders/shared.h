@@ -334,7 +334,7 @@ PR_CONST kSphereSmallPixels = 64;
 PR_CONST kSphereTileShift = 4;
 PR_CONST kSphereTileSide = 16;    // 1 << kSphereTileShift
 PR_CONST kSphereChunkPixels = 256; // kSphereTileSide^2
-PR_CONST kSphereTileCutPixels = 1024; // a 32 x 32 box: four tiles' area
+PR_CONST kSphereTileCutPixels = 256; // a 16 x 16 box: one tile's area
 
 // Particle index of a pixel (or impostor) without a sphere.
 PR_CONST kNoParticle = 0xFFFFFFFFu;
@@ -383,7 +383,8 @@ struct SphereFrame {
   uint tilesX;          // sphere-compute: tiles per row of tileBounds, ceil(width / kSphereTileSide)
   uint64_t tileBounds;  // sphere-compute: uint per screen tile, floatBits of a view depth that every pixel
                         // center of the tile is known to be covered at or nearer (ones: none known)
-  uint64_t reserved;
+  uint64_t drawnChunks; // sphere-compute: uint[chunkCapacity], list indices of the chunks the large pass
+                        // draws (those not behind their tiles' bounds); their count is SphereChunks::drawn
 };
 
 // One part of a particle set on the GPU, as the resolve and large-sphere passes find it by index.

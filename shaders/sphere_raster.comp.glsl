@@ -2,7 +2,8 @@
 // sphere-compute, pass 1: one thread per sphere of a part. Culls the sphere (near plane, frustum, bad
 // values), then either ray-tests its whole pixel box itself (at most kSphereSmallPixels pixels: most
 // spheres of a large set) or cuts the box into chunks of at most 256 pixels (screen tiles, or bands of box
-// rows) appended to the large-sphere list for sphere_tile_bound.comp and sphere_raster_large.comp, so
+// rows) appended to the large-sphere list for passes 2-4 (sphere_tile_bound, sphere_chunk_cull and
+// sphere_raster_large.comp), so
 // that a sphere filling the screen is spread over many workgroups instead of serializing a frame on one
 // thread.
 //
