@@ -33,7 +33,7 @@ uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, B
     if (depth[k] > closest * float(PR_HQS_DEPTH_FACTOR)) pixel[k] = kNoPixel; // hidden: not blended
   }
   // Colors of the points that blend; a thread's four points are consecutive and often share a pixel, so
-  // the sums of a shared pixel go with its first point (fewer lanes for the subgroup to combine).
+  // they are added per pixel first (fewer lanes for the subgroup to combine, fewer subgroup steps).
   uint r[4], g[4], b[4], n[4];
   [[unroll]] for (uint k = 0u; k < 4u; ++k) {
     r[k] = g[k] = b[k] = n[k] = 0u;
@@ -42,17 +42,7 @@ uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, B
     n[k] = 1u;
     ++blended;
   }
-  [[unroll]] for (uint k = 1u; k < 4u; ++k) {
-    [[unroll]] for (uint e = 0u; e < k; ++e) {
-      if (pixel[k] != kNoPixel && pixel[k] == pixel[e]) {
-        r[e] += r[k];
-        g[e] += g[k];
-        b[e] += b[k];
-        n[e] += n[k];
-        pixel[k] = kNoPixel;
-      }
-    }
-  }
+  hqsMergeFour(pixel, r, g, b, n);
   [[unroll]] for (uint k = 0u; k < 4u; ++k)
     hqsBlend(acc, pixels, true, pixel[k], r[k], g[k], b[k], n[k]);
   return blended;

@@ -1,12 +1,12 @@
 // Blending for high-quality splatting, shared by hqs, hqs1r and batch-hqs: subgroup aggregation, then the
 // atomics of either accumulator layout. Needs the subgroup basic/vote/ballot/arithmetic/shuffle extensions
-// and common.inc.glsl.
+// and common.inc.glsl (and GL_EXT_control_flow_attributes).
 //
-// Contention decides the speed of HQS: in a dense overview every pixel blends hundreds of points, and the
-// lanes of a subgroup (consecutive points in Morton or scan order) mostly share a few pixels. So lanes first
-// add within the subgroup, one round per distinct pixel (a ballot picks the lowest pending lane, every lane
+// Contention decides the speed of HQS: in a dense overview every pixel blends hundreds of points, and
+// consecutive points (Morton or scan order) mostly share a few pixels. So a thread first adds its four
+// consecutive points per pixel (hqsMergeFour), then lanes add within the subgroup, one round per distinct pixel (a ballot picks the lowest pending lane, every lane
 // on its pixel adds to it), for at most kHqsRounds pixels; lanes still pending after that add alone. One
-// atomic (hqs1r) or two (hqs) per distinct pixel of a subgroup instead of one or two per point. On the H200
+// atomic (hqs1r) or two (hqs) per distinct pixel of a subgroup's 4 x 32 points instead of one or two per point. On the H200
 // this beat VK_NV_shader_subgroup_partitioned by far (bench/NOTES.md), and it runs on every device.
 
 // Distinct pixels a subgroup combines before the rest add alone: bounds the rounds where a subgroup's points
@@ -45,26 +45,83 @@ void hqsAccumulateTwo(Uint64Array acc, uint pixel, uint r, uint g, uint b, uint 
 }
 
 // Sums over the lanes of the subgroup: every lane brings the sums of the points it blends into `pixel`
-// (0xFFFFFFFF: none) and leaves with `writes` set if it is to add the sums it then holds. Call in uniform
-// control flow. Sums stay in 32 bits (a subgroup has at most 128 lanes).
+// (0xFFFFFFFF: none; at most kHqsLanePoints points) and leaves with `writes` set if it is to add the sums it
+// then holds. Call in uniform control flow.
+//
+// A round's sums are two subgroup adds, not four: r | g << 16 and b | count << 16. A subgroup of up to 64
+// lanes with up to 4 points each sums at most 64 x 4 x 255 = 65,280 per field, so the 16-bit fields never
+// carry into each other; wider subgroups (none known) take the four 32-bit adds. Subgroup adds are the
+// bulk of the rounds' work on NVIDIA (bench/NOTES.md, "HQS: what the accumulation pass spends").
+const uint kHqsLanePoints = 4u;
 void hqsSubgroupSums(uint pixel, inout uint r, inout uint g, inout uint b, inout uint count, out bool writes) {
   bool pending = pixel != 0xFFFFFFFFu;
   writes = false;
+  bool packed = gl_SubgroupSize * kHqsLanePoints * 255u <= 0xFFFFu;
+  uint lo = packed ? r | (g << 16) : r, hi = packed ? b | (count << 16) : b;
   for (uint round = 0u; round < kHqsRounds && subgroupAny(pending); ++round) {
     uint leader = subgroupBallotFindLSB(subgroupBallot(pending));
     uint leaderPixel = subgroupShuffle(pixel, leader);
     bool mine = pending && pixel == leaderPixel;
-    uint sr = subgroupAdd(mine ? r : 0u), sg = subgroupAdd(mine ? g : 0u);
-    uint sb = subgroupAdd(mine ? b : 0u), sc = subgroupAdd(mine ? count : 0u);
     bool lead = gl_SubgroupInvocationID == leader;
-    r = lead ? sr : r;
-    g = lead ? sg : g;
-    b = lead ? sb : b;
-    count = lead ? sc : count;
+    uint slo = subgroupAdd(mine ? lo : 0u), shi = subgroupAdd(mine ? hi : 0u);
+    lo = lead ? slo : lo;
+    hi = lead ? shi : hi;
+    if (!packed) {
+      uint sg = subgroupAdd(mine ? g : 0u), sc = subgroupAdd(mine ? count : 0u);
+      g = lead ? sg : g;
+      count = lead ? sc : count;
+    }
     writes = writes || lead;
     pending = pending && !mine;
   }
   writes = writes || pending; // past kHqsRounds pixels: alone
+  r = packed ? lo & 0xFFFFu : lo;
+  g = packed ? lo >> 16 : g;
+  b = packed ? hi & 0xFFFFu : hi;
+  count = packed ? hi >> 16 : count;
+}
+
+// A thread's four consecutive points, which often share a pixel: the sums of a pixel go to its first entry
+// and the entries left are moved to the front, so that entries 1-3 are empty in most lanes of an ordered
+// cloud and their subgroup step (hqsBlend) is skipped as a whole. Empty entries have pixel 0xFFFFFFFF and
+// zero sums.
+void hqsMergeFour(inout uint pixel[4], inout uint r[4], inout uint g[4], inout uint b[4], inout uint n[4]) {
+  [[unroll]] for (uint k = 1u; k < 4u; ++k) {
+    [[unroll]] for (uint e = 0u; e < k; ++e) {
+      if (pixel[k] != 0xFFFFFFFFu && pixel[k] == pixel[e]) {
+        r[e] += r[k];
+        g[e] += g[k];
+        b[e] += b[k];
+        n[e] += n[k];
+        pixel[k] = 0xFFFFFFFFu;
+      }
+    }
+  }
+  uint outPixel[4], outR[4], outG[4], outB[4], outN[4];
+  [[unroll]] for (uint o = 0u; o < 4u; ++o) {
+    outPixel[o] = 0xFFFFFFFFu;
+    outR[o] = outG[o] = outB[o] = outN[o] = 0u;
+  }
+  uint kept = 0u;
+  [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+    if (pixel[k] == 0xFFFFFFFFu) continue;
+    // Constant indices only (a dynamic index would put the arrays in local memory).
+    [[unroll]] for (uint o = 0u; o <= k; ++o) {
+      if (o == kept) {
+        outPixel[o] = pixel[k];
+        outR[o] = r[k];
+        outG[o] = g[k];
+        outB[o] = b[k];
+        outN[o] = n[k];
+      }
+    }
+    ++kept;
+  }
+  pixel = outPixel;
+  r = outR;
+  g = outG;
+  b = outB;
+  n = outN;
 }
 
 // Blends one group of points per lane (`pixel` 0xFFFFFFFF: none; r, g, b, count their sums) into the

@@ -5,44 +5,85 @@
 //   ONE_ROUND 0 (hqs):   aux = 2 uint64 per pixel: (r << 32 | g), (b << 32 | count); two atomicAdds
 //   ONE_ROUND 1 (hqs1r): aux = 1 uint64 per pixel packing r, g, b, count in 16 bits each, one atomicAdd;
 //                        then 2 uint64 per pixel of 32-bit fallback sums for points past the 255th.
-// Like raster_closest, a thread draws POINTS_PER_THREAD points a workgroup size apart (lanes of a subgroup
-// hold consecutive points), loading all positions first; a point reads its color only once it is known to
-// blend, so hidden points cost their 12 B of position alone.
+// A thread draws 4 consecutive points (three 16-byte position loads; the colors, one 16-byte load, only if one
+// of them blends): it adds them per pixel before the subgroup does (hqsMergeFour), so a subgroup step covers
+// 128 consecutive points and makes a few atomics for them. That, not the loads, decides the pass's speed in
+// dense views (bench/NOTES.md, "HQS: what the accumulation pass spends").
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
+#extension GL_EXT_control_flow_attributes : require
 #include "common.inc.glsl"
 #include "hqs_accumulate.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
 layout(push_constant) uniform Push { RasterPush pc; };
 layout(constant_id = 0) const uint ONE_ROUND = 0;
-layout(constant_id = 1) const uint POINTS_PER_THREAD = 1;
 #define DEPTH_INT40 0
 #include "point.inc.glsl"
 
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Vec4Array { vec4 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
+
+// Points are 12 B (x, y, z) and a part's buffers start 16-byte aligned, so 4 points from a multiple of 4 are
+// three aligned vec4s; the part's last, partial quad is read point by point.
+void loadFour(uint first, out vec3 p[4]) {
+  if (first + 3u < pc.pointCount) {
+    Vec4Array a = Vec4Array(pc.positions);
+    uint at = 3u * (first / 4u);
+    vec4 q0 = a.v[at], q1 = a.v[at + 1u], q2 = a.v[at + 2u];
+    p[0] = q0.xyz;
+    p[1] = vec3(q0.w, q1.xy);
+    p[2] = vec3(q1.zw, q2.x);
+    p[3] = q2.yzw;
+  } else {
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) p[k] = loadPositionOrZero(first + k);
+  }
+}
+
+uvec4 loadColors(uint first) {
+  if (first + 3u < pc.pointCount) return Uvec4Array(pc.colors).v[first / 4u];
+  uvec4 c = uvec4(0u);
+  [[unroll]] for (uint k = 0u; k < 4u; ++k)
+    if (first + k < pc.pointCount) c[k] = UintArray(pc.colors).v[first + k];
+  return c;
+}
+
 void main() {
   // No early return anywhere: the subgroup operations of hqsBlend need every lane.
-  uint first = firstPointOfThread(POINTS_PER_THREAD);
-  vec3 positions[POINTS_PER_THREAD];
-  for (uint k = 0; k < POINTS_PER_THREAD; ++k)
-    positions[k] = loadPositionOrZero(first + k * kPointGroupSize);
-  Uint64Array fb = Uint64Array(pc.framebuffer);
-  for (uint k = 0; k < POINTS_PER_THREAD; ++k) {
-    uint i = first + k * kPointGroupSize;
-    uint pixel = kNoPixel, r = 0u, g = 0u, b = 0u;
+  uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
+  uint first = group * (kPointGroupSize * 4u) + 4u * gl_LocalInvocationIndex;
+  vec3 p[4];
+  loadFour(first, p);
+  // Project all four, then read their pixels' closest depths together, then the colors if any blends.
+  uint pixel[4];
+  float depth[4];
+  [[unroll]] for (uint k = 0u; k < 4u; ++k) {
     uint64_t word;
-    if (i < pc.pointCount && depthWordOf(positions[k], pixel, word)) {
-      float closest = uintBitsToFloat(uint(fb.v[pixel] >> 32));
-      if (uintBitsToFloat(uint(word >> 32)) > closest * float(PR_HQS_DEPTH_FACTOR))
-        pixel = kNoPixel; // hidden: not blended, its color never read
-      else
-        hqsChannels(UintArray(pc.colors).v[i], r, g, b);
-    } else {
-      pixel = kNoPixel;
-    }
-    hqsBlend(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0, pixel, r, g, b, pixel != kNoPixel ? 1u : 0u);
+    depth[k] = 0.0;
+    if (first + k < pc.pointCount && depthWordOf(p[k], pixel[k], word))
+      depth[k] = uintBitsToFloat(uint(word >> 32));
+    else
+      pixel[k] = kNoPixel;
   }
+  Uint64Array fb = Uint64Array(pc.framebuffer);
+  bool blends = false;
+  [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+    if (pixel[k] == kNoPixel) continue;
+    float closest = uintBitsToFloat(uint(fb.v[pixel[k]] >> 32));
+    if (depth[k] > closest * float(PR_HQS_DEPTH_FACTOR)) pixel[k] = kNoPixel; // hidden: not blended
+    blends = blends || pixel[k] != kNoPixel;
+  }
+  uvec4 colors = blends ? loadColors(first) : uvec4(0u); // hidden points cost their 12 B of position alone
+  uint r[4], g[4], b[4], n[4];
+  [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+    bool blended = pixel[k] != kNoPixel;
+    hqsChannels(blended ? colors[k] : 0u, r[k], g[k], b[k]);
+    n[k] = blended ? 1u : 0u;
+  }
+  hqsMergeFour(pixel, r, g, b, n);
+  [[unroll]] for (uint k = 0u; k < 4u; ++k)
+    hqsBlend(Uint64Array(pc.aux), pc.width * pc.height, ONE_ROUND != 0, pixel[k], r[k], g[k], b[k], n[k]);
 }

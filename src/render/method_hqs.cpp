@@ -15,6 +15,9 @@ bool oneRound(const MethodInfo& method) {
   return false;
 }
 
+// Points per thread of raster_hqs.comp (fixed in the shader).
+constexpr uint32_t kAccumulatePointsPerThread = 4;
+
 class HqsMethod : public PointMethod {
 public:
   HqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
@@ -31,8 +34,8 @@ public:
                                   {/* REDUCE= */ 1, 1},
                                   {/* DEPTH_ONLY= */ 3, 1},
                                   {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
-    accumulate_ = gpu::ComputeProgram(context, method.shader,
-                                      method.spec.with({{/* POINTS_PER_THREAD= */ 1, kPointsPerThread}}));
+    // The accumulation pass draws 4 consecutive points per thread (its loads: three vec4s of positions).
+    accumulate_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
     // The resolve reads the accumulators in the layout ONE_ROUND chose (the same constant id).
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", method.spec.span());
   }
@@ -50,8 +53,12 @@ public:
         frame, targets, depth_.groupSize() * kPointsPerThread, base,
         [&](const shared::RasterPush& push, gpu::Grid grid) { depth_.dispatch(cmd, grid.x, grid.y, push); });
     gpu::fullBarrier(cmd);
-    forEachPart(frame, targets, accumulate_.groupSize() * kPointsPerThread, base,
+    forEachPart(frame, targets, accumulate_.groupSize() * kAccumulatePointsPerThread, base,
                 [&](const shared::RasterPush& push, gpu::Grid grid) {
+                  // Each part's buffers are allocations of their own, aligned beyond 16 B on every driver;
+                  // the shader's vec4 loads rely on it.
+                  if ((push.positions | push.colors) % 16 != 0)
+                    throw InternalError("internal error: HQS point buffers not 16-byte aligned");
                   accumulate_.dispatch(cmd, grid.x, grid.y, push);
                 });
     gpu::fullBarrier(cmd);
