@@ -132,6 +132,25 @@ BatchView viewBox(vec3 lo, vec3 hi, BatchCamera cam, uint forcedWords, bool cull
   return v;
 }
 
+// A box decision in a buffer (shared.h, LodNodeView), for passes that read it instead of computing it.
+LodNodeView storeView(BatchView v) {
+  return LodNodeView(vec4(v.cx, uintBitsToFloat(v.words)), vec4(v.cy, v.inside ? 1.0 : 0.0), vec4(v.cz, 0.0),
+                     vec4(v.offset, 0.0), vec4(v.lo, 0.0), vec4(v.step, 0.0));
+}
+
+BatchView loadView(LodNodeView s) {
+  BatchView v;
+  v.words = floatBitsToUint(s.cx.w);
+  v.inside = s.cy.w != 0.0;
+  v.cx = s.cx.xyz;
+  v.cy = s.cy.xyz;
+  v.cz = s.cz.xyz;
+  v.offset = s.offset.xyz;
+  v.lo = s.lo.xyz;
+  v.step = s.step.xyz;
+  return v;
+}
+
 // 1 + f/1024 for the three 10-bit fields f of a coordinate word (x in bits 0-9, y 10-19, z 20-29): each
 // field is moved to the top of a float's mantissa under the exponent of 1. Two integer ops a field and no
 // int-to-float conversion, which runs at a quarter of the float rate on NVIDIA GPUs.
@@ -221,12 +240,18 @@ struct BatchWords {
   uint64_t colors;
 };
 
+// The medium and low words of points 4g .. 4g + 3, as loadQuad (whose high words a pass may have loaded
+// already).
+void loadLowerQuads(BatchWords at, uint g, uint words, out uvec4 medium, out uvec4 low) {
+  medium = words >= 2u ? Uvec4Array(at.medium).v[g] : uvec4(0u);
+  low = words >= 3u ? Uvec4Array(at.low).v[g] : uvec4(0u);
+}
+
 // The words of the box's points 4g .. 4g + 3 (uvec4 g of each word buffer), the first `words` of them;
 // zeros for the others.
 void loadQuad(BatchWords at, uint g, uint words, out uvec4 high, out uvec4 medium, out uvec4 low) {
   high = Uvec4Array(at.high).v[g];
-  medium = words >= 2u ? Uvec4Array(at.medium).v[g] : uvec4(0u);
-  low = words >= 3u ? Uvec4Array(at.low).v[g] : uvec4(0u);
+  loadLowerQuads(at, g, words, medium, low);
 }
 
 // Statistics (shared.h, kStat*): a thread counts in a register, the workgroup sums in shared memory, and

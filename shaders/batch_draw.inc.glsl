@@ -6,6 +6,8 @@
 //   PREFETCH   0: thread t draws points t + 128 j, one 32-bit load per word
 //              1: thread t loads the words of points 4 (t + 128 j) .. + 3 with one 128-bit load per word
 //   DEPTH_ONLY 1: the word is depth << 32 alone (the depth pass of the HQS methods)
+//   EARLY_HIGH 1: main() loaded the high words of each thread's first step into firstStepHigh before the
+//              box decision (loadFirstStepHigh), so that their latency overlaps the decision's
 // Either way a thread has 4 points in flight: their words are loaded together, then all 4 projected, then
 // their pixels read, then the atomics done, so that neither the loads of the words nor those of the pixels
 // wait for one another. A point on the same pixel as the thread's previous point of the four takes the
@@ -21,6 +23,9 @@ const uint GROUP = 4u; // points in flight per thread
 // arithmetic that may wrap) made the compiler compute a second address per point.
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer DepthHalves { uvec2 v[]; };
 
+// With EARLY_HIGH: the high words of the thread's first step, loaded by main() before the box decision.
+uint firstStepHigh[GROUP];
+
 // Index in the box of point u (< GROUP) of a thread's step `step`.
 uint pointOfStep(uint step, uint u) {
   if (PREFETCH == 0u) return gl_LocalInvocationIndex + (step * GROUP + u) * kPointGroupSize;
@@ -28,16 +33,17 @@ uint pointOfStep(uint step, uint u) {
 }
 
 // The words of a thread's step `step` of the box: its GROUP points' first `words` words (zeros for the others
-// and past the box's `count` points when `checked`).
-void loadStep(uint step, uint words, bool checked, BatchWords at, uint count, out uint h[GROUP], out uint m[GROUP],
-              out uint l[GROUP]) {
+// and past the box's `count` points when `checked`). Without `high`, h is left as it is (firstStepHigh).
+void loadStep(uint step, uint words, bool checked, bool high, BatchWords at, uint count, inout uint h[GROUP],
+              out uint m[GROUP], out uint l[GROUP]) {
   if (PREFETCH == 0u) {
-    UintArray high = UintArray(at.high), medium = UintArray(at.medium), low = UintArray(at.low);
+    UintArray highs = UintArray(at.high), medium = UintArray(at.medium), low = UintArray(at.low);
     [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
       uint local = pointOfStep(step, u);
-      h[u] = m[u] = l[u] = 0u;
+      m[u] = l[u] = 0u;
+      if (high) h[u] = 0u;
       if (checked && local >= count) continue;
-      h[u] = high.v[local];
+      if (high) h[u] = highs.v[local];
       if (words >= 2u) m[u] = medium.v[local];
       if (words >= 3u) l[u] = low.v[local];
     }
@@ -45,13 +51,32 @@ void loadStep(uint step, uint words, bool checked, BatchWords at, uint count, ou
     uint local = pointOfStep(step, 0u);
     // Word buffers are padded to a multiple of 4 points, and a box starts at a multiple of 4.
     uvec4 hq = uvec4(0u), mq = uvec4(0u), lq = uvec4(0u);
-    if (!checked || local < count) loadQuad(at, local / 4u, words, hq, mq, lq);
+    if (!checked || local < count) {
+      if (high) hq = Uvec4Array(at.high).v[local / 4u];
+      loadLowerQuads(at, local / 4u, words, mq, lq);
+    }
     [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
-      h[u] = hq[u];
+      if (high) h[u] = hq[u];
       m[u] = mq[u];
       l[u] = lq[u];
     }
   }
+}
+
+// The words of step `step`: with EARLY_HIGH, step 0 takes its high words from firstStepHigh.
+void loadStepWords(uint step, uint words, bool checked, BatchWords at, uint count, out uint h[GROUP],
+                   out uint m[GROUP], out uint l[GROUP]) {
+  bool early = EARLY_HIGH != 0u && step == 0u;
+  if (early) h = firstStepHigh;
+  loadStep(step, words, checked, !early, at, count, h, m, l);
+}
+
+// The high words of the thread's first step into firstStepHigh, zeros past the box's `count` points: they do
+// not depend on the box decision (one word is the least any drawn box loads), so a pass whose decision is a
+// long chain loads them before it. In a culled box they are loaded for nothing (1/20 of a batch's words).
+void loadFirstStepHigh(BatchWords at, uint count) {
+  uint m[GROUP], l[GROUP];
+  loadStep(0u, 1u, true, true, at, count, firstStepHigh, m, l);
 }
 
 // Projects the loaded points of a step with `words` words each into one camera's image and does their atomics;
@@ -61,6 +86,9 @@ uint drawStep(BatchView v, uint words, bool checked, uint h[GROUP], uint m[GROUP
   Uint64Array fb = Uint64Array(framebuffer);
   DepthHalves depths = DepthHalves(framebuffer);
   uint pixel[GROUP], depth[GROUP], payload[GROUP];
+  // Whether every point projects to a pixel: no test can drop one (projectInside), so the merge below need
+  // not ask whether point u was dropped (a compare a point, on the path of every point of the overview).
+  const bool allProjected = !checked && words != 3u;
   [[unroll]] for (uint u = 0u; u < GROUP; ++u) {
     uint local = pointOfStep(step, u);
     payload[u] = DEPTH_ONLY != 0u ? 0u : payloadBase + local;
@@ -69,7 +97,7 @@ uint drawStep(BatchView v, uint words, bool checked, uint h[GROUP], uint m[GROUP
       pixel[u] = kNoPixel;
       depth[u] = 0xFFFFFFFFu; // above any seen value: no atomic
     }
-    if (u > 0u && pixel[u] == pixel[u - 1u] && pixel[u] != kNoPixel) {
+    if (u > 0u && pixel[u] == pixel[u - 1u] && (allProjected || pixel[u] != kNoPixel)) {
       // Keep the smaller word: the closer point, or on equal depth the lower index (u - 1).
       if (depth[u - 1u] <= depth[u]) {
         depth[u] = depth[u - 1u];
@@ -103,7 +131,7 @@ uint drawBox(BatchView v, uint words, bool checked, BatchWords at, uint payloadB
   uint rendered = 0u;
   for (uint step = 0u; step < steps; ++step) {
     uint h[GROUP], m[GROUP], l[GROUP];
-    loadStep(step, words, checked, at, count, h, m, l);
+    loadStepWords(step, words, checked, at, count, h, m, l);
     rendered += drawStep(v, words, checked, h, m, l, step, payloadBase, count, cam, framebuffer);
   }
   return rendered;
@@ -135,7 +163,7 @@ uint drawBoxStereo(BatchView v0, BatchView v1, uint words0, uint words1, bool ch
   uint rendered = 0u;
   for (uint step = 0u; step < steps; ++step) {
     uint h[GROUP], m[GROUP], l[GROUP];
-    loadStep(step, loaded, checked, at, count, h, m, l);
+    loadStepWords(step, loaded, checked, at, count, h, m, l);
     if (words0 != 0u) rendered += drawStep(v0, words0, checked, h, m, l, step, payloadBase, count, cam0, framebuffer);
     if (words1 != 0u) rendered += drawStep(v1, words1, checked, h, m, l, step, payloadBase, count, cam1, framebuffer);
   }

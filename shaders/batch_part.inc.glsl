@@ -23,13 +23,31 @@ BatchCamera batchCamera(FrameRef frame, uint eye) {
   return cam;
 }
 
-// The decision of the batch being drawn, handed from thread 0 to the workgroup.
+// 1: the frame's decisions were computed by batch_views.comp before the pass (BatchFrame::views) and a
+// workgroup reads its batch's with one load; 0: thread 0 computes it and hands it to the workgroup through
+// shared memory, between two barriers (kept only to time the difference: method rows batch-prefetch-shared*).
+layout(constant_id = 4) const uint VIEW_PASS = 1;
+
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer BatchViews { LodNodeView v[]; };
+
+// The decision of the batch being drawn, handed from thread 0 to the workgroup (VIEW_PASS 0).
 shared BatchView sharedBatchView;
 
-// The decision for batch `batch` of the part, the same bits in every thread. Thread 0 alone loads the bounds
-// and runs viewBox (~300 instructions, ~3.7 a point when all 128 threads ran it: bench/NOTES.md, session 6);
-// the others wait at the barrier, so every thread of the workgroup must call it, in uniform control flow.
+// Where the decision of batch `batch` of the part for eye `eye` is in BatchFrame::views.
+uint viewIndex(uint batch, uint eye, uint eyes) {
+  return (pc.firstView + batch) * eyes + eye;
+}
+
+// The decision for batch `batch` of the part, the same bits in every thread: read from the view pass's
+// buffer, or (VIEW_PASS 0) computed by thread 0 alone (~300 instructions, ~3.7 a point when all 128 threads
+// ran it: bench/NOTES.md, session 6) while the others wait at the barrier, so that every thread of the
+// workgroup must then call it, in uniform control flow.
 BatchView viewBatch(uint batch, BatchCamera cam, uint forcedWords, bool culling) {
+  if (VIEW_PASS != 0u) {
+    FrameRef frame = FrameRef(pc.frame);
+    uint eye = cam.offset != 0u ? 1u : 0u; // batchCamera: the right eye's image is the half at offset width
+    return loadView(BatchViews(frame.f.views).v[viewIndex(batch, eye, frame.f.eyes)]);
+  }
   barrier(); // a previous call's readers are done with sharedBatchView (the stereo passes call it twice)
   if (gl_LocalInvocationIndex == 0u) {
     BatchBounds bounds = BoundsArray(pc.bounds).v[batch];

@@ -6,6 +6,9 @@
 
 layout(constant_id = 0) const uint PREFETCH = 0;
 layout(constant_id = 1) const uint DEPTH_ONLY = 0;
+// 1: each thread's first words are loaded before the batch's decision (batch_draw.inc.glsl); 0 only to time
+// the difference (method rows batch-prefetch-late, batch-prefetch-shared).
+layout(constant_id = 3) const uint EARLY_HIGH = 1;
 
 #include "batch_draw.inc.glsl"
 
@@ -15,6 +18,7 @@ void main() {
   BatchCamera cam = batchCamera(frame, 0u);
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
+  if (EARLY_HIGH != 0u) loadFirstStepHigh(batchWords(first), count);
   BatchView v = viewBatch(gl_WorkGroupID.x, cam, frame.f.forcedWords, frame.f.culling != 0u);
   uint payloadBase = (pc.part << kVisibilityPartShift) | first;
   uint rendered = 0u, words = v.words;

@@ -7,6 +7,7 @@
 
 layout(constant_id = 0) const uint PREFETCH = 1;
 layout(constant_id = 1) const uint DEPTH_ONLY = 0;
+const uint EARLY_HIGH = 0u; // the node's decision is one load, from the node pass
 
 #include "batch_draw.inc.glsl"
 

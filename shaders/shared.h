@@ -206,6 +206,9 @@ struct BatchFrame {
                     // right half with rightViewProj[part] (specialization constant STEREO of the passes)
   uint64_t partColors[kMaxVisibilityParts]; // RGBA8 colors of visibility part p (the resolve's table)
   mat4 rightViewProj[kMaxVisibilityParts];  // stereo: the right half's view-projection of part p
+  uint64_t views;    // LodNodeView per batch and eye of the frame, at (BatchPush::firstView + batch) * eyes
+                     // + eye: the box decisions, written by batch_views.comp before the drawing passes
+  uint64_t unused;   // keeps the size a multiple of 16 (std430)
 };
 
 // Push constants of the batch passes: one dispatch draws one part, one workgroup per batch.
@@ -220,7 +223,7 @@ struct BatchPush {
   uint pointCount; // points of the part
   float nearW;     // points with c.w <= nearW are dropped
   uint part;       // visibility part number of this part
-  uint reserved;
+  uint firstView;  // index of the part's first batch among the frame's batches (BatchFrame::views)
 };
 
 // ------------------------------------------------------------------------------------------------------
@@ -258,9 +261,9 @@ struct LodPage {
 };
 
 // A node's box decision (batch.inc.glsl's BatchView), computed once per node and pass by lod_nodes.comp and
-// read by every page of the node: the screen map's rows (cx, cy, cz, offset), the min corner and the steps
-// of the 30-bit quantization. cx.w holds the coordinate words (0: culled), cy.w 1 when every point of the
-// box is inside the image (as float bits).
+// read by every page of the node (a batch's likewise: batch_views.comp, BatchFrame::views): the screen map's
+// rows (cx, cy, cz, offset), the min corner and the steps of the 30-bit quantization. cx.w holds the
+// coordinate words (0: culled), cy.w 1 when every point of the box is inside the image (as float bits).
 struct LodNodeView {
   vec4 cx;
   vec4 cy;

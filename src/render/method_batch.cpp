@@ -1,7 +1,9 @@
 // The 2022 batch methods (Schuetz, Kerbl, Wimmer, "Software Rasterization of 2 Billion Points in Real
 // Time"): batch and batch-prefetch (raster_batch.comp, then resolve_batch.comp fetching the colors of
 // visible points) and batch-hqs (a prefetch depth pass, raster_batch_hqs.comp accumulating, resolve_hqs.comp
-// with hqs1r's layout). They read scenes in the batched layout (render/scene.h).
+// with hqs1r's layout). They read scenes in the batched layout (render/scene.h). Before the drawing passes,
+// batch_views.comp computes every batch's box decision once into a buffer that they read.
+#include <algorithm>
 #include <cstring>
 
 #include "base/error.h"
@@ -14,13 +16,15 @@ namespace pointrast {
 namespace {
 
 // Calls draw(push, batches) for every part of every scene, numbering parts in draw order: the number is
-// the part's visibility part (shared.h), and the index of its colors in BatchFrame::partColors.
+// the part's visibility part (shared.h), and the index of its colors in BatchFrame::partColors. Batches are
+// numbered over the frame too (BatchPush::firstView).
 template <class Draw>
 void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frameAddress, Draw&& draw) {
   const double aspect = double(targets.eyeWidth()) / double(targets.height);
   shared::BatchPush push{};
   push.frame = frameAddress;
   uint32_t number = 0;
+  uint32_t batches = 0;
   for (const GpuScene* scene : frame.scenes) {
     // The matrix and near plane of forEachPart(): the same projection as the 2021 methods (the left eye's
     // for stereo; the right eye's is in the frame).
@@ -34,21 +38,43 @@ void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frame
       push.colors = part.colors.address();
       push.pointCount = uint32_t(part.count);
       push.part = number++;
+      push.firstView = batches;
+      batches += uint32_t(part.batchCount());  // <= 64 parts x kMaxPartBatches
       draw(push, uint32_t(part.batchCount())); // <= kMaxPartBatches: one row of workgroups
     }
   }
 }
 
+// The batches of a frame's scenes.
+uint64_t frameBatches(const Frame& frame) {
+  uint64_t batches = 0;
+  for (const GpuScene* scene : frame.scenes)
+    for (const ScenePart& part : scene->parts())
+      batches += part.batchCount();
+  return batches;
+}
+
+// The value the row gives specialization constant `id`, or the shader's default.
+uint32_t specValue(const MethodInfo& method, uint32_t id, uint32_t shaderDefault) {
+  for (const gpu::SpecConstant& s : method.spec.span())
+    if (s.id == id) return s.value;
+  return shaderDefault;
+}
+
 class BatchMethod : public PointMethod {
 public:
   BatchMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height, uint32_t eyes)
-      : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
+      : context_(context), hqs_(method.output == MethodOutput::Blend),
+        viewPass_(specValue(method, kViewPassId, 1) != 0), eyes_(eyes) {
     // The row's constants: PREFETCH (one 128-bit load of 4 consecutive points) and, for the blending
-    // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes.
+    // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes. EARLY_HIGH and
+    // VIEW_PASS (batch_draw.inc.glsl, batch_part.inc.glsl) are left on except by the timing references.
     const gpu::SpecConstant stereo{/* STEREO= */ 2, eyes == 2 ? 1u : 0u};
+    const gpu::SpecConstant viewPass{kViewPassId, viewPass_ ? 1u : 0u};
     raster_ = gpu::ComputeProgram(context, method.shader, method.spec.with({stereo}));
+    if (viewPass_) views_ = gpu::ComputeProgram(context, "batch_views.comp");
     if (hqs_) {
-      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo});
+      accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo, viewPass});
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
       // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
       accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
@@ -80,6 +106,7 @@ public:
     f.culling = frame.settings.batchCulling ? 1 : 0;
     f.pitch = targets.width;
     f.eyes = eyes_;
+    if (viewPass_) f.views = viewBuffer(frame).address();
     const double aspect = double(targets.eyeWidth()) / double(targets.height);
     uint32_t part = 0;
     for (const GpuScene* scene : frame.scenes) {
@@ -97,6 +124,13 @@ public:
     gpu::vkCmdFillBuffer(cmd, stats_.handle(), 0, VK_WHOLE_SIZE, 0);
     if (hqs_) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
     gpu::fullBarrier(cmd);
+    if (viewPass_) {
+      forEachBatchPart(
+          frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
+            views_.dispatch(cmd, (batches + views_.groupSize() - 1) / views_.groupSize(), 1, push);
+          });
+      gpu::fullBarrier(cmd);
+    }
     forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
       raster_.dispatch(cmd, batches, 1, push);
     });
@@ -124,14 +158,29 @@ public:
   }
 
 private:
+  static constexpr uint32_t kViewPassId = 4; // VIEW_PASS
+
+  // BatchFrame::views, grown to the frame's batches. The frames of one submission draw the same scenes, so
+  // it never changes under a recorded frame.
+  const gpu::Buffer& viewBuffer(const Frame& frame) {
+    const uint64_t bytes = std::max<uint64_t>(1, frameBatches(frame)) * eyes_ * sizeof(shared::LodNodeView);
+    if (!viewRecords_ || viewRecords_.size() < bytes)
+      viewRecords_ =
+          gpu::Buffer(context_, bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, "batch box decisions");
+    return viewRecords_;
+  }
+
   static constexpr uint64_t kStatsBytes = uint64_t(shared::kBatchStatSlots) * shared::kBatchStatCount * 8;
   gpu::Context& context_;
   bool hqs_;
+  bool viewPass_; // batch_views.comp computes the box decisions (VIEW_PASS)
   uint32_t eyes_;
   gpu::ComputeProgram raster_;     // batch / batch-prefetch, or batch-hqs's depth pass
+  gpu::ComputeProgram views_;      // batch_views.comp
   gpu::ComputeProgram accumulate_; // batch-hqs
   gpu::ComputeProgram resolve_;
   gpu::Buffer accumulators_; // batch-hqs
+  gpu::Buffer viewRecords_;  // shared::LodNodeView per batch and eye (BatchFrame::views)
   gpu::Buffer frame_;        // shared::BatchFrame, device-local
   gpu::Buffer frameUpload_;  // its host-written source
   gpu::Buffer stats_;        // uint64_t[kBatchStatSlots][kBatchStatCount]

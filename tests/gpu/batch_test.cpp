@@ -8,7 +8,9 @@
 // - statistics are exact on a hand-built scene of known batches and known occlusion;
 // - several parts and several scenes give the framebuffer of one part (the part number of visibility
 //   indices), and more than 64 parts or a scene of the wrong layout is a clear error;
-// - batch-hqs equals hqs within 1 per channel.
+// - batch-hqs equals hqs within 1 per channel;
+// - the ways of reaching a batch's decision (a pass before the drawing, or one thread of the workgroup; the
+//   first words loaded before or after it: the timing reference rows) write the same framebuffer words.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -476,6 +478,46 @@ TEST_F(GpuTest, BatchPartsAndScenesGiveTheFramebufferOfOnePart) {
       EXPECT_EQ(split.stats.points, cloud.size());
     }
   }
+}
+
+TEST_F(GpuTest, EveryWayToABatchDecisionWritesTheSameWords) {
+  uint32_t w = 240, h = 160;
+  const Method references[] = {pointMethod("batch-prefetch-shared"),
+                               pointMethod("batch-prefetch-shared-early"),
+                               pointMethod("batch-prefetch-late")};
+  for (auto& [cloudName, original] : testClouds()) {
+    PointCloud cloud = original;
+    reorder(cloud, Order::Morton, 2);
+    // Parts of three batches (the last one short), so that batches are numbered across parts.
+    GpuScene scene(*context, cloud, batched(3 * 10240));
+    for (auto& [viewName, camera] : views(cloud.bounds, double(w) / h)) {
+      for (uint32_t precision : {0u, 3u}) {
+        std::string where = cloudName + " / " + viewName + ", precision " + std::to_string(precision);
+        Drawn shipped = draw(*context, scene, camera, w, h, {pointMethod("batch-prefetch"), precision});
+        EXPECT_GT(litCount(shipped.image), 100u) << where;
+        for (Method method : references) {
+          Drawn other = draw(*context, scene, camera, w, h, {method, precision});
+          EXPECT_EQ(other.words, shipped.words) << where << ": " << methodName(method);
+          EXPECT_EQ(other.stats.batch->batchesRendered, shipped.stats.batch->batchesRendered) << where;
+          // (the atomics done, pointsRendered, depend on which workgroup reaches a pixel first)
+          EXPECT_EQ(other.stats.batch->pointsProcessed, shipped.stats.batch->pointsProcessed) << where;
+        }
+      }
+    }
+  }
+  // One renderer drawing a scene of more batches after one of fewer: the decisions' buffer grows.
+  std::mt19937_64 rng(17);
+  PointCloud small = randomBoxCloud(rng, 20'000, {5, 5, 5}), large = randomBoxCloud(rng, 90'000, {5, 5, 5});
+  GpuScene smallScene(*context, small, batched()), largeScene(*context, large, batched());
+  Camera camera = overviewCamera(large.bounds, double(w) / h);
+  Renderer renderer(*context, w, h);
+  RenderSettings settings;
+  settings.method = pointMethod("batch-prefetch");
+  settings.captureWords = true;
+  renderer.render(smallScene, camera, settings);
+  renderer.render(largeScene, camera, settings);
+  EXPECT_EQ(renderer.framebufferWords(),
+            draw(*context, largeScene, camera, w, h, {pointMethod("batch-prefetch-shared")}).words);
 }
 
 TEST_F(GpuTest, BatchLayoutAndPartLimitsAreClearErrors) {

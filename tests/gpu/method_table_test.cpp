@@ -59,7 +59,9 @@ TEST(MethodTable, AnUnknownNameListsEveryMethod) {
 }
 
 TEST(MethodTable, NameListsComeFromTheRows) {
-  EXPECT_EQ(methodNamesReading(SceneLayout::Batched), "batch, batch-prefetch and batch-hqs");
+  EXPECT_EQ(methodNamesReading(SceneLayout::Batched), "batch, batch-prefetch, batch-prefetch-shared, "
+                                                      "batch-prefetch-shared-early, batch-prefetch-late and "
+                                                      "batch-hqs");
   std::vector<Method> two = {pointMethod("earlyz"), pointMethod("hqs")};
   EXPECT_EQ(methodNameList(two), "earlyz and hqs");
 }

@@ -1,0 +1,19 @@
+#version 460
+// The box decisions of a part's batches (batch.inc.glsl's viewBox), one thread per batch and eye, into
+// BatchFrame::views before the frame's drawing passes: a drawing workgroup then reads its batch's decision
+// with one load (batch_part.inc.glsl, VIEW_PASS) instead of waiting at two barriers while one of its threads
+// runs the decision's long dependent chain.
+#include "batch_part.inc.glsl"
+
+void main() {
+  FrameRef frame = FrameRef(pc.frame);
+  uint batch = gl_GlobalInvocationID.x;
+  if (batch * kBatchPoints >= pc.pointCount) return;
+  BatchBounds bounds = BoundsArray(pc.bounds).v[batch];
+  uint eyes = frame.f.eyes;
+  for (uint eye = 0u; eye < eyes; ++eye) {
+    BatchView v = viewBox(bounds.min.xyz, bounds.max.xyz, batchCamera(frame, eye), frame.f.forcedWords,
+                          frame.f.culling != 0u);
+    BatchViews(frame.f.views).v[viewIndex(batch, eye, eyes)] = storeView(v);
+  }
+}
