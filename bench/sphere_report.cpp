@@ -305,7 +305,8 @@ void sphereCounters(std::ostringstream& md, const SphereTables& t) {
   if (!points && !compute) return;
   md << "## Per-frame counters (the most of an orbit's cameras)\n\n";
   md << "sphere-points: spheres larger than the device's largest point, drawn incomplete (per billboard, "
-        "conservative off); sphere-compute: chunks of large spheres listed (16x16-pixel screen tiles of their boxes), and large spheres "
+        "conservative off); sphere-compute: chunks of large spheres listed (16x16-pixel screen tiles of the "
+        "largest boxes, bands of box rows of the others), and large spheres "
         "that drew their chunks themselves (list full).\n\n";
   md << "| data set | orbit | layout |";
   for (SphereBillboard b : c.billboards)

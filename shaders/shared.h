@@ -329,13 +329,15 @@ PR_CONST kSphereGroupSize = 128;
 // A sphere whose clamped pixel box has at most 64 pixels (8 x 8) is ray-tested by its own thread; a larger
 // one is cut into chunks for the large-sphere pass, so that a close-up does not serialize on one thread.
 PR_CONST kSphereSmallPixels = 64;
-// Large-sphere chunks: one screen tile of 16 x 16 pixels (tile (tx, ty) holds pixels [16 tx, 16 tx + 15] x
-// [16 ty, 16 ty + 15]) clipped to the sphere's box, one pixel per thread of a 256-thread workgroup. Tiles
-// rather than runs of box pixels, although a box just above the small limit straddles up to four of them,
-// so that one depth bound per tile (SphereFrame::tileBounds) can skip a whole chunk with one comparison.
+// Large-sphere chunks, at most 256 pixels each, one pixel per thread of a 256-thread workgroup. A box of
+// more than kSphereTileCutPixels pixels is cut along screen tiles of 16 x 16 pixels (tile (tx, ty) holds
+// pixels [16 tx, 16 tx + 15] x [16 ty, 16 ty + 15]) clipped to the box, so that one depth bound per tile
+// (SphereFrame::tileBounds) can skip a whole chunk with one comparison; a smaller one, which would
+// straddle up to four tiles for a few hidden chunks, into bands of whole box rows (256 / width rows each).
 PR_CONST kSphereTileShift = 4;
 PR_CONST kSphereTileSide = 16;    // 1 << kSphereTileShift
 PR_CONST kSphereChunkPixels = 256; // kSphereTileSide^2
+PR_CONST kSphereTileCutPixels = 256; // a 16 x 16 box: one tile's area
 
 // Particle index of a pixel (or impostor) without a sphere.
 PR_CONST kNoParticle = 0xFFFFFFFFu;
@@ -384,7 +386,8 @@ struct SphereFrame {
   uint tilesX;          // sphere-compute: tiles per row of tileBounds, ceil(width / kSphereTileSide)
   uint64_t tileBounds;  // sphere-compute: uint per screen tile, floatBits of a view depth that every pixel
                         // center of the tile is known to be covered at or nearer (ones: none known)
-  uint64_t reserved;
+  uint64_t drawnChunks; // sphere-compute: uint[chunkCapacity], list indices of the chunks the large pass
+                        // draws (those not behind their tiles' bounds); their count is SphereChunks::drawn
 };
 
 // One part of a particle set on the GPU, as the resolve and large-sphere passes find it by index.

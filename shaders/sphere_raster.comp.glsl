@@ -1,9 +1,11 @@
 #version 460
 // sphere-compute, pass 1: one thread per sphere of a part. Culls the sphere (near plane, frustum, bad
 // values), then either ray-tests its whole pixel box itself (at most kSphereSmallPixels pixels: most
-// spheres of a large set) or cuts the box along the screen's 16 x 16 tiles into chunks appended to the
-// large-sphere list for sphere_tile_bound.comp and sphere_raster_large.comp, so that a sphere filling the
-// screen is spread over many workgroups instead of serializing a frame on one thread.
+// spheres of a large set) or cuts the box into chunks of at most 256 pixels (screen tiles, or bands of box
+// rows) appended to the large-sphere list for passes 2-4 (sphere_tile_bound, sphere_chunk_cull and
+// sphere_raster_large.comp), so
+// that a sphere filling the screen is spread over many workgroups instead of serializing a frame on one
+// thread.
 //
 // The list never overflows silently: chunks past its capacity are drawn here, by the sphere's own thread
 // (slow but exact), and the sphere is counted in `spilled`. Chunks are reserved with one 64-bit atomicAdd
@@ -31,15 +33,26 @@ void main() {
     coverBox(center, s.radius, index, box);
     return;
   }
-  ivec2 firstTile = box.xy >> int(kSphereTileShift);
-  uint tilesX = uint((box.z >> int(kSphereTileShift)) - firstTile.x + 1);
-  uint n = tilesX * uint((box.w >> int(kSphereTileShift)) - firstTile.y + 1);
+  // The chunks are the cells of a grid clipped to the box: screen tiles for a sphere much larger than a
+  // tile (their depth bounds skip most of a close-up's hidden chunks), bands of whole box rows for a
+  // mid-size one (a box just above the small limit straddles up to four tiles but fills one band).
+  ivec2 origin;
+  uvec2 step;
+  if (size.x * size.y > TILE_CUT_PIXELS || size.x > kSphereChunkPixels) {
+    origin = (box.xy >> int(kSphereTileShift)) << int(kSphereTileShift);
+    step = uvec2(kSphereTileSide);
+  } else {
+    origin = box.xy;
+    step = uvec2(size.x, kSphereChunkPixels / size.x);
+  }
+  uvec2 cells = uvec2(box.zw - origin) / step + 1;
+  uint n = cells.x * cells.y;
   SphereChunks list = SphereChunks(frame.chunks);
   uint64_t at = atomicAdd(list.count, uint64_t(n));
   uint front = floatBitsToUint(-center.z - s.radius);
   for (uint k = 0; k < n; ++k) {
-    ivec4 tile = tilePixels(uvec2(firstTile) + uvec2(k % tilesX, k / tilesX));
-    ivec4 chunk = ivec4(max(tile.xy, box.xy), min(tile.zw, box.zw));
+    ivec2 lo = origin + ivec2(uvec2(k % cells.x, k / cells.x) * step);
+    ivec4 chunk = ivec4(max(lo, box.xy), min(lo + ivec2(step) - 1, box.zw));
     if (at + k < uint64_t(frame.chunkCapacity))
       list.entries[uint(at) + k] = uvec4(index, packChunk(chunk), front);
     else

@@ -4,18 +4,23 @@
 
 // COUNT_WORK: count pixels tested, depth atomics and skipped chunks in frame.counters (one global atomic
 // each: for tests and measurements of the work, never for timing). TILE_BOUND: skip large-sphere chunks
-// behind their tile's depth bound (off only to compare the work with and without it).
+// behind their tile's depth bound (off only to compare the work with and without it). TILE_CUT_PIXELS:
+// the box size (pixels) above which a large sphere is cut along screen tiles rather than into bands of
+// whole box rows (kSphereTileCutPixels; other values only to count the work of other choices).
 layout(constant_id = 3) const uint COUNT_WORK = 0;
 layout(constant_id = 4) const uint TILE_BOUND = 1;
+layout(constant_id = 5) const uint TILE_CUT_PIXELS = kSphereTileCutPixels;
 
 // The large-sphere list: chunks asked for (64 bits: it keeps counting past the capacity and must never
-// wrap), spheres that drew some of their chunks themselves because the list was full, then entries
-// (global particle index, chunk x0 | y0 << 16, chunk x1 | y1 << 16 (inclusive pixel bounds: one tile
-// clipped to the sphere's box), floatBits of the sphere's front depth: center depth - radius).
+// wrap), spheres that drew some of their chunks themselves because the list was full, chunks left to draw
+// after the cull pass (their list indices in SphereFrame::drawnChunks), then entries
+// (global particle index, chunk x0 | y0 << 16, chunk x1 | y1 << 16 (inclusive pixel bounds of at most
+// kSphereChunkPixels pixels: a screen tile or a band of whole box rows, clipped to the sphere's box),
+// floatBits of the sphere's front depth: center depth - radius).
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer SphereChunks {
   uint64_t count;
   uint spilled;
-  uint reserved;
+  uint drawn;
   uvec4 entries[];
 };
 
@@ -65,4 +70,19 @@ ivec4 tilePixels(uvec2 t) {
 
 uint tileOf(ivec2 pixel) {
   return uint(pixel.y >> kSphereTileShift) * frame.tilesX + uint(pixel.x >> kSphereTileShift);
+}
+
+// Whether a listed chunk lies behind the depth bound of every tile it touches, so that its sphere loses
+// each of its pixels: a tile chunk touches one tile, a band of box rows up to a few; a chunk touching
+// more than 2 x 2 tiles is never skipped. The four reads are unrolled: llvmpipe ends an invocation's
+// loops after 65535 iterations in all, and a loop here would count against the caller's.
+bool chunkHidden(uvec4 entry) {
+  if (TILE_BOUND == 0) return false;
+  ivec4 tiles = ivec4(unpackChunk(entry.yz)) >> int(kSphereTileShift);
+  if (any(greaterThan(tiles.zw - tiles.xy, ivec2(1)))) return false;
+  UintArray bounds = UintArray(frame.tileBounds);
+  uint row0 = uint(tiles.y) * frame.tilesX, row1 = uint(tiles.w) * frame.tilesX;
+  uint bound = max(max(bounds.v[row0 + uint(tiles.x)], bounds.v[row0 + uint(tiles.z)]),
+                   max(bounds.v[row1 + uint(tiles.x)], bounds.v[row1 + uint(tiles.z)]));
+  return entry.w > bound;
 }

@@ -2,7 +2,7 @@
 // sphere-compute, pass 2: the tile depth bounds, one thread per chunk of the large-sphere list, before any
 // chunk is drawn. A chunk that is its whole tile (clipped to the image) and whose sphere covers the tile's
 // four corner pixel centers lowers the tile's bound to the largest of the four hit depths, so that pass 3
-// skips every chunk of a sphere whose front lies behind it. Why that is exact:
+// (the cull) drops every chunk of a sphere whose front lies behind it. Why that is exact:
 //   - the directions that pass through a sphere form a convex cone (narrowed here to those passing at
 //     least r^2 / 256 inside, so that rounding cannot turn an inner pixel into a miss), and the pixel
 //     centers of the tile are convex combinations of its corners on the plane z = -1: every one is hit;

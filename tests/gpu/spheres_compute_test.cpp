@@ -324,8 +324,11 @@ TEST_F(GpuTest, SphereComputeTileBoundsSkipHiddenLargeSpheresAndKeepTheFrame) {
   options.progress = false;
   const ParticleSet set = generateParticles(ParticleScene::Block, options);
   const Camera camera = shortOrbitCamera(set.bounds);
+  // Every large sphere cut along tiles first (at this size most are mid-size, which the default cuts into
+  // bands of box rows), so that the bounds have the most to skip.
   SphereSettings settings;
   settings.countWork = true;
+  settings.tileCutPixels = shared::kSphereSmallPixels;
   GpuFrame bounded = renderGpu(*context, set, camera, 320, 240, {}, settings);
   settings.tileBound = false;
   GpuFrame unbounded = renderGpu(*context, set, camera, 320, 240, {}, settings);
@@ -341,6 +344,17 @@ TEST_F(GpuTest, SphereComputeTileBoundsSkipHiddenLargeSpheresAndKeepTheFrame) {
   EXPECT_EQ(bounded.index, unbounded.index);
   EXPECT_EQ(bounded.depth, unbounded.depth);
   EXPECT_EQ(bounded.image, unbounded.image);
+  // The default cut (bands for mid-size spheres) and bands wherever a band fits: the same frame again,
+  // from fewer listed chunks.
+  for (uint32_t cut : {0u, 1u << 30}) {
+    settings.tileBound = true;
+    settings.tileCutPixels = cut;
+    GpuFrame recut = renderGpu(*context, set, camera, 320, 240, {}, settings);
+    EXPECT_EQ(recut.index, bounded.index) << "tiles above " << cut << " pixels";
+    EXPECT_EQ(recut.depth, bounded.depth) << "tiles above " << cut << " pixels";
+    EXPECT_EQ(recut.image, bounded.image) << "tiles above " << cut << " pixels";
+    EXPECT_LT(recut.stats.largeChunks, bounded.stats.largeChunks) << "tiles above " << cut << " pixels";
+  }
   EXPECT_GT(std::count_if(bounded.index.begin(), bounded.index.end(),
                           [](uint32_t i) { return i != shared::kNoParticle; }),
             320 * 240 * 9 / 10)
@@ -351,6 +365,72 @@ TEST_F(GpuTest, SphereComputeTileBoundsSkipHiddenLargeSpheresAndKeepTheFrame) {
   EXPECT_LT(bounded.stats.largePixelsTested * 2, unbounded.stats.largePixelsTested);
   EXPECT_LT(bounded.stats.pixelsTested, unbounded.stats.pixelsTested);
   EXPECT_LE(bounded.stats.depthAtomics, unbounded.stats.depthAtomics);
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+
+// Not a check: the work counts behind the choice of kSphereTileCutPixels (bench/NOTES.md), printed per
+// threshold for generated riemann-like and laser-like scenes on the short orbit's first camera, scaled so
+// that spheres cover about as many pixels as in the spheres2023 suite at full scale (1920x1080). Run with
+// --gtest_also_run_disabled_tests; about two minutes on lavapipe (2 cores).
+TEST_F(GpuTest, DISABLED_SphereComputeWorkByTileCut) {
+  struct Case {
+    const char* name;
+    ParticleScene scene;
+    uint64_t particles;
+    uint32_t width, height;
+  } cases[] = {{"riemann-like", ParticleScene::Block, 200'000, 640, 360},
+               {"riemann-like", ParticleScene::Block, 1'000'000, 1280, 720},
+               {"laser-like", ParticleScene::Laser, 1'000'000, 1280, 720}};
+  for (const Case& c : cases) {
+    ParticleGenerateOptions options;
+    options.particles = c.particles;
+    options.progress = false;
+    const ParticleSet set = generateParticles(c.scene, options);
+    ParticleUploadOptions upload;
+    upload.progress = false;
+    GpuParticles particles(*context, set, upload);
+    SphereRenderer renderer(*context, c.width, c.height);
+    std::vector<uint32_t> reference;
+    const SphereRaycast cpu = c.particles <= 1'000'000
+                                  ? renderCpu(set, shortOrbitCamera(set.bounds), c.width, c.height)
+                                  : SphereRaycast{};
+    // The first threshold again last: whether this lavapipe renders the frame reproducibly at that size.
+    for (uint32_t cut : {64u, 256u, 576u, 1024u, 2304u, 4096u, 16384u, 65536u, 64u}) {
+      SphereSettings settings;
+      settings.countWork = true;
+      settings.tileCutPixels = cut;
+      const SphereStats stats = renderer.render(particles, shortOrbitCamera(set.bounds), settings);
+      std::printf("| %s %llu k, %ux%u | %u | %llu | %llu | %llu | %llu | %llu |", c.name,
+                  (unsigned long long)(c.particles / 1000), c.width, c.height, cut,
+                  (unsigned long long)stats.largeChunks, (unsigned long long)stats.skippedChunks,
+                  (unsigned long long)stats.largePixelsTested, (unsigned long long)stats.pixelsTested,
+                  (unsigned long long)stats.depthAtomics);
+      // Frames that differ between thresholds, or from the CPU ray caster beyond a few silhouette pixels
+      // (float against double), would void the counts.
+      std::vector<uint32_t> indices = renderer.indices();
+      if (reference.empty()) reference = indices;
+      size_t differing = 0;
+      for (size_t p = 0; p < indices.size(); ++p)
+        differing += indices[p] != reference[p];
+      size_t offCpu = 0;
+      for (size_t p = 0; p < cpu.index.size(); ++p)
+        offCpu += indices[p] != cpu.index[p];
+      std::printf("  (%zu pixels differ from the first row's frame, %zu from the CPU's)\n", differing,
+                  offCpu);
+      EXPECT_EQ(differing, 0u) << c.name << ", tiles above " << cut << " pixels";
+      EXPECT_LE(offCpu, indices.size() / 10000) << c.name << ", tiles above " << cut << " pixels";
+    }
+    // Without the bounds every listed chunk is drawn: 875 k on the 1 M frame with tiles everywhere, more
+    // than llvmpipe's loop limit lets 8 workgroups draw (8 x 65535), so this checks the draw pass's grid.
+    SphereSettings unbounded;
+    unbounded.tileBound = false;
+    unbounded.tileCutPixels = shared::kSphereSmallPixels;
+    renderer.render(particles, shortOrbitCamera(set.bounds), unbounded);
+    EXPECT_EQ(renderer.indices(), reference) << c.name << ", without bounds";
+  }
 }
 
 } // namespace pointrast::test

@@ -1,14 +1,16 @@
 // sphere-compute: spheres rasterized in compute shaders into the visibility buffer of the 2022 point
 // renderer (Schuetz et al., "Software Rasterization of 2 Billion Points in Real Time"): per pixel the 64-bit
 // minimum of floatBits(view depth of the ray hit) << 32 | particle index, then a resolve that shades the
-// winner. Four passes per frame (shaders/sphere_*.comp.glsl):
+// winner. Five passes per frame (shaders/sphere_*.comp.glsl):
 //   1. one thread per sphere: cull, then ray-test the pixel box alone if it has at most 64 pixels, or
-//      append its chunks (16 x 16 screen tiles clipped to the box) to the large-sphere list;
+//      append its chunks to the large-sphere list: 16 x 16 screen tiles clipped to the box if the box is
+//      much larger than a tile, else bands of whole box rows (up to 256 pixels each);
 //   2. one thread per listed chunk: a chunk whose sphere surely covers its whole tile lowers the tile's
 //      depth bound;
-//   3. the listed chunks, one per workgroup iteration, one pixel per thread; a chunk behind its tile's
-//      bound is skipped whole (the overdraw of close-ups, where most large spheres are hidden);
-//   4. resolve: shade the winning sphere at each pixel.
+//   3. one thread per listed chunk: a chunk behind the bounds of the tiles it touches is dropped (the
+//      overdraw of close-ups, where most large spheres are hidden), the others are listed to draw;
+//   4. the chunks left to draw, one per workgroup iteration, one pixel per thread;
+//   5. resolve: shade the winning sphere at each pixel.
 #include <algorithm>
 #include <map>
 
@@ -28,17 +30,21 @@ namespace {
 // as many chunks as runs of 256 box pixels did (a box straddles tile borders): the riemann-like stand-in's
 // first short-orbit camera lists 3.1 M at 1920x1080, where runs listed at most 1.5 M.
 constexpr uint32_t kDefaultChunkCapacity = 8u << 20;
-constexpr uint64_t kChunkHeaderBytes = 16; // 64-bit count, spilled, reserved (entries are 16-byte aligned)
+// Chunks one invocation of the large pass may loop over on a CPU device (llvmpipe: 65535 loop iterations
+// per invocation, all loops together; the rest for the loops inside one chunk's work).
+constexpr uint32_t kCpuLoopIterations = 32768;
+constexpr uint64_t kChunkHeaderBytes = 16; // 64-bit count, spilled, drawn (entries are 16-byte aligned)
 constexpr uint64_t kCounterBytes = 16;     // SphereFrame::counters, uint[4]
 
 struct Programs {
-  gpu::ComputeProgram raster, bound, large, resolve;
+  gpu::ComputeProgram raster, bound, cull, large, resolve;
 };
 
-// The pipelines' variant: the particle layout and the two switches of sphere_raster.inc.glsl.
+// The pipelines' variant: the particle layout and the switches of sphere_raster.inc.glsl.
 struct Variant {
   uint32_t layout;
   bool countWork, tileBound;
+  uint32_t tileCutPixels;
   auto operator<=>(const Variant&) const = default;
 };
 
@@ -50,6 +56,8 @@ public:
                                "sphere visibility buffer");
     chunks_ = gpu::Buffer(context, kChunkHeaderBytes + uint64_t(kDefaultChunkCapacity) * 16,
                           gpu::kBufferUsage, gpu::MemoryKind::Device, "large-sphere chunks");
+    drawnChunks_ = gpu::Buffer(context, uint64_t(kDefaultChunkCapacity) * 4, gpu::kBufferUsage,
+                               gpu::MemoryKind::Device, "large-sphere chunks to draw");
     tilesX_ = (width + shared::kSphereTileSide - 1) / shared::kSphereTileSide;
     tiles_ = uint64_t(tilesX_) * ((height + shared::kSphereTileSide - 1) / shared::kSphereTileSide);
     tileBounds_ = gpu::Buffer(context, tiles_ * 4, gpu::kBufferUsage, gpu::MemoryKind::Device,
@@ -57,8 +65,13 @@ public:
     counters_ = gpu::Buffer(context, kCounterBytes, gpu::kBufferUsage, gpu::MemoryKind::Device,
                             "sphere-compute work counters");
     // The large pass strides over the list with a fixed grid: enough workgroups to fill a big GPU
-    // (4096 x 256 threads), or a few per core on a CPU device, where idle workgroups are not free.
-    largeGroups_ = context.info().software() ? 4 * hardwareThreads() : 4096;
+    // (4096 x 256 threads), or a few per core on a CPU device, where idle workgroups are not free, but
+    // at least enough that no invocation loops over more than kCpuLoopIterations chunks: llvmpipe ends
+    // every loop of an invocation after 65535 iterations in all (its loop limiter), which silently left
+    // the chunks past 8 x 65535 undrawn on a 2-core machine.
+    largeGroups_ = context.info().software()
+                       ? std::max(4 * hardwareThreads(), unsigned(kDefaultChunkCapacity / kCpuLoopIterations))
+                       : 4096;
   }
 
   void prepare(const SphereSettings& settings, shared::SphereFrame& frame) override {
@@ -67,10 +80,12 @@ public:
     chunkCapacity_ = settings.chunkCapacity ? std::min(settings.chunkCapacity, kDefaultChunkCapacity)
                                             : kDefaultChunkCapacity;
     frame.chunkCapacity = chunkCapacity_;
+    frame.drawnChunks = drawnChunks_.address();
     frame.tilesX = tilesX_;
     frame.tileBounds = tileBounds_.address();
     frame.counters = counters_.address();
-    variant_ = {0, settings.countWork, settings.tileBound};
+    variant_ = {0, settings.countWork, settings.tileBound,
+                settings.tileCutPixels ? settings.tileCutPixels : shared::kSphereTileCutPixels};
   }
 
   void recordFrame(const SphereDraw& draw, SphereTargets& targets) override {
@@ -100,6 +115,8 @@ public:
       p.bound.dispatch(cmd, largeGroups_, 1, push);
       gpu::fullBarrier(cmd);
     }
+    p.cull.dispatch(cmd, largeGroups_, 1, push);
+    gpu::fullBarrier(cmd);
     p.large.dispatch(cmd, largeGroups_, 1, push);
     gpu::fullBarrier(cmd);
     recordSphereResolve(cmd, p.resolve, targets.frame.address(), pixels_);
@@ -112,7 +129,7 @@ public:
     struct {
       uint64_t count;   // chunks asked for, also past the capacity
       uint32_t spilled; // spheres that drew chunks themselves
-      uint32_t reserved;
+      uint32_t drawn;   // chunks left to draw by the cull pass
     } header;
     gpu::readBuffer(context_, chunks_, 0, &header, sizeof header);
     stats.largeChunks = std::min<uint64_t>(header.count, chunkCapacity_);
@@ -133,12 +150,14 @@ private:
     if (found != programs_.end()) return found->second;
     Programs p;
     p.raster = gpu::ComputeProgram(context_, "sphere_raster.comp",
-                                   {{/* LAYOUT= */ 0, v.layout}, {/* COUNT_WORK= */ 3, v.countWork}});
+                                   {{/* LAYOUT= */ 0, v.layout},
+                                    {/* COUNT_WORK= */ 3, v.countWork},
+                                    {/* TILE_CUT_PIXELS= */ 5, v.tileCutPixels}});
     p.bound = gpu::ComputeProgram(context_, "sphere_tile_bound.comp", {{/* LAYOUT= */ 0, v.layout}});
+    p.cull = gpu::ComputeProgram(context_, "sphere_chunk_cull.comp",
+                                 {{/* COUNT_WORK= */ 3, v.countWork}, {/* TILE_BOUND= */ 4, v.tileBound}});
     p.large = gpu::ComputeProgram(context_, "sphere_raster_large.comp",
-                                  {{/* LAYOUT= */ 0, v.layout},
-                                   {/* COUNT_WORK= */ 3, v.countWork},
-                                   {/* TILE_BOUND= */ 4, v.tileBound}});
+                                  {{/* LAYOUT= */ 0, v.layout}, {/* COUNT_WORK= */ 3, v.countWork}});
     p.resolve = gpu::ComputeProgram(context_, "sphere_resolve.comp", {{/* LAYOUT= */ 0, v.layout}});
     return programs_.emplace(v, std::move(p)).first->second;
   }
@@ -147,6 +166,7 @@ private:
   uint64_t pixels_;
   gpu::Buffer framebuffer_;
   gpu::Buffer chunks_;
+  gpu::Buffer drawnChunks_;
   uint32_t tilesX_;
   uint64_t tiles_;
   gpu::Buffer tileBounds_;

@@ -82,6 +82,10 @@ struct SphereSettings {
   // so the frame is slower; for tests and measurements of the work, not for timing).
   bool tileBound = true;
   bool countWork = false;
+  // sphere-compute: large spheres whose box has more pixels than this are cut along screen tiles, smaller
+  // ones into bands of box rows; 0 = the default (shared::kSphereTileCutPixels). Only to count the work
+  // of other choices; the image is the same for every value.
+  uint32_t tileCutPixels = 0;
   // Methods that rasterize billboards (sphereMethodTakesBillboards): the impostor, and overestimating
   // conservative rasterization (VK_EXT_conservative_rasterization). Others refuse anything but the default.
   SphereBillboard billboard = SphereBillboard::Screen;
@@ -99,7 +103,7 @@ struct SphereStats {
   double medianMs = 0, minMs = 0, maxMs = 0; // GPU time of clear + draw + resolve, timestamp queries
   uint32_t frames = 0;
   uint64_t particles = 0;      // particles submitted per frame
-  uint64_t largeChunks = 0;    // sphere-compute: chunks (16 x 16 tiles) of large spheres listed, last frame
+  uint64_t largeChunks = 0;    // sphere-compute: chunks (tiles, bands) of large spheres listed, last frame
   uint64_t spilledSpheres = 0; // sphere-compute: large spheres that drew chunks themselves (list full)
   // sphere-compute with SphereSettings::countWork, the last frame: pixels tested (each one read of the
   // visibility word, then the ray test unless early-z rejects it), of which in large-sphere chunks,
