@@ -13,6 +13,17 @@
 // scatter (shuffled orders), while ordered clouds rarely have more pixels per subgroup.
 const uint kHqsRounds = 4u;
 
+// Workgroups launched one after another run at the same time, and in an ordered cloud they would draw
+// neighbouring points into the same pixels: their atomics would queue on the same accumulator words. So the
+// accumulation passes hand workgroup g the chunk (g % 16) * (n / 16) + g / 16 of the n chunks (the last n % 16
+// keep their place): workgroups running together draw chunks a sixteenth of the part apart. On the H200 this
+// took hqs1r from 8.4 to 7.0 ms on a 796 M Morton overview, with the same atomics (bench/NOTES.md, session 7).
+const uint kHqsInterleave = 16u;
+uint hqsInterleavedChunk(uint group, uint groups) {
+  uint per = groups / kHqsInterleave;
+  return group < per * kHqsInterleave ? (group % kHqsInterleave) * per + group / kHqsInterleave : group;
+}
+
 // The single-atomic layout of the 2022 paper (hqs1r, batch-hqs; resolved by resolve_hqs.comp with
 // ONE_ROUND = 1): acc holds one uint64_t per pixel packing r, g, b, count in 16 bits each, exact up to 255
 // points (255 x 255 < 2^16), then two 32-bit-per-channel fallback words per pixel for later points:

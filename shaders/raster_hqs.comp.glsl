@@ -53,8 +53,10 @@ uvec4 loadColors(uint first) {
 
 void main() {
   // No early return anywhere: the subgroup operations of hqsBlend need every lane.
-  uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
-  uint first = group * (kPointGroupSize * 4u) + 4u * gl_LocalInvocationIndex;
+  const uint chunkPoints = kPointGroupSize * 4u;
+  uint chunk = hqsInterleavedChunk(gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x,
+                                   (pc.pointCount + chunkPoints - 1u) / chunkPoints);
+  uint first = chunk * chunkPoints + 4u * gl_LocalInvocationIndex;
   vec3 p[4];
   loadFour(first, p);
   // Project all four, then read their pixels' closest depths together, then the colors if any blends.
