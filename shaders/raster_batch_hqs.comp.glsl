@@ -15,14 +15,13 @@ void main() {
   beginStats();
   FrameRef frame = FrameRef(pc.frame);
   BatchCamera cam = batchCamera(frame, 0u);
-  uint batch = hqsInterleavedChunk(gl_WorkGroupID.x, gl_NumWorkGroups.x); // one workgroup per batch
-  uint first = batch * kBatchPoints;
+  uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
-  BatchView v = viewBatch(batch, 0u);
+  BatchView v = viewBatch(gl_WorkGroupID.x, 0u);
   uint blended = 0u;
   if (STEREO != 0u) {
     BatchCamera right = batchCamera(frame, 1u);
-    BatchView v1 = viewBatch(batch, 1u);
+    BatchView v1 = viewBatch(gl_WorkGroupID.x, 1u);
     blended = blendBoxStereo(v, v1, batchWords(first), count, kBatchPrefetchSteps, cam, right,
                              frame.f.framebuffer, frame.f.accumulators);
   } else {
