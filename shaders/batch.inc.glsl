@@ -5,9 +5,9 @@
 // coordinate words as its projected size needs (cloud/batch_words.h has the bit layout) and are decoded
 // relative to its min corner. Points are projected by project.inc.glsl, like the 2021 methods.
 //
-// A box decision (viewBox) depends only on the box and the camera, so it is computed once per box: by one
-// thread of the workgroup and shared (a batch, batch_part.inc.glsl) or by the node pass and stored (an
-// octree node, lod.inc.glsl). Either way every thread draws with the same bits.
+// A box decision (viewBox) depends only on the box and the camera, so it is computed once per box, by a
+// pass before the drawing: batch_views.comp for the batches of a part (batch_part.inc.glsl), the node pass
+// for octree nodes (lod.inc.glsl). Every thread of a drawing workgroup reads the same bits.
 #include "common.inc.glsl"
 #include "project.inc.glsl"
 
@@ -249,11 +249,15 @@ void loadQuad(BatchWords at, uint g, uint words, out uvec4 high, out uvec4 mediu
 }
 
 // Statistics (shared.h, kStat*): a thread counts in a register, the workgroup sums in shared memory, and
-// one thread adds the sums to the workgroup's row of the statistics buffer.
+// one thread adds the sums to the workgroup's row of the statistics buffer. COUNT 0: nothing is counted
+// (the pipelines of frames whose counts nobody reads: the shared sum and its two barriers cost ~5 % of
+// batch-prefetch's frame on an H200).
+layout(constant_id = 5) const uint COUNT = 1;
 shared uint groupCount;
 
 // First thing in main(), by every thread.
 void beginStats() {
+  if (COUNT == 0u) return;
   if (gl_LocalInvocationIndex == 0u) groupCount = 0u;
   barrier();
 }
@@ -261,6 +265,7 @@ void beginStats() {
 // Last thing in main(), by every thread: `mine` adds to counter `counter`; with `batchCounts` the batch is
 // counted too (processed; rendered and its points by precision unless v.words == 0).
 void endStats(uint64_t statsAddress, uint counter, uint mine, bool batchCounts, uint words, uint count) {
+  if (COUNT == 0u) return;
   if (mine != 0u) atomicAdd(groupCount, mine);
   barrier();
   if (gl_LocalInvocationIndex != 0u) return;

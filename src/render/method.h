@@ -38,6 +38,10 @@ struct Frame {
   const RenderSettings& settings;
   // The camera of each half of the image (one for mono: `camera`; left half first for stereo).
   std::span<const Camera> views;
+  // Whether the frame gathers the method's counts (readStats). Renderer::render counts its last timed frame
+  // only: the batch methods draw the others with pipelines that count nothing, since counting costs ~5 %
+  // of a frame on an H200 (bench/NOTES.md, session 7).
+  bool counted = true;
 };
 
 class PointMethod {

@@ -60,11 +60,15 @@ public:
       : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
     // The row's constants: PREFETCH (one 128-bit load of 4 consecutive points) and, for the blending
     // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes.
+    // COUNT (batch.inc.glsl): the pipelines of counted frames gather the statistics, the others do not.
     const gpu::SpecConstant stereo{/* STEREO= */ 2, eyes == 2 ? 1u : 0u};
+    const gpu::SpecConstant uncounted{kCountId, 0};
     raster_ = gpu::ComputeProgram(context, method.shader, method.spec.with({stereo}));
+    rasterUncounted_ = gpu::ComputeProgram(context, method.shader, method.spec.with({stereo, uncounted}));
     views_ = gpu::ComputeProgram(context, "batch_views.comp");
     if (hqs_) {
       accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo});
+      accumulateUncounted_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo, uncounted});
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
       // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
       accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
@@ -118,8 +122,9 @@ public:
       views_.dispatch(cmd, (batches + views_.groupSize() - 1) / views_.groupSize(), 1, push);
     });
     gpu::fullBarrier(cmd);
+    const gpu::ComputeProgram& raster = frame.counted ? raster_ : rasterUncounted_;
     forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
-      raster_.dispatch(cmd, batches, 1, push);
+      raster.dispatch(cmd, batches, 1, push);
     });
     gpu::fullBarrier(cmd);
     shared::ResolvePush resolve =
@@ -127,7 +132,7 @@ public:
     if (hqs_) {
       forEachBatchPart(frame, targets, frame_.address(),
                        [&](const shared::BatchPush& push, uint32_t batches) {
-                         accumulate_.dispatch(cmd, batches, 1, push);
+                         (frame.counted ? accumulate_ : accumulateUncounted_).dispatch(cmd, batches, 1, push);
                        });
       gpu::fullBarrier(cmd);
       resolve.aux = accumulators_.address();
@@ -159,9 +164,12 @@ private:
   gpu::Context& context_;
   bool hqs_;
   uint32_t eyes_;
+  static constexpr uint32_t kCountId = 5; // COUNT
   gpu::ComputeProgram raster_;     // batch / batch-prefetch, or batch-hqs's depth pass
+  gpu::ComputeProgram rasterUncounted_;
   gpu::ComputeProgram views_;      // batch_views.comp
   gpu::ComputeProgram accumulate_; // batch-hqs
+  gpu::ComputeProgram accumulateUncounted_;
   gpu::ComputeProgram resolve_;
   gpu::Buffer accumulators_; // batch-hqs
   gpu::Buffer viewRecords_;  // shared::LodNodeView per batch and eye (BatchFrame::views)

@@ -217,11 +217,13 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
     timestamps.reset(cmd);
     if (post) postTimestamps->reset(cmd);
     Frame frame{cmd, scenes, camera, effective, eyes};
+    frame.counted = false;
     for (uint32_t w = 0; w < settings.warmup; ++w) {
       m.recordFrame(frame, t);
       if (post) post_->record(cmd, eyeViews, settings.post);
     }
     for (uint32_t f = 0; f < frames; ++f) {
+      frame.counted = f + 1 == frames; // the counts (FrameStats::batch) are the last timed frame's
       timestamps.begin(cmd, f);
       m.recordFrame(frame, t);
       if (post) post_->record(cmd, eyeViews, settings.post, &*postTimestamps, f * kPostPasses);

@@ -480,6 +480,37 @@ TEST_F(GpuTest, BatchPartsAndScenesGiveTheFramebufferOfOnePart) {
   }
 }
 
+// Only the last timed frame counts (the others draw with pipelines that count nothing): a render of several
+// frames after warm-ups reports the counts of one frame and draws what a single frame draws.
+TEST_F(GpuTest, BatchCountsAreThoseOfOneFrameWhateverTheFrames) {
+  uint32_t w = 240, h = 160;
+  std::mt19937_64 rng(5);
+  PointCloud cloud = randomBoxCloud(rng, 60'000, {5, 5, 5});
+  reorder(cloud, Order::Morton, 2);
+  GpuScene scene(*context, cloud, batched());
+  Camera camera = overviewCamera(cloud.bounds, double(w) / h);
+  for (Method method : {pointMethod("batch"), pointMethod("batch-prefetch"), pointMethod("batch-hqs")}) {
+    Drawn one = draw(*context, scene, camera, w, h, {method});
+    Renderer renderer(*context, w, h);
+    RenderSettings settings;
+    settings.method = method;
+    settings.captureWords = true;
+    settings.background = 0;
+    settings.warmup = 2;
+    settings.frames = 3;
+    FrameStats many = renderer.render(scene, camera, settings);
+    ASSERT_TRUE(one.stats.batch && many.batch) << methodName(method);
+    EXPECT_EQ(many.frames, 3u);
+    EXPECT_EQ(many.batch->batchesProcessed, one.stats.batch->batchesProcessed) << methodName(method);
+    EXPECT_EQ(many.batch->batchesRendered, one.stats.batch->batchesRendered) << methodName(method);
+    EXPECT_EQ(many.batch->pointsProcessed, cloud.size()) << methodName(method);
+    EXPECT_EQ(many.batch->pointsBlended, one.stats.batch->pointsBlended) << methodName(method);
+    EXPECT_EQ(many.batch->bytesRead, one.stats.batch->bytesRead) << methodName(method);
+    EXPECT_GT(many.batch->pointsRendered, 0u) << methodName(method);
+    EXPECT_EQ(renderer.image(), one.image) << methodName(method);
+  }
+}
+
 // The batches' decisions live in a buffer of the renderer, computed by a pass before the drawing: one
 // renderer drawing a scene of more batches after one of fewer must grow it and draw what a fresh one draws.
 TEST_F(GpuTest, TheBatchDecisionBufferGrowsWithTheScene) {
