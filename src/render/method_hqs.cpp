@@ -28,13 +28,14 @@ public:
         gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
                     oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
     // The depth pass is the fastest closest-point shader on the H200 (reduce-earlyz, 4 points per thread;
-    // bench/NOTES.md), reading positions only. The accumulation pass draws points in the same order.
+    // bench/NOTES.md), reading positions only.
     depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
                                  {{/* EARLY_Z= */ 0, 1},
                                   {/* REDUCE= */ 1, 1},
                                   {/* DEPTH_ONLY= */ 3, 1},
                                   {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
-    // The accumulation pass draws 4 consecutive points per thread (its loads: three vec4s of positions).
+    // The accumulation pass draws 4 consecutive points per thread (its loads: three vec4s of positions),
+    // its workgroups' chunks interleaved (raster_hqs.comp, hqs_accumulate.inc.glsl).
     accumulate_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
     // The resolve reads the accumulators in the layout ONE_ROUND chose (the same constant id).
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", method.spec.span());
