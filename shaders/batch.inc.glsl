@@ -16,7 +16,6 @@ layout(local_size_x = kPointGroupSize) in;
 // LodFrame: eyes); the drawing loops read each point's words once and project them twice.
 layout(constant_id = 2) const uint STEREO = 0;
 
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
 
 // Margin of the culling tests, relative to the sum of the absolute terms of a clip coordinate: the float
 // rounding of projecting (and of decoding) a point stays below a few ulps of that sum (2^-23 each), far

@@ -7,9 +7,10 @@
 
 layout(local_size_x = 256) in;
 layout(push_constant) uniform Push { CopyPush pc; };
-layout(buffer_reference, std430, buffer_reference_align = 16) buffer Uvec4Array { uvec4 v[]; };
+// Written, so not common.inc.glsl's readonly Uvec4Array.
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Uvec4Words { uvec4 v[]; };
 
 void main() {
   uint i = linearInvocation(pc.groupsX, 256);
-  if (i < pc.count) Uvec4Array(pc.destination).v[i] = Uvec4Array(pc.source).v[i];
+  if (i < pc.count) Uvec4Words(pc.destination).v[i] = Uvec4Array(pc.source).v[i];
 }

@@ -24,9 +24,6 @@ layout(constant_id = 0) const uint ONE_ROUND = 0;
 #define DEPTH_INT40 0
 #include "point.inc.glsl"
 
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Vec4Array { vec4 v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
-
 // Points are 12 B (x, y, z) and a part's buffers start 16-byte aligned, so 4 points from a multiple of 4 are
 // three aligned vec4s; the part's last, partial quad is read point by point.
 void loadFour(uint first, out vec3 p[4]) {

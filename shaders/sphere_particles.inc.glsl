@@ -9,8 +9,6 @@ layout(constant_id = 0) const uint LAYOUT = kSphereLayoutVec4x2;
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer SphereFrameRef {
   SphereFrame f;
 };
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Vec4Array { vec4 v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Uvec4Array { uvec4 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer PartTable {
   SpherePartRef v[];
 };
