@@ -338,6 +338,15 @@ PR_CONST kSphereTileShift = 4;
 PR_CONST kSphereTileSide = 16;    // 1 << kSphereTileShift
 PR_CONST kSphereChunkPixels = 256; // kSphereTileSide^2
 PR_CONST kSphereTileCutPixels = 256; // a 16 x 16 box: one tile's area
+// Occlusion culling in sphere-compute: the particles of a part in batches of kSphereBatchSize (one
+// workgroup of the per-sphere pass), each with bounds computed once per particle set. A frame draws the
+// batches visible in the last frame first, then builds a conservative depth pyramid from what they drew
+// (16 x 16-pixel tiles and cells of kSphereCoarseTiles^2 tiles), tests every other batch's bounds against
+// it and draws those that may show.
+PR_CONST kSphereBatchSize = 128;        // kSphereGroupSize
+PR_CONST kSphereCoarseTiles = 8;        // a coarse cell: 8 x 8 tiles, 128 x 128 pixels
+PR_CONST kSphereCoarseShift = 3;
+PR_CONST kSphereBatchTestCells = 16;    // tiles or coarse cells a batch's test reads at most
 
 // Particle index of a pixel (or impostor) without a sphere.
 PR_CONST kNoParticle = 0xFFFFFFFFu;
@@ -388,6 +397,20 @@ struct SphereFrame {
                         // center of the tile is known to be covered at or nearer (ones: none known)
   uint64_t drawnChunks; // sphere-compute: uint[chunkCapacity], list indices of the chunks the large pass
                         // draws (those not behind their tiles' bounds); their count is SphereChunks::drawn
+  // sphere-compute's occlusion culling of batches (kSphereBatchSize consecutive particles of a part):
+  uint64_t batchBounds; // vec4 lo, vec4 hi per batch: bounds of its valid spheres, radii included (lo > hi:
+                        // none valid); relative to the particles' origin, like the particles. Batch
+                        // part * batchesPerPart + j holds particles [128 j, 128 j + 127] of the part
+  uint64_t batchFlags;  // uint per batch: 1 = in the list the frame draws first (visible in the last frame)
+  uint64_t batchList;   // SphereBatchList: the batches the second draw takes (found to show, not drawn first)
+  uint64_t hiz;         // uint per screen tile (tilesX per row), then per coarse cell of
+                        // kSphereCoarseTiles^2 tiles (coarseX per row): floatBits of a view depth that
+                        // every pixel center of the tile or cell is covered at or nearer by the end of the
+                        // frame (ones: none known)
+  uint batches;         // batches of the set: batchesPerPart in every part but the last
+  uint batchesPerPart;  // ceil(partCapacity / kSphereBatchSize)
+  uint coarseX;         // coarse cells per row of hiz
+  uint coarseOffset;    // index of hiz's first coarse cell (the tile count)
 };
 
 // One part of a particle set on the GPU, as the resolve and large-sphere passes find it by index.
@@ -400,7 +423,8 @@ struct SpherePartRef {
 // Push constants of every sphere compute pass.
 struct SpherePush {
   uint64_t frame;     // SphereFrame
-  uint64_t particles; // the part drawn by this dispatch (per-sphere pass)
+  uint64_t particles; // the part drawn by this dispatch (per-sphere pass); with occlusion culling the
+                      // SphereBatchList the per-sphere pass draws, or the batch cull fills for the next frame
   uint first;         // global index of the part's first particle
   uint count;         // particles in the part
   uint groupsX;       // workgroups per row of a 2D dispatch; the large-sphere pass: workgroups in all

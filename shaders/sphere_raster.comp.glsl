@@ -15,19 +15,22 @@
 #include "sphere_raster.inc.glsl"
 #include "grid.inc.glsl"
 
+// LIST: 0 = every sphere of the part (occlusion culling off); 1 = the batches of the SphereBatchList at
+// pc.particles, whatever part each is in, a fixed grid of pc.groupsX workgroups striding over the list
+// (one workgroup is one batch).
+layout(constant_id = 6) const uint LIST = 0;
+
 layout(local_size_x = kSphereGroupSize) in;
 layout(push_constant) uniform Push { SpherePush pc; };
 
-void main() {
-  uint local = linearInvocation(pc.groupsX, kSphereGroupSize);
-  if (local >= pc.count) return;
-  frame = SphereFrameRef(pc.frame).f;
-  Sphere s = loadSphere(pc.particles, pc.count, local);
+// Sphere `local` of the part at `part` (`count` spheres, the first of global index `first`).
+void drawSphere(uint64_t part, uint count, uint first, uint local) {
+  Sphere s = loadSphere(part, count, local);
   vec3 center;
   if (!viewSphere(s, center)) return;
   ivec4 box = spherePixelBox(center, s.radius);
   if (box.z < box.x || box.w < box.y) return;
-  uint index = pc.first + local;
+  uint index = first + local;
   uvec2 size = uvec2(box.zw - box.xy + 1);
   if (size.x * size.y <= kSphereSmallPixels) {
     coverBox(center, s.radius, index, box);
@@ -59,4 +62,23 @@ void main() {
       coverBox(center, s.radius, index, chunk);
   }
   if (at + n > uint64_t(frame.chunkCapacity)) atomicAdd(list.spilled, 1u);
+}
+
+void main() {
+  frame = SphereFrameRef(pc.frame).f;
+  if (LIST != 0) {
+    SphereBatchList batches = SphereBatchList(pc.particles);
+    uint total = batches.count;
+    for (uint e = gl_WorkGroupID.x; e < total; e += pc.groupsX) {
+      uint batch = batches.entries[e];
+      uint part = batch / frame.batchesPerPart;
+      uint local = (batch - part * frame.batchesPerPart) * kSphereBatchSize + gl_LocalInvocationIndex;
+      SpherePartRef ref = PartTable(frame.parts).v[part];
+      if (local < ref.count) drawSphere(ref.address, ref.count, part * frame.partCapacity, local);
+    }
+    return;
+  }
+  uint local = linearInvocation(pc.groupsX, kSphereGroupSize);
+  if (local >= pc.count) return;
+  drawSphere(pc.particles, pc.count, pc.first, local);
 }

@@ -24,6 +24,14 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer SphereChunk
   uvec4 entries[];
 };
 
+// A list of batches for the per-sphere pass of an occlusion-culled frame (the batches visible in the
+// last frame, drawn first; those found to show after that, drawn second): their count, then indices.
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer SphereBatchList {
+  uint count;
+  uint reserved[3];
+  uint entries[];
+};
+
 void countWork(uint counter) {
   if (COUNT_WORK != 0) atomicAdd(UintArray(frame.counters).v[counter], 1u);
 }

@@ -1,6 +1,7 @@
 #include "render/spheres/gpu_particles.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -165,6 +166,8 @@ GpuParticles::GpuParticles(gpu::Context& context, const ParticleSet& set,
                            const ParticleUploadOptions& options)
     : count_(set.size()), origin_(set.origin), bounds_(sphereBounds(set)), globalRadius_(set.globalRadius),
       globalColor_(set.globalColor) {
+  static std::atomic<uint64_t> uploads{0};
+  id_ = ++uploads;
   assert(set.xyz.size() % 3 == 0);
   assert(set.radius.empty() || set.radius.size() == count_);
   assert(set.colors.empty() || set.colors.size() == count_);

@@ -86,6 +86,9 @@ public:
   uint64_t partCapacity() const { return partCapacity_; }
   // SpherePartRef per part, device-local.
   const gpu::Buffer& partTable() const { return partTable_; }
+  // Unique per upload in this process: methods that derive data from the particles (sphere-compute's batch
+  // bounds) rebuild it when the id changes.
+  uint64_t id() const { return id_; }
   // GPU bytes of particle data (what a method that reads every particle once must read per frame).
   uint64_t bytes() const { return count_ * particleLayoutInfo(layout_).bytesPerParticle; }
 
@@ -99,6 +102,7 @@ private:
   Bounds bounds_;
   float globalRadius_ = 1.0f;
   uint32_t globalColor_ = 0;
+  uint64_t id_ = 0;
 };
 
 } // namespace pointrast

@@ -82,6 +82,10 @@ struct SphereSettings {
   // so the frame is slower; for tests and measurements of the work, not for timing).
   bool tileBound = true;
   bool countWork = false;
+  // sphere-compute: occlusion culling of batches of 128 consecutive particles (draw last frame's visible
+  // batches, test the others against the depth they left, draw those that may show). The image is the
+  // same with it off; off only to compare.
+  bool occlusionCull = true;
   // sphere-compute: large spheres whose box has more pixels than this are cut along screen tiles, smaller
   // ones into bands of box rows; 0 = the default (shared::kSphereTileCutPixels). Only to count the work
   // of other choices; the image is the same for every value.
@@ -104,6 +108,9 @@ struct SphereStats {
   uint32_t frames = 0;
   uint64_t particles = 0;      // particles submitted per frame
   uint64_t largeChunks = 0;    // sphere-compute: chunks (tiles, bands) of large spheres listed, last frame
+  // sphere-compute with occlusion culling, the last frame: batches of the set, batches that may show (the
+  // next frame's first draw), and batches its second draw took (not drawn first, found to show)
+  uint64_t batches = 0, visibleBatches = 0, lateBatches = 0;
   uint64_t spilledSpheres = 0; // sphere-compute: large spheres that drew chunks themselves (list full)
   // sphere-compute with SphereSettings::countWork, the last frame: pixels tested (each one read of the
   // visibility word, then the ray test unless early-z rejects it), of which in large-sphere chunks,
