@@ -110,6 +110,8 @@ nlohmann::json sphereResultJson(const SphereBenchRun& run, const SphereResult& r
   j["clamped_spheres"] = r.clampedSpheres;
   j["large_chunks"] = r.largeChunks;
   j["spilled_spheres"] = r.spilledSpheres;
+  j["batches"] = r.batches;
+  j["visible_batches"] = r.visibleBatches;
   if (!run.stopped.empty()) j["stopped"] = run.stopped;
   return j;
 }
@@ -294,6 +296,8 @@ bool sphereCounterCells(const SphereTables& t, const std::string& dataset, Orbit
     any = any || r;
     cells.push_back(count(r, &SphereResult::largeChunks));
     cells.push_back(count(r, &SphereResult::spilledSpheres));
+    cells.push_back(!r || !r->ok() ? count(r, &SphereResult::visibleBatches)
+                                   : std::to_string(r->visibleBatches) + " of " + std::to_string(r->batches));
   }
   return any;
 }
@@ -306,14 +310,15 @@ void sphereCounters(std::ostringstream& md, const SphereTables& t) {
   md << "## Per-frame counters (the most of an orbit's cameras)\n\n";
   md << "sphere-points: spheres larger than the device's largest point, drawn incomplete (per billboard, "
         "conservative off); sphere-compute: chunks of large spheres listed (16x16-pixel screen tiles of the "
-        "largest boxes, bands of box rows of the others), and large spheres "
-        "that drew their chunks themselves (list full).\n\n";
+        "largest boxes, bands of box rows of the others), large spheres "
+        "that drew their chunks themselves (list full), and batches of 128 particles (stored in spatial "
+        "order) that the occlusion test found visible, to be drawn first by the next frame.\n\n";
   md << "| data set | orbit | layout |";
   for (SphereBillboard b : c.billboards)
     if (points) md << " sphere-points clamped, " << sphereBillboardName(b) << " |";
-  if (compute) md << " sphere-compute large chunks | spilled |";
+  if (compute) md << " sphere-compute large chunks | spilled | visible batches |";
   md << "\n| --- | --- | --- |";
-  for (size_t k = 0; k < (points ? c.billboards.size() : 0) + (compute ? 2 : 0); ++k)
+  for (size_t k = 0; k < (points ? c.billboards.size() : 0) + (compute ? 3 : 0); ++k)
     md << " ---: |";
   md << "\n";
   for (const DatasetOutcome* d : t.datasets)

@@ -191,6 +191,8 @@ void timeSphereCombination(SphereRenderer& renderer, const GpuParticles& particl
     r.clampedSpheres = std::max(r.clampedSpheres, stats.clampedSpheres);
     r.largeChunks = std::max(r.largeChunks, stats.largeChunks);
     r.spilledSpheres = std::max(r.spilledSpheres, stats.spilledSpheres);
+    r.batches = stats.batches;
+    r.visibleBatches = std::max(r.visibleBatches, stats.visibleBatches);
   }
 }
 

@@ -47,8 +47,9 @@ struct SphereBenchConfig {
 constexpr uint64_t kSphereSharedBytesPerPixel = 12;
 constexpr uint64_t kSphereMethodBytesPerPixel = 16;
 constexpr uint64_t kSphereFixedBytes = uint64_t(160) << 20;
-// Host bytes per generated particle: position (12) and color (4).
-constexpr uint64_t kSphereHostBytesPerParticle = 16;
+// Host bytes per generated particle: position (12) and color (4), and while uploading the spatial order's
+// sort keys and indices (16: two of each, 4 B).
+constexpr uint64_t kSphereHostBytesPerParticle = 32;
 
 // GPU: particles x the largest bytes per particle of `layouts` + targets of `methods` methods; host:
 // particles x 16 B, plus the GPU bytes on a software device.
@@ -73,6 +74,8 @@ struct SphereResult {
   uint64_t clampedSpheres = 0;   // sphere-points: the most spheres clamped to the largest point, any camera
   uint64_t largeChunks = 0;      // sphere-compute: the most large-sphere chunks of a camera's frame
   uint64_t spilledSpheres = 0;   // sphere-compute: the most spilled large spheres of a camera's frame
+  uint64_t batches = 0;          // sphere-compute: batches of 128 particles (occlusion culling)
+  uint64_t visibleBatches = 0;   // sphere-compute: the most batches a camera's last frame found visible
   uint32_t bytesPerParticle = 0; // of the layout
   double particlesPerSecond = 0;
   double effectiveBytesPerSecond = 0; // particles x bytesPerParticle / median time

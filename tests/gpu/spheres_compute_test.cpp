@@ -329,6 +329,7 @@ TEST_F(GpuTest, SphereComputeTileBoundsSkipHiddenLargeSpheresAndKeepTheFrame) {
   SphereSettings settings;
   settings.countWork = true;
   settings.tileCutPixels = shared::kSphereSmallPixels;
+  settings.occlusionCull = false; // which would drop hidden spheres before they list chunks
   GpuFrame bounded = renderGpu(*context, set, camera, 320, 240, {}, settings);
   settings.tileBound = false;
   GpuFrame unbounded = renderGpu(*context, set, camera, 320, 240, {}, settings);

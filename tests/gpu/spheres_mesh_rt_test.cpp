@@ -407,7 +407,8 @@ TEST_F(SphereMeshRtDeviceTest, AabbPassBoundsEverySphereInEveryLayout) {
       std::vector<float> box(part.count * 6);
       gpu::readBuffer(*context, boxes, 0, box.data(), box.size() * sizeof(float));
       for (uint64_t i = 0; i < part.count; ++i) {
-        uint64_t g = part.first + i;
+        // The particle of the set at this GPU position (uploads are in spatial order).
+        uint64_t g = particles.order() ? (*particles.order())[part.first + i] : part.first + i;
         const float* b = &box[6 * i];
         double r = perRadius ? double(float(set.radius[g])) : double(set.globalRadius);
         bool valid = r > 0 && std::isfinite(r);

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "base/progress.h"
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
@@ -50,22 +51,25 @@ float channel(uint32_t rgba, int c) {
   return float((rgba >> (8 * c)) & 0xFFu) / 255.0f;
 }
 
-// Writes particles [first, first + n) of the set into the stream regions (region s holds stream s of
-// these n particles, tightly packed).
-void fillStreams(ParticleLayout layout, const ParticleSet& set, uint64_t first, uint64_t n,
-                 const std::vector<char*>& regions) {
-  const float* xyz = set.xyz.data() + 3 * first;
+// Writes the particles at upload positions [first + begin, first + end) into the stream regions (region s
+// holds stream s of the chunk starting at upload position `first`, tightly packed), reading upload
+// position k from particle order[k] of the set (k itself without an order).
+void fillStreams(ParticleLayout layout, const ParticleSet& set, const uint32_t* order, uint64_t first,
+                 uint64_t begin, uint64_t end, const std::vector<char*>& regions) {
+  auto source = [&](uint64_t i) -> uint64_t { return order ? order[first + i] : first + i; };
+  const float* xyz = set.xyz.data();
   switch (layout) {
   case ParticleLayout::Soa8: {
     float* s[8];
     for (int k = 0; k < 8; ++k)
       s[k] = reinterpret_cast<float*>(regions[k]);
-    for (uint64_t i = 0; i < n; ++i) {
-      uint32_t color = set.colorOf(first + i);
-      s[0][i] = xyz[3 * i];
-      s[1][i] = xyz[3 * i + 1];
-      s[2][i] = xyz[3 * i + 2];
-      s[3][i] = set.radiusOf(first + i);
+    for (uint64_t i = begin; i < end; ++i) {
+      uint64_t j = source(i);
+      uint32_t color = set.colorOf(j);
+      s[0][i] = xyz[3 * j];
+      s[1][i] = xyz[3 * j + 1];
+      s[2][i] = xyz[3 * j + 2];
+      s[3][i] = set.radiusOf(j);
       for (int c = 0; c < 4; ++c)
         s[4 + c][i] = channel(color, c);
     }
@@ -74,10 +78,11 @@ void fillStreams(ParticleLayout layout, const ParticleSet& set, uint64_t first, 
   case ParticleLayout::Vec4x2: {
     auto* positions = reinterpret_cast<float*>(regions[0]);
     auto* colors = reinterpret_cast<float*>(regions[1]);
-    for (uint64_t i = 0; i < n; ++i) {
-      uint32_t color = set.colorOf(first + i);
-      std::memcpy(positions + 4 * i, xyz + 3 * i, 12);
-      positions[4 * i + 3] = set.radiusOf(first + i);
+    for (uint64_t i = begin; i < end; ++i) {
+      uint64_t j = source(i);
+      uint32_t color = set.colorOf(j);
+      std::memcpy(positions + 4 * i, xyz + 3 * j, 12);
+      positions[4 * i + 3] = set.radiusOf(j);
       for (int c = 0; c < 4; ++c)
         colors[4 * i + c] = channel(color, c);
     }
@@ -85,20 +90,87 @@ void fillStreams(ParticleLayout layout, const ParticleSet& set, uint64_t first, 
   }
   case ParticleLayout::Aos: {
     char* out = regions[0];
-    for (uint64_t i = 0; i < n; ++i) {
-      uint32_t color = set.colorOf(first + i);
-      std::memcpy(out + 16 * i, xyz + 3 * i, 12);
+    for (uint64_t i = begin; i < end; ++i) {
+      uint64_t j = source(i);
+      uint32_t color = set.colorOf(j);
+      std::memcpy(out + 16 * i, xyz + 3 * j, 12);
       std::memcpy(out + 16 * i + 12, &color, 4);
     }
     break;
   }
   case ParticleLayout::Xyz:
-    std::memcpy(regions[0], xyz, n * 12);
+    if (!order) {
+      std::memcpy(regions[0] + 12 * begin, xyz + 3 * (first + begin), (end - begin) * 12);
+    } else {
+      for (uint64_t i = begin; i < end; ++i)
+        std::memcpy(regions[0] + 12 * i, xyz + 3 * source(i), 12);
+    }
     break;
   }
 }
 
+// The 10 low bits of v spread to every third bit.
+uint32_t spreadBits(uint32_t v) {
+  v &= 0x3FFu;
+  v = (v | (v << 16)) & 0x030000FFu;
+  v = (v | (v << 8)) & 0x0300F00Fu;
+  v = (v | (v << 4)) & 0x030C30C3u;
+  v = (v | (v << 2)) & 0x09249249u;
+  return v;
+}
+
 } // namespace
+
+std::vector<uint32_t> spatialOrder(const ParticleSet& set) {
+  const uint64_t n = set.size();
+  if (n > 0xFFFFFFFFull) throw UnsupportedError("spatial order: more than 2^32 particles");
+  // Cells of a 1024^3 grid over the centers' bounds (relative to the origin, where the floats are).
+  const glm::dvec3 lo = set.bounds.min - set.origin, extent = set.bounds.max - set.bounds.min;
+  const glm::dvec3 scale = glm::dvec3(1024.0) / glm::max(extent, glm::dvec3(1e-30));
+  std::vector<uint32_t> keys(n), order(n), keysOut(n), orderOut(n);
+  constexpr uint64_t kBlock = 1u << 20;
+  parallelBlocksOn(0, n, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
+    for (uint64_t i = begin; i < end; ++i) {
+      uint32_t cell[3];
+      for (int a = 0; a < 3; ++a) {
+        double q = (double(set.xyz[3 * i + a]) - lo[a]) * scale[a];
+        cell[a] = q >= 0 && q < 1024 ? uint32_t(q) : (q >= 1024 ? 1023u : 0u); // NaN: 0
+      }
+      keys[i] = spreadBits(cell[0]) | spreadBits(cell[1]) << 1 | spreadBits(cell[2]) << 2;
+      order[i] = uint32_t(i);
+    }
+  });
+  // A stable least-significant-digit radix sort, three digits of 10 bits; per pass, each block counts
+  // its digits, then scatters its particles after those of lower digits and of earlier blocks.
+  const uint64_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<uint64_t> counts(blocks * 1024);
+  for (int shift = 0; shift < 30; shift += 10) {
+    std::fill(counts.begin(), counts.end(), 0);
+    parallelBlocksOn(0, n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
+      uint64_t* c = counts.data() + b * 1024;
+      for (uint64_t i = begin; i < end; ++i)
+        ++c[(keys[i] >> shift) & 1023u];
+    });
+    uint64_t at = 0;
+    for (uint32_t digit = 0; digit < 1024; ++digit)
+      for (uint64_t b = 0; b < blocks; ++b) {
+        uint64_t c = counts[b * 1024 + digit];
+        counts[b * 1024 + digit] = at;
+        at += c;
+      }
+    parallelBlocksOn(0, n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
+      uint64_t* next = counts.data() + b * 1024;
+      for (uint64_t i = begin; i < end; ++i) {
+        uint64_t to = next[(keys[i] >> shift) & 1023u]++;
+        keysOut[to] = keys[i];
+        orderOut[to] = order[i];
+      }
+    });
+    keys.swap(keysOut);
+    order.swap(orderOut);
+  }
+  return order;
+}
 
 std::span<const ParticleLayoutInfo> particleLayoutTable() {
   return kLayouts;
@@ -222,11 +294,16 @@ GpuParticles::GpuParticles(gpu::Context& context, const ParticleSet& set,
     regionOffsets.push_back(offset);
     offset += chunk * bytes;
   }
+  if (options.spatialOrder && count_ > 1)
+    order_ = std::make_shared<const std::vector<uint32_t>>(spatialOrder(set));
+  const uint32_t* order = order_ ? order_->data() : nullptr;
   Progress progress("uploading particles to GPU", count_, " particles", options.progress);
   for (const ParticlePart& part : parts_) {
     for (uint64_t at = 0; at < part.count; at += chunk) {
       uint64_t n = std::min(chunk, part.count - at);
-      fillStreams(layout_, set, part.first + at, n, regions);
+      parallelBlocksOn(0, n, 1u << 16, [&](uint64_t, uint64_t begin, uint64_t end) {
+        fillStreams(layout_, set, order, part.first + at, begin, end, regions);
+      });
       context.submitAndWait([&](VkCommandBuffer cmd) {
         uint64_t streamStart = 0; // byte where stream s of this part begins
         for (size_t s = 0; s < elements.size(); ++s) {

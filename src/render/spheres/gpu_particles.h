@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -64,8 +65,16 @@ struct ParticlePart {
 struct ParticleUploadOptions {
   std::optional<ParticleLayout> layout; // nullopt: compactLayout(set)
   uint64_t maxPartParticles = 0;        // 0: as many as fit one buffer, <= 64 M
+  // Store the particles in spatial order (spatialOrder below), so that consecutive particles lie close
+  // together: sphere-compute's occlusion culling tests batches of consecutive particles by their bounds.
+  // Indices reported by the renderers stay those of the set.
+  bool spatialOrder = true;
   bool progress = true;
 };
+
+// The particles of the set (indices) in the Morton order of the cells of a 1024^3 grid over their centers'
+// bounds, in their order within a cell: a stable sort by cell, on all hardware threads.
+std::vector<uint32_t> spatialOrder(const ParticleSet& set);
 
 class GpuParticles {
 public:
@@ -86,6 +95,9 @@ public:
   uint64_t partCapacity() const { return partCapacity_; }
   // SpherePartRef per part, device-local.
   const gpu::Buffer& partTable() const { return partTable_; }
+  // The set index of the particle at each GPU position (what the visibility buffers hold); null: the
+  // set's own order.
+  const std::shared_ptr<const std::vector<uint32_t>>& order() const { return order_; }
   // Unique per upload in this process: methods that derive data from the particles (sphere-compute's batch
   // bounds) rebuild it when the id changes.
   uint64_t id() const { return id_; }
@@ -103,6 +115,7 @@ private:
   float globalRadius_ = 1.0f;
   uint32_t globalColor_ = 0;
   uint64_t id_ = 0;
+  std::shared_ptr<const std::vector<uint32_t>> order_;
 };
 
 } // namespace pointrast

@@ -296,6 +296,7 @@ SphereStats SphereRenderer::render(const GpuParticles& particles, const Camera& 
     }
   });
   last_ = &m;
+  lastOrder_ = particles.order();
   std::vector<double> ms = timestamps.milliseconds();
   SphereStats stats;
   stats.frames = frames;
@@ -321,7 +322,11 @@ std::vector<float> SphereRenderer::depth() {
 
 std::vector<uint32_t> SphereRenderer::indices() {
   if (!last_) throw InputError("no sphere frame has been rendered yet");
-  return last_->indices();
+  std::vector<uint32_t> indices = last_->indices();
+  if (lastOrder_) // GPU positions -> indices of the set
+    for (uint32_t& i : indices)
+      if (i != shared::kNoParticle) i = (*lastOrder_)[i];
+  return indices;
 }
 
 } // namespace pointrast

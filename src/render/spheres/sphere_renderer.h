@@ -158,6 +158,7 @@ private:
   std::unique_ptr<SphereTargets> targets_;
   std::vector<std::pair<SphereMethod, std::unique_ptr<SphereMethodImpl>>> methods_;
   SphereMethodImpl* last_ = nullptr; // the method of the last frame (depth and indices come from it)
+  std::shared_ptr<const std::vector<uint32_t>> lastOrder_; // GpuParticles::order() of the last frame
 };
 
 } // namespace pointrast
