@@ -342,11 +342,15 @@ PR_CONST kSphereTileCutPixels = 256; // a 16 x 16 box: one tile's area
 // workgroup of the per-sphere pass), each with bounds computed once per particle set. A frame draws the
 // batches visible in the last frame first, then builds a conservative depth pyramid from what they drew
 // (16 x 16-pixel tiles and cells of kSphereCoarseTiles^2 tiles), tests every other batch's bounds against
-// it and draws those that may show.
+// it and draws those that may show. The pyramid has 4 x 4-pixel cells too: a batch at long range covers a
+// few pixels, and a tile's depth range over a slanted surface (tens of units) would keep many layers.
 PR_CONST kSphereBatchSize = 128;        // kSphereGroupSize
 PR_CONST kSphereCoarseTiles = 8;        // a coarse cell: 8 x 8 tiles, 128 x 128 pixels
 PR_CONST kSphereCoarseShift = 3;
-PR_CONST kSphereBatchTestCells = 16;    // tiles or coarse cells a batch's test reads at most
+PR_CONST kSphereBatchTestCells = 16;    // fine cells, tiles or coarse cells a batch's test reads at most
+PR_CONST kSphereFineShift = 2;          // a fine cell: 4 x 4 pixels
+PR_CONST kSphereFineSide = 4;
+PR_CONST kSphereFinePerTile = 4;        // fine cells per tile side
 
 // Particle index of a pixel (or impostor) without a sphere.
 PR_CONST kNoParticle = 0xFFFFFFFFu;
@@ -404,13 +408,16 @@ struct SphereFrame {
   uint64_t batchFlags;  // uint per batch: 1 = in the list the frame draws first (visible in the last frame)
   uint64_t batchList;   // SphereBatchList: the batches the second draw takes (found to show, not drawn first)
   uint64_t hiz;         // uint per screen tile (tilesX per row), then per coarse cell of
-                        // kSphereCoarseTiles^2 tiles (coarseX per row): floatBits of a view depth that
-                        // every pixel center of the tile or cell is covered at or nearer by the end of the
-                        // frame (ones: none known)
+                        // kSphereCoarseTiles^2 tiles (coarseX per row), then per fine cell of
+                        // kSphereFineSide^2 pixels: floatBits of a view depth that every pixel center of
+                        // the tile or cell is covered at or nearer by the end of the frame (ones: none
+                        // known)
   uint batches;         // batches of the set: batchesPerPart in every part but the last
   uint batchesPerPart;  // ceil(partCapacity / kSphereBatchSize)
   uint coarseX;         // coarse cells per row of hiz
   uint coarseOffset;    // index of hiz's first coarse cell (the tile count)
+  uint fineOffset;      // index of hiz's first fine cell (4 x 4 pixels, 4 tilesX per row), after the coarse
+  uint reserved[3];
 };
 
 // One part of a particle set on the GPU, as the resolve and large-sphere passes find it by index.

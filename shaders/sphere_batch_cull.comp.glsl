@@ -3,7 +3,7 @@
 // (radii included) are projected; if the nearest of their eight corners lies behind the depth pyramid
 // (sphere_hiz.comp) over every pixel the bounds may cover, none of its spheres can win a pixel: each would
 // be strictly deeper than what that pixel ends the frame with. The test reads at most
-// kSphereBatchTestCells tiles, else as many coarse cells, else it keeps the batch. A batch that may show
+// kSphereBatchTestCells fine cells, else as many tiles, else as many coarse cells, else it keeps the batch. A batch that may show
 // is appended to the next frame's first list (at pc.particles), and also to this frame's second list if
 // the first draw did not take it; every batch's flag becomes whether it may show.
 #extension GL_KHR_shader_subgroup_ballot : require
@@ -47,15 +47,19 @@ bool batchMayShow(vec3 lo, vec3 hi) {
   ivec2 p0 = ivec2(clamp(ceil(first - 1.0), vec2(0.0), size));
   ivec2 p1 = ivec2(clamp(floor(last), vec2(-1.0), size - 1.0));
   if (any(lessThan(p1, p0))) return false; // outside the image
-  uint level = frame.coarseOffset, row = frame.coarseX;
-  uvec4 cells = uvec4(p0, p1) >> (kSphereTileShift + kSphereCoarseShift);
-  uvec4 tiles = uvec4(p0, p1) >> kSphereTileShift;
-  if ((tiles.z - tiles.x + 1) * (tiles.w - tiles.y + 1) <= kSphereBatchTestCells) {
+  // The finest level whose cells over the pixels number at most kSphereBatchTestCells.
+  uint level = frame.fineOffset, row = frame.tilesX * kSphereFinePerTile;
+  uvec4 cells = uvec4(p0, p1) >> kSphereFineShift;
+  if ((cells.z - cells.x + 1) * (cells.w - cells.y + 1) > kSphereBatchTestCells) {
     level = 0u;
     row = frame.tilesX;
-    cells = tiles;
-  } else if ((cells.z - cells.x + 1) * (cells.w - cells.y + 1) > kSphereBatchTestCells) {
-    return true;
+    cells = uvec4(p0, p1) >> kSphereTileShift;
+  }
+  if ((cells.z - cells.x + 1) * (cells.w - cells.y + 1) > kSphereBatchTestCells) {
+    level = frame.coarseOffset;
+    row = frame.coarseX;
+    cells = uvec4(p0, p1) >> (kSphereTileShift + kSphereCoarseShift);
+    if ((cells.z - cells.x + 1) * (cells.w - cells.y + 1) > kSphereBatchTestCells) return true;
   }
   // Against the rounding of corner and sphere transforms: 1024 units in the last place (~1.2e-4 of the
   // depth) nearer.

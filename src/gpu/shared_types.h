@@ -52,9 +52,10 @@ static_assert(sizeof(LodPush) == 80 && offsetof(LodPush, frame) == 64 && offseto
 static_assert(kLodPageSteps * 4 * kPointGroupSize == kLodPagePoints && kLodPagePoints % 4 == 0);
 
 // Spheres: SphereFrame lives in a buffer read with std430 rules (struct alignment 16 for its mat4/vec4).
-static_assert(sizeof(SphereFrame) == 224);
+static_assert(sizeof(SphereFrame) == 240);
 static_assert(offsetof(SphereFrame, batchBounds) == 176 && offsetof(SphereFrame, batches) == 208);
-static_assert(kSphereBatchSize == kSphereGroupSize && kSphereCoarseTiles == 1u << kSphereCoarseShift);
+static_assert(kSphereBatchSize == kSphereGroupSize && kSphereCoarseTiles == 1u << kSphereCoarseShift &&
+              kSphereFineSide == 1u << kSphereFineShift && kSphereFinePerTile * kSphereFineSide == kSphereTileSide);
 static_assert(offsetof(SphereFrame, pixelToRay) == 64);
 static_assert(offsetof(SphereFrame, framebuffer) == 80);
 static_assert(offsetof(SphereFrame, image) == 104);

@@ -81,8 +81,8 @@ public:
     tilesY_ = (height + shared::kSphereTileSide - 1) / shared::kSphereTileSide;
     coarseX_ = (tilesX_ + shared::kSphereCoarseTiles - 1) / shared::kSphereCoarseTiles;
     coarse_ = uint64_t(coarseX_) * ((tilesY_ + shared::kSphereCoarseTiles - 1) / shared::kSphereCoarseTiles);
-    hiz_ = gpu::Buffer(context, (tiles_ + coarse_) * 4, gpu::kBufferUsage, gpu::MemoryKind::Device,
-                       "sphere depth pyramid");
+    hiz_ = gpu::Buffer(context, (tiles_ * (1 + shared::kSphereFinePerTile * shared::kSphereFinePerTile) + coarse_) * 4,
+                       gpu::kBufferUsage, gpu::MemoryKind::Device, "sphere depth pyramid");
     // The large pass strides over the list with a fixed grid: enough workgroups to fill a big GPU
     // (4096 x 256 threads), or a few per core on a CPU device, where idle workgroups are not free, but
     // at least enough that no invocation loops over more than kCpuLoopIterations chunks: llvmpipe ends
@@ -109,6 +109,7 @@ public:
     frame.hiz = hiz_.address();
     frame.coarseX = coarseX_;
     frame.coarseOffset = uint32_t(tiles_);
+    frame.fineOffset = uint32_t(tiles_ + coarse_);
   }
 
   // Occlusion culling: the batches' bounds and flags, rebuilt when the particle set changes (a set is
