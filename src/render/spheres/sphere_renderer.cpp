@@ -68,9 +68,10 @@ bool pointBillboardOptions(gpu::Context& context, const SphereSettings& settings
 
 constexpr SphereMethodInfo kSphereMethods[] = {
     {SphereMethod::Compute, "sphere-compute",
-     "compute rasterization of ray-cast spheres into a 64-bit depth|index visibility buffer; large spheres "
-     "split into 16x16-pixel tiles across workgroups, tiles hidden behind nearer spheres skipped; then a "
-     "shading resolve",
+     "compute rasterization of ray-cast spheres into a 64-bit depth|index visibility buffer; batches of "
+     "128 neighboring particles hidden behind what the last frame's visible batches drew are skipped; large "
+     "spheres split into 16x16-pixel tiles across workgroups, tiles hidden behind nearer spheres skipped; "
+     "then a shading resolve",
      alwaysSupported},
     {SphereMethod::Points, "sphere-points",
      "hardware point list, gl_PointSize from the projected bounds (clamped to the largest point), ray-cast "
