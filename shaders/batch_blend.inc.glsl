@@ -82,3 +82,51 @@ uint blendBoxStereo(BatchView v0, BatchView v1, BatchWords at, uint count, uint 
   }
   return blended;
 }
+
+// One camera, a batch of an ordered cloud: each thread blends its kBatchPointsPerThread consecutive points
+// in order (quads firstQuad, firstQuad + 1, ...), sums a run of points on one pixel in registers (the pixel's
+// closest depth read once per run) and adds the run's sums with one atomic when the pixel changes and at
+// the end. No subgroup step: in a dense overview most of a thread's points share one or two pixels, and
+// the rounds that merge lanes cost more than the atomics they save (bench/NOTES.md, session 8). Same
+// projection and depth test as blendStep, so the sums (and the image) are the same. Returns the points
+// this thread blended.
+uint blendBoxRuns(BatchView v, BatchWords at, uint count, BatchCamera cam, uint64_t framebuffer,
+                  uint64_t accumulators) {
+  if (v.words == 0u) return 0u;
+  Uint64Array fb = Uint64Array(framebuffer);
+  Uint64Array acc = Uint64Array(accumulators);
+  uint pixels = cam.pitch * cam.height; // the whole framebuffer
+  uint blended = 0u;
+  uint runPixel = kNoPixel;
+  float runLimit = 0.0;
+  uint r = 0u, g = 0u, b = 0u, n = 0u;
+  const uint quads = kBatchPointsPerThread / 4u;
+  for (uint s = 0u; s < quads; ++s) {
+    uint q = gl_LocalInvocationIndex * quads + s;
+    uint local = 4u * q;
+    if (local >= count) break;
+    uvec4 h, m, l;
+    loadQuad(at, q, v.words, h, m, l);
+    [[unroll]] for (uint k = 0u; k < 4u; ++k) {
+      uint p, depthBits;
+      if (local + k >= count || !projectBatchPoint(v, v.words, true, h[k], m[k], l[k], cam, p, depthBits))
+        continue;
+      if (p != runPixel) {
+        if (n != 0u) hqsAccumulate(acc, pixels, runPixel, r, g, b, n);
+        r = g = b = n = 0u;
+        runPixel = p;
+        runLimit = uintBitsToFloat(uint(fb.v[p] >> 32)) * float(PR_HQS_DEPTH_FACTOR);
+      }
+      if (uintBitsToFloat(depthBits) > runLimit) continue; // hidden: not blended
+      uint cr, cg, cb;
+      hqsChannels(UintArray(at.colors).v[local + k], cr, cg, cb);
+      r += cr;
+      g += cg;
+      b += cb;
+      ++n;
+      ++blended;
+    }
+  }
+  if (n != 0u) hqsAccumulate(acc, pixels, runPixel, r, g, b, n);
+  return blended;
+}
