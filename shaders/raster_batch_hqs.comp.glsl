@@ -1,7 +1,6 @@
 #version 460
 // batch-hqs, accumulation pass (2022): after a depth pass (raster_batch.comp with PREFETCH and DEPTH_ONLY),
-// each batch of a part blends its points with batch_blend.inc.glsl: a thread's consecutive points in runs
-// of one pixel (blendBoxRuns), or in stereo both eyes from one load (blendBoxStereo).
+// each batch of a part blends its points with batch_blend.inc.glsl.
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -26,7 +25,8 @@ void main() {
     blended = blendBoxStereo(v, v1, batchWords(first), count, kBatchPrefetchSteps, cam, right,
                              frame.f.framebuffer, frame.f.accumulators);
   } else {
-    blended = blendBoxRuns(v, batchWords(first), count, cam, frame.f.framebuffer, frame.f.accumulators);
+    blended = blendBox(v, batchWords(first), count, kBatchPrefetchSteps, cam, frame.f.framebuffer,
+                       frame.f.accumulators);
   }
   endStats(frame.f.stats, kStatPointsBlended, blended, false, v.words, count);
 }
