@@ -12,27 +12,15 @@ namespace pointrast::test {
 
 namespace {
 
-struct Frame {
-  std::vector<uint32_t> image, index;
-  std::vector<float> depth;
-  SphereStats stats;
-};
-
-Frame renderWith(SphereRenderer& renderer, const GpuParticles& particles, const Camera& camera, bool cull,
-                 uint32_t warmup = 1) {
+GpuFrame renderWith(SphereRenderer& renderer, const GpuParticles& particles, const Camera& camera, bool cull,
+                    uint32_t warmup = 1) {
   SphereSettings settings;
-  settings.background = kBackground;
   settings.occlusionCull = cull;
   settings.warmup = warmup;
-  Frame f;
-  f.stats = renderer.render(particles, camera, settings);
-  f.image = renderer.image();
-  f.index = renderer.indices();
-  f.depth = renderer.depth();
-  return f;
+  return renderFrame(renderer, particles, camera, settings);
 }
 
-void expectSameFrame(const Frame& culled, const Frame& reference, const std::string& what) {
+void expectSameFrame(const GpuFrame& culled, const GpuFrame& reference, const std::string& what) {
   size_t differing = 0;
   for (size_t p = 0; p < reference.index.size(); ++p)
     differing += culled.index[p] != reference.index[p];
@@ -74,7 +62,7 @@ TEST_F(GpuTest, SphereOcclusionCullingKeepsTheFrameInEveryLayout) {
     upload.maxPartParticles = 1000; // parts that end inside a batch
     GpuParticles particles(*context, c.set, upload);
     SphereRenderer renderer(*context, 200, 150);
-    Frame reference = renderWith(renderer, particles, camera, false);
+    GpuFrame reference = renderWith(renderer, particles, camera, false);
     // The first frame after the upload draws every batch first; the later ones only the visible.
     for (uint32_t warmup : {0u, 1u, 3u})
       expectSameFrame(renderWith(renderer, particles, camera, true, warmup), reference,
@@ -104,11 +92,11 @@ TEST_F(GpuTest, SphereOcclusionCullingDropsHiddenBatchesOfADenseSetAndKeepsTheFr
   uint64_t batches = 0, visible = 0;
   for (const View& v : views) {
     const Camera camera = orbit(particles.bounds(), v.angle, v.distance, v.elevation);
-    Frame reference = renderWith(renderer, particles, camera, false);
-    Frame culled = renderWith(renderer, particles, camera, true, 0);
+    GpuFrame reference = renderWith(renderer, particles, camera, false);
+    GpuFrame culled = renderWith(renderer, particles, camera, true, 0);
     expectSameFrame(culled, reference, "view at " + std::to_string(v.angle / kDegree) + " degrees");
     // Twice in a row: the second frame draws the batches the first found visible.
-    Frame again = renderWith(renderer, particles, camera, true, 1);
+    GpuFrame again = renderWith(renderer, particles, camera, true, 1);
     expectSameFrame(again, reference, "again at " + std::to_string(v.angle / kDegree) + " degrees");
     EXPECT_EQ(again.stats.batches, (particles.count() + shared::kSphereBatchSize - 1) / shared::kSphereBatchSize);
     EXPECT_LE(again.stats.visibleBatches, again.stats.batches);

@@ -65,11 +65,9 @@ struct GpuFrame {
   SphereStats stats;
 };
 
-inline GpuFrame renderGpu(gpu::Context& context, const ParticleSet& set, const Camera& camera, uint32_t w,
-                          uint32_t h, ParticleUploadOptions upload = {}, SphereSettings settings = {}) {
-  upload.progress = false;
-  GpuParticles particles(context, set, upload);
-  SphereRenderer renderer(context, w, h);
+// A frame of an existing renderer and upload (the background set to kBackground).
+inline GpuFrame renderFrame(SphereRenderer& renderer, const GpuParticles& particles, const Camera& camera,
+                            SphereSettings settings = {}) {
   settings.background = kBackground;
   GpuFrame frame;
   frame.stats = renderer.render(particles, camera, settings);
@@ -77,6 +75,14 @@ inline GpuFrame renderGpu(gpu::Context& context, const ParticleSet& set, const C
   frame.depth = renderer.depth();
   frame.index = renderer.indices();
   return frame;
+}
+
+inline GpuFrame renderGpu(gpu::Context& context, const ParticleSet& set, const Camera& camera, uint32_t w,
+                          uint32_t h, ParticleUploadOptions upload = {}, SphereSettings settings = {}) {
+  upload.progress = false;
+  GpuParticles particles(context, set, upload);
+  SphereRenderer renderer(context, w, h);
+  return renderFrame(renderer, particles, camera, settings);
 }
 
 inline SphereRaycast renderCpu(const ParticleSet& set, const Camera& camera, uint32_t w, uint32_t h,
