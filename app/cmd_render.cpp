@@ -377,13 +377,18 @@ nlohmann::json sphereJson(const gpu::Context& context, const SphereSettings& set
     j["meshlet"] = settings.meshlet;
     j["task_cull"] = settings.taskCull;
   }
-  if (settings.method == SphereMethod::RayTracing) j["build_ms"] = stats.buildMs;
+  if (settings.method == SphereMethod::RayTracing || settings.method == SphereMethod::Compute)
+    j["build_ms"] = stats.buildMs; // sphere-rt's structures, sphere-compute's batch bounds
   j["input"] = set.source;
   j["particles"] = stats.particles;
   addTimes(j, a, stats.frames, stats.medianMs, stats.minMs, stats.maxMs);
   j["particles_per_second"] = perSecond(stats.particles, stats.medianMs);
   j["large_chunks"] = stats.largeChunks;
   j["spilled_spheres"] = stats.spilledSpheres;
+  if (settings.method == SphereMethod::Compute) { // occlusion culling: batches of 128 particles
+    j["batches"] = stats.batches;
+    j["visible_batches"] = stats.visibleBatches;
+  }
   j["clamped_spheres"] = stats.clampedSpheres;
   j["camera"] = describeCamera(camera);
   j["image_hash"] = hashText(pixels);

@@ -35,7 +35,8 @@ TEST(SpheresCli, RenderParticleSceneWritesPngAndJson) {
   ASSERT_TRUE(fs::exists(png));
   EXPECT_EQ(slurp(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   for (const char* key : {"\"method\":\"sphere-compute\"", "\"layout\":\"soa8\"", "\"particles\":20000",
-                          "\"width\":320", "\"median_ms\"", "\"large_chunks\"", "\"image_hash\""})
+                          "\"width\":320", "\"median_ms\"", "\"large_chunks\"", "\"batches\":157",
+                          "\"visible_batches\"", "\"build_ms\"", "\"image_hash\""})
     EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing in " << r.out;
   EXPECT_EQ(r.out.find('\n'), r.out.size() - 1) << "one JSON line: " << r.out;
 }

@@ -118,8 +118,9 @@ struct SphereStats {
   uint64_t pixelsTested = 0, largePixelsTested = 0, depthAtomics = 0, skippedChunks = 0;
   uint64_t clampedSpheres = 0; // sphere-points, sphere-mesh-points: spheres larger than the largest point,
                                // drawn incomplete
-  // sphere-rt: GPU time of building the acceleration structures (AABBs, bottom and top levels) before the
-  // frames, timestamp queries; not part of the frame times above.
+  // GPU time of what a method builds from the particles before the frames, timestamp queries; not part of
+  // the frame times above. sphere-rt: the acceleration structures (AABBs, bottom and top levels), every
+  // render; sphere-compute: the batches' bounds, once per upload (0 after).
   double buildMs = 0;
   uint64_t rtBottomLevels = 0; // sphere-rt: bottom-level structures built (a piece of a part each)
 };
