@@ -1,8 +1,9 @@
 #version 460
 // sphere-compute's occlusion culling, once per particle set: the bounds of every batch (kSphereBatchSize
 // consecutive particles of a part), one thread per batch, its flag set and its entry written in the list
-// at pc.particles (whose count the host sets), so that the first frame draws every batch before the test. Only spheres that pass viewSphere's value checks (finite center, positive finite
-// radius) count: a batch with none gets lo > hi and is never drawn (every sphere of it would be culled).
+// at pc.particles (whose count the host sets), so that the first frame draws every batch before the test.
+// Only spheres with a finite center and a positive finite radius (finiteSphere) count: a batch with none
+// gets lo > hi and is never drawn (every sphere of it would be culled).
 #include "sphere_raster.inc.glsl"
 #include "grid.inc.glsl"
 
@@ -24,8 +25,7 @@ void main() {
   uint end = min(first + kSphereBatchSize, ref.count);
   for (uint i = first; i < end; ++i) {
     Sphere s = loadSphere(ref.address, ref.count, i);
-    const float kHuge = 3.0e38;
-    if (!(all(lessThan(abs(s.center), vec3(kHuge))) && s.radius > 0.0 && s.radius < kHuge)) continue;
+    if (!finiteSphere(s.center, s.radius)) continue;
     lo = min(lo, s.center - s.radius);
     hi = max(hi, s.center + s.radius);
   }

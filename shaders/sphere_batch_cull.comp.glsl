@@ -37,7 +37,7 @@ bool batchMayShow(vec3 lo, vec3 hi) {
     // Bounds reaching the near plane are not tested (NaN fails the comparison too).
     if (!(depth > frame.nearW)) return true;
     nearest = min(nearest, depth);
-    vec2 pixel = (v.xy / depth - frame.pixelToRay.yw) / frame.pixelToRay.xz;
+    vec2 pixel = rayPixel(frame.pixelToRay, v.xy / depth);
     first = min(first, pixel);
     last = max(last, pixel);
   }

@@ -27,8 +27,8 @@ vec4 sphereCameraSquare(vec3 center, float radius, vec4 pixelToRay) {
   vec2 c = center.xy;
   vec2 reach = radius * (d * sqrt(c * c + vec2(k)) + abs(c) * radius) / k;
   float h = max(reach.x, reach.y);
-  vec2 p0 = ((c - h) / d - pixelToRay.yw) / pixelToRay.xz;
-  vec2 p1 = ((c + h) / d - pixelToRay.yw) / pixelToRay.xz;
+  vec2 p0 = rayPixel(pixelToRay, (c - h) / d);
+  vec2 p1 = rayPixel(pixelToRay, (c + h) / d);
   return vec4(min(p0, p1), max(p0, p1)); // sy < 0 flips y
 }
 

@@ -57,15 +57,20 @@ Sphere sphereByIndex(uint index) {
   return loadSphere(ref.address, ref.count, index - part * frame.partCapacity);
 }
 
+// Whether a center has finite coordinates and the radius is a positive finite number (written so that NaN
+// fails): the spheres any method draws.
+bool finiteSphere(vec3 center, float radius) {
+  const float kHuge = 3.0e38;
+  return all(lessThan(abs(center), vec3(kHuge))) && radius > 0.0 && radius < kHuge;
+}
+
 // The sphere's center in view space; false if the sphere is culled: not entirely beyond the near plane
 // (center depth - radius <= nearW: crossing spheres are dropped whole, never clipped), or with a
 // non-finite coordinate or a radius that is not a positive finite number. Comparisons are written so
 // that NaN fails them.
 bool viewSphere(Sphere s, out vec3 center) {
   center = (frame.view * vec4(s.center, 1.0)).xyz;
-  const float kHuge = 3.0e38;
-  return all(lessThan(abs(center), vec3(kHuge))) && s.radius > 0.0 && s.radius < kHuge &&
-         -center.z - s.radius > frame.nearW;
+  return finiteSphere(center, s.radius) && -center.z - s.radius > frame.nearW;
 }
 
 // Pixels whose centers the sphere may cover, clamped to the image: (x0, y0, x1, y1), empty when x1 < x0

@@ -24,8 +24,7 @@ void main() {
   if (i >= pc.count) return;
   frame = SphereFrameRef(pc.frame).f;
   Sphere s = loadSphere(pc.particles, pc.count, i);
-  const float kHuge = 3.0e38;
-  bool valid = all(lessThan(abs(s.center), vec3(kHuge))) && s.radius > 0.0 && s.radius < kHuge;
+  bool valid = finiteSphere(s.center, s.radius);
   vec3 a = abs(s.center);
   float extent = s.radius * (1.0 + 1.0 / 4096.0) + max(a.x, max(a.y, a.z)) * (1.0 / 262144.0);
   vec3 lo = s.center - extent, hi = s.center + extent;

@@ -13,6 +13,11 @@ vec3 sphereRay(vec4 pixelToRay, vec2 pixel) {
   return vec3(pixel.x * pixelToRay.x + pixelToRay.y, pixel.y * pixelToRay.z + pixelToRay.w, -1.0);
 }
 
+// The inverse: the pixel position of the view-space point at xy / depth = slope.
+vec2 rayPixel(vec4 pixelToRay, vec2 slope) {
+  return (slope - pixelToRay.yw) / pixelToRay.xz;
+}
+
 // Nearest hit t > 0 of the ray t * dir with a sphere that lies entirely in front of the eye (callers cull
 // the others). Numerically robust form of Haines, Guenther and Akenine-Moeller, "Precision Improvements
 // for Ray/Sphere Intersection" (Ray Tracing Gems, ch. 7):

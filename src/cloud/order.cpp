@@ -259,6 +259,29 @@ struct MortonKey {
   void prefetch(uint64_t i) const { __builtin_prefetch(positions + 3 * i); }
 };
 
+// Maps particle centers to the cells of a 1024^3 grid over the set's center bounds (spatialOrder).
+struct ParticleCellKey {
+  static constexpr int kBits = 30;
+  const float* xyz;
+  double lo[3], cellsPerUnit[3];
+
+  ParticleCellKey(const ParticleSet& set) : xyz(set.xyz.data()) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = set.bounds.min[a] - set.origin[a]; // where the floats are: relative to the origin
+      cellsPerUnit[a] = 1024.0 / std::max(set.bounds.max[a] - set.bounds.min[a], 1e-30);
+    }
+  }
+  uint64_t operator()(uint64_t i) const {
+    uint32_t c[3];
+    for (int a = 0; a < 3; ++a) {
+      const double q = (double(xyz[3 * i + a]) - lo[a]) * cellsPerUnit[a];
+      c[a] = q >= 0 && q < 1024 ? uint32_t(q) : (q >= 1024 ? 1023u : 0u); // NaN: 0
+    }
+    return spreadBits3(c[0]) | spreadBits3(c[1]) << 1 | spreadBits3(c[2]) << 2;
+  }
+  void prefetch(uint64_t i) const { __builtin_prefetch(xyz + 3 * i); }
+};
+
 struct ShuffleKey {
   static constexpr int kBits = 64;
   uint64_t seed;
@@ -397,6 +420,19 @@ void reorder(PointCloud& cloud, Order kind, uint64_t seed) {
   std::vector<uint64_t> order;
   computeOrder(order, cloud, kind, seed);
   applyOrder(cloud, order);
+}
+
+std::vector<uint32_t> spatialOrder(const ParticleSet& set) {
+  const uint64_t n = set.size();
+  if (n > 0xFFFFFFFFull) throw UnsupportedError("spatial order: more than 2^32 particles");
+  std::vector<uint64_t> order(n);
+  sortByKey(order.data(), n, ParticleCellKey(set));
+  std::vector<uint32_t> narrow(n);
+  parallelBlocks(n, uint64_t(1) << 20, [&](uint64_t, uint64_t begin, uint64_t end) {
+    for (uint64_t i = begin; i < end; ++i)
+      narrow[i] = static_cast<uint32_t>(order[i]);
+  });
+  return narrow;
 }
 
 } // namespace pointrast

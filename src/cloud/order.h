@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cloud/cloud.h"
+#include "cloud/particles.h"
 
 namespace pointrast {
 
@@ -50,5 +51,11 @@ PointCloud orderedCopy(const PointCloud& cloud, const std::vector<uint64_t>& ord
 
 // computeOrder + applyOrder (no-op for Original).
 void reorder(PointCloud& cloud, Order kind, uint64_t seed);
+
+// The particles of the set (indices) in the Morton order of the cells of a 1024^3 grid over their centers'
+// bounds (set.bounds, each axis cut in 1024), in the set's order within a cell: consecutive particles lie
+// close together, as sphere-compute's batches need. The sort of computeOrder, on all hardware threads;
+// throws UnsupportedError past 2^32 particles.
+std::vector<uint32_t> spatialOrder(const ParticleSet& set);
 
 } // namespace pointrast

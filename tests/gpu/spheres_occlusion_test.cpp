@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "cloud/order.h"
 #include "cloud/particles_generate.h"
 #include "gpu/shared_types.h"
 #include "spheres_test_util.h"

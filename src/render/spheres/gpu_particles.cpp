@@ -9,6 +9,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "base/progress.h"
+#include "cloud/order.h"
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
 
@@ -109,68 +110,7 @@ void fillStreams(ParticleLayout layout, const ParticleSet& set, const uint32_t* 
   }
 }
 
-// The 10 low bits of v spread to every third bit.
-uint32_t spreadBits(uint32_t v) {
-  v &= 0x3FFu;
-  v = (v | (v << 16)) & 0x030000FFu;
-  v = (v | (v << 8)) & 0x0300F00Fu;
-  v = (v | (v << 4)) & 0x030C30C3u;
-  v = (v | (v << 2)) & 0x09249249u;
-  return v;
-}
-
 } // namespace
-
-std::vector<uint32_t> spatialOrder(const ParticleSet& set) {
-  const uint64_t n = set.size();
-  if (n > 0xFFFFFFFFull) throw UnsupportedError("spatial order: more than 2^32 particles");
-  // Cells of a 1024^3 grid over the centers' bounds (relative to the origin, where the floats are).
-  const glm::dvec3 lo = set.bounds.min - set.origin, extent = set.bounds.max - set.bounds.min;
-  const glm::dvec3 scale = glm::dvec3(1024.0) / glm::max(extent, glm::dvec3(1e-30));
-  std::vector<uint32_t> keys(n), order(n), keysOut(n), orderOut(n);
-  constexpr uint64_t kBlock = 1u << 20;
-  parallelBlocksOn(0, n, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
-    for (uint64_t i = begin; i < end; ++i) {
-      uint32_t cell[3];
-      for (int a = 0; a < 3; ++a) {
-        double q = (double(set.xyz[3 * i + a]) - lo[a]) * scale[a];
-        cell[a] = q >= 0 && q < 1024 ? uint32_t(q) : (q >= 1024 ? 1023u : 0u); // NaN: 0
-      }
-      keys[i] = spreadBits(cell[0]) | spreadBits(cell[1]) << 1 | spreadBits(cell[2]) << 2;
-      order[i] = uint32_t(i);
-    }
-  });
-  // A stable least-significant-digit radix sort, three digits of 10 bits; per pass, each block counts
-  // its digits, then scatters its particles after those of lower digits and of earlier blocks.
-  const uint64_t blocks = (n + kBlock - 1) / kBlock;
-  std::vector<uint64_t> counts(blocks * 1024);
-  for (int shift = 0; shift < 30; shift += 10) {
-    std::fill(counts.begin(), counts.end(), 0);
-    parallelBlocksOn(0, n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
-      uint64_t* c = counts.data() + b * 1024;
-      for (uint64_t i = begin; i < end; ++i)
-        ++c[(keys[i] >> shift) & 1023u];
-    });
-    uint64_t at = 0;
-    for (uint32_t digit = 0; digit < 1024; ++digit)
-      for (uint64_t b = 0; b < blocks; ++b) {
-        uint64_t c = counts[b * 1024 + digit];
-        counts[b * 1024 + digit] = at;
-        at += c;
-      }
-    parallelBlocksOn(0, n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
-      uint64_t* next = counts.data() + b * 1024;
-      for (uint64_t i = begin; i < end; ++i) {
-        uint64_t to = next[(keys[i] >> shift) & 1023u]++;
-        keysOut[to] = keys[i];
-        orderOut[to] = order[i];
-      }
-    });
-    keys.swap(keysOut);
-    order.swap(orderOut);
-  }
-  return order;
-}
 
 std::span<const ParticleLayoutInfo> particleLayoutTable() {
   return kLayouts;

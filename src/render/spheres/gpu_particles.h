@@ -65,16 +65,12 @@ struct ParticlePart {
 struct ParticleUploadOptions {
   std::optional<ParticleLayout> layout; // nullopt: compactLayout(set)
   uint64_t maxPartParticles = 0;        // 0: as many as fit one buffer, <= 64 M
-  // Store the particles in spatial order (spatialOrder below), so that consecutive particles lie close
+  // Store the particles in spatial order (spatialOrder, cloud/order.h), so that consecutive particles lie close
   // together: sphere-compute's occlusion culling tests batches of consecutive particles by their bounds.
   // Indices reported by the renderers stay those of the set.
   bool spatialOrder = true;
   bool progress = true;
 };
-
-// The particles of the set (indices) in the Morton order of the cells of a 1024^3 grid over their centers'
-// bounds, in their order within a cell: a stable sort by cell, on all hardware threads.
-std::vector<uint32_t> spatialOrder(const ParticleSet& set);
 
 class GpuParticles {
 public:
