@@ -47,8 +47,8 @@ struct SphereBenchConfig {
 constexpr uint64_t kSphereSharedBytesPerPixel = 12;
 constexpr uint64_t kSphereMethodBytesPerPixel = 16;
 constexpr uint64_t kSphereFixedBytes = uint64_t(160) << 20;
-// Host bytes per generated particle: position (12) and color (4), and while uploading the spatial order's
-// sort keys and indices (16: two of each, 4 B).
+// Host bytes per generated particle: position (12) and color (4), and while uploading the spatial order
+// (cloud/order.h: 8 B sorted indices and the 4 B order kept, at most 12; counted as 16).
 constexpr uint64_t kSphereHostBytesPerParticle = 32;
 
 // GPU: particles x the largest bytes per particle of `layouts` + targets of `methods` methods; host:
