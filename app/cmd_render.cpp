@@ -650,6 +650,11 @@ void printPointSummary(const RenderArgs& a, const RenderSettings& settings, cons
                 humanCount(double(b.pointsProcessed)).c_str(), humanCount(double(b.pointsByWords[0])).c_str(),
                 humanCount(double(b.pointsByWords[1])).c_str(),
                 humanCount(double(b.pointsByWords[2])).c_str(), humanCount(double(b.pointsRendered)).c_str());
+    if (settings.method == pointMethod("batch-hqs"))
+      std::printf("  blended: %s points; %llu dense batches drawn in one pass (%llu drawn again, %s points "
+                  "blended again)\n",
+                  humanCount(double(b.pointsBlended)).c_str(), (unsigned long long)b.batchesDense,
+                  (unsigned long long)b.batchesRedrawn, humanCount(double(b.pointsTakenBack)).c_str());
   }
   if (stats.post)
     std::printf(

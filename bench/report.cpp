@@ -58,6 +58,9 @@ nlohmann::json batchStatsJson(const BatchStats& b) {
           {"points_rendered", b.pointsRendered},
           {"points_blended", b.pointsBlended},
           {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
+          {"batches_dense", b.batchesDense},
+          {"points_taken_back", b.pointsTakenBack},
+          {"batches_redrawn", b.batchesRedrawn},
           {"bytes_read", b.bytesRead}};
 }
 

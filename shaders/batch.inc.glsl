@@ -8,6 +8,7 @@
 // A box decision (viewBox) depends only on the box and the camera, so it is computed once per box, by a
 // pass before the drawing: batch_views.comp for the batches of a part (batch_part.inc.glsl), the node pass
 // for octree nodes (lod.inc.glsl). Every thread of a drawing workgroup reads the same bits.
+#extension GL_KHR_shader_subgroup_basic : require
 #include "common.inc.glsl"
 #include "project.inc.glsl"
 
@@ -44,6 +45,8 @@ struct BatchView {
   vec3 cx, cy, cz; // screen map: X = cx.x g.x + cx.y g.y + cx.z g.z + offset.x; Y, Z likewise
   vec3 offset;
   vec3 lo, step; // the batch's min corner (relative to the scene origin) and 2^30 quantization steps
+  vec4 rect;     // pixels its points can land on: first column, first row, last column, last row; x < 0: not
+                 // known (boxPixelRect, computed for the batches of a part only)
 };
 
 // The camera of a batch pass: view-projection relative to the scene origin, near plane, image size, and
@@ -127,14 +130,15 @@ BatchView viewBox(vec3 lo, vec3 hi, BatchCamera cam, uint forcedWords, bool cull
   v.offset = vec3(dot(rowX, origin), dot(rowY, origin), dot(rowW, origin));
   v.lo = lo;
   v.step = step;
+  v.rect = vec4(-1.0);
   if (culling && (left || right || below || above || behind)) v.words = 0u;
   return v;
 }
 
 // A box decision in a buffer (shared.h, LodNodeView), for passes that read it instead of computing it.
 LodNodeView storeView(BatchView v) {
-  return LodNodeView(vec4(v.cx, uintBitsToFloat(v.words)), vec4(v.cy, v.inside ? 1.0 : 0.0), vec4(v.cz, 0.0),
-                     vec4(v.offset, 0.0), vec4(v.lo, 0.0), vec4(v.step, 0.0));
+  return LodNodeView(vec4(v.cx, uintBitsToFloat(v.words)), vec4(v.cy, v.inside ? 1.0 : 0.0), vec4(v.cz, v.rect.x),
+                     vec4(v.offset, v.rect.y), vec4(v.lo, v.rect.z), vec4(v.step, v.rect.w));
 }
 
 BatchView loadView(LodNodeView s) {
@@ -147,6 +151,7 @@ BatchView loadView(LodNodeView s) {
   v.offset = s.offset.xyz;
   v.lo = s.lo.xyz;
   v.step = s.step.xyz;
+  v.rect = vec4(s.cz.w, s.offset.w, s.lo.w, s.step.w);
   return v;
 }
 
@@ -230,6 +235,27 @@ bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint me
   return true;
 }
 
+// The pixels of the image that the points of a box v (decided for camera cam) can land on, as the rectangle
+// (first column, first row, last column, last row); x = -1 if not known (a box not inside the image). Every
+// point's fields g lie in [1, 2.002)^3 (1 + f/1024 for the first word, lower words add under 2^-9), so its
+// screen coordinates are the map of a point of that cube; X/Z and Y/Z, quasi-linear where Z > 0, take their
+// extremes at its corners. A point's pixel rounds its own X/Z - 1/2, a few ulps from the corners' bound: one
+// pixel of margin covers that.
+vec4 boxPixelRect(BatchView v, BatchCamera cam) {
+  if (v.words == 0u || !v.inside) return vec4(-1.0);
+  vec2 lo = vec2(3.0e38), hi = vec2(-3.0e38);
+  for (uint k = 0u; k < 8u; ++k) {
+    vec3 g = vec3((k & 1u) != 0u ? 2.002 : 1.0, (k & 2u) != 0u ? 2.002 : 1.0, (k & 4u) != 0u ? 2.002 : 1.0);
+    vec3 s = screenOf(v, g);
+    if (!(s.z > 0.0)) return vec4(-1.0);
+    vec2 p = s.xy / s.z;
+    lo = min(lo, p);
+    hi = max(hi, p);
+  }
+  vec2 last = vec2(float(cam.width - 1u), float(cam.height - 1u));
+  return vec4(clamp(floor(lo) - 1.0, vec2(0.0), last), clamp(ceil(hi) + 1.0, vec2(0.0), last));
+}
+
 // Where the points of a box are: the addresses of its first point's word in each word buffer (16-byte
 // aligned, padded to a multiple of 4 points) and of its first point's RGBA8 color.
 struct BatchWords {
@@ -252,28 +278,36 @@ void loadQuad(BatchWords at, uint g, uint words, out uvec4 high, out uvec4 mediu
 // (the pipelines of frames whose counts nobody reads: the shared sum and its two barriers cost ~5 % of
 // batch-prefetch's frame on an H200).
 layout(constant_id = 5) const uint COUNT = 1;
-shared uint groupCount;
+shared uint groupCount, groupCount2;
 
 // First thing in main(), by every thread.
 void beginStats() {
   if (COUNT == 0u) return;
-  if (gl_LocalInvocationIndex == 0u) groupCount = 0u;
+  if (gl_LocalInvocationIndex == 0u) groupCount = groupCount2 = 0u;
   barrier();
 }
 
-// Last thing in main(), by every thread: `mine` adds to counter `counter`; with `batchCounts` the batch is
-// counted too (processed; rendered and its points by precision unless v.words == 0).
-void endStats(uint64_t statsAddress, uint counter, uint mine, bool batchCounts, uint words, uint count) {
+// Last thing in main(), by every thread: `mine` adds to counter `counter`, `mine2` to `counter2`; with
+// `batchCounts` the batch is counted too (processed; rendered and its points by precision unless
+// v.words == 0).
+void endStatsOf2(uint64_t statsAddress, uint counter, uint mine, uint counter2, uint mine2, bool batchCounts,
+                 uint words, uint count) {
   if (COUNT == 0u) return;
   if (mine != 0u) atomicAdd(groupCount, mine);
+  if (mine2 != 0u) atomicAdd(groupCount2, mine2);
   barrier();
   if (gl_LocalInvocationIndex != 0u) return;
   Uint64Array stats = Uint64Array(statsAddress);
   uint row = (gl_WorkGroupID.x % kBatchStatSlots) * kBatchStatCount;
   if (groupCount != 0u) atomicAdd(stats.v[row + counter], uint64_t(groupCount));
+  if (groupCount2 != 0u) atomicAdd(stats.v[row + counter2], uint64_t(groupCount2));
   if (!batchCounts) return;
   atomicAdd(stats.v[row + kStatBatchesProcessed], 1ul);
   if (words == 0u) return;
   atomicAdd(stats.v[row + kStatBatchesRendered], 1ul);
   atomicAdd(stats.v[row + kStatPointsOneWord + words - 1u], uint64_t(count));
+}
+
+void endStats(uint64_t statsAddress, uint counter, uint mine, bool batchCounts, uint words, uint count) {
+  endStatsOf2(statsAddress, counter, mine, counter, 0u, batchCounts, words, count);
 }

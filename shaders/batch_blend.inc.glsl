@@ -6,10 +6,11 @@
 // both passes decode every point to the same position; colors are read for blended points only. Needs
 // hqs_accumulate.inc.glsl and its subgroup extensions.
 
-// Blends the loaded points of step j (their words in h, m, l, `words` of them) into one camera's image.
+// Blends the loaded points of step j (their words in h, m, l, `words` of them) into one camera's image; if
+// `flags` is not 0, only those on pixels it marks kHqsDenseFlagged (uint per pixel, BatchFrame::denseDepths).
 // Returns the points blended. Call in uniform control flow (hqsBlend's subgroup operations need every lane).
 uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, BatchWords at, uint count,
-               BatchCamera cam, uint64_t framebuffer, uint64_t accumulators) {
+               BatchCamera cam, uint64_t framebuffer, uint64_t accumulators, uint64_t flags) {
   Uint64Array fb = Uint64Array(framebuffer);
   Uint64Array acc = Uint64Array(accumulators);
   uint pixels = cam.pitch * cam.height; // the whole framebuffer: both eyes of a stereo frame
@@ -31,6 +32,7 @@ uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, B
     if (pixel[k] == kNoPixel) continue;
     float closest = uintBitsToFloat(uint(fb.v[pixel[k]] >> 32));
     if (depth[k] > closest * float(PR_HQS_DEPTH_FACTOR)) pixel[k] = kNoPixel; // hidden: not blended
+    else if (flags != 0ul && UintArray(flags).v[pixel[k]] != kHqsDenseFlagged) pixel[k] = kNoPixel;
   }
   // Colors of the points that blend; a thread's four points are consecutive and often share a pixel, so
   // they are added per pixel first (fewer lanes for the subgroup to combine, fewer subgroup steps).
@@ -51,7 +53,7 @@ uint blendStep(BatchView v, uint words, uvec4 h, uvec4 m, uvec4 l, uint local, B
 // Blends the box's `count` points; `steps` steps of 4 points per thread cover the largest box of the pass.
 // Returns the points this thread blended. Call in uniform control flow (v is uniform).
 uint blendBox(BatchView v, BatchWords at, uint count, uint steps, BatchCamera cam, uint64_t framebuffer,
-              uint64_t accumulators) {
+              uint64_t accumulators, uint64_t flags) {
   uint blended = 0u;
   // No early exit from the loops: hqsBlend's subgroup operations need every lane.
   if (v.words == 0u) return 0u;
@@ -59,7 +61,7 @@ uint blendBox(BatchView v, BatchWords at, uint count, uint steps, BatchCamera ca
     uint local = 4u * (gl_LocalInvocationIndex + j * kPointGroupSize);
     uvec4 h = uvec4(0u), m = uvec4(0u), l = uvec4(0u);
     if (local < count) loadQuad(at, local / 4u, v.words, h, m, l);
-    blended += blendStep(v, v.words, h, m, l, local, at, count, cam, framebuffer, accumulators);
+    blended += blendStep(v, v.words, h, m, l, local, at, count, cam, framebuffer, accumulators, flags);
   }
   return blended;
 }
@@ -76,9 +78,9 @@ uint blendBoxStereo(BatchView v0, BatchView v1, BatchWords at, uint count, uint 
     uvec4 h = uvec4(0u), m = uvec4(0u), l = uvec4(0u);
     if (local < count) loadQuad(at, local / 4u, loaded, h, m, l);
     if (v0.words != 0u)
-      blended += blendStep(v0, v0.words, h, m, l, local, at, count, cam0, framebuffer, accumulators);
+      blended += blendStep(v0, v0.words, h, m, l, local, at, count, cam0, framebuffer, accumulators, 0ul);
     if (v1.words != 0u)
-      blended += blendStep(v1, v1.words, h, m, l, local, at, count, cam1, framebuffer, accumulators);
+      blended += blendStep(v1, v1.words, h, m, l, local, at, count, cam1, framebuffer, accumulators, 0ul);
   }
   return blended;
 }

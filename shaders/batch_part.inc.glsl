@@ -45,3 +45,15 @@ BatchWords batchWords(uint first) {
   uint64_t offset = uint64_t(first) * 4ul;
   return BatchWords(pc.high + offset, pc.medium + offset, pc.low + offset, pc.colors + offset);
 }
+
+// Whether batch-hqs draws the batch (its decision v, `count` points) as a dense one: depth and blending in
+// one pass (raster_batch_hqs_dense.comp), then only its points on pixels found wrong blended again. Dense:
+// one coordinate word, inside the image, full, at least kHqsDenseRatio points per pixel of its pixel
+// rectangle, and full subgroups (the dense pass splits the batch by subgroup). Uniform in a workgroup.
+// Needs GL_KHR_shader_subgroup_basic.
+bool denseBatch(BatchView v, uint count) {
+  if (STEREO != 0u || v.words != 1u || !v.inside || count != kBatchPoints || v.rect.x < 0.0) return false;
+  if (FrameRef(pc.frame).f.dense == 0u || gl_NumSubgroups * gl_SubgroupSize != kPointGroupSize) return false;
+  float area = (v.rect.z - v.rect.x + 1.0) * (v.rect.w - v.rect.y + 1.0);
+  return area * float(kHqsDenseRatio) <= float(count);
+}

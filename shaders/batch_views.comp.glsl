@@ -12,8 +12,9 @@ void main() {
   BatchBounds bounds = BoundsArray(pc.bounds).v[batch];
   uint eyes = frame.f.eyes;
   for (uint eye = 0u; eye < eyes; ++eye) {
-    BatchView v = viewBox(bounds.min.xyz, bounds.max.xyz, batchCamera(frame, eye), frame.f.forcedWords,
-                          frame.f.culling != 0u);
+    BatchCamera cam = batchCamera(frame, eye);
+    BatchView v = viewBox(bounds.min.xyz, bounds.max.xyz, cam, frame.f.forcedWords, frame.f.culling != 0u);
+    v.rect = boxPixelRect(v, cam); // batch-hqs: which batches are dense, and which tiles they may touch
     BatchViews(frame.f.views).v[viewIndex(batch, eye, eyes)] = storeView(v);
   }
 }

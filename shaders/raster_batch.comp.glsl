@@ -2,6 +2,7 @@
 // batch and batch-prefetch (see batch.inc.glsl and batch_draw.inc.glsl): one workgroup per batch of a part;
 // the visibility index of a point is part << 26 | its index in the part. Colors are fetched by the resolve,
 // for visible points only.
+#extension GL_KHR_shader_subgroup_basic : require
 #include "batch_part.inc.glsl"
 
 layout(constant_id = 0) const uint PREFETCH = 0;
@@ -18,7 +19,10 @@ void main() {
   BatchView v = viewBatch(gl_WorkGroupID.x, 0u);
   uint payloadBase = (pc.part << kVisibilityPartShift) | first;
   uint rendered = 0u, words = v.words;
-  if (STEREO != 0u) {
+  // batch-hqs's depth pass leaves the dense batches to raster_batch_hqs_dense.comp, which counts them.
+  bool dense = DEPTH_ONLY != 0u && denseBatch(v, count);
+  if (dense) {
+  } else if (STEREO != 0u) {
     BatchCamera right = batchCamera(frame, 1u);
     BatchView v1 = viewBatch(gl_WorkGroupID.x, 1u);
     rendered = drawBoxAsStereo(v, v1, batchWords(first), payloadBase, count, kBatchPoints,
@@ -28,5 +32,5 @@ void main() {
     rendered = drawBoxAs(v, batchWords(first), payloadBase, count, kBatchPoints, kBatchPointsPerThread / GROUP,
                          cam, frame.f.framebuffer);
   }
-  endStats(frame.f.stats, kStatPointsRendered, rendered, true, words, count);
+  endStats(frame.f.stats, kStatPointsRendered, rendered, !dense, words, count);
 }

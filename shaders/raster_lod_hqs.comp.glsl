@@ -28,7 +28,7 @@ void main() {
                                lodCamera(f, 1u), f.framebuffer, f.accumulators);
     } else {
       blended = blendBox(v, pageWords(page.address), count, kLodPageSteps, lodCamera(f, 0u), f.framebuffer,
-                         f.accumulators);
+                         f.accumulators, 0ul);
     }
   }
   endStats(f.stats, kStatPointsBlended, blended, false, 0u, 0u);

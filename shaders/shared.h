@@ -143,6 +143,12 @@ PR_CONST kEmptyDepthBits = 0x7FFFFFFFu; // above every finite positive float
 // High-quality splatting (2019): a point is blended into its pixel if its linear depth is within 1 % of
 // the closest point's.
 #define PR_HQS_DEPTH_FACTOR 1.01
+// batch-hqs draws a batch in one pass (depth and blending together, then a per-pixel check) when it is
+// dense: one coordinate word, inside the image, full, and at least kHqsDenseRatio points per pixel of its
+// pixel rectangle. kHqsDenseFlagged marks a pixel whose first-pass sums were dropped (hqs_dense_check.comp).
+PR_CONST kHqsDenseRatio = 8;
+PR_CONST kHqsDenseTile = 16;
+PR_CONST kHqsDenseFlagged = 0xFFFFFFFFu;
 // hqs1r: one 64-bit word per pixel packs r, g, b, count in 16 bits each. 255 points of 255 sum to 65025,
 // below 2^16, so a pixel stays exact up to 255 points; later points go to 32-bit fallback sums.
 PR_CONST kHqs1rMaxCount = 255;
@@ -175,7 +181,7 @@ PR_CONST kMaxVisibilityParts = 64;
 // counts and adds them to row (workgroup id % 64), so 64 addresses share the atomics instead of one; the
 // host sums the rows after the frame.
 PR_CONST kBatchStatSlots = 64;
-PR_CONST kBatchStatCount = 8;
+PR_CONST kBatchStatCount = 10;
 PR_CONST kStatBatchesProcessed = 0; // workgroups that ran (every batch of every part)
 PR_CONST kStatBatchesRendered = 1;  // batches not culled
 PR_CONST kStatPointsRendered = 2;   // points that passed early-z and did the atomicMin
@@ -183,6 +189,9 @@ PR_CONST kStatPointsBlended = 3;    // batch-hqs: points blended into their pixe
 PR_CONST kStatPointsOneWord = 4;    // points of rendered batches decoded from 1, 2, 3 words; their sum
 PR_CONST kStatPointsTwoWords = 5;   // is the number of points processed
 PR_CONST kStatPointsThreeWords = 6;
+PR_CONST kStatBatchesDense = 7;    // batch-hqs: batches drawn in one pass (denseBatch)
+PR_CONST kStatPointsTakenBack = 8; // batch-hqs: their points on flagged pixels, blended again
+PR_CONST kStatBatchesRedrawn = 9;  // batch-hqs: dense batches the accumulation pass draws again
 
 // Bounds of one batch relative to the scene origin, rounded once to float from the exact (double) bounds
 // its points were quantized in. w is unused.
@@ -208,7 +217,13 @@ struct BatchFrame {
   mat4 rightViewProj[kMaxVisibilityParts];  // stereo: the right half's view-projection of part p
   uint64_t views;    // LodNodeView per batch and eye of the frame, at (BatchPush::firstView + batch) * eyes
                      // + eye: the box decisions, written by batch_views.comp before the drawing passes
-  uint64_t unused;   // keeps the size a multiple of 16 (std430)
+  // batch-hqs's dense batches (raster_batch_hqs_dense.comp): the farthest depth bits they blended per pixel
+  // (uint per framebuffer pixel; kHqsDenseFlagged once hqs_dense_check.comp found the pixel wrong), and one
+  // uint per kHqsDenseTile x kHqsDenseTile tile of the framebuffer, not 0 where a pixel of it is flagged.
+  uint64_t denseDepths;
+  uint64_t denseTiles;
+  uint dense;  // 1: dense batches blend in the first pass; 0 (a debug setting): every batch takes two passes
+  uint tilesX; // tiles per framebuffer row: pitch / kHqsDenseTile rounded up
 };
 
 // Push constants of the batch passes: one dispatch draws one part, one workgroup per batch.
@@ -263,7 +278,9 @@ struct LodPage {
 // A node's box decision (batch.inc.glsl's BatchView), computed once per node and pass by lod_nodes.comp and
 // read by every page of the node (a batch's likewise: batch_views.comp, BatchFrame::views): the screen map's
 // rows (cx, cy, cz, offset), the min corner and the steps of the 30-bit quantization. cx.w holds the
-// coordinate words (0: culled), cy.w 1 when every point of the box is inside the image (as float bits).
+// coordinate words (0: culled), cy.w 1 when every point of the box is inside the image (as float bits);
+// cz.w, offset.w, lo.w, step.w the pixel rectangle its points can land on (first column, first row, last
+// column, last row; cz.w < 0: not known), which batch_views.comp computes for batches and nodes leave at -1.
 struct LodNodeView {
   vec4 cx;
   vec4 cy;

@@ -2,7 +2,10 @@
 // Time"): batch and batch-prefetch (raster_batch.comp, then resolve_batch.comp fetching the colors of
 // visible points) and batch-hqs (a prefetch depth pass, raster_batch_hqs.comp accumulating, resolve_hqs.comp
 // with hqs1r's layout). They read scenes in the batched layout (render/scene.h). Before the drawing passes,
-// batch_views.comp computes every batch's box decision once into a buffer that they read.
+// batch_views.comp computes every batch's box decision once into a buffer that they read. batch-hqs draws
+// dense batches (many points a pixel) in one pass instead of two (batch_dense.inc.glsl): beside the depth
+// pass, raster_batch_hqs_dense.comp blends them at once; hqs_dense_check.comp then takes back the pixels
+// where that was wrong, and the accumulation pass blends their dense points again with the usual test.
 #include <algorithm>
 #include <cstring>
 
@@ -45,6 +48,11 @@ void forEachBatchPart(const Frame& frame, const Targets& targets, uint64_t frame
   }
 }
 
+// Dense tiles (shared.h, kHqsDenseTile) along n pixels.
+uint32_t tilesAcross(uint32_t n) {
+  return (n + shared::kHqsDenseTile - 1) / shared::kHqsDenseTile;
+}
+
 // The batches of a frame's scenes.
 uint64_t frameBatches(const Frame& frame) {
   uint64_t batches = 0;
@@ -69,10 +77,19 @@ public:
     if (hqs_) {
       accumulate_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo});
       accumulateUncounted_ = gpu::ComputeProgram(context, "raster_batch_hqs.comp", {stereo, uncounted});
+      if (eyes == 1) {
+        dense_ = gpu::ComputeProgram(context, "raster_batch_hqs_dense.comp");
+        denseUncounted_ = gpu::ComputeProgram(context, "raster_batch_hqs_dense.comp", {uncounted});
+        check_ = gpu::ComputeProgram(context, "hqs_dense_check.comp");
+        checkUncounted_ = gpu::ComputeProgram(context, "hqs_dense_check.comp", {uncounted});
+      }
       resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", {{/* ONE_ROUND= */ 0, 1}});
-      // hqs1r's accumulators: 1 packed + 2 fallback uint64 per pixel.
-      accumulators_ = gpu::Buffer(context, uint64_t(width) * height * 24, gpu::kBufferUsage,
-                                  gpu::MemoryKind::Device, "batch-hqs accumulators");
+      // hqs1r's accumulators (1 packed + 2 fallback uint64 per pixel), then the dense batches' farthest
+      // depths (uint per pixel) and flagged tiles (uint per tile).
+      const uint64_t pixels = uint64_t(width) * height;
+      const uint64_t tiles = uint64_t(tilesAcross(width)) * tilesAcross(height);
+      accumulators_ = gpu::Buffer(context, pixels * 28 + tiles * 4, gpu::kBufferUsage, gpu::MemoryKind::Device,
+                                  "batch-hqs accumulators");
     } else {
       resolve_ = gpu::ComputeProgram(context, "resolve_batch.comp");
     }
@@ -94,6 +111,10 @@ public:
     f.framebuffer = targets.framebuffer.address();
     f.stats = stats_.address();
     f.accumulators = hqs_ ? accumulators_.address() : 0;
+    f.denseDepths = hqs_ ? accumulators_.address() + pixels * 24 : 0;
+    f.denseTiles = hqs_ ? accumulators_.address() + pixels * 28 : 0;
+    f.dense = hqs_ && eyes_ == 1 && frame.settings.batchHqsDense ? 1 : 0;
+    f.tilesX = tilesAcross(targets.width);
     f.width = targets.eyeWidth();
     f.height = targets.height;
     f.forcedWords = frame.settings.precision;
@@ -126,6 +147,19 @@ public:
     forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
       raster.dispatch(cmd, batches, 1, push);
     });
+    if (f.dense != 0) {
+      // Beside the depth pass (both only take minima and add): dense batches in one pass, then the check.
+      const gpu::ComputeProgram& dense = frame.counted ? dense_ : denseUncounted_;
+      forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
+        dense.dispatch(cmd, batches, 1, push);
+      });
+      gpu::fullBarrier(cmd);
+      shared::BatchPush push{};
+      push.frame = frame_.address();
+      const gpu::ComputeProgram& check = frame.counted ? check_ : checkUncounted_;
+      const auto grid = gpu::gridFor(pixels, check.groupSize());
+      check.dispatch(cmd, grid.x, grid.y, push);
+    }
     gpu::fullBarrier(cmd);
     shared::ResolvePush resolve =
         resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
@@ -170,6 +204,10 @@ private:
   gpu::ComputeProgram views_;      // batch_views.comp
   gpu::ComputeProgram accumulate_; // batch-hqs
   gpu::ComputeProgram accumulateUncounted_;
+  gpu::ComputeProgram dense_; // batch-hqs, mono: the dense batches' first pass and the per-pixel check
+  gpu::ComputeProgram denseUncounted_;
+  gpu::ComputeProgram check_;
+  gpu::ComputeProgram checkUncounted_;
   gpu::ComputeProgram resolve_;
   gpu::Buffer accumulators_; // batch-hqs
   gpu::Buffer viewRecords_;  // shared::LodNodeView per batch and eye (BatchFrame::views)

@@ -385,10 +385,17 @@ BatchStats batchStatsFromRows(const uint64_t (&rows)[shared::kBatchStatSlots][sh
     s.pointsByWords[w] = sum[shared::kStatPointsOneWord + w];
     s.pointsProcessed += s.pointsByWords[w];
   }
+  s.batchesDense = sum[shared::kStatBatchesDense];
+  s.pointsTakenBack = sum[shared::kStatPointsTakenBack];
+  s.batchesRedrawn = sum[shared::kStatBatchesRedrawn];
   // Every batch (or octree node) reads its bounds, every point of a drawn one its words.
   const uint64_t once = s.batchesProcessed * sizeof(shared::BatchBounds) +
                         4 * (s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2]);
-  s.bytesRead = hqs ? 2 * once + 4 * s.pointsBlended : once;
+  // HQS: the accumulation pass reads the words again, but not those of dense batches (one word a point)
+  // unless it draws them again; colors are read for every blended point, and for a dense batch's points
+  // taken back twice.
+  const uint64_t denseWords = 4 * uint64_t(shared::kBatchPoints) * (s.batchesDense - s.batchesRedrawn);
+  s.bytesRead = hqs ? 2 * once - denseWords + 4 * (s.pointsBlended + s.pointsTakenBack) : once;
   return s;
 }
 

@@ -48,6 +48,9 @@ struct RenderSettings {
   // the batch under half a pixel), 1..3 = forced (3 = full 30-bit precision).
   uint32_t precision = 0;
   bool batchCulling = true; // batch methods: frustum culling of batches (off only to test that it is exact)
+  // batch-hqs: dense batches take one pass over their points instead of two (off only to test that the image
+  // is the same)
+  bool batchHqsDense = true;
   PostSettings post;        // the resolve stage after the method: point size, dilation, eye-dome lighting
   // LOD methods: nodes whose projected size (Potree's: the pixel radius of the node cube's bounding sphere)
   // is under minNodePx are not drawn, nor their subtrees; at most pointBudget points a frame (0: no limit).
@@ -67,8 +70,14 @@ struct BatchStats {
   uint64_t pointsRendered = 0;           // points that passed early-z (did the atomicMin)
   uint64_t pointsBlended = 0;            // batch-hqs: points blended into their pixel's average
   uint64_t pointsByWords[3] = {0, 0, 0}; // points processed with 1, 2, 3 coordinate words
+  // batch-hqs: batches drawn in one pass (dense: many points a pixel), their points taken back on pixels
+  // where that was wrong, and the dense batches drawn again for those
+  uint64_t batchesDense = 0;
+  uint64_t pointsTakenBack = 0;
+  uint64_t batchesRedrawn = 0;
   // Bytes of point data read: 4 per coordinate word, 32 per rendered batch's bounds; batch-hqs reads the
-  // words twice (depth and accumulation pass) and the color of every blended point.
+  // words twice (depth and accumulation pass) and the color of every blended point, except that a dense
+  // batch's words are read once (twice if redrawn) and its colors all in the first pass.
   uint64_t bytesRead = 0;
 };
 

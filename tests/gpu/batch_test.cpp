@@ -8,7 +8,8 @@
 // - statistics are exact on a hand-built scene of known batches and known occlusion;
 // - several parts and several scenes give the framebuffer of one part (the part number of visibility
 //   indices), and more than 64 parts or a scene of the wrong layout is a clear error;
-// - batch-hqs equals hqs within 1 per channel;
+// - batch-hqs equals hqs within 1 per channel, and its one-pass drawing of dense batches gives the image of
+//   two passes, also where pixels must be taken back;
 // - the ways of reaching a batch's decision (a pass before the drawing, or one thread of the workgroup; the
 //   first words loaded before or after it: the timing reference rows) write the same framebuffer words.
 #include <algorithm>
@@ -45,6 +46,7 @@ struct Draw {
   Method method = pointMethod("batch");
   uint32_t precision = 0;
   bool culling = true;
+  bool dense = true; // batch-hqs: dense batches in one pass
 };
 
 Drawn draw(gpu::Context& context, std::span<const GpuScene* const> scenes, const Camera& camera, uint32_t w,
@@ -54,6 +56,7 @@ Drawn draw(gpu::Context& context, std::span<const GpuScene* const> scenes, const
   settings.method = d.method;
   settings.precision = d.precision;
   settings.batchCulling = d.culling;
+  settings.batchHqsDense = d.dense;
   settings.captureWords = true;
   settings.background = 0;
   Drawn out;
@@ -645,6 +648,72 @@ TEST_F(GpuTest, BatchHqsMatchesHqs) {
   maxChannelDiff(b.image, hqs, &withinOne);
   EXPECT_GE(withinOne, 0.998);
   EXPECT_GT(b.stats.batch->pointsBlended, litCount(b.image));
+}
+
+} // namespace pointrast::test
+
+namespace pointrast::test {
+
+// batch-hqs draws dense batches (many points a pixel) in one pass, and takes back the pixels where a dense
+// batch blended a point beyond 1 % of the closest depth. The image and the points blended are exactly those
+// of two passes over every batch: at overview densities in Morton and original order, with a second layer
+// behind the terrain mixed into the same batches (pixels taken back), and where few batches are dense.
+TEST_F(GpuTest, BatchHqsDenseBatchesGiveTheTwoPassImage) {
+  GenerateOptions options;
+  options.points = 1'000'000;
+  options.progress = false;
+  PointCloud terrain = generateScene(Scene::Terrain, options);
+  const Camera camera = overviewCamera(terrain.bounds, 160.0 / 72.0);
+  // The second layer: every point again, lower by 3 % of the camera's distance, so that from above it lies
+  // beyond 1 % of the surface's depth where both project, and within a batch of the surface in Morton order.
+  ASSERT_TRUE(terrain.hasColor());
+  PointCloud layers = terrain;
+  const double drop = 0.03 * glm::length(camera.eye - terrain.bounds.center());
+  const int32_t steps = int32_t(std::lround(drop / terrain.scale.z));
+  for (uint64_t i = 0; i < terrain.size(); ++i) {
+    layers.positions.insert(layers.positions.end(), {terrain.positions[3 * i], terrain.positions[3 * i + 1],
+                                                     terrain.positions[3 * i + 2] - steps});
+    layers.colors.push_back(~terrain.colors[i] | 0xFF000000u);
+  }
+  computeBounds(layers);
+  // From straight above, a pixel's points lie within 1 % of its closest: dense batches are mostly right.
+  Camera above;
+  const glm::dvec3 size = terrain.bounds.max - terrain.bounds.min;
+  above.eye = terrain.bounds.center() + glm::dvec3(0, 0, 1.2 * std::max(size.x, size.y));
+  above.target = terrain.bounds.center();
+  above.up = {0, 1, 0};
+  struct Case {
+    const char* name;
+    const PointCloud* cloud;
+    Camera camera;
+    Order order;
+    uint32_t w, h;
+  };
+  for (const Case& c : {Case{"terrain, Morton, 160x72", &terrain, camera, Order::Morton, 160, 72},
+                        Case{"terrain, original order, 160x72", &terrain, camera, Order::Original, 160, 72},
+                        Case{"two layers, Morton, 160x72", &layers, camera, Order::Morton, 160, 72},
+                        Case{"terrain from above, Morton, 160x72", &terrain, above, Order::Morton, 160, 72},
+                        Case{"two layers from above, Morton, 160x72", &layers, above, Order::Morton, 160, 72},
+                        Case{"terrain, Morton, 960x432", &terrain, camera, Order::Morton, 960, 432}}) {
+    PointCloud ordered = *c.cloud;
+    reorder(ordered, c.order, 1);
+    GpuScene scene(*context, ordered, batched());
+    Drawn one = draw(*context, scene, c.camera, c.w, c.h, {pointMethod("batch-hqs")});
+    Drawn two = draw(*context, scene, c.camera, c.w, c.h, {pointMethod("batch-hqs"), 0, true, false});
+    const BatchStats& s1 = *one.stats.batch;
+    const BatchStats& s2 = *two.stats.batch;
+    EXPECT_TRUE(one.image == two.image) << c.name;
+    EXPECT_EQ(s1.pointsBlended, s2.pointsBlended) << c.name;
+    EXPECT_EQ(s1.pointsProcessed, s2.pointsProcessed) << c.name;
+    EXPECT_EQ(s2.batchesDense, 0u) << c.name;
+    EXPECT_GT(s1.batchesDense, 0u) << c.name;
+    EXPECT_GT(litCount(one.image), 1000u) << c.name;
+    std::printf("%s: %zu pixels lit, %llu of %llu batches dense, %llu redrawn, %llu points taken back, %llu "
+                "blended\n",
+                c.name, litCount(one.image), (unsigned long long)s1.batchesDense,
+                (unsigned long long)s1.batchesRendered, (unsigned long long)s1.batchesRedrawn,
+                (unsigned long long)s1.pointsTakenBack, (unsigned long long)s1.pointsBlended);
+  }
 }
 
 } // namespace pointrast::test

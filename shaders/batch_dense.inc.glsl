@@ -1,0 +1,151 @@
+// batch-hqs's dense batches (batch_part.inc.glsl, denseBatch): depth and blending in one pass over the points.
+//
+// In a dense view every pixel takes hundreds of a batch's points, nearly all within 1 % of its closest depth:
+// a batch's 10240 points fall on a few dozen pixels. So a dense batch adds every point's color to its pixel at
+// once, and records per pixel the closest depth (the framebuffer's depth half, as the depth pass) and the
+// farthest depth it blended (BatchFrame::denseDepths). After the pass, hqs_dense_check.comp finds the pixels
+// where some dense point lies beyond 1 % of the closest depth; it drops their sums and flags them, and the
+// accumulation pass blends again the dense batches' points on flagged pixels only, with the usual test. The
+// other pixels' dense sums are exactly those of the two-pass method: every point added passes its test.
+//
+// A thread walks DENSE_RUN consecutive points and adds those on one pixel in registers (a run), so a point
+// costs its projection and a few adds. Consecutive threads of a subgroup hold consecutive pieces, and a
+// subgroup's pieces follow each other through the batch; a run that crosses pieces is joined across lanes by
+// a segmented scan and across steps by a carry, so one set of atomics is done per run: in a Morton-ordered
+// overview, a few per thousand points. Needs batch_part.inc.glsl, hqs_accumulate.inc.glsl (hqsAccumulate,
+// hqsChannels) and the subgroup basic and shuffle (with relative) extensions.
+
+// Points a thread walks at a time; 80 / DENSE_RUN steps cover a batch.
+layout(constant_id = 7) const uint DENSE_RUN = 16;
+
+// Consecutive points of a piece on one pixel: their channel sums, count and depth range (depth bits).
+struct DenseRun {
+  uint pixel; // kNoPixel: no run
+  uint r, g, b, n;
+  uint near, far;
+};
+
+DenseRun denseRunAt(uint pixel) {
+  return DenseRun(pixel, 0u, 0u, 0u, 0u, 0xFFFFFFFFu, 0u);
+}
+
+// a then b, on the same pixel.
+DenseRun denseJoin(DenseRun a, DenseRun b) {
+  return DenseRun(b.pixel, a.r + b.r, a.g + b.g, a.b + b.b, a.n + b.n, min(a.near, b.near), max(a.far, b.far));
+}
+
+DenseRun denseShuffle(DenseRun x, uint lane) {
+  return DenseRun(subgroupShuffle(x.pixel, lane), subgroupShuffle(x.r, lane), subgroupShuffle(x.g, lane),
+                  subgroupShuffle(x.b, lane), subgroupShuffle(x.n, lane), subgroupShuffle(x.near, lane),
+                  subgroupShuffle(x.far, lane));
+}
+
+DenseRun denseShuffleUp(DenseRun x, uint delta) {
+  return DenseRun(subgroupShuffleUp(x.pixel, delta), subgroupShuffleUp(x.r, delta), subgroupShuffleUp(x.g, delta),
+                  subgroupShuffleUp(x.b, delta), subgroupShuffleUp(x.n, delta), subgroupShuffleUp(x.near, delta),
+                  subgroupShuffleUp(x.far, delta));
+}
+
+// Where a dense pass writes.
+struct DenseTargets {
+  Uint64Array framebuffer; // depth bits << 32 (the depth pass's words)
+  Uint64Array acc;         // hqs1r's accumulators
+  UintArray far;           // BatchFrame::denseDepths
+  uint pixels;             // of the framebuffer
+};
+
+// Adds a finished run to its pixel: the sums, the closest depth, the farthest depth. Returns the depth
+// atomics done (0 or 1).
+uint denseWrite(DenseRun run, DenseTargets t) {
+  hqsAccumulate(t.acc, t.pixels, run.pixel, run.r, run.g, run.b, run.n);
+  if (run.far > t.far.v[run.pixel]) atomicMax(t.far.v[run.pixel], run.far);
+  if (run.near >= uint(t.framebuffer.v[run.pixel] >> 32)) return 0u;
+  atomicMin(t.framebuffer.v[run.pixel], uint64_t(run.near) << 32);
+  return 1u;
+}
+
+// Draws a dense batch (v: one word, inside, full): every point blended into its pixel. Returns the depth
+// atomics done by this thread. Call in uniform control flow, by every thread of the workgroup.
+uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
+  uint lane = gl_SubgroupInvocationID, size = gl_SubgroupSize;
+  // Subgroup s draws points [80 size s, 80 size (s + 1)) of the batch, DENSE_RUN size of them a step.
+  uint piece = gl_SubgroupID * kBatchPointsPerThread * size + lane * DENSE_RUN;
+  uint writes = 0u;
+  DenseRun carry = denseRunAt(kNoPixel); // the subgroup's open run from the step before (uniform)
+  for (uint step = 0u; step < kBatchPointsPerThread / DENSE_RUN; ++step) {
+    uint quad = (piece + step * size * DENSE_RUN) / 4u;
+    uvec4 words[DENSE_RUN / 4u], colors[DENSE_RUN / 4u];
+    [[unroll]] for (uint q = 0u; q < DENSE_RUN / 4u; ++q) {
+      words[q] = Uvec4Array(at.high).v[quad + q];
+      colors[q] = Uvec4Array(at.colors).v[quad + q];
+    }
+    // The piece's runs: the first is kept in `head` (an earlier lane may continue it), the last in `run`
+    // (a later lane may), those between are complete and written at once.
+    DenseRun head = denseRunAt(kNoPixel), run = denseRunAt(kNoPixel);
+    [[unroll]] for (uint i = 0u; i < DENSE_RUN; ++i) {
+      uint pixel, depth;
+      projectBatchPoint(v, 1u, false, words[i / 4u][i % 4u], 0u, 0u, cam, pixel, depth);
+      if (pixel != run.pixel) {
+        if (run.pixel != kNoPixel) {
+          if (head.pixel == kNoPixel) head = run;
+          else writes += denseWrite(run, t);
+        }
+        run = denseRunAt(pixel);
+      }
+      uint r, g, b;
+      hqsChannels(colors[i / 4u][i % 4u], r, g, b);
+      run.r += r;
+      run.g += g;
+      run.b += b;
+      run.n += 1u;
+      run.near = min(run.near, depth);
+      run.far = max(run.far, depth);
+    }
+    // Joining across lanes. A lane's first run continues the open run on its left (the previous lane's last
+    // run, or the carry for lane 0) if they share the pixel. A lane with a single run passes the open run on,
+    // one with several closes it into its head. Segmented inclusive scan of the open runs: `chain` while the
+    // run reaches further left.
+    bool several = head.pixel != kNoPixel;
+    uint firstPixel = several ? head.pixel : run.pixel;
+    uint leftPixel = subgroupShuffleUp(run.pixel, 1u);
+    bool join = firstPixel == (lane == 0u ? carry.pixel : leftPixel);
+    DenseRun open = run;
+    bool chain = !several && join;
+    for (uint d = 1u; d < size; d *= 2u) {
+      DenseRun left = denseShuffleUp(open, d);
+      bool leftChain = subgroupShuffleUp(uint(chain), d) != 0u;
+      if (lane >= d && chain) {
+        open = denseJoin(left, open);
+        chain = leftChain;
+      }
+    }
+    if (chain) open = denseJoin(carry, open); // reaches back through lane 0 to the carry
+    DenseRun incoming = denseShuffleUp(open, 1u);
+    if (lane == 0u) incoming = carry;
+    if (several && join) head = denseJoin(incoming, head);
+    bool nextJoins = subgroupShuffleDown(uint(join), 1u) != 0u;
+    // Writes: the carry if lane 0 did not continue it, every head, every open run the next lane does not
+    // continue; the last lane's open run is the next step's carry.
+    if (lane == 0u && !join && carry.pixel != kNoPixel) writes += denseWrite(carry, t);
+    if (several) writes += denseWrite(head, t);
+    if (lane + 1u < size && !nextJoins) writes += denseWrite(open, t);
+    carry = denseShuffle(open, size - 1u);
+  }
+  if (lane == 0u && carry.pixel != kNoPixel) writes += denseWrite(carry, t);
+  return writes;
+}
+
+// Whether a tile of the pixel rectangle of a dense batch (v) holds a pixel that hqs_dense_check.comp flagged:
+// only then must the accumulation pass draw the batch again. Call in uniform control flow, by every thread
+// of the workgroup.
+shared uint denseFlaggedTiles;
+bool denseBatchFlagged(BatchView v, uint64_t tiles, uint tilesX) {
+  if (gl_LocalInvocationIndex == 0u) denseFlaggedTiles = 0u;
+  barrier();
+  uvec4 r = uvec4(v.rect) / kHqsDenseTile;
+  uint across = r.z - r.x + 1u, count = across * (r.w - r.y + 1u);
+  for (uint k = gl_LocalInvocationIndex; k < count; k += kPointGroupSize)
+    if (UintArray(tiles).v[(r.y + k / across) * tilesX + r.x + k % across] != 0u) denseFlaggedTiles = 1u;
+  barrier();
+  return denseFlaggedTiles != 0u;
+}
