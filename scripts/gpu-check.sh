@@ -3,7 +3,8 @@
 # validation layer, the CLI tests, and the checks and benchmarks named by the arguments. Results go to
 # $OUT (default ./gpu-out). Suites: SUITE_LIMIT (bench --time-limit: wall seconds after which no further
 # combination starts; the process is killed 90 s later if it still runs), SUITE_FRAMES,
-# SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS;
+# SUITE_BUDGET (GPU seconds per combination, see `pointrast bench --help`), SUITE_METHODS, SUITE_ARGS,
+# SUITE_VIEWS (batch1g);
 # BIG4G_METHOD (default batch).
 # OCTREE_CACHE: the octree cache of lodsuite and lod2022 (default /tmp/octrees: on the machine's disk).
 #   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
@@ -146,7 +147,8 @@ for what in "$@"; do
     # The batch methods against dedup on the 1,000 M terrain overview of paper2022 (Morton, 2560x1140), in
     # one process so that their ratios are sound; SUITE_METHODS picks the methods. dedup comes first: the clocks
     # settle on it and it runs for a while, so that no batch method is the first one timed after the upload.
-    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench terrain --points 1G --orders morton --views overview \
+    # SUITE_VIEWS: the views (default overview).
+    POINTRAST_VALIDATION=0 timeout $((${SUITE_LIMIT:-470} + 90)) $pr bench terrain --points 1G --orders morton --views "${SUITE_VIEWS:-overview}" \
       --width 2560 --height 1140 --methods "${SUITE_METHODS:-dedup,batch,batch-prefetch}" --frames "${SUITE_FRAMES:-30}" \
       --time-limit "${SUITE_LIMIT:-470}" --out "$OUT" --name batch1g --json > "$OUT/batch1g.jsonl" || status=1
     ;;

@@ -45,8 +45,8 @@ struct BatchView {
   vec3 cx, cy, cz; // screen map: X = cx.x g.x + cx.y g.y + cx.z g.z + offset.x; Y, Z likewise
   vec3 offset;
   vec3 lo, step; // the batch's min corner (relative to the scene origin) and 2^30 quantization steps
-  vec4 rect;     // pixels its points can land on: first column, first row, last column, last row; x < 0: not
-                 // known (boxPixelRect, computed for the batches of a part only)
+  vec4 rect;     // batch-hqs's dense batches: the pixels its points can land on (first column, first row, last
+                 // column, last row); x < 0: not a dense batch (denseRect, batch_part.inc.glsl)
 };
 
 // The camera of a batch pass: view-projection relative to the scene origin, near plane, image size, and
@@ -236,12 +236,15 @@ bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint me
 }
 
 // The pixels of the image that the points of a box v (decided for camera cam) can land on, as the rectangle
-// (first column, first row, last column, last row); x = -1 if not known (a box not inside the image). Every
+// (first column, first row, last column, last row), and the range of their depths (Z); x = -1 if not known (a
+// box not inside the image). Every
 // point's fields g lie in [1, 2.002)^3 (1 + f/1024 for the first word, lower words add under 2^-9), so its
 // screen coordinates are the map of a point of that cube; X/Z and Y/Z, quasi-linear where Z > 0, take their
 // extremes at its corners. A point's pixel rounds its own X/Z - 1/2, a few ulps from the corners' bound: one
 // pixel of margin covers that.
-vec4 boxPixelRect(BatchView v, BatchCamera cam) {
+vec4 boxPixelRect(BatchView v, BatchCamera cam, out float nearZ, out float farZ) {
+  nearZ = 3.0e38;
+  farZ = 0.0;
   if (v.words == 0u || !v.inside) return vec4(-1.0);
   vec2 lo = vec2(3.0e38), hi = vec2(-3.0e38);
   for (uint k = 0u; k < 8u; ++k) {
@@ -249,6 +252,8 @@ vec4 boxPixelRect(BatchView v, BatchCamera cam) {
     vec3 s = screenOf(v, g);
     if (!(s.z > 0.0)) return vec4(-1.0);
     vec2 p = s.xy / s.z;
+    nearZ = min(nearZ, s.z);
+    farZ = max(farZ, s.z);
     lo = min(lo, p);
     hi = max(hi, p);
   }

@@ -16,7 +16,11 @@
 // hqsChannels) and the subgroup basic and shuffle (with relative) extensions.
 
 // Points a thread walks at a time; 80 / DENSE_RUN steps cover a batch.
-layout(constant_id = 7) const uint DENSE_RUN = 16;
+layout(constant_id = 7) const uint DENSE_RUN = 8;
+layout(constant_id = 8) const uint DENSE_PREFETCH = 1; // EXPERIMENT
+// Quads of 4 points a thread holds: arrays are sized for the largest DENSE_RUN (16), and indexed only below
+// DENSE_RUN / 4 in unrolled loops, so the rest are never allocated.
+const uint kDenseQuads = 4u;
 
 // Consecutive points of a piece on one pixel: their channel sums, count and depth range (depth bits).
 struct DenseRun {
@@ -64,21 +68,36 @@ uint denseWrite(DenseRun run, DenseTargets t) {
   return 1u;
 }
 
-// Draws a dense batch (v: one word, inside, full): every point blended into its pixel. Returns the depth
-// atomics done by this thread. Call in uniform control flow, by every thread of the workgroup.
+// Loads the words and colors of a thread's DENSE_RUN points from quad `quad` on.
+void denseLoad(BatchWords at, uint quad, out uvec4 words[kDenseQuads], out uvec4 colors[kDenseQuads]) {
+  [[unroll]] for (uint q = 0u; q < DENSE_RUN / 4u; ++q) {
+    words[q] = Uvec4Array(at.high).v[quad + q];
+    colors[q] = Uvec4Array(at.colors).v[quad + q];
+  }
+}
+
+// A run summed within a thread keeps red and blue in one word (r | b << 16: at most DENSE_RUN x 255 each);
+// this spreads them out.
+DenseRun denseUnpack(DenseRun run) {
+  return DenseRun(run.pixel, run.r & 0xFFFFu, run.g, run.r >> 16, run.n, run.near, run.far);
+}
+
+// Draws a dense batch (denseBatch): every point blended into its pixel. Returns the depth atomics done by
+// this thread. Call in uniform control flow, by every thread of the workgroup.
 uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
   uint lane = gl_SubgroupInvocationID, size = gl_SubgroupSize;
   // Subgroup s draws points [80 size s, 80 size (s + 1)) of the batch, DENSE_RUN size of them a step.
   uint piece = gl_SubgroupID * kBatchPointsPerThread * size + lane * DENSE_RUN;
+  const uint steps = kBatchPointsPerThread / DENSE_RUN;
   uint writes = 0u;
   DenseRun carry = denseRunAt(kNoPixel); // the subgroup's open run from the step before (uniform)
-  for (uint step = 0u; step < kBatchPointsPerThread / DENSE_RUN; ++step) {
-    uint quad = (piece + step * size * DENSE_RUN) / 4u;
-    uvec4 words[DENSE_RUN / 4u], colors[DENSE_RUN / 4u];
-    [[unroll]] for (uint q = 0u; q < DENSE_RUN / 4u; ++q) {
-      words[q] = Uvec4Array(at.high).v[quad + q];
-      colors[q] = Uvec4Array(at.colors).v[quad + q];
-    }
+  uvec4 words[kDenseQuads], colors[kDenseQuads];
+  if (DENSE_PREFETCH != 0u) denseLoad(at, piece / 4u, words, colors);
+  for (uint step = 0u; step < steps; ++step) {
+    if (DENSE_PREFETCH == 0u) denseLoad(at, (piece + step * size * DENSE_RUN) / 4u, words, colors);
+    // The next step's points are loaded while this one's are drawn.
+    uvec4 nextWords[kDenseQuads], nextColors[kDenseQuads];
+    if (DENSE_PREFETCH != 0u && step + 1u < steps) denseLoad(at, (piece + (step + 1u) * size * DENSE_RUN) / 4u, nextWords, nextColors);
     // The piece's runs: the first is kept in `head` (an earlier lane may continue it), the last in `run`
     // (a later lane may), those between are complete and written at once.
     DenseRun head = denseRunAt(kNoPixel), run = denseRunAt(kNoPixel);
@@ -87,39 +106,40 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
       projectBatchPoint(v, 1u, false, words[i / 4u][i % 4u], 0u, 0u, cam, pixel, depth);
       if (pixel != run.pixel) {
         if (run.pixel != kNoPixel) {
-          if (head.pixel == kNoPixel) head = run;
-          else writes += denseWrite(run, t);
+          if (head.pixel == kNoPixel) head = denseUnpack(run);
+          else writes += denseWrite(denseUnpack(run), t);
         }
         run = denseRunAt(pixel);
       }
-      uint r, g, b;
-      hqsChannels(colors[i / 4u][i % 4u], r, g, b);
-      run.r += r;
-      run.g += g;
-      run.b += b;
+      uint color = colors[i / 4u][i % 4u];
+      run.r += color & 0x00FF00FFu; // red and blue
+      run.g += (color >> 8) & 0xFFu;
       run.n += 1u;
       run.near = min(run.near, depth);
       run.far = max(run.far, depth);
     }
+    run = denseUnpack(run);
     // Joining across lanes. A lane's first run continues the open run on its left (the previous lane's last
     // run, or the carry for lane 0) if they share the pixel. A lane with a single run passes the open run on,
-    // one with several closes it into its head. Segmented inclusive scan of the open runs: `chain` while the
-    // run reaches further left.
+    // one with several closes it into its head. Segmented inclusive scan of the open runs; bit 31 of `key`
+    // (the pixel otherwise: framebuffers hold under 2^31 pixels) says that the run reaches further left.
     bool several = head.pixel != kNoPixel;
     uint firstPixel = several ? head.pixel : run.pixel;
     uint leftPixel = subgroupShuffleUp(run.pixel, 1u);
     bool join = firstPixel == (lane == 0u ? carry.pixel : leftPixel);
     DenseRun open = run;
-    bool chain = !several && join;
+    uint key = run.pixel | (!several && join ? 0x80000000u : 0u);
     for (uint d = 1u; d < size; d *= 2u) {
-      DenseRun left = denseShuffleUp(open, d);
-      bool leftChain = subgroupShuffleUp(uint(chain), d) != 0u;
-      if (lane >= d && chain) {
+      uint leftKey = subgroupShuffleUp(key, d);
+      DenseRun left = DenseRun(0u, subgroupShuffleUp(open.r, d), subgroupShuffleUp(open.g, d),
+                               subgroupShuffleUp(open.b, d), subgroupShuffleUp(open.n, d),
+                               subgroupShuffleUp(open.near, d), subgroupShuffleUp(open.far, d));
+      if (lane >= d && key >= 0x80000000u) {
         open = denseJoin(left, open);
-        chain = leftChain;
+        key = (key & 0x7FFFFFFFu) | (leftKey & 0x80000000u);
       }
     }
-    if (chain) open = denseJoin(carry, open); // reaches back through lane 0 to the carry
+    if (key >= 0x80000000u) open = denseJoin(carry, open); // reaches back through lane 0 to the carry
     DenseRun incoming = denseShuffleUp(open, 1u);
     if (lane == 0u) incoming = carry;
     if (several && join) head = denseJoin(incoming, head);
@@ -130,6 +150,12 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
     if (several) writes += denseWrite(head, t);
     if (lane + 1u < size && !nextJoins) writes += denseWrite(open, t);
     carry = denseShuffle(open, size - 1u);
+    if (DENSE_PREFETCH != 0u) {
+      [[unroll]] for (uint q = 0u; q < DENSE_RUN / 4u; ++q) {
+        words[q] = nextWords[q];
+        colors[q] = nextColors[q];
+      }
+    }
   }
   if (lane == 0u && carry.pixel != kNoPixel) writes += denseWrite(carry, t);
   return writes;

@@ -46,14 +46,25 @@ BatchWords batchWords(uint first) {
   return BatchWords(pc.high + offset, pc.medium + offset, pc.low + offset, pc.colors + offset);
 }
 
-// Whether batch-hqs draws the batch (its decision v, `count` points) as a dense one: depth and blending in
-// one pass (raster_batch_hqs_dense.comp), then only its points on pixels found wrong blended again. Dense:
-// one coordinate word, inside the image, full, at least kHqsDenseRatio points per pixel of its pixel
-// rectangle, and full subgroups (the dense pass splits the batch by subgroup). Uniform in a workgroup.
-// Needs GL_KHR_shader_subgroup_basic.
-bool denseBatch(BatchView v, uint count) {
-  if (STEREO != 0u || v.words != 1u || !v.inside || count != kBatchPoints || v.rect.x < 0.0) return false;
-  if (FrameRef(pc.frame).f.dense == 0u || gl_NumSubgroups * gl_SubgroupSize != kPointGroupSize) return false;
-  float area = (v.rect.z - v.rect.x + 1.0) * (v.rect.w - v.rect.y + 1.0);
-  return area * float(kHqsDenseRatio) <= float(count);
+// batch-hqs's dense batches: depth and blending in one pass (raster_batch_hqs_dense.comp), then only their points
+// on pixels found wrong blended again. The batch `batch` of the part (decision v, for camera cam) is dense if
+// it has one coordinate word, lies inside the image, is full, spans at most 1 % of depth (so that its points
+// on a pixel pass one another's test: only a closer batch can make a pixel wrong) and has at least
+// kHqsDenseRatio points per pixel of its pixel rectangle. Returns that rectangle (boxPixelRect), or x = -1
+// for a batch that is not dense. Computed once per batch by batch_views.comp (BatchView::rect).
+vec4 denseRect(BatchView v, BatchCamera cam, uint batch) {
+  if (v.words != 1u || (batch + 1u) * kBatchPoints > pc.pointCount) return vec4(-1.0);
+  float nearZ, farZ;
+  vec4 r = boxPixelRect(v, cam, nearZ, farZ);
+  if (r.x < 0.0 || farZ > nearZ * float(PR_HQS_DEPTH_FACTOR)) return vec4(-1.0);
+  float area = (r.z - r.x + 1.0) * (r.w - r.y + 1.0);
+  return area * float(kHqsDenseRatio) <= float(kBatchPoints) ? r : vec4(-1.0);
+}
+
+// Whether batch-hqs draws a batch (its decision v) as a dense one: it is (denseRect), the frame lets it, the
+// frame is mono and the subgroups are full (the dense pass splits the batch by subgroup). Uniform in a
+// workgroup. Needs GL_KHR_shader_subgroup_basic.
+bool denseBatch(BatchView v) {
+  if (STEREO != 0u || v.rect.x < 0.0) return false;
+  return FrameRef(pc.frame).f.dense != 0u && gl_NumSubgroups * gl_SubgroupSize == kPointGroupSize;
 }

@@ -14,7 +14,7 @@ void main() {
   for (uint eye = 0u; eye < eyes; ++eye) {
     BatchCamera cam = batchCamera(frame, eye);
     BatchView v = viewBox(bounds.min.xyz, bounds.max.xyz, cam, frame.f.forcedWords, frame.f.culling != 0u);
-    v.rect = boxPixelRect(v, cam); // batch-hqs: which batches are dense, and which tiles they may touch
+    v.rect = denseRect(v, cam, batch); // batch-hqs: which batches are dense, and which tiles they may touch
     BatchViews(frame.f.views).v[viewIndex(batch, eye, eyes)] = storeView(v);
   }
 }

@@ -20,7 +20,7 @@ void main() {
   uint payloadBase = (pc.part << kVisibilityPartShift) | first;
   uint rendered = 0u, words = v.words;
   // batch-hqs's depth pass leaves the dense batches to raster_batch_hqs_dense.comp, which counts them.
-  bool dense = DEPTH_ONLY != 0u && denseBatch(v, count);
+  bool dense = DEPTH_ONLY != 0u && denseBatch(v);
   if (dense) {
   } else if (STEREO != 0u) {
     BatchCamera right = batchCamera(frame, 1u);

@@ -27,7 +27,7 @@ void main() {
     BatchView v1 = viewBatch(gl_WorkGroupID.x, 1u);
     blended = blendBoxStereo(v, v1, batchWords(first), count, kBatchPrefetchSteps, cam, right,
                              frame.f.framebuffer, frame.f.accumulators);
-  } else if (!denseBatch(v, count)) {
+  } else if (!denseBatch(v)) {
     blended = blendBox(v, batchWords(first), count, kBatchPrefetchSteps, cam, frame.f.framebuffer,
                        frame.f.accumulators, 0ul);
   } else if (denseBatchFlagged(v, frame.f.denseTiles, frame.f.tilesX)) {

@@ -18,7 +18,7 @@ void main() {
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
   BatchView v = viewBatch(gl_WorkGroupID.x, 0u);
-  bool dense = denseBatch(v, count);
+  bool dense = denseBatch(v);
   uint writes = 0u;
   if (dense) {
     BatchCamera cam = batchCamera(frame, 0u);
