@@ -236,15 +236,12 @@ bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint me
 }
 
 // The pixels of the image that the points of a box v (decided for camera cam) can land on, as the rectangle
-// (first column, first row, last column, last row), and the range of their depths (Z); x = -1 if not known (a
-// box not inside the image). Every
+// (first column, first row, last column, last row); x = -1 if not known (a box not inside the image). Every
 // point's fields g lie in [1, 2.002)^3 (1 + f/1024 for the first word, lower words add under 2^-9), so its
 // screen coordinates are the map of a point of that cube; X/Z and Y/Z, quasi-linear where Z > 0, take their
 // extremes at its corners. A point's pixel rounds its own X/Z - 1/2, a few ulps from the corners' bound: one
 // pixel of margin covers that.
-vec4 boxPixelRect(BatchView v, BatchCamera cam, out float nearZ, out float farZ) {
-  nearZ = 3.0e38;
-  farZ = 0.0;
+vec4 boxPixelRect(BatchView v, BatchCamera cam) {
   if (v.words == 0u || !v.inside) return vec4(-1.0);
   vec2 lo = vec2(3.0e38), hi = vec2(-3.0e38);
   for (uint k = 0u; k < 8u; ++k) {
@@ -252,8 +249,6 @@ vec4 boxPixelRect(BatchView v, BatchCamera cam, out float nearZ, out float farZ)
     vec3 s = screenOf(v, g);
     if (!(s.z > 0.0)) return vec4(-1.0);
     vec2 p = s.xy / s.z;
-    nearZ = min(nearZ, s.z);
-    farZ = max(farZ, s.z);
     lo = min(lo, p);
     hi = max(hi, p);
   }

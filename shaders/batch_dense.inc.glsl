@@ -17,7 +17,8 @@
 
 // Points a thread walks at a time; 80 / DENSE_RUN steps cover a batch.
 layout(constant_id = 7) const uint DENSE_RUN = 8;
-layout(constant_id = 8) const uint DENSE_PREFETCH = 1; // EXPERIMENT
+layout(constant_id = 8) const uint DENSE_PREFETCH = 0; // EXPERIMENT
+layout(constant_id = 9) const uint DENSE_DIAG = 0; // EXPERIMENT 1: no scan, 2: no writes
 // Quads of 4 points a thread holds: arrays are sized for the largest DENSE_RUN (16), and indexed only below
 // DENSE_RUN / 4 in unrolled loops, so the rest are never allocated.
 const uint kDenseQuads = 4u;
@@ -107,7 +108,7 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
       if (pixel != run.pixel) {
         if (run.pixel != kNoPixel) {
           if (head.pixel == kNoPixel) head = denseUnpack(run);
-          else writes += denseWrite(denseUnpack(run), t);
+          else if (DENSE_DIAG != 2u || run.n == 12345u) writes += denseWrite(denseUnpack(run), t);
         }
         run = denseRunAt(pixel);
       }
@@ -119,6 +120,15 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
       run.far = max(run.far, depth);
     }
     run = denseUnpack(run);
+    if (DENSE_DIAG == 2u) {
+      if (run.n == 12345u || head.n == 12345u) writes += denseWrite(run, t);
+      continue;
+    }
+    if (DENSE_DIAG == 1u) {
+      if (head.pixel != kNoPixel) writes += denseWrite(head, t);
+      writes += denseWrite(run, t);
+      continue;
+    }
     // Joining across lanes. A lane's first run continues the open run on its left (the previous lane's last
     // run, or the carry for lane 0) if they share the pixel. A lane with a single run passes the open run on,
     // one with several closes it into its head. Segmented inclusive scan of the open runs; bit 31 of `key`

@@ -48,15 +48,19 @@ BatchWords batchWords(uint first) {
 
 // batch-hqs's dense batches: depth and blending in one pass (raster_batch_hqs_dense.comp), then only their points
 // on pixels found wrong blended again. The batch `batch` of the part (decision v, for camera cam) is dense if
-// it has one coordinate word, lies inside the image, is full, spans at most 1 % of depth (so that its points
-// on a pixel pass one another's test: only a closer batch can make a pixel wrong) and has at least
-// kHqsDenseRatio points per pixel of its pixel rectangle. Returns that rectangle (boxPixelRect), or x = -1
-// for a batch that is not dense. Computed once per batch by batch_views.comp (BatchView::rect).
+// it has one coordinate word, lies inside the image, is full, has at least kHqsDenseRatio points per pixel of
+// its pixel rectangle, and was not drawn again in the last kHqsDenseRetry frames or so (its points then lay
+// behind closer ones: most likely they still do, and two passes cost less). Returns that rectangle
+// (boxPixelRect), or x = -1 for a batch that is not dense. Computed once per batch by batch_views.comp
+// (BatchView::rect).
 vec4 denseRect(BatchView v, BatchCamera cam, uint batch) {
-  if (v.words != 1u || (batch + 1u) * kBatchPoints > pc.pointCount) return vec4(-1.0);
-  float nearZ, farZ;
-  vec4 r = boxPixelRect(v, cam, nearZ, farZ);
-  if (r.x < 0.0 || farZ > nearZ * float(PR_HQS_DEPTH_FACTOR)) return vec4(-1.0);
+  FrameRef frame = FrameRef(pc.frame);
+  if (frame.f.dense == 0u || v.words != 1u || (batch + 1u) * kBatchPoints > pc.pointCount) return vec4(-1.0);
+  UintArray history = UintArray(frame.f.denseHistory);
+  uint index = pc.firstView + batch, redrawn = history.v[1u + index];
+  if (redrawn != 0u && history.v[0] - redrawn < kHqsDenseRetry + index % kHqsDenseRetry) return vec4(-1.0);
+  vec4 r = boxPixelRect(v, cam);
+  if (r.x < 0.0) return r;
   float area = (r.z - r.x + 1.0) * (r.w - r.y + 1.0);
   return area * float(kHqsDenseRatio) <= float(kBatchPoints) ? r : vec4(-1.0);
 }

@@ -10,6 +10,7 @@ void main() {
   FrameRef frame = FrameRef(pc.frame);
   uint pitch = frame.f.pitch, pixels = pitch * frame.f.height;
   uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * kPointGroupSize + gl_LocalInvocationIndex;
+  if (i == 0u) ++UintArray(frame.f.denseHistory).v[0]; // this frame's number (denseRect)
   if (i >= pixels) return;
   UintArray far = UintArray(frame.f.denseDepths);
   uint farthest = far.v[i];

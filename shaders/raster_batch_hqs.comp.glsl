@@ -34,9 +34,14 @@ void main() {
     // A dense batch blended in the first pass; here only its points on the pixels found wrong, if any.
     blended = blendBox(v, batchWords(first), count, kBatchPrefetchSteps, cam, frame.f.framebuffer,
                        frame.f.accumulators, frame.f.denseDepths);
-    if (COUNT != 0u && gl_LocalInvocationIndex == 0u)
-      atomicAdd(Uint64Array(frame.f.stats).v[(gl_WorkGroupID.x % kBatchStatSlots) * kBatchStatCount +
-                                             kStatBatchesRedrawn], 1ul);
+    if (gl_LocalInvocationIndex == 0u) {
+      // Two passes for this batch for a while (denseRect).
+      UintArray history = UintArray(frame.f.denseHistory);
+      history.v[1u + pc.firstView + gl_WorkGroupID.x] = history.v[0];
+      if (COUNT != 0u)
+        atomicAdd(Uint64Array(frame.f.stats).v[(gl_WorkGroupID.x % kBatchStatSlots) * kBatchStatCount +
+                                               kStatBatchesRedrawn], 1ul);
+    }
   }
   endStats(frame.f.stats, kStatPointsBlended, blended, false, v.words, count);
 }

@@ -149,6 +149,7 @@ PR_CONST kEmptyDepthBits = 0x7FFFFFFFu; // above every finite positive float
 PR_CONST kHqsDenseRatio = 8;
 PR_CONST kHqsDenseTile = 16;
 PR_CONST kHqsDenseFlagged = 0xFFFFFFFFu;
+PR_CONST kHqsDenseRetry = 32;
 // hqs1r: one 64-bit word per pixel packs r, g, b, count in 16 bits each. 255 points of 255 sum to 65025,
 // below 2^16, so a pixel stays exact up to 255 points; later points go to 32-bit fallback sums.
 PR_CONST kHqs1rMaxCount = 255;
@@ -224,6 +225,11 @@ struct BatchFrame {
   uint64_t denseTiles;
   uint dense;  // 1: dense batches blend in the first pass; 0 (a debug setting): every batch takes two passes
   uint tilesX; // tiles per framebuffer row: pitch / kHqsDenseTile rounded up
+  // uint: [0] the number of the last frame drawn with dense batches (hqs_dense_check.comp counts), then per
+  // batch of the frame (BatchPush::firstView + batch) the number of the last frame that drew it again (0:
+  // none). Such a batch is not dense for the next kHqsDenseRetry to 2 kHqsDenseRetry - 1 frames.
+  uint64_t denseHistory;
+  uint64_t reserved;
 };
 
 // Push constants of the batch passes: one dispatch draws one part, one workgroup per batch.

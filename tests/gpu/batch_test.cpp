@@ -47,6 +47,7 @@ struct Draw {
   uint32_t precision = 0;
   bool culling = true;
   bool dense = true; // batch-hqs: dense batches in one pass
+  uint32_t warmup = 1;
 };
 
 Drawn draw(gpu::Context& context, std::span<const GpuScene* const> scenes, const Camera& camera, uint32_t w,
@@ -57,6 +58,7 @@ Drawn draw(gpu::Context& context, std::span<const GpuScene* const> scenes, const
   settings.precision = d.precision;
   settings.batchCulling = d.culling;
   settings.batchHqsDense = d.dense;
+  settings.warmup = d.warmup;
   settings.captureWords = true;
   settings.background = 0;
   Drawn out;
@@ -663,8 +665,8 @@ TEST_F(GpuTest, BatchHqsDenseBatchesGiveTheTwoPassImage) {
   options.points = 1'000'000;
   options.progress = false;
   PointCloud terrain = generateScene(Scene::Terrain, options);
-  // Dense batches span at most 1 % of depth: seen from 20 times the overview's distance (with a 20 times
-  // narrower field of view), a batch of a million points does, as one of a billion does from the overview.
+  // Seen from 20 times the overview's distance (with a 20 times narrower field of view), a batch of a million
+  // points spans as little depth as one of a billion does from the overview.
   auto farther = [](Camera c) {
     c.eye = c.target + 20.0 * (c.eye - c.target);
     c.fovY /= 20.0;
@@ -706,11 +708,17 @@ TEST_F(GpuTest, BatchHqsDenseBatchesGiveTheTwoPassImage) {
     PointCloud ordered = *c.cloud;
     reorder(ordered, c.order, 1);
     GpuScene scene(*context, ordered, batched());
-    Drawn one = draw(*context, scene, c.camera, c.w, c.h, {pointMethod("batch-hqs")});
+    // The first frame, and the next: batches drawn again in the first are not dense in the second.
+    Drawn one = draw(*context, scene, c.camera, c.w, c.h, {pointMethod("batch-hqs"), 0, true, true, 0});
+    Drawn next = draw(*context, scene, c.camera, c.w, c.h, {pointMethod("batch-hqs"), 0, true, true, 1});
     Drawn two = draw(*context, scene, c.camera, c.w, c.h, {pointMethod("batch-hqs"), 0, true, false});
     const BatchStats& s1 = *one.stats.batch;
     const BatchStats& s2 = *two.stats.batch;
     EXPECT_TRUE(one.image == two.image) << c.name;
+    EXPECT_TRUE(next.image == two.image) << c.name;
+    EXPECT_EQ(next.stats.batch->pointsBlended, s2.pointsBlended) << c.name;
+    EXPECT_EQ(next.stats.batch->batchesRedrawn, 0u) << c.name;
+    EXPECT_EQ(next.stats.batch->batchesDense, s1.batchesDense - s1.batchesRedrawn) << c.name;
     EXPECT_EQ(s1.pointsBlended, s2.pointsBlended) << c.name;
     EXPECT_EQ(s1.pointsProcessed, s2.pointsProcessed) << c.name;
     EXPECT_EQ(s2.batchesDense, 0u) << c.name;
