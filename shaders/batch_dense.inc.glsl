@@ -12,8 +12,8 @@
 // costs its projection and a few adds. Consecutive threads of a subgroup hold consecutive pieces, and a
 // subgroup's pieces follow each other through the batch; a run that crosses pieces is joined across lanes by
 // a segmented scan and across steps by a carry, so one set of atomics is done per run: in a Morton-ordered
-// overview, a few per thousand points. Needs batch_part.inc.glsl, hqs_accumulate.inc.glsl (hqsAccumulate,
-// hqsChannels) and the subgroup basic and shuffle (with relative) extensions.
+// overview, a few per thousand points. Needs batch_part.inc.glsl and the subgroup basic and shuffle (with
+// relative) extensions.
 
 // Points a thread walks at a time; 80 / DENSE_RUN steps cover a batch.
 layout(constant_id = 7) const uint DENSE_RUN = 8;
@@ -59,12 +59,15 @@ struct DenseTargets {
   uint pixels;             // of the framebuffer
 };
 
-// Adds a finished run to its pixel: the sums, the closest depth, the farthest depth. Returns the depth
-// atomics done (0 or 1).
+// Adds a finished run to its pixel: the sums (to hqs1r's 32-bit fallback words, which the resolve adds to
+// the packed word), the closest depth, the farthest depth. No result is read back, so the four atomics go
+// out without waiting (a read before each, or the packed word's check, left a warp waiting for the L2 four
+// times a run). Returns 1: the depth atomics done.
 uint denseWrite(DenseRun run, DenseTargets t) {
-  hqsAccumulate(t.acc, t.pixels, run.pixel, run.r, run.g, run.b, run.n);
-  if (run.far > t.far.v[run.pixel]) atomicMax(t.far.v[run.pixel], run.far);
-  if (run.near >= uint(t.framebuffer.v[run.pixel] >> 32)) return 0u;
+  if (DENSE_DIAG == 3u && run.n != 12345u) return 0u; // EXPERIMENT
+  atomicAdd(t.acc.v[t.pixels + 2u * run.pixel], (uint64_t(run.r) << 32) | uint64_t(run.g));
+  atomicAdd(t.acc.v[t.pixels + 2u * run.pixel + 1u], (uint64_t(run.b) << 32) | uint64_t(run.n));
+  atomicMax(t.far.v[run.pixel], run.far);
   atomicMin(t.framebuffer.v[run.pixel], uint64_t(run.near) << 32);
   return 1u;
 }
