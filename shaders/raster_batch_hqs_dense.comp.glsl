@@ -22,8 +22,7 @@ void main() {
   uint writes = 0u;
   if (dense) {
     BatchCamera cam = batchCamera(frame, 0u);
-    DenseTargets t = DenseTargets(Uint64Array(frame.f.framebuffer), Uint64Array(frame.f.accumulators),
-                                  UintArray(frame.f.denseDepths), cam.pitch * cam.height);
+    DenseTargets t = denseTargets(v, cam, frame.f.framebuffer, frame.f.accumulators, frame.f.denseDepths);
     writes = drawDense(v, batchWords(first), cam, t);
   }
   // A dense batch blends all its points here (hqs_dense_check.comp takes back those of flagged pixels); the
