@@ -51,90 +51,26 @@ DenseRun denseShuffleUp(DenseRun x, uint delta) {
                   subgroupShuffleUp(x.far, delta));
 }
 
-// Where a dense pass writes, and the batch's pixel rectangle (BatchView::rect), whose pixels the workgroup
-// sums in shared memory before the global atomics.
+// Where a dense pass writes.
 struct DenseTargets {
   Uint64Array framebuffer; // depth bits << 32 (the depth pass's words)
   Uint64Array acc;         // hqs1r's accumulators
   UintArray far;           // BatchFrame::denseDepths
   uint pixels;             // of the framebuffer
-  uint pitch;              // framebuffer pixels per row
-  float perRow;            // 1 / pitch
-  uint base;               // framebuffer index of the rectangle's first pixel
-  uint across, rows;       // its size (across x rows <= kHqsDenseTable)
 };
 
-DenseTargets denseTargets(BatchView v, BatchCamera cam, uint64_t framebuffer, uint64_t accumulators,
-                          uint64_t denseDepths) {
-  uvec4 r = uvec4(v.rect);
-  return DenseTargets(Uint64Array(framebuffer), Uint64Array(accumulators), UintArray(denseDepths),
-                      cam.pitch * cam.height, cam.pitch, 1.0 / float(cam.pitch),
-                      cam.offset + r.y * cam.pitch + r.x, r.z - r.x + 1u, r.w - r.y + 1u);
-}
-
-// The workgroup's sums per pixel of the rectangle: red, green, blue, count, closest and farthest depth bits,
-// kHqsDenseTable of each.
-shared uint denseTable[6u * kHqsDenseTable];
-
-// Sums a run's points into its pixel's shared entry, or, for a pixel outside the rectangle (a rounding
-// surprise that the clamp of projectInside put elsewhere), into the pixel itself.
-void denseGlobal(DenseRun run, DenseTargets t);
+// Adds a finished run to its pixel: the sums to hqs1r's 32-bit fallback words (the resolve adds them to the
+// packed word), the closest and the farthest depth where they change them. The two reads are issued together
+// and the sums need no result back: a write waits for the L2 once. Returns the depth atomics done (0 or 1).
 uint denseWrite(DenseRun run, DenseTargets t) {
   if (DENSE_DIAG == 3u && run.n != 12345u) return 0u; // EXPERIMENT
-  // Row and column in the rectangle: a float estimate of the row (exact offsets below 2^24 make it the row
-  // or one less), then one correction.
-  uint offset = run.pixel - t.base;
-  uint dy = uint(float(offset) * t.perRow);
-  uint dx = offset - dy * t.pitch;
-  if (dx >= t.pitch) {
-    dy += 1u;
-    dx -= t.pitch;
-  }
-  if (offset >= t.rows * t.pitch || dy >= t.rows || dx >= t.across) {
-    denseGlobal(run, t);
-    return 1u;
-  }
-  uint slot = dy * t.across + dx;
-  atomicAdd(denseTable[slot], run.r);
-  atomicAdd(denseTable[kHqsDenseTable + slot], run.g);
-  atomicAdd(denseTable[2u * kHqsDenseTable + slot], run.b);
-  atomicAdd(denseTable[3u * kHqsDenseTable + slot], run.n);
-  atomicMin(denseTable[4u * kHqsDenseTable + slot], run.near);
-  atomicMax(denseTable[5u * kHqsDenseTable + slot], run.far);
-  return 0u;
-}
-
-// Adds a pixel's sums to the global words: hqs1r's 32-bit fallback sums (the resolve adds them to the packed
-// word), the closest depth, the farthest depth. No result is read back, so the atomics go out without
-// waiting.
-void denseGlobal(DenseRun run, DenseTargets t) {
+  uint closest = uint(t.framebuffer.v[run.pixel] >> 32), farthest = t.far.v[run.pixel];
   atomicAdd(t.acc.v[t.pixels + 2u * run.pixel], (uint64_t(run.r) << 32) | uint64_t(run.g));
   atomicAdd(t.acc.v[t.pixels + 2u * run.pixel + 1u], (uint64_t(run.b) << 32) | uint64_t(run.n));
-  atomicMax(t.far.v[run.pixel], run.far);
+  if (run.far > farthest) atomicMax(t.far.v[run.pixel], run.far);
+  if (run.near >= closest) return 0u;
   atomicMin(t.framebuffer.v[run.pixel], uint64_t(run.near) << 32);
-}
-
-// The table's entries cleared (first thing of a dense batch) and added to the global words (last thing).
-// Call in uniform control flow, by every thread of the workgroup. Returns the pixels written.
-void denseClear(DenseTargets t) {
-  for (uint s = gl_LocalInvocationIndex; s < t.rows * t.across; s += kPointGroupSize) {
-    [[unroll]] for (uint k = 0u; k < 6u; ++k) denseTable[k * kHqsDenseTable + s] = k == 4u ? 0xFFFFFFFFu : 0u;
-  }
-  barrier();
-}
-uint denseFlush(DenseTargets t) {
-  barrier();
-  uint written = 0u;
-  for (uint s = gl_LocalInvocationIndex; s < t.rows * t.across; s += kPointGroupSize) {
-    uint n = denseTable[3u * kHqsDenseTable + s];
-    if (n == 0u) continue;
-    uint pixel = t.base + (s / t.across) * t.pitch + s % t.across;
-    denseGlobal(DenseRun(pixel, denseTable[s], denseTable[kHqsDenseTable + s], denseTable[2u * kHqsDenseTable + s], n,
-                         denseTable[4u * kHqsDenseTable + s], denseTable[5u * kHqsDenseTable + s]),
-                t);
-    ++written;
-  }
-  return written;
+  return 1u;
 }
 
 // Loads the words and colors of a thread's DENSE_RUN points from quad `quad` on.
@@ -154,7 +90,6 @@ DenseRun denseUnpack(DenseRun run) {
 // Draws a dense batch (denseBatch): every point blended into its pixel. Returns the depth atomics done by
 // this thread. Call in uniform control flow, by every thread of the workgroup.
 uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
-  denseClear(t);
   uint lane = gl_SubgroupInvocationID, size = gl_SubgroupSize;
   // Subgroup s draws points [80 size s, 80 size (s + 1)) of the batch, DENSE_RUN size of them a step.
   uint piece = gl_SubgroupID * kBatchPointsPerThread * size + lane * DENSE_RUN;
@@ -237,7 +172,7 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
     }
   }
   if (lane == 0u && carry.pixel != kNoPixel) writes += denseWrite(carry, t);
-  return writes + denseFlush(t);
+  return writes;
 }
 
 // Whether a tile of the pixel rectangle of a dense batch (v) holds a pixel that hqs_dense_check.comp flagged:

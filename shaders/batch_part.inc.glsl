@@ -49,7 +49,7 @@ BatchWords batchWords(uint first) {
 // batch-hqs's dense batches: depth and blending in one pass (raster_batch_hqs_dense.comp), then only their points
 // on pixels found wrong blended again. The batch `batch` of the part (decision v, for camera cam) is dense if
 // it has one coordinate word, lies inside the image, is full, has at least kHqsDenseRatio points per pixel of
-// its pixel rectangle and at most kHqsDenseTable pixels there, and was not drawn again in the last kHqsDenseRetry frames or so (its points then lay
+// its pixel rectangle, and was not drawn again in the last kHqsDenseRetry frames or so (its points then lay
 // behind closer ones: most likely they still do, and two passes cost less). Returns that rectangle
 // (boxPixelRect), or x = -1 for a batch that is not dense. Computed once per batch by batch_views.comp
 // (BatchView::rect).
@@ -62,7 +62,7 @@ vec4 denseRect(BatchView v, BatchCamera cam, uint batch) {
   vec4 r = boxPixelRect(v, cam);
   if (r.x < 0.0) return r;
   float area = (r.z - r.x + 1.0) * (r.w - r.y + 1.0);
-  return area * float(kHqsDenseRatio) <= float(kBatchPoints) && area <= float(kHqsDenseTable) ? r : vec4(-1.0);
+  return area * float(kHqsDenseRatio) <= float(kBatchPoints) ? r : vec4(-1.0);
 }
 
 // Whether batch-hqs draws a batch (its decision v) as a dense one: it is (denseRect), the frame lets it, the

@@ -22,7 +22,8 @@ void main() {
   uint writes = 0u;
   if (dense) {
     BatchCamera cam = batchCamera(frame, 0u);
-    DenseTargets t = denseTargets(v, cam, frame.f.framebuffer, frame.f.accumulators, frame.f.denseDepths);
+    DenseTargets t = DenseTargets(Uint64Array(frame.f.framebuffer), Uint64Array(frame.f.accumulators),
+                                  UintArray(frame.f.denseDepths), cam.pitch * cam.height);
     writes = drawDense(v, batchWords(first), cam, t);
   }
   // A dense batch blends all its points here (hqs_dense_check.comp takes back those of flagged pixels); the

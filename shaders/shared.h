@@ -147,7 +147,6 @@ PR_CONST kEmptyDepthBits = 0x7FFFFFFFu; // above every finite positive float
 // dense: one coordinate word, inside the image, full, and at least kHqsDenseRatio points per pixel of its
 // pixel rectangle. kHqsDenseFlagged marks a pixel whose first-pass sums were dropped (hqs_dense_check.comp).
 PR_CONST kHqsDenseRatio = 8;
-PR_CONST kHqsDenseTable = 512; // pixels of a dense batch's rectangle at most: its workgroup sums them in shared memory
 PR_CONST kHqsDenseTile = 16;
 PR_CONST kHqsDenseFlagged = 0xFFFFFFFFu;
 PR_CONST kHqsDenseRetry = 32;

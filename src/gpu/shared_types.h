@@ -36,7 +36,7 @@ static_assert(offsetof(BatchFrame, partColors) == 48);
 static_assert(offsetof(BatchFrame, rightViewProj) == 48 + 8 * kMaxVisibilityParts); // 16-aligned for std430
 static_assert(offsetof(BatchFrame, views) == 48 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
 static_assert(offsetof(BatchFrame, denseTiles) == 64 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
-static_assert(sizeof(BatchFrame) == 80 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
+static_assert(sizeof(BatchFrame) == 96 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
 static_assert(kBatchPoints == 10240 && kBatchPrefetchSteps * 4 == kBatchPointsPerThread);
 static_assert(uint64_t(kMaxPartBatches) * kBatchPoints <= kVisibilityLocalMask + 1ull);
 static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 32);

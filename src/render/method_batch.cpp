@@ -115,6 +115,7 @@ public:
     f.denseTiles = hqs_ ? accumulators_.address() + pixels * 28 : 0;
     f.dense = hqs_ && eyes_ == 1 && frame.settings.batchHqsDense ? 1 : 0;
     f.tilesX = tilesAcross(targets.width);
+    f.denseHistory = f.dense != 0 ? historyBuffer(frame, cmd).address() : 0;
     f.width = targets.eyeWidth();
     f.height = targets.height;
     f.forcedWords = frame.settings.precision;
@@ -194,6 +195,18 @@ private:
     return viewRecords_;
   }
 
+  // BatchFrame::denseHistory, grown to the frame's batches and cleared when made (like viewBuffer, it never
+  // changes under a recorded frame).
+  const gpu::Buffer& historyBuffer(const Frame& frame, VkCommandBuffer cmd) {
+    const uint64_t bytes = 4 * (1 + frameBatches(frame));
+    if (!history_ || history_.size() < bytes) {
+      history_ =
+          gpu::Buffer(context_, bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, "batch-hqs dense history");
+      gpu::vkCmdFillBuffer(cmd, history_.handle(), 0, VK_WHOLE_SIZE, 0); // before the frame's first barrier
+    }
+    return history_;
+  }
+
   static constexpr uint64_t kStatsBytes = uint64_t(shared::kBatchStatSlots) * shared::kBatchStatCount * 8;
   gpu::Context& context_;
   bool hqs_;
@@ -211,6 +224,7 @@ private:
   gpu::ComputeProgram resolve_;
   gpu::Buffer accumulators_; // batch-hqs
   gpu::Buffer viewRecords_;  // shared::LodNodeView per batch and eye (BatchFrame::views)
+  gpu::Buffer history_;      // batch-hqs: BatchFrame::denseHistory
   gpu::Buffer frame_;        // shared::BatchFrame, device-local
   gpu::Buffer frameUpload_;  // its host-written source
   gpu::Buffer stats_;        // uint64_t[kBatchStatSlots][kBatchStatCount]
