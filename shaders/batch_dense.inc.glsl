@@ -8,20 +8,17 @@
 // accumulation pass blends again the dense batches' points on flagged pixels only, with the usual test. The
 // other pixels' dense sums are exactly those of the two-pass method: every point added passes its test.
 //
-// A thread walks DENSE_RUN consecutive points and adds those on one pixel in registers (a run), so a point
+// A thread walks kDenseRun consecutive points and adds those on one pixel in registers (a run), so a point
 // costs its projection and a few adds. Consecutive threads of a subgroup hold consecutive pieces, and a
 // subgroup's pieces follow each other through the batch; a run that crosses pieces is joined across lanes by
-// a segmented scan and across steps by a carry, so one set of atomics is done per run: in a Morton-ordered
-// overview, a few per thousand points. Needs batch_part.inc.glsl and the subgroup basic and shuffle (with
+// a segmented scan and across steps by a carry, so one set of atomics is done per run (in the 1 G Morton
+// overview, 46 M runs: one per 21 points). Needs batch_part.inc.glsl and the subgroup basic and shuffle (with
 // relative) extensions.
 
-// Points a thread walks at a time; 80 / DENSE_RUN steps cover a batch.
-layout(constant_id = 7) const uint DENSE_RUN = 8;
-layout(constant_id = 8) const uint DENSE_PREFETCH = 0; // EXPERIMENT
-layout(constant_id = 9) const uint DENSE_DIAG = 0; // EXPERIMENT 1: no scan, 2: no writes
-// Quads of 4 points a thread holds: arrays are sized for the largest DENSE_RUN (16), and indexed only below
-// DENSE_RUN / 4 in unrolled loops, so the rest are never allocated.
-const uint kDenseQuads = 4u;
+// Points a thread walks at a time; 80 / kDenseRun steps cover a batch. On the H200, 8 took 3.63 ms for the
+// 1 G overview where 4 took 4.7 (twice the scans) and 16 took 4.5-4.8 (bench/NOTES.md, session 9).
+const uint kDenseRun = 8u;
+const uint kDenseQuads = kDenseRun / 4u;
 
 // Consecutive points of a piece on one pixel: their channel sums, count and depth range (depth bits).
 struct DenseRun {
@@ -63,7 +60,6 @@ struct DenseTargets {
 // packed word), the closest and the farthest depth where they change them. The two reads are issued together
 // and the sums need no result back: a write waits for the L2 once. Returns the depth atomics done (0 or 1).
 uint denseWrite(DenseRun run, DenseTargets t) {
-  if (DENSE_DIAG == 3u && run.n != 12345u) return 0u; // EXPERIMENT
   uint closest = uint(t.framebuffer.v[run.pixel] >> 32), farthest = t.far.v[run.pixel];
   atomicAdd(t.acc.v[t.pixels + 2u * run.pixel], (uint64_t(run.r) << 32) | uint64_t(run.g));
   atomicAdd(t.acc.v[t.pixels + 2u * run.pixel + 1u], (uint64_t(run.b) << 32) | uint64_t(run.n));
@@ -73,15 +69,15 @@ uint denseWrite(DenseRun run, DenseTargets t) {
   return 1u;
 }
 
-// Loads the words and colors of a thread's DENSE_RUN points from quad `quad` on.
+// Loads the words and colors of a thread's kDenseRun points from quad `quad` on.
 void denseLoad(BatchWords at, uint quad, out uvec4 words[kDenseQuads], out uvec4 colors[kDenseQuads]) {
-  [[unroll]] for (uint q = 0u; q < DENSE_RUN / 4u; ++q) {
+  [[unroll]] for (uint q = 0u; q < kDenseQuads; ++q) {
     words[q] = Uvec4Array(at.high).v[quad + q];
     colors[q] = Uvec4Array(at.colors).v[quad + q];
   }
 }
 
-// A run summed within a thread keeps red and blue in one word (r | b << 16: at most DENSE_RUN x 255 each);
+// A run summed within a thread keeps red and blue in one word (r | b << 16: at most kDenseRun x 255 each);
 // this spreads them out.
 DenseRun denseUnpack(DenseRun run) {
   return DenseRun(run.pixel, run.r & 0xFFFFu, run.g, run.r >> 16, run.n, run.near, run.far);
@@ -91,28 +87,24 @@ DenseRun denseUnpack(DenseRun run) {
 // this thread. Call in uniform control flow, by every thread of the workgroup.
 uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
   uint lane = gl_SubgroupInvocationID, size = gl_SubgroupSize;
-  // Subgroup s draws points [80 size s, 80 size (s + 1)) of the batch, DENSE_RUN size of them a step.
-  uint piece = gl_SubgroupID * kBatchPointsPerThread * size + lane * DENSE_RUN;
-  const uint steps = kBatchPointsPerThread / DENSE_RUN;
+  // Subgroup s draws points [80 size s, 80 size (s + 1)) of the batch, kDenseRun size of them a step.
+  uint piece = gl_SubgroupID * kBatchPointsPerThread * size + lane * kDenseRun;
   uint writes = 0u;
   DenseRun carry = denseRunAt(kNoPixel); // the subgroup's open run from the step before (uniform)
-  uvec4 words[kDenseQuads], colors[kDenseQuads];
-  if (DENSE_PREFETCH != 0u) denseLoad(at, piece / 4u, words, colors);
-  for (uint step = 0u; step < steps; ++step) {
-    if (DENSE_PREFETCH == 0u) denseLoad(at, (piece + step * size * DENSE_RUN) / 4u, words, colors);
-    // The next step's points are loaded while this one's are drawn.
-    uvec4 nextWords[kDenseQuads], nextColors[kDenseQuads];
-    if (DENSE_PREFETCH != 0u && step + 1u < steps) denseLoad(at, (piece + (step + 1u) * size * DENSE_RUN) / 4u, nextWords, nextColors);
+  for (uint step = 0u; step < kBatchPointsPerThread / kDenseRun; ++step) {
+    // (Loading the next step's points while drawing these was slower on the H200: more registers.)
+    uvec4 words[kDenseQuads], colors[kDenseQuads];
+    denseLoad(at, (piece + step * size * kDenseRun) / 4u, words, colors);
     // The piece's runs: the first is kept in `head` (an earlier lane may continue it), the last in `run`
     // (a later lane may), those between are complete and written at once.
     DenseRun head = denseRunAt(kNoPixel), run = denseRunAt(kNoPixel);
-    [[unroll]] for (uint i = 0u; i < DENSE_RUN; ++i) {
+    [[unroll]] for (uint i = 0u; i < kDenseRun; ++i) {
       uint pixel, depth;
       projectBatchPoint(v, 1u, false, words[i / 4u][i % 4u], 0u, 0u, cam, pixel, depth);
       if (pixel != run.pixel) {
         if (run.pixel != kNoPixel) {
           if (head.pixel == kNoPixel) head = denseUnpack(run);
-          else if (DENSE_DIAG != 2u || run.n == 12345u) writes += denseWrite(denseUnpack(run), t);
+          else writes += denseWrite(denseUnpack(run), t);
         }
         run = denseRunAt(pixel);
       }
@@ -124,15 +116,6 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
       run.far = max(run.far, depth);
     }
     run = denseUnpack(run);
-    if (DENSE_DIAG == 2u) {
-      if (run.n == 12345u || head.n == 12345u) writes += denseWrite(run, t);
-      continue;
-    }
-    if (DENSE_DIAG == 1u) {
-      if (head.pixel != kNoPixel) writes += denseWrite(head, t);
-      writes += denseWrite(run, t);
-      continue;
-    }
     // Joining across lanes. A lane's first run continues the open run on its left (the previous lane's last
     // run, or the carry for lane 0) if they share the pixel. A lane with a single run passes the open run on,
     // one with several closes it into its head. Segmented inclusive scan of the open runs; bit 31 of `key`
@@ -164,12 +147,6 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
     if (several) writes += denseWrite(head, t);
     if (lane + 1u < size && !nextJoins) writes += denseWrite(open, t);
     carry = denseShuffle(open, size - 1u);
-    if (DENSE_PREFETCH != 0u) {
-      [[unroll]] for (uint q = 0u; q < DENSE_RUN / 4u; ++q) {
-        words[q] = nextWords[q];
-        colors[q] = nextColors[q];
-      }
-    }
   }
   if (lane == 0u && carry.pixel != kNoPixel) writes += denseWrite(carry, t);
   return writes;

@@ -2,14 +2,10 @@
 // batch-hqs, first pass of the dense batches (batch_dense.inc.glsl): depth and blending together. It runs
 // beside the depth pass of the other batches (raster_batch.comp with DEPTH_ONLY, which skips dense ones).
 #extension GL_KHR_shader_subgroup_basic : require
-#extension GL_KHR_shader_subgroup_vote : require
-#extension GL_KHR_shader_subgroup_arithmetic : require
-#extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_KHR_shader_subgroup_shuffle_relative : require
 #extension GL_EXT_control_flow_attributes : require
 #include "batch_part.inc.glsl"
-#include "hqs_accumulate.inc.glsl"
 #include "batch_dense.inc.glsl"
 
 void main() {

@@ -144,8 +144,9 @@ PR_CONST kEmptyDepthBits = 0x7FFFFFFFu; // above every finite positive float
 // the closest point's.
 #define PR_HQS_DEPTH_FACTOR 1.01
 // batch-hqs draws a batch in one pass (depth and blending together, then a per-pixel check) when it is
-// dense: one coordinate word, inside the image, full, and at least kHqsDenseRatio points per pixel of its
-// pixel rectangle. kHqsDenseFlagged marks a pixel whose first-pass sums were dropped (hqs_dense_check.comp).
+// dense: one coordinate word, inside the image, full, at least kHqsDenseRatio points per pixel of its pixel
+// rectangle, and not drawn again in the last kHqsDenseRetry frames or so (batch_part.inc.glsl, denseRect).
+// kHqsDenseFlagged marks a pixel whose first-pass sums were dropped (hqs_dense_check.comp).
 PR_CONST kHqsDenseRatio = 8;
 PR_CONST kHqsDenseTile = 16;
 PR_CONST kHqsDenseFlagged = 0xFFFFFFFFu;
