@@ -209,8 +209,9 @@ void markdownBandwidth(std::ostringstream& md, const PointTables& t) {
   if (batched)
     md << " *: the bytes the frame read, from the batch statistics: 4 per coordinate word of each point "
           "processed, 32 per batch's (or octree node's) bounds; batch-hqs and lod-hqs read both twice "
-          "(depth "
-          "and blending pass) and the color of each blended point.";
+          "(depth and blending pass) and the color of each blended point, except that batch-hqs reads the "
+          "words of a dense batch once (twice if it draws the batch again) and all its colors in the first "
+          "pass.";
   md << "\n\n";
   methodTable(md, t, bandwidthView, [](const Result& r) { return printf1("%.0f%%", r.copyFraction * 100); });
 }
