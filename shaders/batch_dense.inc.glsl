@@ -1,4 +1,5 @@
-// batch-hqs's dense batches (batch_part.inc.glsl, denseBatch): depth and blending in one pass over the points.
+// batch-hqs's dense batches (denseBatch below, denseRect in batch_part.inc.glsl): depth and blending in one
+// pass over the points.
 //
 // In a dense view every pixel takes hundreds of a batch's points, nearly all within 1 % of its closest depth:
 // a batch's 10240 points fall on a few dozen pixels. So a dense batch adds every point's color to its pixel at
@@ -24,7 +25,7 @@ bool denseBatch(BatchView v) {
 }
 
 // Points a thread walks at a time; 80 / kDenseRun steps cover a batch. On the H200, 8 took 3.63 ms for the
-// 1 G overview where 4 took 4.7 (twice the scans) and 16 took 4.5-4.8 (bench/NOTES.md, session 9).
+// 1 G overview where 4 took 4.7 (twice the scans) and 16 took 4.5-7.2 (bench/NOTES.md, session 9).
 const uint kDenseRun = 8u;
 const uint kDenseQuads = kDenseRun / 4u;
 
