@@ -8,6 +8,7 @@
 // A box decision (viewBox) depends only on the box and the camera, so it is computed once per box, by a
 // pass before the drawing: batch_views.comp for the batches of a part (batch_part.inc.glsl), the node pass
 // for octree nodes (lod.inc.glsl). Every thread of a drawing workgroup reads the same bits.
+#extension GL_KHR_shader_subgroup_basic : require
 #include "common.inc.glsl"
 #include "project.inc.glsl"
 

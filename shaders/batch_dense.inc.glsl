@@ -16,14 +16,6 @@
 // overview, 46 M runs: one per 21 points). Needs batch_part.inc.glsl and the subgroup basic and shuffle (with
 // relative) extensions.
 
-// Whether batch-hqs draws a batch (its decision v) as a dense one, depth and blending in one pass: it is a
-// candidate (denseCandidate) and the subgroups are full (the dense pass splits the batch by subgroup). A
-// candidate on a device with partial subgroups gets its depths from the dense pass (drawDenseDepths) and
-// is blended by the accumulation pass like any other batch. Uniform in a workgroup.
-bool denseBatch(BatchView v) {
-  return denseCandidate(v) && gl_NumSubgroups * gl_SubgroupSize == kPointGroupSize;
-}
-
 // Points a thread walks at a time; 80 / kDenseRun steps cover a batch. On the H200, 8 took 3.63 ms for the
 // 1 G overview where 4 took 4.7 (twice the scans) and 16 took 4.5-7.2 (bench/NOTES.md, session 9).
 const uint kDenseRun = 8u;
@@ -159,21 +151,6 @@ uint drawDense(BatchView v, BatchWords at, BatchCamera cam, DenseTargets t) {
   }
   if (lane == 0u && carry.pixel != kNoPixel) writes += denseWrite(carry, t);
   return writes;
-}
-
-// The depth pass's work for a candidate that is not dense (partial subgroups): every point's depth << 32
-// with an atomicMin, one point at a time. Returns the atomics done.
-uint drawDenseDepths(BatchView v, BatchWords at, BatchCamera cam, uint64_t framebuffer) {
-  uint written = 0u;
-  for (uint i = gl_LocalInvocationIndex; i < kBatchPoints; i += kPointGroupSize) {
-    uint pixel, depth;
-    projectBatchPoint(v, 1u, false, UintArray(at.high).v[i], 0u, 0u, cam, pixel, depth);
-    if (depth < uint(Uint64Array(framebuffer).v[pixel] >> 32)) {
-      atomicMin(Uint64Array(framebuffer).v[pixel], uint64_t(depth) << 32);
-      ++written;
-    }
-  }
-  return written;
 }
 
 // Whether a tile of the pixel rectangle of a dense batch (v) holds a pixel that hqs_dense_check.comp flagged:

@@ -65,9 +65,10 @@ vec4 denseRect(BatchView v, BatchCamera cam, uint batch) {
   return area * float(kHqsDenseRatio) <= float(kBatchPoints) ? r : vec4(-1.0);
 }
 
-// Whether batch-hqs's depth pass leaves a batch (its decision v) to the dense pass: denseRect found it dense
-// for this frame, which is mono. Uniform in a workgroup. (batch_dense.inc.glsl, denseBatch: whether the dense
-// pass then blends it too.)
-bool denseCandidate(BatchView v) {
-  return STEREO == 0u && v.rect.x >= 0.0;
+// Whether batch-hqs draws a batch (its decision v) as a dense one: it is (denseRect), the frame lets it, the
+// frame is mono and the subgroups are full (the dense pass splits the batch by subgroup). Uniform in a
+// workgroup. Needs GL_KHR_shader_subgroup_basic.
+bool denseBatch(BatchView v) {
+  if (STEREO != 0u || v.rect.x < 0.0) return false;
+  return FrameRef(pc.frame).f.dense != 0u && gl_NumSubgroups * gl_SubgroupSize == kPointGroupSize;
 }

@@ -2,6 +2,7 @@
 // batch and batch-prefetch (see batch.inc.glsl and batch_draw.inc.glsl): one workgroup per batch of a part;
 // the visibility index of a point is part << 26 | its index in the part. Colors are fetched by the resolve,
 // for visible points only.
+#extension GL_KHR_shader_subgroup_basic : require
 #include "batch_part.inc.glsl"
 
 layout(constant_id = 0) const uint PREFETCH = 0;
@@ -19,7 +20,7 @@ void main() {
   uint payloadBase = (pc.part << kVisibilityPartShift) | first;
   uint rendered = 0u, words = v.words;
   // batch-hqs's depth pass leaves the dense batches to raster_batch_hqs_dense.comp, which counts them.
-  bool dense = DEPTH_ONLY != 0u && denseCandidate(v);
+  bool dense = DEPTH_ONLY != 0u && denseBatch(v);
   if (dense) {
   } else if (STEREO != 0u) {
     BatchCamera right = batchCamera(frame, 1u);

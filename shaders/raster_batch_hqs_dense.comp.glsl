@@ -14,20 +14,18 @@ void main() {
   uint first = gl_WorkGroupID.x * kBatchPoints;
   uint count = min(kBatchPoints, pc.pointCount - first);
   BatchView v = viewBatch(gl_WorkGroupID.x, 0u);
-  bool candidate = denseCandidate(v), dense = denseBatch(v);
+  bool dense = denseBatch(v);
   uint writes = 0u;
-  BatchCamera cam = batchCamera(frame, 0u);
   if (dense) {
+    BatchCamera cam = batchCamera(frame, 0u);
     DenseTargets t = DenseTargets(Uint64Array(frame.f.framebuffer), Uint64Array(frame.f.accumulators),
                                   UintArray(frame.f.denseDepths), cam.pitch * cam.height);
     writes = drawDense(v, batchWords(first), cam, t);
-  } else if (candidate) {
-    writes = drawDenseDepths(v, batchWords(first), cam, frame.f.framebuffer);
   }
   // A dense batch blends all its points here (hqs_dense_check.comp takes back those of flagged pixels); the
-  // depth pass counts the other batches, and leaves the candidates to this pass.
+  // depth pass counts the other batches.
   endStatsOf2(frame.f.stats, kStatPointsBlended, dense ? kBatchPointsPerThread : 0u, kStatPointsRendered, writes,
-              candidate, v.words, count);
+              dense, v.words, count);
   if (COUNT != 0u && dense && gl_LocalInvocationIndex == 0u)
     atomicAdd(Uint64Array(frame.f.stats).v[(gl_WorkGroupID.x % kBatchStatSlots) * kBatchStatCount + kStatBatchesDense],
               1ul);
