@@ -1,5 +1,5 @@
-// batch-hqs's dense batches (denseBatch below, denseRect in batch_part.inc.glsl): depth and blending in one
-// pass over the points.
+// batch-hqs's dense batches (batch_part.inc.glsl: denseRect, denseBatch): depth and blending in one pass
+// over the points.
 //
 // In a dense view every pixel takes hundreds of a batch's points, nearly all within 1 % of its closest depth:
 // a batch's 10240 points fall on a few dozen pixels. So a dense batch adds every point's color to its pixel at
