@@ -11,7 +11,7 @@
 #include "commands.h"
 #include "input.h"
 #include "io/format_table.h"
-#include "io/potree.h"
+#include "io/potree/potree.h"
 #include "io/writer.h"
 
 namespace pointrast::app {

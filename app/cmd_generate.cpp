@@ -13,7 +13,7 @@
 #include "cloud/order.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
-#include "io/particles_io.h"
+#include "io/particles/particles_io.h"
 #include "io/writer.h"
 
 namespace pointrast::app {

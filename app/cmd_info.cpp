@@ -14,7 +14,7 @@
 #include "gpu/context.h"
 #include "input.h"
 #include "io/format_table.h"
-#include "io/particles_io.h"
+#include "io/particles/particles_io.h"
 #include "io/reader.h"
 
 namespace pointrast::app {

@@ -16,7 +16,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "io/format_table.h"
-#include "io/lod_potree.h"
+#include "io/potree/lod_potree.h"
 
 namespace pointrast::app {
 

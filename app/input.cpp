@@ -8,7 +8,7 @@
 #include "cloud/generate.h"
 #include "cloud/particles_generate.h"
 #include "io/format_table.h"
-#include "io/particles_io.h"
+#include "io/particles/particles_io.h"
 #include "io/reader.h"
 
 namespace pointrast::app {

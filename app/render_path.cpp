@@ -11,7 +11,7 @@
 #include "base/progress.h"
 #include "cli_util.h"
 #include "gpu/context.h"
-#include "io/video_writer.h"
+#include "io/media/video_writer.h"
 #include "view/path_render.h"
 
 namespace pointrast::app {

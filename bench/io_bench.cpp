@@ -13,9 +13,9 @@
 #include "base/parallel.h"
 #include "bench/report.h"
 #include "io/io_util.h"
-#include "io/laz_chunk.h"
-#include "io/laz_compose.h"
-#include "io/laz_reader.h"
+#include "io/las/laz_chunk.h"
+#include "io/las/laz_compose.h"
+#include "io/las/laz_reader.h"
 
 namespace pointrast::bench {
 

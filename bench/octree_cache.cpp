@@ -19,9 +19,9 @@
 #include "cloud/lod_grid.h"
 #include "cloud/point_record.h"
 #include "io/format_table.h"
-#include "io/lod_builder.h"
-#include "io/lod_potree.h"
-#include "io/potree.h"
+#include "io/potree/lod_builder.h"
+#include "io/potree/lod_potree.h"
+#include "io/potree/potree.h"
 
 namespace pointrast::bench {
 

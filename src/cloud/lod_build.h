@@ -1,5 +1,5 @@
 // The octree build's phases on points held in memory, and the parallel chunk pipeline that the
-// out-of-core driver (io/lod_builder.h) shares: count -> chunk -> distribute -> index + write.
+// out-of-core driver (io/potree/lod_builder.h) shares: count -> chunk -> distribute -> index + write.
 // No files: the driver reads inputs and spills; these work on records and hand nodes to a NodeSink.
 #pragma once
 

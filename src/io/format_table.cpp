@@ -7,14 +7,14 @@
 
 #include "cloud/octree.h"
 #include "io/formats.h"
-#include "io/copc.h"
-#include "io/ept.h"
+#include "io/copc_ept/copc.h"
+#include "io/copc_ept/ept.h"
 #include "io/io_util.h"
-#include "io/las_format.h"
-#include "io/las_source.h"
-#include "io/laz_reader.h"
+#include "io/las/las_format.h"
+#include "io/las/las_source.h"
+#include "io/las/laz_reader.h"
 #include "io/point_source.h"
-#include "io/potree.h"
+#include "io/potree/potree.h"
 
 namespace pointrast::io {
 

@@ -45,7 +45,7 @@ struct FormatProbe {
 };
 
 // What the file holds: points (rendered by the point methods) or particles (spheres with radii, drawn by
-// the sphere methods through io/particles_io.h).
+// the sphere methods through io/particles/particles_io.h).
 enum class FormatContent { Points, Particles };
 
 struct FormatInfo {

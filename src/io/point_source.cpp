@@ -10,8 +10,8 @@
 
 #include "io/format_table.h"
 #include "io/io_util.h"
-#include "io/las_format.h"
-#include "io/las_source.h"
+#include "io/las/las_format.h"
+#include "io/las/las_source.h"
 #include "io/reader.h"
 
 namespace pointrast::io {

@@ -14,7 +14,7 @@
 #include "base/error.h"
 #include "base/progress.h"
 #include "gpu/timer.h"
-#include "io/video_writer.h"
+#include "io/media/video_writer.h"
 #include "io/writer.h"
 
 namespace pointrast::view {

@@ -18,7 +18,7 @@
 #include "bench/suites.h"
 #include "gpu/gpu_fixture.h"
 #include "gpu/lod_octree.h"
-#include "io/potree.h"
+#include "io/potree/potree.h"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include "bench/octree_cache.h"
 #include "cloud/generate.h"
 #include "cloud/point_record.h"
-#include "io/potree.h"
+#include "io/potree/potree.h"
 
 namespace {
 

@@ -16,7 +16,7 @@
 
 #include "cloud/octree.h"
 #include "fuzz_input.h"
-#include "io/copc.h"
+#include "io/copc_ept/copc.h"
 #include "laz_seeds.h"
 
 namespace {

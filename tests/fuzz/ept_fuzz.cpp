@@ -18,7 +18,7 @@
 
 #include "cloud/octree.h"
 #include "fuzz_input.h"
-#include "io/ept.h"
+#include "io/copc_ept/ept.h"
 #include "laz_seeds.h"
 
 #include <zstd.h>

@@ -5,7 +5,7 @@
 
 #include "fuzz_input.h"
 #include "io/formats.h"
-#include "io/las_source.h"
+#include "io/las/las_source.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::run(

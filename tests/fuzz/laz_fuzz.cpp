@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "fuzz_input.h"
-#include "io/laz_reader.h"
+#include "io/las/laz_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // LAZ codes identical points in a fraction of a bit each: a small input may truly hold millions of

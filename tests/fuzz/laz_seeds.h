@@ -14,9 +14,9 @@
 
 #include "base/error.h"
 #include "io/io_util.h"
-#include "io/laz_chunk.h"
-#include "io/laz_common.h"
-#include "io/laz_format.h"
+#include "io/las/laz_chunk.h"
+#include "io/las/laz_common.h"
+#include "io/las/laz_format.h"
 
 namespace fuzz {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "io/laz_chunk.h"
-#include "io/laz_common.h"
-#include "io/laz_format.h"
+#include "io/las/laz_chunk.h"
+#include "io/las/laz_common.h"
+#include "io/las/laz_format.h"
 #include "laz_seeds.h"
 
 namespace {

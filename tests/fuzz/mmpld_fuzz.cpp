@@ -2,7 +2,7 @@
 // first frame and, in files of several, the last.
 // Seeds: mmpld
 #include "fuzz_input.h"
-#include "io/particles_io.h"
+#include "io/particles/particles_io.h"
 
 namespace {
 

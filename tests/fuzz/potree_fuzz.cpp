@@ -15,7 +15,7 @@
 
 #include "base/error.h"
 #include "base/progress.h"
-#include "io/potree.h"
+#include "io/potree/potree.h"
 #include "io/reader.h"
 
 namespace {

@@ -24,7 +24,7 @@
 #include "gpu/spirv_reflect.h"
 #include "gpu_fixture.h"
 #include "io/format_table.h"
-#include "io/potree.h"
+#include "io/potree/potree.h"
 #include "io/writer.h"
 #include "lod_octree.h"
 #include "render/lod/lod_render.h"

@@ -3,11 +3,11 @@
 #include <map>
 #include <thread>
 
-#include "io/copc.h"
+#include "io/copc_ept/copc.h"
 #include "io/io_test_util.h"
-#include "io/las_records.h"
-#include "io/laz_format.h"
-#include "io/laz_reader.h"
+#include "io/las/las_records.h"
+#include "io/las/laz_format.h"
+#include "io/las/laz_reader.h"
 
 using pointrast::InputError;
 using pointrast::PointRecord;

@@ -4,8 +4,8 @@
 #include <map>
 #include <thread>
 
-#include "io/copc.h"
-#include "io/ept.h"
+#include "io/copc_ept/copc.h"
+#include "io/copc_ept/ept.h"
 #include "io/ept_test_data.h"
 #include "io/io_test_util.h"
 

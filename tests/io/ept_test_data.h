@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 #include <zstd.h>
 
-#include "io/copc.h"
+#include "io/copc_ept/copc.h"
 #include "io/io_test_util.h"
-#include "io/laz_compose.h"
-#include "io/laz_format.h"
+#include "io/las/laz_compose.h"
+#include "io/las/laz_format.h"
 
 namespace iotest {
 

@@ -8,7 +8,7 @@
 #include "fuzz/prepare_steps.h"
 #include "io/formats.h"
 #include "io/io_test_util.h"
-#include "io/particles_io.h"
+#include "io/particles/particles_io.h"
 
 namespace {
 

@@ -2,7 +2,7 @@
 // must either succeed or throw InputError: no crash, no other exception, no huge allocation (run under
 // AddressSanitizer, see environment_test.cpp).
 #include "io/io_test_util.h"
-#include "io/laz_compose.h"
+#include "io/las/laz_compose.h"
 #include "io/writer.h"
 
 using pointrast::InputError;

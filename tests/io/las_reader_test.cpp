@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "io/io_test_util.h"
-#include "io/las_format.h"
+#include "io/las/las_format.h"
 #include "io/writer.h"
 
 using pointrast::InputError;

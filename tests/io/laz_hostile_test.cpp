@@ -2,10 +2,10 @@
 // bytes. Each must read or give one InputError naming the file: no crash, no hang, no allocation beyond
 // what the data codes (run under AddressSanitizer, which fails on allocations of the claimed sizes).
 #include "io/io_test_util.h"
-#include "io/las_format.h"
-#include "io/laz_compose.h"
-#include "io/laz_format.h"
-#include "io/laz_reader.h"
+#include "io/las/las_format.h"
+#include "io/las/laz_compose.h"
+#include "io/las/laz_format.h"
+#include "io/las/laz_reader.h"
 
 using pointrast::InputError;
 using namespace pointrast::io;

@@ -3,9 +3,9 @@
 #include <thread>
 
 #include "io/io_test_util.h"
-#include "io/las_format.h"
-#include "io/las_records.h"
-#include "io/laz_reader.h"
+#include "io/las/las_format.h"
+#include "io/las/las_records.h"
+#include "io/las/laz_reader.h"
 #include "io/sha256.h"
 
 using pointrast::InputError;

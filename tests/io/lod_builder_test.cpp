@@ -6,8 +6,8 @@
 #include "cloud/lod_test_util.h"
 #include "io/io_test_util.h"
 #include "io/io_util.h"
-#include "io/las_format.h"
-#include "io/lod_builder.h"
+#include "io/las/las_format.h"
+#include "io/potree/lod_builder.h"
 #include "io/point_source.h"
 #include "io/writer.h"
 

@@ -4,9 +4,9 @@
 // and the folder's bytes are the same from 1 and 2 threads and out of core.
 #include "cloud/lod_test_util.h"
 #include "io/io_test_util.h"
-#include "io/lod_potree.h"
+#include "io/potree/lod_potree.h"
 #include "io/point_source.h"
-#include "io/potree_format.h"
+#include "io/potree/potree_format.h"
 #include "io/potree_test_util.h"
 #include "io/writer.h"
 

@@ -7,7 +7,7 @@
 
 #include "io/formats.h"
 #include "io/io_test_util.h"
-#include "io/particles_io.h"
+#include "io/particles/particles_io.h"
 
 using pointrast::Bounds;
 using pointrast::InputError;

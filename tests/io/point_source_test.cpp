@@ -6,8 +6,8 @@
 
 #include "io/io_test_util.h"
 #include "io/io_util.h"
-#include "io/las_format.h"
-#include "io/las_source.h"
+#include "io/las/las_format.h"
+#include "io/las/las_source.h"
 #include "io/point_source.h"
 
 namespace {

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "io/io_test_util.h"
-#include "io/potree_format.h"
+#include "io/potree/potree_format.h"
 
 namespace {
 

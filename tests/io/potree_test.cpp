@@ -11,7 +11,7 @@
 
 #include "cloud/octree_cloud.h"
 #include "io/format_table.h"
-#include "io/potree_format.h"
+#include "io/potree/potree_format.h"
 #include "io/potree_test_util.h"
 #include "io/writer.h"
 

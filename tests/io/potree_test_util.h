@@ -15,8 +15,8 @@
 
 #include "cloud/octree.h"
 #include "io/io_test_util.h"
-#include "io/potree.h"
-#include "io/potree_format.h"
+#include "io/potree/potree.h"
+#include "io/potree/potree_format.h"
 
 namespace potreetest {
 

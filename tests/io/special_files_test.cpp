@@ -10,7 +10,7 @@
 #include "io/format_table.h"
 #include "io/formats.h"
 #include "io/io_test_util.h"
-#include "io/las_format.h"
+#include "io/las/las_format.h"
 
 using pointrast::InputError;
 using namespace pointrast::io;

@@ -5,7 +5,7 @@
 #include <functional>
 #include <vector>
 
-#include "io/copc.h"
+#include "io/copc_ept/copc.h"
 #include "io/io_test_util.h"
 #include "io/point_source.h"
 

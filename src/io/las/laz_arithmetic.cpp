@@ -1,0 +1,176 @@
+
+
+#include "io/las/laz_arithmetic.h"
+
+#include <algorithm>
+#include <cassert>
+
+namespace pointrast::io::laz {
+
+void BitModel::update() {
+  // Halve the counts when they reach the maximum, so the model keeps adapting.
+  if ((bitCount += updateCycle) > kBitMaxCount) {
+    bitCount = (bitCount + 1) >> 1;
+    bit0Count = (bit0Count + 1) >> 1;
+    if (bit0Count == bitCount) ++bitCount;
+  }
+  const uint32_t scale = 0x80000000u / bitCount;
+  bit0Prob = (bit0Count * scale) >> (31 - kBitLengthShift);
+  updateCycle = std::min<uint32_t>((5 * updateCycle) >> 2, 64);
+  bitsUntilUpdate = updateCycle;
+}
+
+void SymbolModel::create(uint32_t symbols) {
+  assert(symbols >= 2 && symbols <= 2048);
+  symbols_ = symbols;
+  lastSymbol_ = symbols - 1;
+  size_t words = 2 * size_t(symbols);
+  if (symbols > 16) {
+    // A table of at least one entry per symbol: FastAC sizes it for four symbols per entry, but the
+    // bisection within an entry mispredicts, and a finer table costs nothing in exactness (it only
+    // narrows the search; the distribution decides).
+    uint32_t tableBits = 3;
+    while (symbols > (1u << tableBits))
+      ++tableBits;
+    tableSize_ = 1u << tableBits;
+    tableShift_ = kLengthShift - tableBits;
+    words += tableSize_ + 2;
+  } else {
+    tableSize_ = tableShift_ = 0;
+  }
+  storage_ = std::make_unique<uint32_t[]>(words);
+  distribution_ = storage_.get();
+  symbolCount_ = distribution_ + symbols;
+  decoderTable_ = symbols > 16 ? symbolCount_ + symbols : nullptr;
+  ready_ = false;
+}
+
+void SymbolModel::reset() {
+  assert(symbols_ != 0);
+  totalCount_ = 0;
+  updateCycle_ = symbols_;
+  std::fill(symbolCount_, symbolCount_ + symbols_, 1u);
+  update();
+  symbolsUntilUpdate_ = updateCycle_ = (symbols_ + 6) >> 1;
+  ready_ = true;
+}
+
+void SymbolModel::update() {
+  if ((totalCount_ += updateCycle_) > kMaxCount) {
+    totalCount_ = 0;
+    for (uint32_t n = 0; n < symbols_; ++n)
+      totalCount_ += (symbolCount_[n] = (symbolCount_[n] + 1) >> 1);
+  }
+  const uint32_t scale = 0x80000000u / totalCount_;
+  uint32_t sum = 0;
+  if (!decoderTable_) {
+    for (uint32_t k = 0; k < symbols_; ++k) {
+      distribution_[k] = (scale * sum) >> (31 - kLengthShift);
+      sum += symbolCount_[k];
+    }
+  } else {
+    uint32_t s = 0;
+    for (uint32_t k = 0; k < symbols_; ++k) {
+      distribution_[k] = (scale * sum) >> (31 - kLengthShift);
+      sum += symbolCount_[k];
+      const uint32_t w = distribution_[k] >> tableShift_;
+      while (s < w)
+        decoderTable_[++s] = k - 1;
+    }
+    decoderTable_[0] = 0;
+    while (s <= tableSize_)
+      decoderTable_[++s] = symbols_ - 1;
+  }
+  updateCycle_ = std::min((5 * updateCycle_) >> 2, (symbols_ + 6) << 3);
+  symbolsUntilUpdate_ = updateCycle_;
+}
+
+// ---- encoder ----------------------------------------------------------------------------------------
+
+void ArithmeticEncoder::encodeBit(BitModel& m, uint32_t bit) {
+  const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
+  if (bit == 0) {
+    length_ = x;
+    ++m.bit0Count;
+  } else {
+    const uint32_t initBase = base_;
+    base_ += x;
+    length_ -= x;
+    if (initBase > base_) propagateCarry();
+  }
+  if (length_ < kMinLength) renormalize();
+  if (--m.bitsUntilUpdate == 0) m.update();
+}
+
+void ArithmeticEncoder::encodeSymbol(SymbolModel& m, uint32_t sym) {
+  assert(sym < m.symbols_);
+  const uint32_t initBase = base_;
+  if (sym == m.lastSymbol_) {
+    const uint32_t x = m.distribution_[sym] * (length_ >> kLengthShift);
+    base_ += x;
+    length_ -= x;
+  } else {
+    const uint32_t x = m.distribution_[sym] * (length_ >>= kLengthShift);
+    base_ += x;
+    length_ = m.distribution_[sym + 1] * length_ - x;
+  }
+  if (initBase > base_) propagateCarry();
+  if (length_ < kMinLength) renormalize();
+  ++m.symbolCount_[sym];
+  if (--m.symbolsUntilUpdate_ == 0) m.update();
+}
+
+void ArithmeticEncoder::writeBits(uint32_t bits, uint32_t value) {
+  assert(bits >= 1 && bits <= 32);
+  if (bits > 19) {
+    writeBits(16, value & 0xFFFF);
+    value >>= 16;
+    bits -= 16;
+  }
+  const uint32_t initBase = base_;
+  base_ += value * (length_ >>= bits);
+  if (initBase > base_) propagateCarry();
+  if (length_ < kMinLength) renormalize();
+}
+
+std::vector<uint8_t> ArithmeticEncoder::finish() {
+  const uint32_t initBase = base_;
+  bool anotherByte = true;
+  if (length_ > 2 * kMinLength) {
+    base_ += kMinLength;
+    length_ = kMinLength >> 1;
+  } else {
+    base_ += kMinLength >> 1;
+    length_ = kMinLength >> 9;
+    anotherByte = false;
+  }
+  if (initBase > base_) propagateCarry();
+  renormalize();
+  // Zero bytes so the decoder's reads ahead stay inside the stream.
+  out_.push_back(0);
+  out_.push_back(0);
+  if (anotherByte) out_.push_back(0);
+  std::vector<uint8_t> bytes = std::move(out_);
+  *this = ArithmeticEncoder();
+  return bytes;
+}
+
+void ArithmeticEncoder::propagateCarry() {
+  // FastAC's interval arithmetic guarantees a carry never runs past the first byte.
+  for (auto it = out_.rbegin(); it != out_.rend(); ++it) {
+    if (*it != 0xFF) {
+      ++*it;
+      return;
+    }
+    *it = 0;
+  }
+}
+
+void ArithmeticEncoder::renormalize() {
+  do {
+    out_.push_back(static_cast<uint8_t>(base_ >> 24));
+    base_ <<= 8;
+  } while ((length_ <<= 8) < kMinLength);
+}
+
+} // namespace pointrast::io::laz

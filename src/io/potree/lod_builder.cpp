@@ -1,0 +1,306 @@
+#include "io/potree/lod_builder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include <unistd.h>
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "base/progress.h"
+#include "io/io_util.h"
+#include "io/potree/lod_inputs.h"
+#include "io/potree/lod_spill.h"
+
+namespace pointrast::io {
+
+using namespace detail;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Bytes a point costs in memory: 24 B read + 32 B distributed (record and code) while both exist.
+constexpr uint64_t kInMemoryBytesPerPoint = 56;
+// Bytes a chunk point costs a thread that indexes it out of core (records read 24 B, items 32 B, a
+// cell's sort buffer up to 32 B, output 24 B).
+constexpr uint64_t kIndexBytesPerPoint = 112;
+constexpr uint64_t kFixedBytes = uint64_t(64) << 20; // histograms, chunk tables, I/O buffers
+
+uint64_t readMemInfo(const char* key) {
+  std::ifstream in("/proc/meminfo");
+  std::string name;
+  uint64_t kb = 0;
+  std::string unit;
+  while (in >> name >> kb >> unit)
+    if (name == key) return kb * 1024;
+  return 0;
+}
+
+uint64_t cgroupLimit() {
+  std::ifstream in("/sys/fs/cgroup/memory.max"); // cgroup v2; "max" when unlimited
+  uint64_t bytes = 0;
+  if (in >> bytes) return bytes;
+  return 0;
+}
+
+// Runs body(worker) on `threads` threads; the first exception is rethrown after all have stopped.
+template <class Body> void runWorkers(unsigned threads, Body&& body) {
+  std::exception_ptr error;
+  std::mutex mutex;
+  auto guarded = [&](unsigned t) {
+    try {
+      body(t);
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      if (!error) error = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t)
+    pool.emplace_back(guarded, t);
+  guarded(0);
+  for (auto& t : pool)
+    t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+} // namespace
+
+uint64_t defaultBuildMemory() {
+  uint64_t total = readMemInfo("MemTotal:");
+  const uint64_t limit = cgroupLimit();
+  if (limit && (total == 0 || limit < total)) total = limit;
+  if (total == 0) total = uint64_t(8) << 30; // unknown: assume a small machine
+  return total / 2;
+}
+
+struct OctreeBuilder::State {
+  LodBuildOptions options;
+  BuildInputs inputs;
+  unsigned threads = 1;
+  lod::LodRunOptions run;
+  lod::LodParams params;
+  uint64_t memory = 0;
+  uint64_t inMemoryChunk = 0;
+  bool inMemory = true;
+  bool scanned = false;
+  lod::Pieces pieces; // in memory: every point, after scan()
+  lod::LodGrid grid;
+  lod::OctreeMetadata metadata;
+  std::vector<lod::LodPhase> phases;
+  Clock::time_point start;
+
+  State(const std::vector<std::filesystem::path>& paths, const LodBuildOptions& o)
+      : options(o), inputs(paths) {}
+
+  unsigned readThreads() const {
+    return std::min<unsigned>(threads, static_cast<unsigned>(std::max<size_t>(inputs.tasks().size(), 1)));
+  }
+
+  // Calls fn(worker, task, records) for every piece on readThreads() workers; records is the worker's
+  // buffer.
+  template <class Fn> void readAll(const char* label, Fn&& fn) {
+    const auto& tasks = inputs.tasks();
+    std::optional<Progress> progress;
+    if (options.progress) progress.emplace(label, inputs.points());
+    std::atomic<size_t> next{0};
+    runWorkers(readThreads(), [&](unsigned worker) {
+      std::vector<PointRecord> records;
+      for (size_t t; (t = next.fetch_add(1)) < tasks.size();) {
+        lod::checkCancel(run);
+        fn(worker, t, records);
+        if (progress) progress->advance(tasks[t].points);
+      }
+    });
+    if (progress) progress->finish();
+  }
+};
+
+OctreeBuilder::OctreeBuilder(const std::vector<std::filesystem::path>& inputs, const LodBuildOptions& options)
+    : state_(std::make_unique<State>(inputs, options)) {
+  State& s = *state_;
+  s.threads = options.threads ? options.threads : hardwareThreads();
+  s.run.threads = s.threads;
+  s.run.cancel = options.cancel;
+  s.run.progress = options.progress;
+  s.params.leafPoints = std::max<uint64_t>(options.leafPoints, 1);
+  s.params.averageColors = options.averageColors;
+  s.memory = options.memoryBytes ? options.memoryBytes : defaultBuildMemory();
+  const uint64_t n = s.inputs.points();
+  s.inMemoryChunk = lod::inMemoryChunkLimit(n, s.threads, s.params.leafPoints);
+  const uint64_t need =
+      n * kInMemoryBytesPerPoint + uint64_t(s.threads) * s.inMemoryChunk * kIndexBytesPerPoint + kFixedBytes;
+  s.inMemory = need <= s.memory;
+}
+
+OctreeBuilder::~OctreeBuilder() = default;
+
+uint64_t OctreeBuilder::points() const {
+  return state_->inputs.points();
+}
+bool OctreeBuilder::inMemory() const {
+  return state_->inMemory;
+}
+
+const lod::OctreeMetadata& OctreeBuilder::scan() {
+  State& s = *state_;
+  if (s.scanned) return s.metadata;
+  s.start = Clock::now();
+  const lod::PhaseClock readClock;
+  const auto& tasks = s.inputs.tasks();
+  std::vector<BuildInputs::Scan> scans(tasks.size());
+  if (s.inMemory) {
+    s.pieces.resize(tasks.size());
+    s.readAll("reading", [&](unsigned, size_t t, std::vector<PointRecord>&) {
+      s.inputs.read(tasks[t], s.pieces[t]);
+      scans[t] = BuildInputs::scan(s.pieces[t]);
+    });
+    if (s.inputs.decideColors(scans))
+      parallelBlocksOn(s.threads, tasks.size(), 1,
+                       [&](uint64_t t, uint64_t, uint64_t) { s.inputs.widen(tasks[t], s.pieces[t]); });
+  } else {
+    s.readAll("scanning", [&](unsigned, size_t t, std::vector<PointRecord>& records) {
+      s.inputs.read(tasks[t], records);
+      scans[t] = BuildInputs::scan(records);
+    });
+    s.inputs.decideColors(scans);
+  }
+  pointrast::detail::QuantBox box;
+  for (const auto& scan : scans)
+    box.expand(scan.box);
+  if (box.empty()) throw InputError(s.inputs.names() + ": no points to build an octree from");
+  const lod::LodGrid first = lod::makeLodGrid(box, s.inputs.scale(), s.inputs.offset());
+  s.grid =
+      lod::makeLodGrid(box, s.inputs.scale(), s.inputs.offset(),
+                       lod::gridLevelsForSpacing(first.cube.max.x - first.cube.min.x, s.options.spacing));
+  s.phases.push_back(readClock.done("read", s.inputs.points(), s.inputs.fileBytes()));
+
+  lod::OctreeMetadata& m = s.metadata;
+  m.source = s.inputs.names();
+  m.cube = s.grid.cube;
+  m.bounds = pointrast::detail::worldBounds(box, s.grid.scale, s.grid.offset);
+  m.spacing = s.grid.spacing();
+  m.scale = s.grid.scale;
+  m.offset = s.grid.offset;
+  m.pointCount = s.inputs.points();
+  m.fields = s.inputs.fields();
+  s.scanned = true;
+  return m;
+}
+
+LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::path& tempDir) {
+  State& s = *state_;
+  scan();
+  LodBuildReport report;
+  report.outOfCore = !s.inMemory;
+  report.memoryBytes = s.memory;
+  report.threads = s.threads;
+  report.inputBytes = s.inputs.fileBytes();
+  const uint64_t n = s.inputs.points();
+  const lod::LodGrid& grid = s.grid;
+
+  if (s.inMemory) {
+    lod::LodBuildStats stats = lod::buildInMemory(std::move(s.pieces), grid, s.params, sink, s.run);
+    s.phases.insert(s.phases.end(), stats.phases.begin(), stats.phases.end());
+    report.octree = stats.octree;
+    report.chunks = stats.chunks;
+  } else {
+    const auto& tasks = s.inputs.tasks();
+    lod::PhaseClock clock;
+    std::vector<uint64_t> counts(size_t(1) << 3 * grid.countLevel(), 0);
+    s.readAll("counting", [&](unsigned, size_t task, std::vector<PointRecord>& records) {
+      s.inputs.read(tasks[task], records);
+      lod::countCells(counts.data(), grid, records.data(), records.size());
+    });
+    s.phases.push_back(clock.done("count", n, s.inputs.fileBytes()));
+
+    clock = lod::PhaseClock();
+    // A chunk, indexed by one thread, may take its share of the memory bound.
+    const uint64_t chunkLimit =
+        std::max<uint64_t>(s.params.leafPoints, s.memory / (uint64_t(s.threads) * kIndexBytesPerPoint * 2));
+    const std::vector<lod::LodChunk> chunks = lod::planChunks(counts, grid.countLevel(), chunkLimit);
+    const std::vector<uint32_t> chunkOf = lod::chunkOfCell(chunks, grid.countLevel());
+    uint64_t largest = 0;
+    for (const auto& c : chunks)
+      largest = std::max(largest, c.points);
+    if (largest > chunkLimit)
+      warn(s.inputs.names(),
+           strFormat(
+               "one cell of the cube holds %s points, more than the memory bound allows one chunk to hold; "
+               "it is indexed in memory anyway",
+               humanCount(double(largest)).c_str()));
+    report.chunks = chunks.size();
+    s.phases.push_back(clock.done("chunk", n));
+
+    clock = lod::PhaseClock();
+    ChunkSpill spill(tempDir, chunks.size());
+    const uint64_t bufferBytes =
+        std::clamp<uint64_t>(s.memory / (4 * uint64_t(s.threads)), 1 << 16, 64 << 20);
+    const int shift = 3 * (lod::kCodeLevels - grid.countLevel());
+    {
+      std::vector<std::unique_ptr<ChunkSpill::Writer>> writers;
+      for (unsigned w = 0; w < s.readThreads(); ++w)
+        writers.push_back(std::make_unique<ChunkSpill::Writer>(spill, bufferBytes));
+      s.readAll("distributing", [&](unsigned worker, size_t task, std::vector<PointRecord>& records) {
+        ChunkSpill::Writer* writer = writers[worker].get();
+        s.inputs.read(tasks[task], records);
+        for (const PointRecord& r : records)
+          writer->add(chunkOf[grid.countCell(r)], r);
+      });
+      for (auto& w : writers)
+        w->flush();
+    }
+    s.phases.push_back(clock.done("distribute", n, s.inputs.fileBytes() + spill.bytesWritten()));
+
+    const size_t window = std::clamp<size_t>(s.memory / std::max<uint64_t>(1, largest * kIndexBytesPerPoint),
+                                             1, 2 * size_t(s.threads));
+    lod::ChunkLoader load = [&](size_t c, std::vector<lod::LodItem>& items) {
+      const lod::LodChunk& chunk = chunks[c];
+      thread_local std::vector<PointRecord> records;
+      spill.read(c, chunk.points, records);
+      // Grouped by histogram cell, the layout indexChunk takes (as distributePoints makes in memory).
+      std::vector<uint64_t> next(static_cast<size_t>(chunk.endCell - chunk.firstCell));
+      uint64_t at = 0;
+      for (size_t i = 0; i < next.size(); ++i) {
+        next[i] = at;
+        at += counts[chunk.firstCell + i];
+      }
+      items.resize(records.size());
+      auto changed = [&] { fail(spill.dir(), "a temporary chunk file changed while the octree was built"); };
+      for (const PointRecord& r : records) {
+        const uint64_t code = grid.code(r);
+        const uint64_t cell = (code >> shift) - chunk.firstCell;
+        if (cell >= next.size() || next[cell] >= items.size()) changed();
+        items[next[cell]++] = {code, r};
+      }
+      for (size_t i = 0; i < next.size(); ++i)
+        if (next[i] != (i + 1 < next.size() ? next[i + 1] - counts[chunk.firstCell + i + 1] : items.size()))
+          changed();
+      return std::span<lod::LodItem>(items);
+    };
+    lod::OctreeAssembler assembler(sink);
+    const lod::IndexTimes times =
+        lod::indexChunks(chunks, counts, load, grid, s.params, assembler, window, s.run);
+    s.phases.push_back(times.index);
+    s.phases.back().bytes = spill.bytesWritten();
+    s.phases.push_back(lod::writePhase(times, n));
+    report.octree = assembler.stats();
+    report.spillBytes = spill.bytesWritten();
+  }
+  report.seconds = since(s.start);
+  report.phases = s.phases;
+  report.metadata = s.metadata;
+  report.metadata.depth = report.octree.levels - 1;
+  return report;
+}
+
+} // namespace pointrast::io

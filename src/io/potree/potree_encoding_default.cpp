@@ -1,0 +1,117 @@
+// Potree 2.0 DEFAULT node encoding: each point's attributes one after another, little endian, in the
+// order metadata.json lists them (the Potree viewer's DecoderWorker.js reads them so).
+#include "io/io_util.h"
+#include "io/potree/potree_format.h"
+
+namespace pointrast::io::potree {
+
+using namespace detail;
+
+namespace {
+
+// Byte offset of each record field within a point (-1: no such attribute).
+struct FieldOffsets {
+  int position = -1, rgb = -1, intensity = -1, returnNumber = -1, classification = -1, pointSourceId = -1;
+  bool everyByte = true; // every byte of a point belongs to a record field (no zeros to write)
+};
+
+// Bytes a record field fills in a point (0: none).
+int fieldBytes(Field field) {
+  switch (field) {
+  case Field::Position:
+    return 12;
+  case Field::Rgb:
+    return 6;
+  case Field::Intensity:
+  case Field::PointSourceId:
+    return 2;
+  case Field::ReturnNumber:
+  case Field::Classification:
+    return 1;
+  case Field::Other:
+    break;
+  }
+  return 0;
+}
+
+FieldOffsets fieldOffsets(const Layout& layout) {
+  FieldOffsets o;
+  int at = 0;
+  for (const Attribute& a : layout.attributes) {
+    switch (a.field) {
+    case Field::Position:
+      o.position = at;
+      break;
+    case Field::Rgb:
+      o.rgb = at;
+      break;
+    case Field::Intensity:
+      o.intensity = at;
+      break;
+    case Field::ReturnNumber:
+      o.returnNumber = at;
+      break;
+    case Field::Classification:
+      o.classification = at;
+      break;
+    case Field::PointSourceId:
+      o.pointSourceId = at;
+      break;
+    case Field::Other:
+      break;
+    }
+    if (fieldBytes(a.field) != a.size) o.everyByte = false;
+    at += a.size;
+  }
+  return o;
+}
+
+} // namespace
+
+void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, uint8_t* dst,
+                   PotreeValueRanges& ranges) {
+  if (n == 0) return; // dst may be null
+  const FieldOffsets o = fieldOffsets(layout);
+  const size_t stride = static_cast<size_t>(layout.defaultStride);
+  if (!o.everyByte) std::memset(dst, 0, n * stride); // attributes without a record field are zeros
+  RecordExtremes extremes(ranges);
+  for (size_t i = 0; i < n; ++i) {
+    const PointRecord& r = records[i];
+    extremes.include(r);
+    uint8_t* p = dst + i * stride;
+    storeLE<int32_t>(p + o.position, r.x);
+    storeLE<int32_t>(p + o.position + 4, r.y);
+    storeLE<int32_t>(p + o.position + 8, r.z);
+    if (o.rgb >= 0)
+      for (int c = 0; c < 3; ++c)
+        storeLE<uint16_t>(p + o.rgb + 2 * c, r.rgb[c]);
+    if (o.intensity >= 0) storeLE<uint16_t>(p + o.intensity, r.intensity);
+    if (o.returnNumber >= 0) p[o.returnNumber] = r.returnNumber;
+    if (o.classification >= 0) p[o.classification] = r.classification;
+    if (o.pointSourceId >= 0) storeLE<uint16_t>(p + o.pointSourceId, r.pointSourceId);
+  }
+  extremes.into(ranges);
+  ranges.count += n;
+}
+
+void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointRecord* dst) {
+  const FieldOffsets o = fieldOffsets(layout);
+  const size_t stride = static_cast<size_t>(layout.defaultStride);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* p = src + i * stride;
+    PointRecord r;
+    r.x = loadLE<int32_t>(p + o.position);
+    r.y = loadLE<int32_t>(p + o.position + 4);
+    r.z = loadLE<int32_t>(p + o.position + 8);
+    if (o.rgb >= 0)
+      for (int c = 0; c < 3; ++c)
+        r.rgb[c] = loadLE<uint16_t>(p + o.rgb + 2 * c);
+    if (o.intensity >= 0) r.intensity = loadLE<uint16_t>(p + o.intensity);
+    if (o.returnNumber >= 0) r.returnNumber = p[o.returnNumber];
+    if (o.classification >= 0) r.classification = p[o.classification];
+    if (o.pointSourceId >= 0) r.pointSourceId = loadLE<uint16_t>(p + o.pointSourceId);
+    dst[i] = r;
+  }
+}
+
+} // namespace pointrast::io::potree
