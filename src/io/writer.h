@@ -19,11 +19,15 @@ enum class LasFlavor {
   Las14Pf7, // LAS 1.4, point format 7 (64-bit counts): 36 B records
 };
 
+// LAS or LAZ by the output's extension: ".laz" writes compressed points (LASzip chunks, see
+// las/laz_encoder.h), anything else uncompressed LAS.
+bool isLazPath(const std::filesystem::path& path);
+
 // Writes the cloud with its own scale/offset. Colors are written 16-bit (v * 257 = v << 8 | v). LAS 1.2
 // can hold at most 2^32 - 1 points; more needs Las14Pf7 (InputError otherwise).
 void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFlavor flavor);
 
-// Streams point records into a LAS file: the records' integers with the given scale/offset, their 16-bit
+// Streams point records into a LAS (or, by the extension, LAZ) file: the records' integers with the given scale/offset, their 16-bit
 // colors and point source ids as stored, the fields' attributes (zero where a field is off; return
 // number 1). For exports that do not hold the whole cloud at once. The header, with counts and bounds
 // from the points, is written by commit(); without commit() nothing is left behind.
@@ -43,6 +47,54 @@ private:
   struct State;
   std::unique_ptr<State> state_;
 };
+
+// Writes raw LAS point records, as an uncompressed LAS or a LAZ file, with a given header, VLRs and
+// EVLRs: what a lossless conversion of a LAS, LAZ or COPC file needs. The header's counts, points by
+// return, bounds, offsets and point format byte are rewritten from the records at commit(); its
+// scale/offset must be finite (InputError otherwise). LAZ: chunks of chunkSize points (or one chunk
+// per writeChunk() call with kVariableChunkSize), encoded in parallel on all cores.
+struct LasFileSetup {
+  std::vector<uint8_t> header;            // the public header block, 227 bytes or more
+  std::vector<std::vector<uint8_t>> vlrs; // each VLR's 54-byte header and payload (no LASzip VLR)
+  std::vector<std::vector<uint8_t>> evlrs; // LAS 1.4: each EVLR's 60-byte header and payload
+  int pointFormat = 3;
+  uint16_t recordLength = 34; // the format's size plus extra bytes
+  bool laz = false;
+  uint32_t chunkSize = 50000;
+};
+inline constexpr uint32_t kVariableChunkSize = 0xFFFFFFFFu;
+
+class LasFileWriter {
+public:
+  LasFileWriter(const std::filesystem::path& path, LasFileSetup setup);
+  ~LasFileWriter();
+  LasFileWriter(const LasFileWriter&) = delete;
+  LasFileWriter& operator=(const LasFileWriter&) = delete;
+
+  // count records of setup.recordLength bytes each.
+  void write(const uint8_t* records, uint64_t count);
+  // Variable-size chunks only: the records of one chunk.
+  void writeChunk(const uint8_t* records, uint64_t count);
+  uint64_t pointsWritten() const;
+  void commit();
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Converts a LAS, LAZ or COPC file to LAS or LAZ (by the output's extension) keeping every point record
+// byte for byte, the header's fields, the VLRs (extra bytes descriptions included) and the EVLRs, but
+// not the LASzip and COPC ones (their offsets would not hold). Waveform formats (4, 5, 9, 10) are
+// refused unless dropWaveforms, which writes their records without the packets (formats 1, 3, 6, 8).
+// Returns the points written. Throws InputError.
+struct LasConvertOptions {
+  bool dropWaveforms = false;
+  uint32_t chunkSize = 50000;
+  bool progress = false;
+};
+uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::path& out,
+                        const LasConvertOptions& options = {});
 
 // Exports every point of an octree as LAS through LasRecordWriter, exactly (the source's integers,
 // scale/offset and 16-bit colors): nodes in forEachNode order, decoded on all cores a batch at a time, so

@@ -1,10 +1,19 @@
-// LAS writer: 1.2 point formats 2 and 3, 1.4 point format 7 (ASPRS LAS 1.4 R15). No VLRs, so the
-// points follow the header directly. Records are built in chunks and written through PartialFile; the
-// header, whose counts and bounds depend on every point, is written last over a placeholder.
+// LAS and LAZ writers (ASPRS LAS 1.4 R15; LAZ through las/laz_encoder.h). LasFileWriter writes raw
+// records under a given header and VLRs: uncompressed after the VLRs, or as LASzip chunks after the
+// LASzip VLR, with the chunk table at the end; the header, whose counts and bounds depend on every
+// point, is written last over a placeholder, through PartialFile. LasRecordWriter builds LAS 1.2 point
+// format 2/3 or 1.4 format 7 records from PointRecords and writes them through a LasFileWriter.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <ctime>
 #include <optional>
 
+#include "base/parallel.h"
+#include "base/progress.h"
 #include "io/las/las_format.h"
+#include "io/las/laz_encoder.h"
+#include "io/las/laz_reader.h"
 #include "io/writer.h"
 
 namespace pointrast::io {
@@ -40,22 +49,380 @@ void copyString(uint8_t* dst, size_t n, const char* s) {
 
 } // namespace
 
+bool isLazPath(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".laz";
+}
+
+// ---- LasFileWriter ----------------------------------------------------------------------------------------
+
+namespace {
+
+// LAZ chunks encoded at once: a few per core, so every core has work while memory stays a few chunks
+// of records per core.
+constexpr uint64_t kChunksPerThread = 2;
+
+std::vector<uint8_t> vlrBytes(const char* userId, uint16_t recordId, const char* description,
+                              const std::vector<uint8_t>& payload) {
+  std::vector<uint8_t> v(las::kVlrHeaderSize + payload.size(), 0);
+  copyString(v.data() + 2, 16, userId);
+  storeLE<uint16_t>(v.data() + 18, recordId);
+  storeLE<uint16_t>(v.data() + 20, static_cast<uint16_t>(payload.size()));
+  copyString(v.data() + 22, 32, description);
+  std::memcpy(v.data() + las::kVlrHeaderSize, payload.data(), payload.size());
+  return v;
+}
+
+} // namespace
+
+struct LasFileWriter::State {
+  std::filesystem::path path;
+  LasFileSetup setup;
+  std::optional<PartialFile> out;
+  std::vector<uint8_t> prefix; // header and VLRs as written at commit
+  uint64_t pointOffset = 0;
+  uint64_t count = 0;
+  int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  std::array<uint64_t, 15> byReturn{};
+  // LAZ
+  std::optional<laz::Layout> layout;
+  std::vector<uint8_t> pending;        // records of the chunks not yet encoded
+  std::vector<uint64_t> pendingCounts; // their chunk sizes (the last one may be partial)
+  std::vector<laz::Chunk> table;
+  uint64_t chunkBytes = 0;
+
+  void account(const uint8_t* records, uint64_t n);
+  void encodePending(bool all);
+};
+
+void LasFileWriter::State::account(const uint8_t* records, uint64_t n) {
+  const size_t rl = setup.recordLength;
+  const bool extended = las::isExtended(setup.pointFormat);
+  for (uint64_t k = 0; k < n; ++k) {
+    const uint8_t* r = records + k * rl;
+    for (int a = 0; a < 3; ++a) {
+      const int32_t q = loadLE<int32_t>(r + 4 * a);
+      qmin[a] = std::min(qmin[a], q);
+      qmax[a] = std::max(qmax[a], q);
+    }
+    const unsigned rn = extended ? (r[14] & 0x0F) : (r[14] & 0x07);
+    if (rn >= 1 && rn <= 15) ++byReturn[rn - 1];
+  }
+  count += n;
+}
+
+void LasFileWriter::State::encodePending(bool all) {
+  const unsigned threads = hardwareThreads();
+  const size_t rl = setup.recordLength;
+  size_t ready = pendingCounts.size();
+  // A partial last chunk of fixed size waits for more records unless this is the end.
+  if (!all && !layout->variableChunks() && ready > 0 && pendingCounts.back() < setup.chunkSize) --ready;
+  if (ready == 0 || (!all && ready < threads * kChunksPerThread)) return;
+  const std::vector<uint64_t> counts(pendingCounts.begin(), pendingCounts.begin() + ptrdiff_t(ready));
+  const std::vector<std::vector<uint8_t>> chunks = laz::encodeChunks(*layout, pending.data(), counts);
+  uint64_t used = 0;
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    out->write(chunks[i].data(), chunks[i].size());
+    table.push_back({0, chunks[i].size(), 0, counts[i]});
+    chunkBytes += chunks[i].size();
+    used += counts[i];
+  }
+  pending.erase(pending.begin(), pending.begin() + ptrdiff_t(used * rl));
+  pendingCounts.erase(pendingCounts.begin(), pendingCounts.begin() + ptrdiff_t(ready));
+}
+
+LasFileWriter::LasFileWriter(const std::filesystem::path& path, LasFileSetup setup)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.path = path;
+  s.setup = std::move(setup);
+  const LasFileSetup& st = s.setup;
+  if (st.header.size() < las::kHeaderSize12 || st.header.size() > UINT16_MAX)
+    fail(path, "the LAS header to write has a wrong size");
+  if (st.pointFormat < 0 || st.pointFormat > las::kMaxPointFormat ||
+      st.recordLength < las::kRecordSize[size_t(st.pointFormat)])
+    fail(path, strFormat("point format %d cannot have %u-byte records", st.pointFormat, st.recordLength));
+  const uint8_t minor = st.header[las::kVersionMinor];
+  if (las::isExtended(st.pointFormat) && minor < 4)
+    fail(path, strFormat("point format %d needs LAS 1.4, the header says 1.%u", st.pointFormat, minor));
+  if ((!st.evlrs.empty() && minor < 4) || (minor >= 4 && st.header.size() < las::kHeaderSize14))
+    fail(path, "the LAS header to write is too short for its version");
+  for (int a = 0; a < 3; ++a) {
+    const double scale = loadLE<double>(st.header.data() + las::kScale + 8 * a);
+    const double offset = loadLE<double>(st.header.data() + las::kOffset + 8 * a);
+    if (!std::isfinite(scale) || scale == 0.0 || !std::isfinite(offset))
+      fail(path, "the scale/offset (NaN, infinite or a zero scale) cannot be written as LAS");
+  }
+  s.prefix = st.header;
+  uint32_t vlrCount = 0;
+  for (const std::vector<uint8_t>& v : st.vlrs) {
+    if (v.size() < las::kVlrHeaderSize || v.size() - las::kVlrHeaderSize > UINT16_MAX)
+      fail(path, "a VLR to write has a wrong size");
+    s.prefix.insert(s.prefix.end(), v.begin(), v.end());
+    ++vlrCount;
+  }
+  if (st.laz) {
+    if (!laz::canEncodePointFormat(st.pointFormat))
+      fail(path, strFormat("point format %d cannot be written as LAZ (formats 0-3 and 6-8 can)", st.pointFormat));
+    if (st.chunkSize == 0) fail(path, "a LAZ chunk size of 0 points");
+    s.layout = laz::encoderLayout(st.pointFormat, st.recordLength, st.chunkSize);
+    const std::vector<uint8_t> vlr =
+        vlrBytes("laszip encoded", 22204, "LAZ by pointrast", laz::laszipVlrPayload(*s.layout));
+    s.prefix.insert(s.prefix.end(), vlr.begin(), vlr.end());
+    ++vlrCount;
+  }
+  if (s.prefix.size() > UINT32_MAX) fail(path, "the VLRs are too large for a LAS header");
+  s.pointOffset = s.prefix.size();
+  storeLE<uint32_t>(s.prefix.data() + las::kPointOffset, uint32_t(s.pointOffset));
+  storeLE<uint32_t>(s.prefix.data() + las::kVlrCount, vlrCount);
+  s.out.emplace(path);
+  const std::vector<uint8_t> placeholder(s.prefix.size() + (st.laz ? 8 : 0), 0);
+  s.out->write(placeholder.data(), placeholder.size());
+}
+
+LasFileWriter::~LasFileWriter() = default;
+
+void LasFileWriter::write(const uint8_t* records, uint64_t count) {
+  State& s = *state_;
+  const size_t rl = s.setup.recordLength;
+  if (s.setup.header[las::kVersionMinor] < 4 && s.count + count > UINT32_MAX)
+    fail(s.path, "more than 4294967295 points do not fit in LAS 1.0-1.3; write LAS 1.4");
+  if (!s.layout) {
+    s.account(records, count);
+    s.out->write(records, size_t(count * rl));
+    return;
+  }
+  if (s.layout->variableChunks()) {
+    writeChunk(records, count);
+    return;
+  }
+  s.account(records, count);
+  for (uint64_t done = 0; done < count;) {
+    if (s.pendingCounts.empty() || s.pendingCounts.back() == s.setup.chunkSize) s.pendingCounts.push_back(0);
+    const uint64_t n = std::min<uint64_t>(count - done, s.setup.chunkSize - s.pendingCounts.back());
+    s.pending.insert(s.pending.end(), records + done * rl, records + (done + n) * rl);
+    s.pendingCounts.back() += n;
+    done += n;
+    s.encodePending(false);
+  }
+}
+
+void LasFileWriter::writeChunk(const uint8_t* records, uint64_t count) {
+  State& s = *state_;
+  if (!s.layout || !s.layout->variableChunks()) {
+    write(records, count);
+    return;
+  }
+  if (count == 0) return;
+  if (count > UINT32_MAX) fail(s.path, "a LAZ chunk of more than 4294967295 points");
+  s.account(records, count);
+  s.pending.insert(s.pending.end(), records, records + count * s.setup.recordLength);
+  s.pendingCounts.push_back(count);
+  s.encodePending(false);
+}
+
+uint64_t LasFileWriter::pointsWritten() const {
+  return state_->count;
+}
+
+void LasFileWriter::commit() {
+  State& s = *state_;
+  const LasFileSetup& st = s.setup;
+  uint8_t* h = s.prefix.data();
+  uint64_t end = s.pointOffset + s.count * st.recordLength;
+  if (s.layout) {
+    s.encodePending(true);
+    const uint64_t tableOffset = s.pointOffset + 8 + s.chunkBytes;
+    const std::vector<uint8_t> table = laz::encodeChunkTable(s.table, s.layout->variableChunks());
+    s.out->write(table.data(), table.size());
+    uint8_t offset[8];
+    storeLE<int64_t>(offset, int64_t(tableOffset));
+    s.out->writeAt(s.pointOffset, offset, 8);
+    end = tableOffset + table.size();
+  }
+  for (const std::vector<uint8_t>& e : st.evlrs)
+    s.out->write(e.data(), e.size());
+
+  const bool extended = las::isExtended(st.pointFormat);
+  const uint8_t minor = h[las::kVersionMinor];
+  h[las::kPointFormat] = static_cast<uint8_t>(st.pointFormat | (s.layout ? 0x80 : 0));
+  storeLE<uint16_t>(h + las::kRecordLength, st.recordLength);
+  // The legacy fields hold formats 0-5 up to 2^32 - 1 points; formats 6-10 leave them 0 (R15 2.4).
+  const bool legacy = !extended && s.count <= UINT32_MAX;
+  storeLE<uint32_t>(h + las::kLegacyCount, legacy ? uint32_t(s.count) : 0);
+  for (int i = 0; i < 5; ++i)
+    storeLE<uint32_t>(h + las::kLegacyByReturn + 4 * i, legacy ? uint32_t(s.byReturn[size_t(i)]) : 0);
+  glm::dvec3 scale, offset;
+  for (int a = 0; a < 3; ++a) {
+    scale[a] = loadLE<double>(h + las::kScale + 8 * a);
+    offset[a] = loadLE<double>(h + las::kOffset + 8 * a);
+  }
+  Bounds bounds;
+  if (s.count > 0)
+    bounds = boundsFromQuantized(s.qmin, s.qmax, scale, offset);
+  else
+    bounds.min = bounds.max = glm::dvec3(0);
+  for (int a = 0; a < 3; ++a) {
+    storeLE<double>(h + las::kMaxX + 16 * a, bounds.max[a]);
+    storeLE<double>(h + las::kMaxX + 16 * a + 8, bounds.min[a]);
+  }
+  if (minor >= 3 && st.header.size() >= las::kHeaderSize13 && st.pointFormat != 4 && st.pointFormat != 5 &&
+      st.pointFormat != 9 && st.pointFormat != 10)
+    storeLE<uint64_t>(h + las::kWaveformStart, 0);
+  if (minor >= 4) {
+    storeLE<uint64_t>(h + las::kEvlrStart, st.evlrs.empty() ? 0 : end);
+    storeLE<uint32_t>(h + las::kEvlrCount, uint32_t(st.evlrs.size()));
+    storeLE<uint64_t>(h + las::kCount64, s.count);
+    for (int i = 0; i < 15; ++i)
+      storeLE<uint64_t>(h + las::kByReturn64 + 8 * i, s.byReturn[size_t(i)]);
+  }
+  s.out->writeAt(0, s.prefix.data(), s.prefix.size());
+  s.out->commit();
+}
+
+// ---- convertLasFile ---------------------------------------------------------------------------------------
+
+namespace {
+
+// Waveform formats and the format of their records without the 29-byte wave packet: the packet starts
+// where the base format's record ends.
+int withoutWaveform(int pointFormat) {
+  switch (pointFormat) {
+  case 4:
+    return 1;
+  case 5:
+    return 3;
+  case 9:
+    return 6;
+  case 10:
+    return 8;
+  default:
+    return pointFormat;
+  }
+}
+constexpr uint16_t kWavePacketBytes = 29;
+
+// The EVLRs of a LAS 1.4 file, each its 60-byte header and payload; COPC's are left out.
+std::vector<std::vector<uint8_t>> readEvlrs(const InputFile& file, const LasHeader& hd) {
+  std::vector<std::vector<uint8_t>> out;
+  uint64_t at = hd.evlrStart;
+  constexpr uint64_t kEvlrHeader = 60;
+  for (uint32_t i = 0; i < hd.evlrCount && hd.evlrStart != 0; ++i) {
+    if (at > file.size() || file.size() - at < kEvlrHeader)
+      fail(file.path(), strFormat("EVLR %u of %u lies past the end of the file", i + 1, hd.evlrCount));
+    std::vector<uint8_t> e(kEvlrHeader);
+    file.readAt(at, e.data(), e.size());
+    const uint64_t length = loadLE<uint64_t>(e.data() + 20);
+    if (length > file.size() - at - kEvlrHeader)
+      fail(file.path(), strFormat("EVLR %u of %u runs past the end of the file", i + 1, hd.evlrCount));
+    const std::string userId(reinterpret_cast<const char*>(e.data() + 2), strnlen(reinterpret_cast<const char*>(e.data() + 2), 16));
+    if (userId != "copc") {
+      e.resize(kEvlrHeader + length);
+      file.readAt(at + kEvlrHeader, e.data() + kEvlrHeader, size_t(length));
+      out.push_back(std::move(e));
+    }
+    at += kEvlrHeader + length;
+  }
+  return out;
+}
+
+} // namespace
+
+uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::path& outPath,
+                        const LasConvertOptions& options) {
+  InputFile file(in);
+  const bool compressed = lasLooksCompressed(file);
+  std::optional<laz::LazFile> lazFile;
+  LasHeader hd;
+  if (compressed) {
+    lazFile = laz::openLaz(file);
+    hd = lazFile->header;
+  } else {
+    hd = readLasHeader(file);
+  }
+  const int format = withoutWaveform(hd.pointFormat);
+  const bool dropWaves = format != hd.pointFormat;
+  if (dropWaves && !options.dropWaveforms)
+    fail(in, strFormat("point format %d carries waveform packets, which the output would lose; "
+                       "--drop-waveforms writes the points without them (format %d)",
+                       hd.pointFormat, format));
+  const uint16_t baseBytes = las::kRecordSize[size_t(format)];
+  const uint16_t inBase = las::kRecordSize[size_t(hd.pointFormat)];
+  if (hd.recordLength < inBase)
+    fail(in, strFormat("%u-byte records are too short for point format %d", hd.recordLength, hd.pointFormat));
+  const uint16_t extraBytes = uint16_t(hd.recordLength - inBase);
+
+  LasFileSetup setup;
+  setup.header.resize(hd.headerSize);
+  file.readAt(0, setup.header.data(), setup.header.size());
+  setup.pointFormat = format;
+  setup.recordLength = uint16_t(baseBytes + extraBytes);
+  setup.laz = isLazPath(outPath);
+  setup.chunkSize = options.chunkSize;
+  if (dropWaves) {
+    // Global encoding bits 1 and 2: waveform data packets internal / external.
+    const uint16_t ge = loadLE<uint16_t>(setup.header.data() + las::kGlobalEncoding);
+    storeLE<uint16_t>(setup.header.data() + las::kGlobalEncoding, uint16_t(ge & ~0x6u));
+  }
+  for (const LasVlr& vlr : hd.vlrs) {
+    if (vlr.userId == "laszip encoded" || vlr.userId == "copc") continue;
+    // Waveform packet descriptors (LASF_Spec 100-354) describe packets that are no longer there.
+    if (dropWaves && vlr.userId == "LASF_Spec" && vlr.recordId >= 100 && vlr.recordId < 355) continue;
+    std::vector<uint8_t> v(las::kVlrHeaderSize + vlr.length);
+    file.readAt(vlr.dataOffset - las::kVlrHeaderSize, v.data(), v.size());
+    setup.vlrs.push_back(std::move(v));
+  }
+  if (hd.versionMinor >= 4) setup.evlrs = readEvlrs(file, hd);
+
+  LasFileWriter writer(outPath, std::move(setup));
+  std::optional<Progress> line;
+  if (options.progress) line.emplace("converting " + in.filename().string(), hd.pointCount);
+  std::vector<uint8_t> stripped;
+  auto deliver = [&](const uint8_t* records, uint64_t n) {
+    if (dropWaves) {
+      const size_t outLength = size_t(baseBytes) + extraBytes;
+      stripped.resize(size_t(n) * outLength);
+      for (uint64_t k = 0; k < n; ++k) {
+        const uint8_t* r = records + k * hd.recordLength;
+        std::memcpy(stripped.data() + k * outLength, r, baseBytes);
+        std::memcpy(stripped.data() + k * outLength + baseBytes, r + baseBytes + kWavePacketBytes, extraBytes);
+      }
+      records = stripped.data();
+    }
+    writer.write(records, n);
+    if (line) line->advance(n);
+  };
+  if (compressed) {
+    detail::decodeLazInWindows(file, *lazFile, detail::lazThreads(),
+                               [&](size_t, std::vector<std::vector<uint8_t>>& records) {
+                                 for (const std::vector<uint8_t>& r : records)
+                                   deliver(r.data(), r.size() / hd.recordLength);
+                               });
+  } else {
+    forEachRecordChunk(file, hd.pointOffset, hd.pointCount, hd.recordLength, lasChunkBytes(),
+                       [&](const uint8_t* records, uint64_t, uint64_t n) { deliver(records, n); });
+  }
+  if (line) line->finish();
+  const uint64_t written = writer.pointsWritten();
+  writer.commit();
+  return written;
+}
+
+// ---- LasRecordWriter --------------------------------------------------------------------------------------
+
 struct LasRecordWriter::State {
   State(const std::filesystem::path& p, LasFlavor flavor) : f(flavorInfo(flavor)), path(p) {}
 
   FlavorInfo f;
   std::filesystem::path path;
-  std::optional<PartialFile> out;
+  std::optional<LasFileWriter> out;
   uint16_t recordLength = 0;
-  glm::dvec3 scale{1.0}, offset{0.0};
   RecordFields fields;
-  uint64_t count = 0;
-  int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-  std::array<uint64_t, 15> byReturn{};
   std::vector<uint8_t> buffer;
 
   void encode(const PointRecord* records, size_t n);
-  void header(uint8_t* h) const;
+  std::vector<uint8_t> header(const glm::dvec3& scale, const glm::dvec3& offset) const;
 };
 
 void LasRecordWriter::State::encode(const PointRecord* records, size_t n) {
@@ -65,12 +432,9 @@ void LasRecordWriter::State::encode(const PointRecord* records, size_t n) {
   for (size_t k = 0; k < n; ++k) {
     const PointRecord& p = records[k];
     uint8_t* r = buffer.data() + k * recordLength;
-    const int32_t q[3] = {p.x, p.y, p.z};
-    for (int a = 0; a < 3; ++a) {
-      storeLE<int32_t>(r + 4 * a, q[a]);
-      qmin[a] = std::min(qmin[a], q[a]);
-      qmax[a] = std::max(qmax[a], q[a]);
-    }
+    storeLE<int32_t>(r, p.x);
+    storeLE<int32_t>(r + 4, p.y);
+    storeLE<int32_t>(r + 8, p.z);
     storeLE<uint16_t>(r + 12, fields.intensity ? p.intensity : 0);
     // Number of returns is not kept by records; writing it equal to the return number keeps the record
     // valid (return number <= number of returns).
@@ -87,22 +451,18 @@ void LasRecordWriter::State::encode(const PointRecord* records, size_t n) {
       r[15] = cls & 0x1F;                           // classes above 31 do not fit formats 0-5
       storeLE<uint16_t>(r + 18, fields.pointSourceId ? p.pointSourceId : 0);
     }
-    if (rn >= 1 && rn <= (extended ? 15 : 5)) ++byReturn[static_cast<size_t>(rn - 1)];
     if (fields.color && rgbOffset >= 0)
       for (int ch = 0; ch < 3; ++ch)
         storeLE<uint16_t>(r + rgbOffset + 2 * ch, p.rgb[ch]);
   }
 }
 
-// Public header block, R15 Table 3 (offsets in las_format.h), for the points written so far.
-void LasRecordWriter::State::header(uint8_t* h) const {
+// Public header block, R15 Table 3 (offsets in las_format.h), without the counts and bounds, which
+// LasFileWriter fills in from the records.
+std::vector<uint8_t> LasRecordWriter::State::header(const glm::dvec3& scale, const glm::dvec3& offset) const {
   const bool extended = las::isExtended(f.pointFormat);
-  Bounds bounds;
-  if (count > 0)
-    bounds = boundsFromQuantized(qmin, qmax, scale, offset); // exactly what a reader computes
-  else
-    bounds.min = bounds.max = glm::dvec3(0);
-  std::memset(h, 0, las::kHeaderSize14);
+  std::vector<uint8_t> bytes(f.headerSize, 0);
+  uint8_t* h = bytes.data();
   std::memcpy(h, "LASF", 4);
   // Global encoding bit 4: CRS (if any) is WKT, required for point formats 6-10 (R15 2.4).
   storeLE<uint16_t>(h + las::kGlobalEncoding, extended ? 0x10 : 0);
@@ -116,27 +476,11 @@ void LasRecordWriter::State::header(uint8_t* h) const {
   storeLE<uint16_t>(h + las::kCreationDay, static_cast<uint16_t>(utc.tm_yday + 1));
   storeLE<uint16_t>(h + las::kCreationYear, static_cast<uint16_t>(utc.tm_year + 1900));
   storeLE<uint16_t>(h + las::kHeaderSizeField, static_cast<uint16_t>(f.headerSize));
-  storeLE<uint32_t>(h + las::kPointOffset, static_cast<uint32_t>(f.headerSize));
-  storeLE<uint32_t>(h + las::kVlrCount, 0);
-  h[las::kPointFormat] = static_cast<uint8_t>(f.pointFormat);
-  storeLE<uint16_t>(h + las::kRecordLength, recordLength);
-  // The legacy count fields stay 0 for formats 6-10 (R15 2.4).
-  if (!extended) {
-    storeLE<uint32_t>(h + las::kLegacyCount, static_cast<uint32_t>(count));
-    for (int i = 0; i < 5; ++i)
-      storeLE<uint32_t>(h + las::kLegacyByReturn + 4 * i, static_cast<uint32_t>(byReturn[i]));
-  }
   for (int a = 0; a < 3; ++a) {
     storeLE<double>(h + las::kScale + 8 * a, scale[a]);
     storeLE<double>(h + las::kOffset + 8 * a, offset[a]);
-    storeLE<double>(h + las::kMaxX + 16 * a, bounds.max[a]);
-    storeLE<double>(h + las::kMaxX + 16 * a + 8, bounds.min[a]);
   }
-  if (f.minor >= 4) {
-    storeLE<uint64_t>(h + las::kCount64, count);
-    for (int i = 0; i < 15; ++i)
-      storeLE<uint64_t>(h + las::kByReturn64 + 8 * i, byReturn[i]);
-  }
+  return bytes;
 }
 
 LasRecordWriter::LasRecordWriter(const std::filesystem::path& path, const glm::dvec3& scale,
@@ -146,39 +490,35 @@ LasRecordWriter::LasRecordWriter(const std::filesystem::path& path, const glm::d
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(scale[a]) || scale[a] == 0.0 || !std::isfinite(offset[a]))
       fail(path, "the cloud's scale/offset cannot be written as LAS");
-  s.scale = scale;
-  s.offset = offset;
   s.fields = fields;
   s.recordLength = las::kRecordSize[static_cast<size_t>(s.f.pointFormat)];
-  s.out.emplace(path);
-  uint8_t placeholder[las::kHeaderSize14] = {}; // rewritten at commit(), when the counts are known
-  s.out->write(placeholder, s.f.headerSize);
+  LasFileSetup setup;
+  setup.header = s.header(scale, offset);
+  setup.pointFormat = s.f.pointFormat;
+  setup.recordLength = s.recordLength;
+  setup.laz = isLazPath(path);
+  s.out.emplace(path, std::move(setup));
 }
 
 LasRecordWriter::~LasRecordWriter() = default;
 
 void LasRecordWriter::write(const PointRecord* records, size_t count) {
   State& s = *state_;
-  if (s.f.minor < 4 && s.count + count > UINT32_MAX)
+  if (s.f.minor < 4 && s.out->pointsWritten() + count > UINT32_MAX)
     fail(s.path, "more than 4294967295 points do not fit in LAS 1.2; write LAS 1.4");
   for (size_t first = 0; first < count; first += kChunkPoints) {
     const size_t n = static_cast<size_t>(std::min<uint64_t>(kChunkPoints, count - first));
     s.encode(records + first, n);
-    s.out->write(s.buffer.data(), s.buffer.size());
+    s.out->write(s.buffer.data(), n);
   }
-  s.count += count;
 }
 
 uint64_t LasRecordWriter::pointsWritten() const {
-  return state_->count;
+  return state_->out->pointsWritten();
 }
 
 void LasRecordWriter::commit() {
-  State& s = *state_;
-  uint8_t h[las::kHeaderSize14];
-  s.header(h);
-  s.out->writeAt(0, h, s.f.headerSize);
-  s.out->commit();
+  state_->out->commit();
 }
 
 void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFlavor flavor) {

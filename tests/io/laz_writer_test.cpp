@@ -1,0 +1,321 @@
+// LAZ encoder and lossless LAS/LAZ conversion: random records of every point format round-trip through
+// the encoder and pointrast's decoder byte for byte; every LAS/LAZ file of the shared data converts to
+// LAZ and LAS keeping its records; hostile inputs give one InputError and leave no file.
+#include <map>
+#include <random>
+
+#include "io/io_test_util.h"
+#include "io/las/las_format.h"
+#include "io/las/laz_chunk.h"
+#include "io/las/laz_encoder.h"
+#include "io/las/laz_reader.h"
+#include "io/writer.h"
+
+using pointrast::InputError;
+using namespace pointrast::io;
+namespace las = pointrast::io::detail::las;
+using pointrast::io::detail::loadLE;
+using pointrast::io::detail::storeLE;
+
+namespace {
+
+// Records that exercise every branch of the item coders: coordinates as random walks with jumps
+// (int32 extremes included), returns that count up, down and jump, GPS times in interleaved sequences
+// with huge jumps and repeats, scanner channel switches, colors with equal and unequal channels, extra
+// bytes that mostly stay.
+std::vector<uint8_t> randomRecords(int pointFormat, uint16_t recordLength, uint64_t n, uint32_t seed) {
+  std::mt19937_64 rng(seed);
+  auto pick = [&](uint64_t k) { return rng() % k; };
+  std::vector<uint8_t> out(n * recordLength);
+  const bool extended = pointFormat >= 6;
+  const int base = las::kRecordSize[size_t(pointFormat)];
+  const int rgb = las::kRgbOffset[size_t(pointFormat)];
+  const bool gps = pointFormat == 1 || pointFormat == 3 || extended;
+  const int gpsAt = extended ? 22 : 20;
+  int32_t xyz[3] = {0, 0, 0};
+  double times[3] = {1000.0, 5e8, 3.5};
+  std::vector<uint8_t> last(recordLength, 0);
+  for (uint64_t i = 0; i < n; ++i) {
+    uint8_t* r = out.data() + i * recordLength;
+    std::memcpy(r, last.data(), recordLength);
+    for (int a = 0; a < 3; ++a) {
+      const uint64_t mode = pick(20);
+      if (mode == 0)
+        xyz[a] = pick(2) ? INT32_MIN : INT32_MAX;
+      else if (mode == 1)
+        xyz[a] = int32_t(uint32_t(rng()));
+      else
+        xyz[a] = int32_t(uint32_t(xyz[a]) + uint32_t(int32_t(pick(200)) - 100));
+      storeLE<int32_t>(r + 4 * a, xyz[a]);
+    }
+    if (pick(3) == 0) storeLE<uint16_t>(r + 12, uint16_t(pick(4) ? pick(300) : rng()));
+    if (pick(4) == 0) r[14] = uint8_t(pick(3) ? (r[14] & 0xF0) | ((r[14] + 1) & 0x0F) : rng());
+    if (pick(5) == 0) r[15] = uint8_t(rng()); // flags / channel (6-10), class and flags (0-5)
+    if (pick(5) == 0) r[16] = uint8_t(pick(2) ? pick(40) : rng());
+    if (pick(6) == 0) r[17] = uint8_t(rng());
+    if (extended) {
+      if (pick(6) == 0) storeLE<int16_t>(r + 18, int16_t(rng()));
+      if (pick(8) == 0) storeLE<uint16_t>(r + 20, uint16_t(rng()));
+    } else {
+      if (pick(8) == 0) storeLE<uint16_t>(r + 18, uint16_t(rng()));
+    }
+    if (gps) {
+      const uint64_t mode = pick(10);
+      double t = loadLE<double>(r + gpsAt);
+      if (mode < 5) {
+        const int s = int(pick(3));
+        times[s] += (mode == 0 ? 1e-5 : 1e-6) * double(1 + pick(3));
+        t = times[s];
+      } else if (mode == 5) {
+        t = times[0] + double(pick(1000)) * 1e3;
+      } else if (mode == 6) {
+        std::memcpy(&t, &times[1], 8);
+        uint64_t bits;
+        std::memcpy(&bits, &t, 8);
+        bits ^= rng();
+        std::memcpy(&t, &bits, 8);
+      } // else: the same time again
+      storeLE<double>(r + gpsAt, t);
+    }
+    if (rgb >= 0 && pick(3) == 0) {
+      const uint16_t v = uint16_t(pick(2) ? pick(256) * 257 : rng());
+      for (int c = 0; c < 3; ++c)
+        storeLE<uint16_t>(r + rgb + 2 * c, pick(3) == 0 ? v : uint16_t(v + pick(700)));
+      if (pointFormat == 8 && pick(2)) storeLE<uint16_t>(r + 36, uint16_t(rng()));
+    }
+    for (int b = base; b < recordLength; ++b)
+      if (pick(4) == 0) r[b] = uint8_t(pick(2) ? r[b] + 1 : rng());
+    std::memcpy(last.data(), r, recordLength);
+  }
+  return out;
+}
+
+std::vector<uint8_t> decodeChunk(const laz::Layout& layout, const std::vector<uint8_t>& bytes, uint64_t count) {
+  laz::ChunkDecoder decoder(layout);
+  std::vector<uint8_t> out;
+  decoder.decode(bytes.data(), bytes.size(), count, out);
+  return out;
+}
+
+// The point records of a LAS or LAZ file as an uncompressed file holds them.
+std::vector<uint8_t> recordsOf(const std::filesystem::path& path) {
+  detail::InputFile file(path);
+  if (detail::lasLooksCompressed(file)) return readLazRecords(path);
+  const detail::LasHeader hd = detail::readLasHeader(file);
+  std::vector<uint8_t> out(hd.pointCount * hd.recordLength);
+  file.readAt(hd.pointOffset, out.data(), out.size());
+  return out;
+}
+
+detail::LasHeader headerOf(const std::filesystem::path& path) {
+  detail::InputFile file(path);
+  return detail::readLasHeader(file, true);
+}
+
+// The VLRs other than LASzip's and COPC's, as (user id, record id) -> payload.
+std::map<std::pair<std::string, uint16_t>, std::vector<uint8_t>> vlrsOf(const std::filesystem::path& path) {
+  detail::InputFile file(path);
+  const detail::LasHeader hd = detail::readLasHeader(file, true);
+  std::map<std::pair<std::string, uint16_t>, std::vector<uint8_t>> out;
+  for (const detail::LasVlr& v : hd.vlrs) {
+    if (v.userId == "laszip encoded" || v.userId == "copc") continue;
+    std::vector<uint8_t> payload(v.length);
+    file.readAt(v.dataOffset, payload.data(), payload.size());
+    out[{v.userId, v.recordId}] = payload;
+  }
+  return out;
+}
+
+struct FormatCase {
+  int pointFormat;
+  uint16_t extraBytes;
+};
+
+class LazEncoderFormats : public ::testing::TestWithParam<FormatCase> {};
+
+TEST_P(LazEncoderFormats, RandomRecordsRoundTripThroughTheDecoder) {
+  const FormatCase c = GetParam();
+  const uint16_t rl = uint16_t(las::kRecordSize[size_t(c.pointFormat)] + c.extraBytes);
+  const laz::Layout layout = laz::encoderLayout(c.pointFormat, rl, 50000);
+  laz::ChunkEncoder encoder(layout);
+  for (uint64_t n : {uint64_t(1), uint64_t(2), uint64_t(7), uint64_t(5000)}) {
+    for (uint32_t seed = 1; seed <= 3; ++seed) {
+      const std::vector<uint8_t> records = randomRecords(c.pointFormat, rl, n, seed);
+      const std::vector<uint8_t> bytes = encoder.encode(records.data(), n);
+      ASSERT_EQ(decodeChunk(layout, bytes, n), records) << "format " << c.pointFormat << ", " << n << " points";
+    }
+  }
+  // Constant records: every layer but XY written empty.
+  std::vector<uint8_t> same = randomRecords(c.pointFormat, rl, 1, 9);
+  for (int i = 0; i < 99; ++i)
+    same.insert(same.end(), same.begin(), same.begin() + rl);
+  EXPECT_EQ(decodeChunk(layout, encoder.encode(same.data(), 100), 100), same);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllFormats, LazEncoderFormats,
+                         ::testing::Values(FormatCase{0, 0}, FormatCase{1, 0}, FormatCase{2, 0}, FormatCase{3, 0},
+                                           FormatCase{3, 5}, FormatCase{0, 1}, FormatCase{6, 0},
+                                           FormatCase{7, 0}, FormatCase{8, 0}, FormatCase{6, 3},
+                                           FormatCase{7, 12}));
+
+// A file of random records through LasFileWriter, fixed and variable chunks, read back by readLazRecords.
+TEST(LazWriter, FixedAndVariableChunksReadBack) {
+  iotest::TempDir dir;
+  for (int format : {3, 7}) {
+    const uint16_t rl = uint16_t(las::kRecordSize[size_t(format)] + 2);
+    const std::vector<uint8_t> records = randomRecords(format, rl, 23456, 5);
+    for (uint32_t chunkSize : {uint32_t(1000), uint32_t(50000), kVariableChunkSize}) {
+      LasFileSetup setup;
+      setup.header.assign(las::kHeaderSize14, 0);
+      std::memcpy(setup.header.data(), "LASF", 4);
+      setup.header[las::kVersionMajor] = 1;
+      setup.header[las::kVersionMinor] = 4;
+      storeLE<uint16_t>(setup.header.data() + las::kHeaderSizeField, uint16_t(las::kHeaderSize14));
+      for (int a = 0; a < 3; ++a)
+        storeLE<double>(setup.header.data() + las::kScale + 8 * a, 0.01);
+      setup.pointFormat = format;
+      setup.recordLength = rl;
+      setup.laz = true;
+      setup.chunkSize = chunkSize;
+      const auto out = dir / ("f" + std::to_string(format) + "-" + std::to_string(chunkSize) + ".laz");
+      {
+        LasFileWriter writer(out, setup);
+        // Uneven pieces: 1, 2, 3... points (one chunk each with variable chunks).
+        uint64_t at = 0;
+        for (uint64_t n = 1; at < 23456; ++n) {
+          const uint64_t k = std::min<uint64_t>(n * 37, 23456 - at);
+          writer.writeChunk(records.data() + at * rl, k);
+          at += k;
+        }
+        writer.commit();
+      }
+      EXPECT_EQ(readLazRecords(out, 1), records) << out;
+      EXPECT_EQ(readLazRecords(out, 4), records) << out;
+      const detail::LasHeader hd = headerOf(out);
+      EXPECT_EQ(hd.pointCount, 23456u);
+      EXPECT_EQ(hd.pointFormat, format);
+    }
+  }
+}
+
+// Every LAS/LAZ file of the shared data to LAZ and to LAS: the same records, byte for byte, the same
+// VLRs (but LASzip's and COPC's), the same header fields.
+TEST(LazWriter, SharedDataConvertsLosslessly) {
+  iotest::TempDir dir;
+  int converted = 0;
+  for (const char* folder : {"las", "laz"}) {
+    for (const auto& entry : std::filesystem::directory_iterator(iotest::data(folder))) {
+      const std::filesystem::path in = entry.path();
+      const std::string ext = in.extension().string();
+      if (ext != ".las" && ext != ".laz") continue;
+      // LASzip 1.x files are refused by the reader; the conversion must refuse them the same way.
+      if (in.filename().string().find("laszip-compressor-version-1") != std::string::npos) {
+        EXPECT_THROW(convertLasFile(in, dir / "refused.laz"), InputError);
+        EXPECT_FALSE(std::filesystem::exists(dir / "refused.laz"));
+        continue;
+      }
+      SCOPED_TRACE(in.string());
+      const std::vector<uint8_t> records = recordsOf(in);
+      const detail::LasHeader inHeader = headerOf(in);
+      for (const char* outExt : {".laz", ".las"}) {
+        const auto out = dir / (in.stem().string() + outExt);
+        const uint64_t written = convertLasFile(in, out);
+        EXPECT_EQ(written, inHeader.pointCount);
+        EXPECT_EQ(recordsOf(out), records) << out;
+        const detail::LasHeader hd = headerOf(out);
+        EXPECT_EQ(hd.pointFormat, inHeader.pointFormat);
+        EXPECT_EQ(hd.recordLength, inHeader.recordLength);
+        EXPECT_EQ(hd.versionMinor, inHeader.versionMinor);
+        EXPECT_EQ(hd.pointCount, inHeader.pointCount);
+        EXPECT_EQ(hd.scale, inHeader.scale);
+        EXPECT_EQ(hd.offset, inHeader.offset);
+        EXPECT_EQ(vlrsOf(out), vlrsOf(in));
+        ++converted;
+      }
+    }
+  }
+  EXPECT_GE(converted, 2 * 18);
+}
+
+TEST(LazWriter, HostileInputsGiveOneError) {
+  iotest::TempDir dir;
+  // A header whose point count promises more records than the file holds.
+  std::vector<uint8_t> bytes = iotest::readBytes(iotest::data("las/1.2-with-color.las"));
+  storeLE<uint32_t>(bytes.data() + las::kLegacyCount, loadLE<uint32_t>(bytes.data() + las::kLegacyCount) + 1000);
+  iotest::writeBytes(dir / "lying.las", bytes);
+  EXPECT_THROW(convertLasFile(dir / "lying.las", dir / "lying.laz"), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "lying.laz"));
+  EXPECT_FALSE(std::filesystem::exists(detail::partialPath(dir / "lying.laz")));
+
+  // NaN scale.
+  bytes = iotest::readBytes(iotest::data("las/1.2-with-color.las"));
+  storeLE<double>(bytes.data() + las::kScale, std::nan(""));
+  iotest::writeBytes(dir / "nan.las", bytes);
+  EXPECT_THROW(convertLasFile(dir / "nan.las", dir / "nan.laz"), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "nan.laz"));
+
+  // A LAZ file whose chunk table claims more points than its chunks code.
+  bytes = iotest::readBytes(iotest::data("laz/simple.laz"));
+  storeLE<uint32_t>(bytes.data() + las::kLegacyCount, loadLE<uint32_t>(bytes.data() + las::kLegacyCount) * 3);
+  iotest::writeBytes(dir / "lying.laz", bytes);
+  EXPECT_THROW(convertLasFile(dir / "lying.laz", dir / "out.las"), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.las"));
+
+  // Waveform formats are refused unless the packets may go.
+  bytes = iotest::readBytes(iotest::data("las/1.2-with-color.las"));
+  detail::InputFile file(iotest::data("las/1.2-with-color.las"));
+  const detail::LasHeader hd = detail::readLasHeader(file);
+  std::vector<uint8_t> wave(bytes.begin(), bytes.begin() + hd.pointOffset);
+  wave[las::kPointFormat] = 5;
+  storeLE<uint16_t>(wave.data() + las::kRecordLength, 63);
+  for (uint64_t i = 0; i < hd.pointCount; ++i) {
+    const uint8_t* r = bytes.data() + hd.pointOffset + i * hd.recordLength;
+    wave.insert(wave.end(), r, r + 34);
+    wave.insert(wave.end(), 29, uint8_t(i));
+  }
+  iotest::writeBytes(dir / "wave.las", wave);
+  try {
+    convertLasFile(dir / "wave.las", dir / "wave.laz");
+    FAIL() << "a waveform file converted without --drop-waveforms";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("waveform"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "wave.laz"));
+  LasConvertOptions drop;
+  drop.dropWaveforms = true;
+  EXPECT_EQ(convertLasFile(dir / "wave.las", dir / "wave.laz", drop), hd.pointCount);
+  EXPECT_EQ(recordsOf(dir / "wave.laz"), recordsOf(iotest::data("las/1.2-with-color.las")));
+  EXPECT_EQ(headerOf(dir / "wave.laz").pointFormat, 3);
+}
+
+// LasRecordWriter (octree exports, clouds) writes LAZ when the name says so: the same records as LAS.
+TEST(LazWriter, RecordWriterWritesLazByExtension) {
+  iotest::TempDir dir;
+  std::vector<pointrast::PointRecord> points(70000);
+  std::mt19937 rng(3);
+  for (auto& p : points) {
+    p.x = int32_t(rng() % 100000);
+    p.y = int32_t(rng() % 100000);
+    p.z = int32_t(rng() % 1000);
+    p.rgb[0] = uint16_t(rng());
+    p.rgb[1] = uint16_t(rng());
+    p.rgb[2] = uint16_t(88 * 256);
+    p.intensity = uint16_t(rng());
+    p.returnNumber = uint8_t(1 + rng() % 5);
+    p.classification = uint8_t(rng() % 20);
+    p.pointSourceId = uint16_t(rng());
+  }
+  pointrast::RecordFields fields;
+  fields.color = fields.intensity = fields.classification = fields.returnNumber = fields.pointSourceId = true;
+  for (LasFlavor flavor : {LasFlavor::Las12Pf3, LasFlavor::Las14Pf7}) {
+    for (const char* name : {"r.las", "r.laz"}) {
+      LasRecordWriter w(dir / name, glm::dvec3(0.01), glm::dvec3(0), fields, flavor);
+      w.write(points.data(), points.size());
+      w.commit();
+    }
+    EXPECT_EQ(recordsOf(dir / "r.laz"), recordsOf(dir / "r.las"));
+    EXPECT_EQ(headerOf(dir / "r.laz").pointCount, points.size());
+  }
+}
+
+} // namespace
