@@ -1,4 +1,4 @@
-// pointrast convert IN OUT.las [--order NAME --seed S]
+// pointrast convert IN OUT.las|OUT.laz [--order NAME --seed S --las VERSION --drop-waveforms --chunk-size N]
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -21,8 +21,27 @@ namespace {
 struct ConvertArgs {
   std::string input, output, order = "original", lasVersion = "auto";
   uint64_t seed = 1;
-  bool quiet = false;
+  uint32_t chunkSize = 50000;
+  bool quiet = false, dropWaveforms = false;
 };
+
+// A LAS, LAZ or COPC file in its own order and point format: every record byte for byte, with its
+// VLRs and EVLRs.
+int convertLasFamily(const ConvertArgs& a) {
+  io::LasConvertOptions options;
+  options.dropWaveforms = a.dropWaveforms;
+  options.chunkSize = a.chunkSize;
+  options.progress = !a.quiet;
+  const uint64_t points = io::convertLasFile(a.input, a.output, options);
+  if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(points)).c_str());
+  return 0;
+}
+
+bool isLasFamily(const io::FormatInfo* format) {
+  if (!format) return false;
+  const std::string name = format->name;
+  return name == "LAS" || name == "LAZ" || name == "COPC";
+}
 
 // Whether an octree's classes or return numbers (by metadata.json's ranges) need LAS 1.4's point format 7
 // to be exported exactly (formats 0-5 hold classes up to 31 and return numbers up to 7).
@@ -49,32 +68,41 @@ int convertOctree(const ConvertArgs& a) {
 
 } // namespace
 
-// LAS 1.2 point format 3 unless the count needs LAS 1.4's 64-bit counts (or --las 1.4 asks for it).
+// LAS (or LAZ, by the extension) 1.2 point format 3 unless the count needs LAS 1.4's 64-bit counts (or --las 1.4 asks for it).
 io::LasFlavor lasFlavorFor(const std::string& output, uint64_t points) {
-  if (std::filesystem::path(output).extension() != ".las")
-    throw InputError(output + ": only LAS output (.las) is supported");
+  const std::filesystem::path ext = std::filesystem::path(output).extension();
+  if (ext != ".las" && ext != ".laz")
+    throw InputError(output + ": only LAS and LAZ output (.las, .laz) is supported");
   return points > 0xFFFFFFFFull ? io::LasFlavor::Las14Pf7 : io::LasFlavor::Las12Pf3;
 }
 
 Command addConvert(CLI::App& app) {
   auto a = std::make_shared<ConvertArgs>();
-  CLI::App* cmd = app.add_subcommand("convert", "Read a point cloud, optionally reorder it, write LAS");
+  CLI::App* cmd = app.add_subcommand("convert", "Read a point cloud, optionally reorder it, write LAS or LAZ");
   cmd->footer(
       "\nOrders (the 2021 paper's vertex orders): original, morton (Z-order over the cubic bounds, 21 bits\n"
       "per axis), shuffled (random permutation), shuffled-morton (Morton, then runs of 128 points\n"
-      "shuffled as wholes). Output: LAS 1.2 point format 3, or 1.4 format 7 with --las 1.4 or when\n"
-      "the cloud has more than 4,294,967,295 points.\n"
+      "shuffled as wholes). OUT ending in .laz is written compressed (LASzip chunks), else as LAS.\n"
+      "A LAS, LAZ or COPC file in its original order is converted losslessly: every point record byte\n"
+      "for byte in its own point format (16-bit colors, NIR, GPS time, flags, extra bytes...), its VLRs\n"
+      "and EVLRs. Waveform formats (4, 5, 9, 10) are refused unless --drop-waveforms.\n"
+      "Other inputs, reordered clouds or --las 1.2/1.4: LAS 1.2 point format 3, or 1.4 format 7 with\n"
+      "--las 1.4 or when the cloud has more than 4,294,967,295 points.\n"
       "A Potree 2.0 octree (its folder or metadata.json) is exported exactly: its integers, scale/offset\n"
       "and 16-bit colors, node after node (LAS 1.4 format 7 when its classes or return numbers need it).\n\n"
       "Examples:\n  pointrast convert scan.ply scan_morton.las --order morton\n"
-      "  pointrast convert octree/ all.las");
+      "  pointrast convert lion.copc.laz lion.laz\n"
+      "  pointrast convert octree/ all.laz");
   cmd->add_option("IN", a->input,
                   "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + ") or Potree 2.0 octree folder")
       ->required();
-  cmd->add_option("OUT", a->output, "LAS file to write")->required();
+  cmd->add_option("OUT", a->output, "LAS or LAZ file to write")->required();
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the shuffled orders")->capture_default_str();
   cmd->add_option("--las", a->lasVersion, "LAS version to write: auto, 1.2 or 1.4")->capture_default_str();
+  cmd->add_option("--chunk-size", a->chunkSize, "Points per LAZ chunk")->capture_default_str();
+  cmd->add_flag("--drop-waveforms", a->dropWaveforms,
+                "Convert waveform point formats (4, 5, 9, 10) without their wave packets");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
   return [a] {
     Progress::setEnabled(!a->quiet);
@@ -83,7 +111,9 @@ Command addConvert(CLI::App& app) {
     lasFlavorFor(a->output, 0);
     if (!pathExists(a->input)) throw InputError(a->input + ": no such file or folder");
     const io::FormatInfo* format = io::detectFormat(a->input);
+    if (a->chunkSize == 0) throw InputError("--chunk-size must be at least 1 point");
     if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
+    if (a->order == "original" && a->lasVersion == "auto" && isLasFamily(format)) return convertLasFamily(*a);
     InputSpec spec;
     spec.source = a->input;
     spec.order = parseOrder(a->order);

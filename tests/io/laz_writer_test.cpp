@@ -5,6 +5,7 @@
 #include <random>
 
 #include "io/io_test_util.h"
+#include "io/laz_random_records.h"
 #include "io/las/las_format.h"
 #include "io/las/laz_chunk.h"
 #include "io/las/laz_encoder.h"
@@ -18,77 +19,6 @@ using pointrast::io::detail::loadLE;
 using pointrast::io::detail::storeLE;
 
 namespace {
-
-// Records that exercise every branch of the item coders: coordinates as random walks with jumps
-// (int32 extremes included), returns that count up, down and jump, GPS times in interleaved sequences
-// with huge jumps and repeats, scanner channel switches, colors with equal and unequal channels, extra
-// bytes that mostly stay.
-std::vector<uint8_t> randomRecords(int pointFormat, uint16_t recordLength, uint64_t n, uint32_t seed) {
-  std::mt19937_64 rng(seed);
-  auto pick = [&](uint64_t k) { return rng() % k; };
-  std::vector<uint8_t> out(n * recordLength);
-  const bool extended = pointFormat >= 6;
-  const int base = las::kRecordSize[size_t(pointFormat)];
-  const int rgb = las::kRgbOffset[size_t(pointFormat)];
-  const bool gps = pointFormat == 1 || pointFormat == 3 || extended;
-  const int gpsAt = extended ? 22 : 20;
-  int32_t xyz[3] = {0, 0, 0};
-  double times[3] = {1000.0, 5e8, 3.5};
-  std::vector<uint8_t> last(recordLength, 0);
-  for (uint64_t i = 0; i < n; ++i) {
-    uint8_t* r = out.data() + i * recordLength;
-    std::memcpy(r, last.data(), recordLength);
-    for (int a = 0; a < 3; ++a) {
-      const uint64_t mode = pick(20);
-      if (mode == 0)
-        xyz[a] = pick(2) ? INT32_MIN : INT32_MAX;
-      else if (mode == 1)
-        xyz[a] = int32_t(uint32_t(rng()));
-      else
-        xyz[a] = int32_t(uint32_t(xyz[a]) + uint32_t(int32_t(pick(200)) - 100));
-      storeLE<int32_t>(r + 4 * a, xyz[a]);
-    }
-    if (pick(3) == 0) storeLE<uint16_t>(r + 12, uint16_t(pick(4) ? pick(300) : rng()));
-    if (pick(4) == 0) r[14] = uint8_t(pick(3) ? (r[14] & 0xF0) | ((r[14] + 1) & 0x0F) : rng());
-    if (pick(5) == 0) r[15] = uint8_t(rng()); // flags / channel (6-10), class and flags (0-5)
-    if (pick(5) == 0) r[16] = uint8_t(pick(2) ? pick(40) : rng());
-    if (pick(6) == 0) r[17] = uint8_t(rng());
-    if (extended) {
-      if (pick(6) == 0) storeLE<int16_t>(r + 18, int16_t(rng()));
-      if (pick(8) == 0) storeLE<uint16_t>(r + 20, uint16_t(rng()));
-    } else {
-      if (pick(8) == 0) storeLE<uint16_t>(r + 18, uint16_t(rng()));
-    }
-    if (gps) {
-      const uint64_t mode = pick(10);
-      double t = loadLE<double>(r + gpsAt);
-      if (mode < 5) {
-        const int s = int(pick(3));
-        times[s] += (mode == 0 ? 1e-5 : 1e-6) * double(1 + pick(3));
-        t = times[s];
-      } else if (mode == 5) {
-        t = times[0] + double(pick(1000)) * 1e3;
-      } else if (mode == 6) {
-        std::memcpy(&t, &times[1], 8);
-        uint64_t bits;
-        std::memcpy(&bits, &t, 8);
-        bits ^= rng();
-        std::memcpy(&t, &bits, 8);
-      } // else: the same time again
-      storeLE<double>(r + gpsAt, t);
-    }
-    if (rgb >= 0 && pick(3) == 0) {
-      const uint16_t v = uint16_t(pick(2) ? pick(256) * 257 : rng());
-      for (int c = 0; c < 3; ++c)
-        storeLE<uint16_t>(r + rgb + 2 * c, pick(3) == 0 ? v : uint16_t(v + pick(700)));
-      if (pointFormat == 8 && pick(2)) storeLE<uint16_t>(r + 36, uint16_t(rng()));
-    }
-    for (int b = base; b < recordLength; ++b)
-      if (pick(4) == 0) r[b] = uint8_t(pick(2) ? r[b] + 1 : rng());
-    std::memcpy(last.data(), r, recordLength);
-  }
-  return out;
-}
 
 std::vector<uint8_t> decodeChunk(const laz::Layout& layout, const std::vector<uint8_t>& bytes, uint64_t count) {
   laz::ChunkDecoder decoder(layout);
@@ -140,13 +70,13 @@ TEST_P(LazEncoderFormats, RandomRecordsRoundTripThroughTheDecoder) {
   laz::ChunkEncoder encoder(layout);
   for (uint64_t n : {uint64_t(1), uint64_t(2), uint64_t(7), uint64_t(5000)}) {
     for (uint32_t seed = 1; seed <= 3; ++seed) {
-      const std::vector<uint8_t> records = randomRecords(c.pointFormat, rl, n, seed);
+      const std::vector<uint8_t> records = iotest::randomRecords(c.pointFormat, rl, n, seed);
       const std::vector<uint8_t> bytes = encoder.encode(records.data(), n);
       ASSERT_EQ(decodeChunk(layout, bytes, n), records) << "format " << c.pointFormat << ", " << n << " points";
     }
   }
   // Constant records: every layer but XY written empty.
-  std::vector<uint8_t> same = randomRecords(c.pointFormat, rl, 1, 9);
+  std::vector<uint8_t> same = iotest::randomRecords(c.pointFormat, rl, 1, 9);
   for (int i = 0; i < 99; ++i)
     same.insert(same.end(), same.begin(), same.begin() + rl);
   EXPECT_EQ(decodeChunk(layout, encoder.encode(same.data(), 100), 100), same);
@@ -163,7 +93,7 @@ TEST(LazWriter, FixedAndVariableChunksReadBack) {
   iotest::TempDir dir;
   for (int format : {3, 7}) {
     const uint16_t rl = uint16_t(las::kRecordSize[size_t(format)] + 2);
-    const std::vector<uint8_t> records = randomRecords(format, rl, 23456, 5);
+    const std::vector<uint8_t> records = iotest::randomRecords(format, rl, 23456, 5);
     for (uint32_t chunkSize : {uint32_t(1000), uint32_t(50000), kVariableChunkSize}) {
       LasFileSetup setup;
       setup.header.assign(las::kHeaderSize14, 0);

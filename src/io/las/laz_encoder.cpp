@@ -696,6 +696,7 @@ public:
     if (bytes_) bytes_->init(records + bytesOffset_, context);
     for (uint64_t i = 1; i < count; ++i) {
       const uint8_t* record = records + i * rl;
+      context = 0; // as the decoder: the channel reaches the other items only at a switch
       point_.write(record, context);
       if (rgb_) rgb_->write(record + rgbOffset_, context);
       if (bytes_) bytes_->write(record + bytesOffset_, context);

@@ -469,6 +469,10 @@ void LayeredChunkDecoder::decode(const uint8_t* data, size_t size, uint64_t coun
   if (bytes_) bytes_->init(data + bytesOffset_, layers_.data() + next, context);
   for (uint64_t i = 1; i < count; ++i) {
     uint8_t* record = recordSlot(out, i, capacity, rl, count);
+    // LASzip's version 3 items hand the other items channel 0 unless the point switches channels (its
+    // per-point context starts at 0 and POINT14 sets it only on a switch); LASzip, laz-perf and laz-rs
+    // all code RGB, NIR and extra bytes of multi-channel files that way.
+    context = 0;
     point_.read(record, context);
     if (rgb_) rgb_->read(record + rgbOffset_, context);
     if (bytes_) bytes_->read(record + bytesOffset_, context);

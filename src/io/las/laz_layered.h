@@ -5,8 +5,10 @@
 //
 // LASzip's behaviour is reproduced where files depend on it: when the scanner channel switches to a
 // channel already seen in the chunk, the RGB, NIR and extra-byte decoders keep predicting from the
-// previous channel's last values (with the new channel's models) and store the result there. That is a
-// LASzip quirk, but every LASzip-written file with several channels encodes exactly that.
+// previous channel's last values (with the new channel's models) and store the result there; and those
+// decoders are handed the new channel only at the point that switches, channel 0 at every other point
+// (LASzip's per-point context starts at 0 in version 3). Those are LASzip quirks, but every
+// LASzip-written file with several channels encodes exactly that, and laz-perf and laz-rs decode it so.
 #pragma once
 
 #include <array>
