@@ -31,10 +31,15 @@ constexpr uint64_t kEmptyWord = ~0ull;
 
 } // namespace
 
-RenderSettings renderSettings(const ViewSettings& view) {
+RenderSettings renderSettings(const ViewSettings& requested) {
+  const ViewSettings view = applicable(requested);
   RenderSettings settings;
   settings.method = view.method;
   settings.background = view.background;
+  settings.depth = view.depth;
+  settings.post = view.post;
+  settings.minNodePx = view.minNodePx;
+  settings.pointBudget = view.pointBudget;
   settings.frames = 1;
   settings.warmup = 0;
   return settings;

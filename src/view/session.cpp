@@ -1,9 +1,13 @@
 #include "view/session.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <utility>
 #include <vector>
 
+#include "base/error.h"
+#include "cloud/attribute_colors.h"
 #include "gpu/timer.h"
 
 namespace pointrast::view {
@@ -27,6 +31,115 @@ std::optional<StandardView> standardViewForKey(Key key) {
   default:
     return std::nullopt;
   }
+}
+
+bool ViewSettings::operator==(const ViewSettings& o) const {
+  auto samePost = [](const PostSettings& a, const PostSettings& b) {
+    return a.pointSize == b.pointSize && a.shape == b.shape && a.sizeMode == b.sizeMode &&
+           a.maxPointSize == b.maxPointSize && a.dilate == b.dilate && a.edlStrength == b.edlStrength &&
+           a.edlRadius == b.edlRadius;
+  };
+  auto sameRange = [](const std::optional<ColorRange>& a, const std::optional<ColorRange>& b) {
+    return a.has_value() == b.has_value() && (!a || (a->lo == b->lo && a->hi == b->hi));
+  };
+  return method == o.method && background == o.background && depth == o.depth && samePost(post, o.post) &&
+         colorSource == o.colorSource && sameRange(colorRange, o.colorRange) && minNodePx == o.minNodePx &&
+         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory;
+}
+
+namespace {
+
+// Shortest text that reads back as the same float or double.
+std::string number(double v) {
+  char text[32];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    if (std::strtod(text, nullptr) == v) break;
+  }
+  return text;
+}
+
+std::string number(float v) {
+  char text[32];
+  for (int digits = 6; digits <= 9; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, double(v));
+    if (std::strtof(text, nullptr) == v) break;
+  }
+  return text;
+}
+
+bool hasRamp(DisplayColorMode::Source source) {
+  return source == DisplayColorMode::Source::Intensity || source == DisplayColorMode::Source::Elevation;
+}
+
+} // namespace
+
+bool takesPost(Method method) {
+  return methodInfo(method).output != MethodOutput::ColorOnly;
+}
+
+bool takesInt40(Method method) {
+  return methodInfo(method).int40Shader != nullptr;
+}
+
+ViewSettings applicable(const ViewSettings& settings) {
+  ViewSettings s = settings;
+  if (!takesPost(s.method)) s.post = PostSettings{};
+  if (!takesInt40(s.method)) s.depth = DepthMode::Float;
+  return s;
+}
+
+std::string describeSettings(const ViewSettings& settings) {
+  const ViewSettings s = applicable(settings);
+  const ViewSettings defaults;
+  const PostSettings& p = s.post;
+  const PostSettings& d = defaults.post;
+  std::string out;
+  auto add = [&](const std::string& option, const std::string& value = {}) {
+    if (!out.empty()) out += ' ';
+    out += option;
+    if (!value.empty()) out += ' ' + value;
+  };
+  if (s.method != defaults.method) add("--method", methodName(s.method));
+  if (s.depth != defaults.depth) add("--depth", depthModeName(s.depth));
+  if (s.background != defaults.background)
+    add("--background", std::to_string(s.background & 0xFF) + "," +
+                            std::to_string((s.background >> 8) & 0xFF) + "," +
+                            std::to_string((s.background >> 16) & 0xFF));
+  if (s.colorSource) add("--color", colorSourceName(*s.colorSource));
+  if (s.colorSource && s.colorRange && hasRamp(*s.colorSource))
+    add("--color-range", number(s.colorRange->lo) + "," + number(s.colorRange->hi));
+  if (p.pointSize != d.pointSize) add("--point-size", number(p.pointSize));
+  if (p.shape != d.shape) add("--point-shape", pointShapeName(p.shape));
+  if (p.sizeMode != d.sizeMode) add("--point-size-mode", pointSizeModeName(p.sizeMode));
+  if (p.maxPointSize != d.maxPointSize) add("--point-size-max", number(p.maxPointSize));
+  if (p.dilate != d.dilate) add("--dilate", std::to_string(p.dilate));
+  if (p.edlStrength > 0) {
+    add("--edl");
+    if (p.edlStrength != 1.0f) add("--edl-strength", number(p.edlStrength));
+    if (p.edlRadius != d.edlRadius) add("--edl-radius", number(p.edlRadius));
+  }
+  if (s.minNodePx != defaults.minNodePx) add("--min-node-px", number(s.minNodePx));
+  if (s.pointBudget != defaults.pointBudget) add("--point-budget", std::to_string(s.pointBudget));
+  if (s.gpuMemory != defaults.gpuMemory) add("--gpu-memory", std::to_string(s.gpuMemory));
+  return out;
+}
+
+void validateSettings(const ViewSettings& s) {
+  validatePostSettings(s.post);
+  if (s.post.edlStrength > kMaxEdlStrength)
+    throw InputError("eye-dome lighting strength must be at most " + number(kMaxEdlStrength));
+  if (s.colorRange) {
+    if (!s.colorSource || !hasRamp(*s.colorSource))
+      throw InputError("a color range applies to the intensity and elevation colors");
+    if (!(std::isfinite(s.colorRange->lo) && std::isfinite(s.colorRange->hi) &&
+          s.colorRange->lo < s.colorRange->hi))
+      throw InputError("a color range must be finite numbers lo < hi");
+  }
+  if (!(s.minNodePx >= 0 && s.minNodePx <= kMaxMinNodePx))
+    throw InputError("the minimum node size must be 0.." + number(kMaxMinNodePx) + " pixels");
+  if (s.pointBudget > kMaxPointBudget) throw InputError("the point budget is out of range");
+  if (s.gpuMemory > kMaxGpuMemory) throw InputError("the GPU memory budget is out of range");
 }
 
 Session::Session(const Bounds& bounds, const Camera& camera, Viewport viewport, const ViewSettings& settings)
@@ -146,19 +259,41 @@ void Session::frameRendered(const FrameReport& report) {
   renderedGeneration_ = generation_;
   recent_.push_back(report);
   if (recent_.size() > kStatsWindow) recent_.pop_front();
-  auto medianOf = [&](double FrameReport::*member) {
+  auto medianOf = [&](auto get) {
     std::vector<double> values;
     for (const FrameReport& r : recent_)
-      values.push_back(r.*member);
-    return gpu::median(values);
+      if (auto v = get(r)) values.push_back(*v);
+    return values.empty() ? 0.0 : gpu::median(values);
   };
   statistics_.frames++;
-  statistics_.renderMs = medianOf(&FrameReport::renderMs);
-  statistics_.presentMs = medianOf(&FrameReport::presentMs);
-  statistics_.hostMs = medianOf(&FrameReport::seconds) * 1e3;
+  statistics_.renderMs = medianOf([](const FrameReport& r) { return std::optional(r.renderMs); });
+  statistics_.presentMs = medianOf([](const FrameReport& r) { return std::optional(r.presentMs); });
+  statistics_.hostMs = medianOf([](const FrameReport& r) { return std::optional(r.seconds); }) * 1e3;
   statistics_.points = report.points;
   statistics_.batch = report.batch;
+  statistics_.post.reset();
+  if (report.post) {
+    auto pass = [&](double PostStats::*member) {
+      return medianOf(
+          [&](const FrameReport& r) { return r.post ? std::optional((*r.post).*member) : std::nullopt; });
+    };
+    statistics_.post =
+        PostStats{pass(&PostStats::splatMs), pass(&PostStats::dilateMs), pass(&PostStats::composeMs)};
+  }
+  statistics_.lod = report.lod;
+  statistics_.status = report.status;
   statistics_.gpuBytes = report.gpuBytes;
+  // Streaming rate: the bytes the source's files gave over the wall time of the recent frames that streamed.
+  const auto now = std::chrono::steady_clock::now();
+  streamed_.push_back({now, report.lod ? report.lod->bytesStreamed : 0});
+  while (streamed_.size() > 1 && now - streamed_.front().first > std::chrono::seconds(2))
+    streamed_.pop_front();
+  statistics_.streamedBytesPerSecond = 0;
+  if (report.lod && streamed_.size() > 1) {
+    double seconds = std::chrono::duration<double>(now - streamed_.front().first).count();
+    uint64_t first = streamed_.front().second, last = streamed_.back().second;
+    if (seconds > 0 && last > first) statistics_.streamedBytesPerSecond = double(last - first) / seconds;
+  }
 }
 
 } // namespace pointrast::view

@@ -5,29 +5,64 @@
 // the frame back.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <glm/glm.hpp>
 
+#include "cloud/cloud.h"
+#include "render/lod/lod_stats.h"
+#include "render/post/post_settings.h"
 #include "render/renderer.h"
 #include "view/camera_path.h"
 #include "view/navigation.h"
 
 namespace pointrast::view {
 
-// What a frame is rendered with. Every change goes through Session::setSettings, which compares, so an
-// unchanged panel costs no frame.
+// What a frame is rendered with: every option of `render` a viewer offers. Every change goes through
+// Session::setSettings, which compares, so an unchanged panel costs no frame.
 struct ViewSettings {
-  Method method; // the first row of the method table: atomicmin
+  Method method;                     // the first row of the method table: atomicmin
   uint32_t background = 0xFF000000u; // RGBA8
-  // The level-of-detail controls (point budget, threshold) and the resolve options (point size, dilation,
-  // eye-dome lighting, coloring) join this struct when their render stages exist; each is compared in
-  // operator== and so triggers a frame like the method does.
-  bool operator==(const ViewSettings&) const = default;
+  DepthMode depth = DepthMode::Float;
+  PostSettings post; // point size, shape and attenuation, dilation, eye-dome lighting
+  // Coloring (render --color, --color-range): no source is the automatic choice (displayColorMode); a
+  // range applies to intensity and elevation only (lo < hi).
+  std::optional<DisplayColorMode::Source> colorSource;
+  std::optional<ColorRange> colorRange;
+  // Level of detail (octree methods): render --min-node-px, --point-budget (0: no limit) and --gpu-memory
+  // (bytes of the node cache; 0: the default, half the device's).
+  double minNodePx = 100;
+  uint64_t pointBudget = 0;
+  uint64_t gpuMemory = 0;
+  bool operator==(const ViewSettings& other) const;
 };
+
+// The limits the panels and the browser's messages hold every setting to (those of render's options).
+constexpr double kMaxMinNodePx = 10000;
+constexpr uint64_t kMaxPointBudget = 1ull << 40;
+constexpr uint64_t kMaxGpuMemory = 1ull << 44; // 16 TiB: any device's memory
+constexpr float kMaxEdlStrength = 10.0f;       // the panels' bound; render takes any finite strength
+
+// What of the settings the method takes: the resolve stage (point size, dilation, eye-dome lighting) is
+// dropped for methods that keep no depth per pixel (MethodOutput::ColorOnly) and int40 depth for methods
+// without it, so that switching the method never makes a frame impossible. Panels show what is dropped
+// as disabled.
+ViewSettings applicable(const ViewSettings& settings);
+bool takesPost(Method method);
+bool takesInt40(Method method);
+
+// The applicable settings as `pointrast render` options, only those that differ from render's defaults, e.g.
+// "--method batch --color intensity --point-size 3 --edl": with the camera's options (describeCamera)
+// they reproduce the viewer's image with render.
+std::string describeSettings(const ViewSettings& settings);
+// Throws InputError, naming the setting, for a value render would refuse (the ranges above,
+// validatePostSettings, a color range that is not lo < hi or given for a source without a ramp).
+void validateSettings(const ViewSettings& settings);
 
 // Front-end state that is not part of the rendered image.
 struct ViewOptions {
@@ -67,8 +102,11 @@ struct FrameReport {
   double presentMs = 0; // GPU time of showing the image (and drawing the panel), where the front end has it
   uint64_t points = 0;  // points submitted
   std::optional<BatchStats> batch;
-  uint64_t gpuBytes = 0; // GPU memory the scene and targets occupy
-  double seconds = 0;    // wall-clock time of the frame on the host (render to present)
+  std::optional<PostStats> post;    // GPU time of the resolve stage's passes, when it ran
+  std::optional<lod::LodStats> lod; // octree methods: selection, drawing, streaming, the node cache
+  std::string status;               // a line for the panel, e.g. "building octree 42 %" or a streaming error
+  uint64_t gpuBytes = 0;            // GPU memory the scene and targets occupy
+  double seconds = 0;               // wall-clock time of the frame on the host (render to present)
 };
 
 // Medians over the last kStatsWindow frames.
@@ -76,7 +114,12 @@ struct Statistics {
   uint64_t frames = 0; // frames rendered since the start
   double renderMs = 0, presentMs = 0, hostMs = 0;
   uint64_t points = 0;
-  std::optional<BatchStats> batch; // of the last frame
+  std::optional<BatchStats> batch;  // of the last frame
+  std::optional<PostStats> post;    // medians of each pass, over the recent frames that ran the stage
+  std::optional<lod::LodStats> lod; // of the last frame
+  std::string status;               // of the last frame
+  // Octree methods: bytes of the source's files streamed per second, over the recent frames' wall time.
+  double streamedBytesPerSecond = 0;
   uint64_t gpuBytes = 0;
 };
 constexpr size_t kStatsWindow = 60;
@@ -159,6 +202,8 @@ private:
   ContentSource* content_ = nullptr;
   glm::dvec2 cursor_{0};
   std::deque<FrameReport> recent_;
+  // (when, LodStats::bytesStreamed) of the frames of the last two seconds
+  std::deque<std::pair<std::chrono::steady_clock::time_point, uint64_t>> streamed_;
   Statistics statistics_;
 };
 
