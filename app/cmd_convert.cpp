@@ -22,6 +22,7 @@ struct ConvertArgs {
   std::string input, output, order = "original", lasVersion = "auto";
   uint64_t seed = 1;
   uint32_t chunkSize = 50000;
+  int pointFormat = -1;
   bool quiet = false, dropWaveforms = false;
 };
 
@@ -29,9 +30,11 @@ struct ConvertArgs {
 // VLRs and EVLRs.
 int convertLasFamily(const ConvertArgs& a) {
   io::LasConvertOptions options;
+  options.pointFormat = a.pointFormat;
   options.dropWaveforms = a.dropWaveforms;
   options.chunkSize = a.chunkSize;
   options.progress = !a.quiet;
+  if (a.lasVersion != "auto") options.versionMinor = a.lasVersion == "1.4" ? 4 : 2;
   const uint64_t points = io::convertLasFile(a.input, a.output, options);
   if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(points)).c_str());
   return 0;
@@ -85,8 +88,9 @@ Command addConvert(CLI::App& app) {
       "shuffled as wholes). OUT ending in .laz is written compressed (LASzip chunks), else as LAS.\n"
       "A LAS, LAZ or COPC file in its original order is converted losslessly: every point record byte\n"
       "for byte in its own point format (16-bit colors, NIR, GPS time, flags, extra bytes...), its VLRs\n"
-      "and EVLRs. Waveform formats (4, 5, 9, 10) are refused unless --drop-waveforms.\n"
-      "Other inputs, reordered clouds or --las 1.2/1.4: LAS 1.2 point format 3, or 1.4 format 7 with\n"
+      "and EVLRs. Waveform formats (4, 5, 9, 10) are refused unless --drop-waveforms. --point-format\n"
+      "or --las 1.2/1.4 (formats 0-3 / 6-8) converts the records, refusing what the format cannot hold.\n"
+      "Other inputs and reordered clouds: LAS 1.2 point format 3, or 1.4 format 7 with\n"
       "--las 1.4 or when the cloud has more than 4,294,967,295 points.\n"
       "A Potree 2.0 octree (its folder or metadata.json) is exported exactly: its integers, scale/offset\n"
       "and 16-bit colors, node after node (LAS 1.4 format 7 when its classes or return numbers need it).\n\n"
@@ -100,6 +104,8 @@ Command addConvert(CLI::App& app) {
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the shuffled orders")->capture_default_str();
   cmd->add_option("--las", a->lasVersion, "LAS version to write: auto, 1.2 or 1.4")->capture_default_str();
+  cmd->add_option("--point-format", a->pointFormat,
+                  "LAS/LAZ/COPC input: the point format to write (0-3, 6-8; default: the input's)");
   cmd->add_option("--chunk-size", a->chunkSize, "Points per LAZ chunk")->capture_default_str();
   cmd->add_flag("--drop-waveforms", a->dropWaveforms,
                 "Convert waveform point formats (4, 5, 9, 10) without their wave packets");
@@ -113,7 +119,11 @@ Command addConvert(CLI::App& app) {
     const io::FormatInfo* format = io::detectFormat(a->input);
     if (a->chunkSize == 0) throw InputError("--chunk-size must be at least 1 point");
     if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
-    if (a->order == "original" && a->lasVersion == "auto" && isLasFamily(format)) return convertLasFamily(*a);
+    if (a->pointFormat != -1 && (a->pointFormat < 0 || !((a->pointFormat <= 3) || (a->pointFormat >= 6 && a->pointFormat <= 8))))
+      throw InputError("--point-format expects 0, 1, 2, 3, 6, 7 or 8");
+    if (a->order == "original" && isLasFamily(format)) return convertLasFamily(*a);
+    if (a->pointFormat != -1)
+      throw InputError("--point-format applies to LAS, LAZ and COPC inputs in their original order");
     InputSpec spec;
     spec.source = a->input;
     spec.order = parseOrder(a->order);

@@ -88,7 +88,12 @@ private:
 // not the LASzip and COPC ones (their offsets would not hold). Waveform formats (4, 5, 9, 10) are
 // refused unless dropWaveforms, which writes their records without the packets (formats 1, 3, 6, 8).
 // Returns the points written. Throws InputError.
+// pointFormat (0-3, 6-8) converts the records to another format (LAS 1.4 for 6-8), refusing with one
+// line a record whose attributes the target cannot hold (colors into format 1, channels into 3...).
 struct LasConvertOptions {
+  int pointFormat = -1;  // -1: the input's (without the waveform packets when they are dropped)
+  int versionMinor = -1; // LAS 1.x: -1 the input's (1.4 when the format needs it), 2 or 4; without
+                         // pointFormat, 2 picks format 0-3 and 4 format 6-8 by the input's attributes
   bool dropWaveforms = false;
   uint32_t chunkSize = 50000;
   bool progress = false;

@@ -76,6 +76,23 @@ TEST(ConvertLazCli, LasToLazToLasComesBackByteForByte) {
   }
 }
 
+TEST(ConvertLazCli, LasVersionAndPointFormatConvertTheRecords) {
+  const fs::path dir = pointrast::test::cliTempDir();
+  const fs::path in = kData / "las/1.2-with-color.las";
+  const fs::path up = dir / "up.laz", back = dir / "back.las";
+  fs::remove(up);
+  fs::remove(back);
+  CliResult r = runPointrast("convert -q --las 1.4 " + in.string() + " " + up.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(pointFormatOf(up), 7); // format 3's GPS time and colors in LAS 1.4
+  r = runPointrast("convert -q --point-format 3 " + up.string() + " " + back.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(recordsOf(back), recordsOf(in));
+  // Colors do not fit format 1: refused, not dropped.
+  expectOneLineFailure(runPointrast("convert -q --point-format 1 " + in.string() + " " + (dir / "pf1.las").string()),
+                       dir / "pf1.las");
+}
+
 TEST(ConvertLazCli, OctreeExportsToLazAsToLas) {
   const fs::path dir = pointrast::test::cliTempDir();
   const potreetest::Tree tree = potreetest::makeTree({.points = 5000, .depth = 4, .color16 = true, .seed = 5});

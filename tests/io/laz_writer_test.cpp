@@ -249,3 +249,46 @@ TEST(LazWriter, RecordWriterWritesLazByExtension) {
 }
 
 } // namespace
+
+namespace {
+
+// Point format conversions: legacy formats through LAS 1.4's and back come back byte for byte; 1.4
+// formats into legacy ones either come back byte for byte or are refused for what would be lost.
+TEST(LazWriter, PointFormatConversionsAreExactOrRefused) {
+  iotest::TempDir dir;
+  static const int kTo14[] = {6, 6, 7, 7, 6, 7, 6, 7, 8, 6, 8};
+  static const int kTo12[] = {0, 1, 2, 3, 1, 3, 1, 3, 3, 1, 3};
+  int exact = 0, refused = 0;
+  for (const char* folder : {"las", "laz"}) {
+    for (const auto& entry : std::filesystem::directory_iterator(iotest::data(folder))) {
+      const std::filesystem::path in = entry.path();
+      if (in.extension() != ".las" && in.extension() != ".laz") continue;
+      if (in.filename().string().find("laszip-compressor-version-1") != std::string::npos) continue;
+      SCOPED_TRACE(in.string());
+      const detail::LasHeader hd = headerOf(in);
+      const int other = hd.pointFormat >= 6 ? kTo12[size_t(hd.pointFormat)] : kTo14[size_t(hd.pointFormat)];
+      LasConvertOptions there;
+      there.pointFormat = other;
+      LasConvertOptions back;
+      back.pointFormat = hd.pointFormat;
+      try {
+        convertLasFile(in, dir / "there.laz", there);
+      } catch (const InputError& e) {
+        EXPECT_LT(other, 6) << e.what(); // legacy to 1.4 never loses anything
+        EXPECT_NE(std::string(e.what()).find("cannot hold"), std::string::npos) << e.what();
+        EXPECT_FALSE(std::filesystem::exists(dir / "there.laz"));
+        ++refused;
+        continue;
+      }
+      EXPECT_EQ(headerOf(dir / "there.laz").pointFormat, other);
+      convertLasFile(dir / "there.laz", dir / "back.las", back);
+      EXPECT_EQ(recordsOf(dir / "back.las"), recordsOf(in));
+      std::filesystem::remove(dir / "there.laz");
+      ++exact;
+    }
+  }
+  EXPECT_GE(exact, 10);
+  std::printf("point format conversions: %d exact, %d refused\n", exact, refused);
+}
+
+} // namespace

@@ -301,7 +301,6 @@ int withoutWaveform(int pointFormat) {
     return pointFormat;
   }
 }
-constexpr uint16_t kWavePacketBytes = 29;
 
 // The EVLRs of a LAS 1.4 file, each its 60-byte header and payload; COPC's are left out.
 std::vector<std::vector<uint8_t>> readEvlrs(const InputFile& file, const LasHeader& hd) {
@@ -327,6 +326,77 @@ std::vector<std::vector<uint8_t>> readEvlrs(const InputFile& file, const LasHead
   return out;
 }
 
+// One record from point format `from` (0-3, 6-8; a waveform format's record read as its base format's,
+// the packet skipped) to `to`, extra bytes copied. Returns what the target format cannot hold (empty when
+// nothing is lost). Layouts, R15 section 2.6: formats 0-5 keep return number and count in 3 bits each,
+// classification in the low 5 bits of byte 15 with the synthetic, key-point and withheld flags above,
+// the scan angle as whole degrees (int8 at 16); formats 6-10 use 4-bit returns, byte 15 for the four
+// flags, scanner channel, scan direction and edge, byte 16 for the class and an int16 scan angle in
+// 0.006 degree steps.
+struct RecordTranscoder {
+  int from, to;
+  uint16_t fromExtraAt, toLength, extra;
+
+  const char* operator()(const uint8_t* in, uint8_t* out) const {
+    const bool fromExt = las::isExtended(from), toExt = las::isExtended(to);
+    if (from == to) { // a waveform format without its packets
+      std::memcpy(out, in, las::kRecordSize[size_t(to)]);
+      std::memcpy(out + las::kRecordSize[size_t(to)], in + fromExtraAt, extra);
+      return nullptr;
+    }
+    std::memset(out, 0, toLength);
+    std::memcpy(out, in, 14); // X, Y, Z, intensity
+    unsigned rn, nr, flags, channel, dir, edge, cls, user, source;
+    int angle; // 0.006 degree steps
+    if (fromExt) {
+      rn = in[14] & 15, nr = in[14] >> 4;
+      flags = in[15] & 15, channel = (in[15] >> 4) & 3, dir = (in[15] >> 6) & 1, edge = in[15] >> 7;
+      cls = in[16], user = in[17], angle = loadLE<int16_t>(in + 18), source = loadLE<uint16_t>(in + 20);
+    } else {
+      rn = in[14] & 7, nr = (in[14] >> 3) & 7, dir = (in[14] >> 6) & 1, edge = in[14] >> 7;
+      cls = in[15] & 31, flags = in[15] >> 5, channel = 0;
+      user = in[17], angle = int(std::lround(int8_t(in[16]) / 0.006)), source = loadLE<uint16_t>(in + 18);
+    }
+    const int gpsFrom = fromExt ? 22 : (from == 1 || from == 3) ? 20 : -1;
+    const int gpsTo = toExt ? 22 : (to == 1 || to == 3) ? 20 : -1;
+    const int rgbFrom = las::kRgbOffset[size_t(from)], rgbTo = las::kRgbOffset[size_t(to)];
+    if (toExt) {
+      out[14] = uint8_t(rn | (nr << 4));
+      out[15] = uint8_t(flags | (channel << 4) | (dir << 6) | (edge << 7));
+      out[16] = uint8_t(cls);
+      out[17] = uint8_t(user);
+      storeLE<int16_t>(out + 18, int16_t(angle));
+      storeLE<uint16_t>(out + 20, uint16_t(source));
+    } else {
+      if (rn > 7 || nr > 7) return "return numbers above 7";
+      if (cls > 31) return "classes above 31";
+      if (flags & 8) return "the overlap flag";
+      if (channel != 0) return "scanner channels";
+      const long rank = std::lround(angle * 0.006);
+      if (std::lround(double(rank) / 0.006) != angle || rank < -128 || rank > 127)
+        return "scan angles finer than a degree";
+      out[14] = uint8_t(rn | (nr << 3) | (dir << 6) | (edge << 7));
+      out[15] = uint8_t(cls | (flags << 5));
+      out[16] = uint8_t(int8_t(rank));
+      out[17] = uint8_t(user);
+      storeLE<uint16_t>(out + 18, uint16_t(source));
+    }
+    auto zero = [](const uint8_t* p, size_t n) {
+      for (size_t i = 0; i < n; ++i)
+        if (p[i]) return false;
+      return true;
+    };
+    if (gpsFrom >= 0 && gpsTo >= 0) std::memcpy(out + gpsTo, in + gpsFrom, 8);
+    if (gpsFrom >= 0 && gpsTo < 0 && !zero(in + gpsFrom, 8)) return "GPS times";
+    if (rgbFrom >= 0 && rgbTo >= 0) std::memcpy(out + rgbTo, in + rgbFrom, 6);
+    if (rgbFrom >= 0 && rgbTo < 0 && !zero(in + rgbFrom, 6)) return "colors";
+    if (from == 8 && to == 8) std::memcpy(out + 36, in + 36, 2);
+    if (from == 8 && to != 8 && !zero(in + 36, 2)) return "near infrared";
+    std::memcpy(out + las::kRecordSize[size_t(to)], in + fromExtraAt, extra);
+    return nullptr;
+  }
+};
+
 } // namespace
 
 uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::path& outPath,
@@ -341,21 +411,51 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
   } else {
     hd = readLasHeader(file);
   }
-  const int format = withoutWaveform(hd.pointFormat);
-  const bool dropWaves = format != hd.pointFormat;
+  const int baseFormat = withoutWaveform(hd.pointFormat);
+  const bool dropWaves = baseFormat != hd.pointFormat;
   if (dropWaves && !options.dropWaveforms)
     fail(in, strFormat("point format %d carries waveform packets, which the output would lose; "
                        "--drop-waveforms writes the points without them (format %d)",
-                       hd.pointFormat, format));
+                       hd.pointFormat, baseFormat));
+  int format = options.pointFormat >= 0 ? options.pointFormat : baseFormat;
+  if (options.pointFormat < 0 && options.versionMinor >= 0) {
+    // The version's format with the input's attributes: 1.4 writes 6-8, 1.0-1.2 writes 0-3.
+    static const int kTo14[] = {6, 6, 7, 7, 6, 7, 6, 7, 8, 6, 8};
+    static const int kTo12[] = {0, 1, 2, 3, 1, 3, 1, 3, 3, 1, 3};
+    format = options.versionMinor >= 4 ? kTo14[size_t(baseFormat)] : kTo12[size_t(baseFormat)];
+  }
+  if (!laz::canEncodePointFormat(format))
+    fail(outPath, strFormat("point format %d cannot be written (formats 0-3 and 6-8 can)", format));
   const uint16_t baseBytes = las::kRecordSize[size_t(format)];
   const uint16_t inBase = las::kRecordSize[size_t(hd.pointFormat)];
   if (hd.recordLength < inBase)
     fail(in, strFormat("%u-byte records are too short for point format %d", hd.recordLength, hd.pointFormat));
   const uint16_t extraBytes = uint16_t(hd.recordLength - inBase);
+  const bool transcode = format != hd.pointFormat;
+  const RecordTranscoder transcoder{baseFormat, format, inBase, uint16_t(baseBytes + extraBytes), extraBytes};
 
   LasFileSetup setup;
   setup.header.resize(hd.headerSize);
   file.readAt(0, setup.header.data(), setup.header.size());
+  if (options.versionMinor >= 0 && options.versionMinor < 4 && las::isExtended(format))
+    fail(outPath, strFormat("point format %d needs LAS 1.4", format));
+  if (options.versionMinor >= 0 && options.versionMinor < 4 && hd.versionMinor >= 3) {
+    // Down to LAS 1.0-1.2: the header ends at 227 bytes, so nothing may need the 1.3-1.4 fields.
+    if (hd.evlrCount > 0) fail(in, "its EVLRs cannot be written to LAS 1.2");
+    setup.header.resize(las::kHeaderSize12);
+    setup.header[las::kVersionMinor] = uint8_t(options.versionMinor);
+    storeLE<uint16_t>(setup.header.data() + las::kHeaderSizeField, uint16_t(las::kHeaderSize12));
+  }
+  if ((las::isExtended(format) || options.versionMinor == 4) && hd.versionMinor < 4) {
+    // Up to LAS 1.4 (formats 6-10 need it): the 1.0-1.3 fields stay, the 1.4 ones start at zero; for
+    // formats 6-10 bit 4 of the global encoding says the CRS, if any, is WKT, as R15 requires.
+    setup.header.resize(std::max<size_t>(setup.header.size(), las::kHeaderSize14), 0);
+    std::fill(setup.header.begin() + las::kWaveformStart, setup.header.begin() + las::kHeaderSize14, 0);
+    setup.header[las::kVersionMinor] = 4;
+    storeLE<uint16_t>(setup.header.data() + las::kHeaderSizeField, uint16_t(setup.header.size()));
+    const uint16_t ge = loadLE<uint16_t>(setup.header.data() + las::kGlobalEncoding);
+    if (las::isExtended(format)) storeLE<uint16_t>(setup.header.data() + las::kGlobalEncoding, uint16_t(ge | 0x10));
+  }
   setup.pointFormat = format;
   setup.recordLength = uint16_t(baseBytes + extraBytes);
   setup.laz = isLazPath(outPath);
@@ -373,23 +473,24 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
     file.readAt(vlr.dataOffset - las::kVlrHeaderSize, v.data(), v.size());
     setup.vlrs.push_back(std::move(v));
   }
-  if (hd.versionMinor >= 4) setup.evlrs = readEvlrs(file, hd);
+  if (setup.header[las::kVersionMinor] >= 4) setup.evlrs = readEvlrs(file, hd);
 
   LasFileWriter writer(outPath, std::move(setup));
   std::optional<Progress> line;
   if (options.progress) line.emplace("converting " + in.filename().string(), hd.pointCount);
-  std::vector<uint8_t> stripped;
+  std::vector<uint8_t> converted;
+  uint64_t done = 0;
   auto deliver = [&](const uint8_t* records, uint64_t n) {
-    if (dropWaves) {
+    if (transcode) {
       const size_t outLength = size_t(baseBytes) + extraBytes;
-      stripped.resize(size_t(n) * outLength);
-      for (uint64_t k = 0; k < n; ++k) {
-        const uint8_t* r = records + k * hd.recordLength;
-        std::memcpy(stripped.data() + k * outLength, r, baseBytes);
-        std::memcpy(stripped.data() + k * outLength + baseBytes, r + baseBytes + kWavePacketBytes, extraBytes);
-      }
-      records = stripped.data();
+      converted.resize(size_t(n) * outLength);
+      for (uint64_t k = 0; k < n; ++k)
+        if (const char* lost = transcoder(records + k * hd.recordLength, converted.data() + k * outLength))
+          fail(in, strFormat("point %llu has %s, which point format %d cannot hold",
+                             static_cast<unsigned long long>(done + k + 1), lost, format));
+      records = converted.data();
     }
+    done += n;
     writer.write(records, n);
     if (line) line->advance(n);
   };
