@@ -125,6 +125,11 @@ std::string describeSettings(const ViewSettings& settings) {
   return out;
 }
 
+std::string describeView(const Camera& camera, const ViewSettings& settings) {
+  std::string options = describeSettings(settings);
+  return describeCamera(camera) + (options.empty() ? "" : " " + options);
+}
+
 void validateSettings(const ViewSettings& s) {
   validatePostSettings(s.post);
   if (s.post.edlStrength > kMaxEdlStrength)

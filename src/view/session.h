@@ -60,6 +60,8 @@ bool takesInt40(Method method);
 // "--method batch --color intensity --point-size 3 --edl": with the camera's options (describeCamera)
 // they reproduce the viewer's image with render.
 std::string describeSettings(const ViewSettings& settings);
+// The camera's options (describeCamera) and then the settings': what the C key prints.
+std::string describeView(const Camera& camera, const ViewSettings& settings);
 // Throws InputError, naming the setting, for a value render would refuse (the ranges above,
 // validatePostSettings, a color range that is not lo < hi or given for a source without a ramp).
 void validateSettings(const ViewSettings& settings);

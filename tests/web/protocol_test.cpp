@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/error.h"
 #include "view/web/client.h"
 
 namespace pointrast::view::web {
@@ -45,8 +46,8 @@ TEST(Protocol, AcceptsEveryShapeThePageSends) {
   EXPECT_TRUE(m.down && m.shift);
   EXPECT_EQ(accepted(R"({"t":"key","key":"ViewIso","down":false})").key, Key::ViewIso);
   m = accepted(R"({"t":"settings","method":"batch","background":[64,64,64]})");
-  EXPECT_EQ(m.method, pointMethod("batch"));
-  EXPECT_EQ(m.background, 0xFF404040u);
+  EXPECT_EQ(m.settings.method, pointMethod("batch"));
+  EXPECT_EQ(m.settings.background, 0xFF404040u);
   m = accepted(R"({"t":"options","supersample":4,"keyframeSeconds":0.5})");
   EXPECT_EQ(m.supersample, 4u);
   EXPECT_DOUBLE_EQ(*m.keyframeSeconds, 0.5);
@@ -93,6 +94,73 @@ TEST(Protocol, RefusesEverythingElseWithAReason) {
   EXPECT_EQ(refused(std::string("{\"t\":\"move\",\"x\":0,\"y\":0}\0garbage", 32)), "a NUL byte");
   // Deep nesting within the size bound is only a refusal, not a crash.
   EXPECT_EQ(refused(std::string(500, '[') + std::string(500, ']')), "a message must be a JSON object");
+}
+
+TEST(Protocol, SettingsCarryEveryRenderOptionAViewerOffers) {
+  ClientMessage m = accepted(
+      R"({"t":"settings","depth":"int40","color":"intensity","colorRange":[10,2000],"pointSize":3,)"
+      R"("pointSizeMax":12,"pointShape":"disc","pointSizeMode":"attenuated","dilate":2,"edlStrength":1.5,)"
+      R"("edlRadius":2,"minNodePx":50,"pointBudget":1000000,"gpuMemory":268435456})");
+  const SettingsChange& c = m.settings;
+  EXPECT_EQ(c.depth, DepthMode::Int40);
+  EXPECT_TRUE(c.color);
+  EXPECT_EQ(c.colorSource, DisplayColorMode::Source::Intensity);
+  EXPECT_TRUE(c.range);
+  ASSERT_TRUE(c.colorRange);
+  EXPECT_EQ(c.colorRange->hi, 2000);
+  EXPECT_EQ(c.pointSize, 3.0f);
+  EXPECT_EQ(c.pointShape, PointShape::Disc);
+  EXPECT_EQ(c.pointSizeMode, PointSizeMode::Attenuated);
+  EXPECT_EQ(c.dilate, 2u);
+  EXPECT_EQ(c.edlStrength, 1.5f);
+  EXPECT_EQ(c.pointBudget, 1000000u);
+  EXPECT_EQ(c.gpuMemory, 268435456u);
+  ViewSettings s = applySettings(ViewSettings{}, c);
+  EXPECT_EQ(s.depth, DepthMode::Int40);
+  EXPECT_EQ(s.post.maxPointSize, 12.0f);
+  EXPECT_EQ(s.post.edlRadius, 2.0f);
+  EXPECT_EQ(s.minNodePx, 50);
+  EXPECT_EQ(describeSettings(s),
+            "--depth int40 --color intensity --color-range 10,2000 --point-size 3 "
+            "--point-shape disc --point-size-mode attenuated --point-size-max 12 --dilate 2 "
+            "--edl --edl-strength 1.5 --edl-radius 2 --min-node-px 50 --point-budget 1000000 "
+            "--gpu-memory 268435456");
+  // "auto" and null go back to the defaults; a new source drops the old range.
+  ViewSettings automatic = applySettings(s, accepted(R"({"t":"settings","color":"auto"})").settings);
+  EXPECT_FALSE(automatic.colorSource);
+  EXPECT_FALSE(automatic.colorRange);
+  EXPECT_FALSE(applySettings(s, accepted(R"({"t":"settings","colorRange":null})").settings).colorRange);
+  EXPECT_EQ(applySettings(s, accepted(R"({"t":"settings","color":"return"})").settings).colorSource,
+            DisplayColorMode::Source::ReturnNumber);
+  // A whole render would refuse is refused here too: a range for colors without a ramp.
+  ViewSettings rgb = applySettings({}, accepted(R"({"t":"settings","color":"rgb"})").settings);
+  EXPECT_THROW(applySettings(rgb, accepted(R"({"t":"settings","colorRange":[0,1]})").settings), InputError);
+  EXPECT_EQ(describeSettings(ViewSettings{}), "");
+}
+
+TEST(Protocol, RefusesSettingsOutOfRenderRanges) {
+  EXPECT_EQ(refused(R"({"t":"settings","depth":"int64"})"), "unknown \"depth\"");
+  EXPECT_EQ(refused(R"({"t":"settings","color":"red"})"), "unknown \"color\"");
+  EXPECT_EQ(refused(R"({"t":"settings","colorRange":[5,5]})"), "\"colorRange\" must be finite with lo < hi");
+  EXPECT_EQ(refused(R"({"t":"settings","colorRange":[0]})"), "\"colorRange\" must be [lo, hi] or null");
+  EXPECT_EQ(refused(R"({"t":"settings","colorRange":["0",1]})"), "\"colorRange\" must be [lo, hi] or null");
+  EXPECT_EQ(refused(R"({"t":"settings","pointSize":0.5})"), "\"pointSize\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","pointSize":33})"), "\"pointSize\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","pointShape":"star"})"), "unknown \"pointShape\"");
+  EXPECT_EQ(refused(R"({"t":"settings","pointSizeMode":"adaptive"})"), "unknown \"pointSizeMode\"");
+  EXPECT_EQ(refused(R"({"t":"settings","dilate":9})"), "\"dilate\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","dilate":1.5})"), "\"dilate\" must be a non-negative integer");
+  EXPECT_EQ(refused(R"({"t":"settings","edlStrength":-1})"), "\"edlStrength\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","edlStrength":11})"), "\"edlStrength\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","edlRadius":0})"), "\"edlRadius\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","minNodePx":-1})"), "\"minNodePx\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","pointBudget":-1})"),
+            "\"pointBudget\" must be a non-negative integer");
+  EXPECT_EQ(refused(R"({"t":"settings","pointBudget":1e300})"),
+            "\"pointBudget\" must be a non-negative integer");
+  EXPECT_EQ(refused(R"({"t":"settings","gpuMemory":18446744073709551615})"), "\"gpuMemory\" is out of range");
+  EXPECT_EQ(refused(R"({"t":"settings","seq":3})"), "\"settings\" changes nothing");
+  EXPECT_EQ(refused(R"({"t":"settings","pointsize":3})"), "unknown field \"pointsize\"");
 }
 
 TEST(Protocol, KeyNamesRoundTrip) {

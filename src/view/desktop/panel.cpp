@@ -1,11 +1,15 @@
 #include "view/desktop/panel.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include <imgui.h>
 
 #include "base/progress.h"
+#include "cloud/attribute_colors.h"
+#include "shared.h"
 
 namespace pointrast::view {
 
@@ -36,6 +40,18 @@ void methodCombo(const PanelInfo& info, ViewSettings& settings, PanelItems& item
   remember(items, "Method");
 }
 
+void depthControls(ViewSettings& settings, PanelItems& items) {
+  ImGui::BeginDisabled(!takesInt40(settings.method));
+  ImGui::TextUnformatted("Depth");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("float", settings.depth == DepthMode::Float)) settings.depth = DepthMode::Float;
+  remember(items, "float");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("int40", settings.depth == DepthMode::Int40)) settings.depth = DepthMode::Int40;
+  remember(items, "int40");
+  ImGui::EndDisabled();
+}
+
 void backgroundControls(ViewSettings& settings, PanelItems& items) {
   ImGui::TextUnformatted("Background");
   for (const Preset& p : kBackgrounds) {
@@ -52,21 +68,193 @@ void backgroundControls(ViewSettings& settings, PanelItems& items) {
   }
 }
 
+// A "-" and a "+" button after the last item, each remembered as `label -` and `label +`; returns -1, 0
+// or 1.
+int steppers(const char* label, PanelItems& items) {
+  int step = 0;
+  ImGui::PushID(label);
+  ImGui::SameLine();
+  if (ImGui::SmallButton("-")) step = -1;
+  remember(items, std::string(label) + " -");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("+")) step = 1;
+  remember(items, std::string(label) + " +");
+  ImGui::PopID();
+  return step;
+}
+
+struct ColorChoice {
+  const char* label;
+  std::optional<DisplayColorMode::Source> source;
+};
+constexpr ColorChoice kColors[] = {
+    {"Auto", std::nullopt},
+    {"RGB", DisplayColorMode::Source::Rgb},
+    {"Intensity", DisplayColorMode::Source::Intensity},
+    {"Elevation", DisplayColorMode::Source::Elevation},
+    {"Classification", DisplayColorMode::Source::Classification},
+    {"Return", DisplayColorMode::Source::ReturnNumber},
+    {"Source", DisplayColorMode::Source::PointSource},
+};
+
+void colorControls(Session& session, ViewSettings& settings, PanelItems& items) {
+  ImGui::TextUnformatted("Color");
+  for (size_t i = 0; i < std::size(kColors); ++i) {
+    if (i != 0 && i != 4) ImGui::SameLine();
+    if (i == 4) ImGui::Indent(48);
+    if (ImGui::RadioButton(kColors[i].label, settings.colorSource == kColors[i].source)) {
+      settings.colorSource = kColors[i].source;
+      settings.colorRange.reset();
+    }
+    remember(items, kColors[i].label);
+  }
+  ImGui::Unindent(48);
+  const bool ramp = settings.colorSource == DisplayColorMode::Source::Intensity ||
+                    settings.colorSource == DisplayColorMode::Source::Elevation;
+  if (!ramp) return;
+  bool custom = settings.colorRange.has_value();
+  if (ImGui::Checkbox("Range", &custom)) {
+    if (custom) {
+      const Bounds& b = session.navigation().bounds();
+      settings.colorRange = settings.colorSource == DisplayColorMode::Source::Elevation
+                                ? ColorRange{b.min.z, b.max.z}
+                                : ColorRange{0.0, 65535.0};
+    } else {
+      settings.colorRange.reset();
+    }
+  }
+  remember(items, "Range");
+  if (!custom) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("(0.5 %% .. 99.5 %% percentiles)");
+    return;
+  }
+  double range[2] = {settings.colorRange->lo, settings.colorRange->hi};
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(220);
+  if (ImGui::InputScalarN("lo, hi", ImGuiDataType_Double, range, 2, nullptr, nullptr, "%.6g",
+                          ImGuiInputTextFlags_EnterReturnsTrue) &&
+      range[0] < range[1])
+    settings.colorRange = ColorRange{range[0], range[1]};
+}
+
+void pointControls(ViewSettings& settings, PanelItems& items) {
+  PostSettings& p = settings.post;
+  const float maxSize = float(shared::kMaxPointSize);
+  ImGui::SetNextItemWidth(160);
+  ImGui::SliderFloat("Point size", &p.pointSize, 1.0f, maxSize, "%.1f px");
+  remember(items, "Point size");
+  p.pointSize = std::clamp(p.pointSize + float(steppers("Point size", items)), 1.0f, maxSize);
+  ImGui::TextUnformatted("Shape");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("Square", p.shape == PointShape::Square)) p.shape = PointShape::Square;
+  remember(items, "Square");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("Disc", p.shape == PointShape::Disc)) p.shape = PointShape::Disc;
+  remember(items, "Disc");
+  bool attenuated = p.sizeMode == PointSizeMode::Attenuated;
+  ImGui::SameLine();
+  if (ImGui::Checkbox("Attenuated", &attenuated))
+    p.sizeMode = attenuated ? PointSizeMode::Attenuated : PointSizeMode::Fixed;
+  remember(items, "Attenuated");
+  if (attenuated) {
+    ImGui::SetNextItemWidth(160);
+    ImGui::SliderFloat("Largest size", &p.maxPointSize, 1.0f, maxSize, "%.1f px");
+    p.maxPointSize = std::clamp(p.maxPointSize, 1.0f, maxSize);
+  }
+  int dilate = int(p.dilate);
+  ImGui::SetNextItemWidth(160);
+  ImGui::SliderInt("Dilation", &dilate, 0, int(shared::kMaxDilateRadius), dilate ? "%d px" : "off");
+  remember(items, "Dilation");
+  dilate += steppers("Dilation", items);
+  p.dilate = uint32_t(std::clamp(dilate, 0, int(shared::kMaxDilateRadius)));
+  bool edl = p.edlStrength > 0;
+  if (ImGui::Checkbox("Eye-dome lighting", &edl)) p.edlStrength = edl ? 1.0f : 0.0f;
+  remember(items, "EDL");
+  if (edl) {
+    ImGui::SetNextItemWidth(160);
+    ImGui::SliderFloat("Strength", &p.edlStrength, 0.05f, kMaxEdlStrength, "%.2f");
+    p.edlStrength = std::clamp(p.edlStrength, 0.05f, kMaxEdlStrength);
+    ImGui::SetNextItemWidth(160);
+    ImGui::SliderFloat("Radius", &p.edlRadius, 0.5f, 16.0f, "%.1f px");
+    p.edlRadius = std::clamp(p.edlRadius, 0.5f, 16.0f);
+  }
+}
+
+// Point budgets offered as presets (0: no limit).
+struct Budget {
+  const char* label;
+  uint64_t points;
+};
+constexpr Budget kBudgets[] = {{"none", 0}, {"1M", 1'000'000}, {"3M", 3'000'000}, {"10M", 10'000'000},
+                               {"30M", 30'000'000}};
+
+void lodControls(ViewSettings& settings, PanelItems& items) {
+  float minPx = float(settings.minNodePx);
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::SliderFloat("Min node size", &minPx, 0.0f, 1000.0f, "%.0f px", ImGuiSliderFlags_Logarithmic))
+    settings.minNodePx = std::clamp(double(minPx), 0.0, kMaxMinNodePx);
+  remember(items, "Min node size");
+  ImGui::TextUnformatted("Point budget");
+  for (const Budget& b : kBudgets) {
+    ImGui::SameLine();
+    if (ImGui::RadioButton(b.label, settings.pointBudget == b.points)) settings.pointBudget = b.points;
+    remember(items, std::string("Budget ") + b.label);
+  }
+  // Any other budget: typed in thousands of points.
+  uint64_t thousands = settings.pointBudget / 1000, step = 100;
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::InputScalar("k points", ImGuiDataType_U64, &thousands, &step, nullptr, "%llu",
+                         ImGuiInputTextFlags_EnterReturnsTrue))
+    settings.pointBudget = std::min(thousands, kMaxPointBudget / 1000) * 1000;
+  uint64_t mib = settings.gpuMemory >> 20, mibStep = 256;
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::InputScalar("GPU memory MiB (0: half)", ImGuiDataType_U64, &mib, &mibStep, nullptr, "%llu",
+                         ImGuiInputTextFlags_EnterReturnsTrue))
+    settings.gpuMemory = std::min(mib, kMaxGpuMemory >> 20) << 20;
+  remember(items, "GPU memory");
+}
+
+std::string mib(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / (1 << 20));
+  return text;
+}
+
 void statistics(const Session& session, const PanelInfo& info) {
   const Statistics& s = session.statistics();
   ImGui::Text("%s", info.device.c_str());
   ImGui::Text("%s: %s points", info.input.c_str(), humanCount(double(info.points)).c_str());
   ImGui::Text("GPU render  %8.3f ms  (clear + draw + resolve)", s.renderMs);
+  if (s.post)
+    ImGui::Text("  resolve stage: splat %.3f, dilate %.3f, compose %.3f ms", s.post->splatMs,
+                s.post->dilateMs, s.post->composeMs);
   ImGui::Text("GPU present %8.3f ms  (image copy + panel)", s.presentMs);
   ImGui::Text("frame (host) %7.2f ms, %llu frames", s.hostMs, static_cast<unsigned long long>(s.frames));
   ImGui::Text("points drawn %s, %s points/s", humanCount(double(s.points)).c_str(),
               humanCount(s.renderMs > 0 ? double(s.points) / (s.renderMs * 1e-3) : 0).c_str());
-  if (s.batch)
+  if (s.batch && !s.lod)
     ImGui::Text("batches %s of %s rendered, %s points passed early-z",
                 humanCount(double(s.batch->batchesRendered)).c_str(),
                 humanCount(double(s.batch->batchesProcessed)).c_str(),
                 humanCount(double(s.batch->pointsRendered)).c_str());
-  ImGui::Text("GPU memory %.1f MiB (scene + targets)", double(s.gpuBytes) / (1 << 20));
+  if (s.lod) {
+    const lod::LodStats& l = *s.lod;
+    ImGui::Text("nodes drawn %s of %s selected (%s points)%s", humanCount(double(l.nodesDrawn)).c_str(),
+                humanCount(double(l.nodesSelected)).c_str(), humanCount(double(l.pointsDrawn)).c_str(),
+                l.budgetReached ? ", budget reached" : "");
+    ImGui::Text("nodes loaded %s, evicted %s, %s passes", humanCount(double(l.nodesLoaded)).c_str(),
+                humanCount(double(l.nodesEvicted)).c_str(), std::to_string(l.passes).c_str());
+    ImGui::Text("streamed %.1f MB/s, %s in all", s.streamedBytesPerSecond * 1e-6,
+                mib(l.bytesStreamed).c_str());
+    ImGui::Text("node cache %s of %s", mib(l.residentBytes).c_str(), mib(l.cacheBytes).c_str());
+    if (l.converged)
+      ImGui::TextColored(ImVec4(0.5f, 1.0f, 0.5f, 1.0f), "converged");
+    else
+      ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "refining");
+  }
+  ImGui::Text("GPU memory %s (scene + targets)", mib(s.gpuBytes).c_str());
+  if (!s.status.empty()) ImGui::TextWrapped("%s", s.status.c_str());
 }
 
 void cameraControls(Session& session, PanelActions& actions, PanelItems& items) {
@@ -115,8 +303,30 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("pointrast", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  const ViewSettings before = settings;
   methodCombo(info, settings, items);
+  depthControls(settings, items);
   backgroundControls(settings, items);
+  if (ImGui::CollapsingHeader("Look", ImGuiTreeNodeFlags_DefaultOpen)) {
+    colorControls(session, settings, items);
+    ImGui::BeginDisabled(!takesPost(settings.method));
+    pointControls(settings, items);
+    ImGui::EndDisabled();
+    if (!takesPost(settings.method))
+      ImGui::TextDisabled("%s keeps no depth per pixel: no point size, dilation or EDL",
+                          methodName(settings.method));
+  }
+  if (ImGui::CollapsingHeader("Level of detail", ImGuiTreeNodeFlags_DefaultOpen)) {
+    ImGui::BeginDisabled(methodInfo(settings.method).layout != SceneLayout::Octree);
+    lodControls(settings, items);
+    ImGui::EndDisabled();
+  }
+  // A value render would refuse (a slider typed past its end with Ctrl+click) keeps the last good settings.
+  try {
+    validateSettings(settings);
+  } catch (const std::exception&) {
+    settings = before;
+  }
   if (ImGui::CollapsingHeader("Statistics", ImGuiTreeNodeFlags_DefaultOpen)) statistics(session, info);
   if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen))
     cameraControls(session, actions, items);
@@ -125,7 +335,7 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
   ImGui::TextDisabled("drag: orbit  right/middle drag: pan  wheel: zoom\n"
                       "double-click: pivot  WASD QE: fly (Shift: fast)\n"
                       "8 2 5 0 4 6: views  F: frame all  K: keyframe\n"
-                      "C: print camera  F12: screenshot  H: hide panel");
+                      "C: print as render options  F12: screenshot  H: hide panel");
   ImVec2 position = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   items["panel"] = {position.x, position.y, size.x, size.y};
   ImGui::End();

@@ -1,4 +1,5 @@
-// The viewer's settings panel (Dear ImGui): method, background, camera views, keyframes, screenshots and
+// The viewer's settings panel (Dear ImGui): method, depth, background, colors, point size and shape,
+// dilation, eye-dome lighting, level of detail, camera views, keyframes, screenshots and
 // live statistics. Built once per shown frame; edits go to a copy of the settings that the caller hands
 // to Session::setSettings, which renders only when something really changed.
 #pragma once

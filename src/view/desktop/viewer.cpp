@@ -241,10 +241,12 @@ void Viewer::handleRequests() {
   }
   if (r.printCamera) {
     if (options_.events)
-      emit(
-          {{"event", "camera"}, {"camera", cameraJson(session_.camera())}, {"pivot", vec(session_.pivot())}});
+      emit({{"event", "camera"},
+            {"camera", cameraJson(session_.camera())},
+            {"pivot", vec(session_.pivot())},
+            {"options", describeSettings(session_.settings())}});
     else
-      std::printf("camera: %s\n", describeCamera(session_.camera()).c_str());
+      std::printf("camera: %s\n", describeView(session_.camera(), session_.settings()).c_str());
     std::fflush(stdout);
   }
   if (r.screenshot) takeScreenshot();
@@ -283,6 +285,7 @@ void Viewer::showFrame() {
                           {"pivot", vec(session_.pivot())},
                           {"method", methodName(session_.settings().method)},
                           {"background", session_.settings().background},
+                          {"options", describeSettings(session_.settings())},
                           {"panel", session_.options().panel},
                           {"render_ms", report.renderMs},
                           {"present_ms", report.presentMs}};

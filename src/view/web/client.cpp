@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/error.h"
+#include "cloud/attribute_colors.h"
 #include "io/writer.h"
 
 namespace pointrast::view::web {
@@ -23,6 +25,32 @@ Json vec(const glm::dvec3& v) {
 
 Json rgb(uint32_t rgba) {
   return {rgba & 0xFF, (rgba >> 8) & 0xFF, (rgba >> 16) & 0xFF};
+}
+
+// The settings as the page's controls show them (the names of the "settings" message), and as render
+// options.
+Json settingsJson(const ViewSettings& s) {
+  const PostSettings& p = s.post;
+  Json j = {{"method", methodName(s.method)},
+            {"background", rgb(s.background)},
+            {"depth", depthModeName(s.depth)},
+            {"color", s.colorSource ? colorSourceName(*s.colorSource) : "auto"},
+            {"colorRange", s.colorRange ? Json{s.colorRange->lo, s.colorRange->hi} : Json()},
+            {"pointSize", p.pointSize},
+            {"pointSizeMax", p.maxPointSize},
+            {"pointShape", pointShapeName(p.shape)},
+            {"pointSizeMode", pointSizeModeName(p.sizeMode)},
+            {"dilate", p.dilate},
+            {"edlStrength", p.edlStrength},
+            {"edlRadius", p.edlRadius},
+            {"minNodePx", s.minNodePx},
+            {"pointBudget", s.pointBudget},
+            {"gpuMemory", s.gpuMemory},
+            {"takesPost", takesPost(s.method)},
+            {"takesInt40", takesInt40(s.method)},
+            {"octree", methodInfo(s.method).layout == SceneLayout::Octree},
+            {"options", describeSettings(s)}};
+  return j;
 }
 
 } // namespace
@@ -118,13 +146,15 @@ void WebClient::receive(const ClientMessage& m) {
       session_->keyUp(m.key);
     stateChanged_ = true; // keyframes, the panel's visibility
     break;
-  case MessageType::Settings: {
-    ViewSettings s = session_->settings();
-    if (m.method) s.method = *m.method;
-    if (m.background) s.background = *m.background;
-    session_->setSettings(s);
+  case MessageType::Settings:
+    // A change that makes no valid whole (a range for a source without a ramp) is answered, not applied.
+    try {
+      session_->setSettings(applySettings(session_->settings(), m.settings));
+    } catch (const InputError& e) {
+      stream_.submitText(Json{{"t", "refused"}, {"text", e.what()}}.dump());
+    }
+    stateChanged_ = true;
     break;
-  }
   case MessageType::Options:
     if (m.supersample) session_->options().supersample = *m.supersample;
     if (m.keyframeSeconds) session_->options().keyframeSeconds = *m.keyframeSeconds;
@@ -153,7 +183,10 @@ void WebClient::serveRequests() {
     stateChanged_ = true;
   }
   if (r.printCamera)
-    stream_.submitText(Json{{"t", "camera"}, {"text", describeCamera(session_->camera())}}.dump());
+    stream_.submitText(Json{{"t", "camera"},
+                            {"text", describeView(session_->camera(), session_->settings())},
+                            {"options", describeSettings(session_->settings())}}
+                           .dump());
   if (r.screenshot) sendScreenshot();
   // r.quit: a client closes its tab, it does not stop the server.
 }
@@ -245,13 +278,32 @@ std::string WebClient::stateJson(const FrameHeader* frame) const {
     stats["batch"] = {{"batchesProcessed", st.batch->batchesProcessed},
                       {"batchesRendered", st.batch->batchesRendered},
                       {"pointsRendered", st.batch->pointsRendered}};
+  if (st.post)
+    stats["post"] = {
+        {"splatMs", st.post->splatMs}, {"dilateMs", st.post->dilateMs}, {"composeMs", st.post->composeMs}};
+  if (st.lod) {
+    const lod::LodStats& l = *st.lod;
+    stats["lod"] = {{"nodesSelected", l.nodesSelected},
+                    {"pointsSelected", l.pointsSelected},
+                    {"nodesDrawn", l.nodesDrawn},
+                    {"pointsDrawn", l.pointsDrawn},
+                    {"budgetReached", l.budgetReached},
+                    {"passes", l.passes},
+                    {"converged", l.converged},
+                    {"nodesLoaded", l.nodesLoaded},
+                    {"nodesEvicted", l.nodesEvicted},
+                    {"bytesStreamed", l.bytesStreamed},
+                    {"residentBytes", l.residentBytes},
+                    {"cacheBytes", l.cacheBytes},
+                    {"bytesPerSecond", st.streamedBytesPerSecond}};
+  }
+  if (!st.status.empty()) stats["status"] = st.status;
   Json j = {{"t", "state"},
             {"seq", seq_},
             {"viewport", {s.viewport().width, s.viewport().height}},
             {"camera", {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", c.fovY}}},
             {"pivot", vec(s.pivot())},
-            {"settings",
-             {{"method", methodName(s.settings().method)}, {"background", rgb(s.settings().background)}}},
+            {"settings", settingsJson(s.settings())},
             {"options",
              {{"panel", s.options().panel},
               {"supersample", s.options().supersample},

@@ -6,6 +6,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/error.h"
+#include "cloud/attribute_colors.h"
+#include "shared.h"
+
 namespace pointrast::view::web {
 
 namespace {
@@ -50,7 +54,10 @@ const TypeName kTypes[] = {
     {MessageType::DoubleClick, "dblclick", {"x", "y"}},
     {MessageType::Wheel, "wheel", {"x", "y", "steps"}},
     {MessageType::Key, "key", {"key", "down", "shift"}},
-    {MessageType::Settings, "settings", {"method", "background"}},
+    {MessageType::Settings,
+     "settings",
+     {"method", "background", "depth", "color", "colorRange", "pointSize", "pointSizeMax", "pointShape",
+      "pointSizeMode", "dilate", "edlStrength", "edlRadius", "minNodePx", "pointBudget", "gpuMemory"}},
     {MessageType::Options, "options", {"supersample", "keyframeSeconds"}},
     {MessageType::Stream, "stream", {"motionScale", "quality", "motionQuality"}},
     {MessageType::Action, "action", {"name"}},
@@ -116,24 +123,81 @@ MouseButton button(const Json& j) {
   }
 }
 
+// One of `names` (the choices of a string field).
+template <typename T, size_t N>
+T choice(const Json& j, const char* name, const std::pair<const char*, T> (&names)[N]) {
+  const std::string& text = string(j, name);
+  for (const auto& [n, value] : names)
+    if (text == n) return value;
+  refuse(std::string("unknown \"") + name + "\"");
+}
+
+constexpr std::pair<const char*, DepthMode> kDepths[] = {{"float", DepthMode::Float},
+                                                         {"int40", DepthMode::Int40}};
+constexpr std::pair<const char*, PointShape> kShapes[] = {{"square", PointShape::Square},
+                                                          {"disc", PointShape::Disc}};
+constexpr std::pair<const char*, PointSizeMode> kSizeModes[] = {{"fixed", PointSizeMode::Fixed},
+                                                                {"attenuated", PointSizeMode::Attenuated}};
+
 void settings(const Json& j, std::span<const Method> methods, ClientMessage& m) {
+  SettingsChange& c = m.settings;
   if (j.contains("method")) {
     const std::string& name = string(j, "method");
     for (Method method : methods)
-      if (name == methodName(method)) m.method = method;
-    if (!m.method) refuse("\"method\" is not a method this device runs");
+      if (name == methodName(method)) c.method = method;
+    if (!c.method) refuse("\"method\" is not a method this device runs");
   }
   if (j.contains("background")) {
     const Json& v = j["background"];
     if (!v.is_array() || v.size() != 3) refuse("\"background\" must be [r, g, b]");
     uint32_t rgba = 0xFF000000u;
-    for (int c = 0; c < 3; ++c) {
-      if (!v[c].is_number_unsigned() || v[c].get<uint64_t>() > 255) refuse("\"background\" takes 0..255");
-      rgba |= uint32_t(v[c].get<uint64_t>()) << (8 * c);
+    for (int i = 0; i < 3; ++i) {
+      if (!v[i].is_number_unsigned() || v[i].get<uint64_t>() > 255) refuse("\"background\" takes 0..255");
+      rgba |= uint32_t(v[i].get<uint64_t>()) << (8 * i);
     }
-    m.background = rgba;
+    c.background = rgba;
   }
-  if (!m.method && !m.background) refuse("\"settings\" changes nothing");
+  if (j.contains("depth")) c.depth = choice(j, "depth", kDepths);
+  if (j.contains("color")) {
+    c.color = true;
+    const std::string& name = string(j, "color");
+    if (name != "auto") {
+      for (auto source : {DisplayColorMode::Source::Rgb, DisplayColorMode::Source::Intensity,
+                          DisplayColorMode::Source::Elevation, DisplayColorMode::Source::Classification,
+                          DisplayColorMode::Source::ReturnNumber, DisplayColorMode::Source::PointSource})
+        if (name == colorSourceName(source)) c.colorSource = source;
+      if (!c.colorSource) refuse("unknown \"color\"");
+    }
+  }
+  if (j.contains("colorRange")) {
+    c.range = true;
+    const Json& v = j["colorRange"];
+    if (!v.is_null()) {
+      if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+        refuse("\"colorRange\" must be [lo, hi] or null");
+      double lo = v[0].get<double>(), hi = v[1].get<double>();
+      if (!std::isfinite(lo) || !std::isfinite(hi) || std::abs(lo) > 1e12 || std::abs(hi) > 1e12 ||
+          !(lo < hi))
+        refuse("\"colorRange\" must be finite with lo < hi");
+      c.colorRange = ColorRange{lo, hi};
+    }
+  }
+  const double maxSize = shared::kMaxPointSize;
+  if (j.contains("pointSize")) c.pointSize = float(number(j, "pointSize", 1, maxSize));
+  if (j.contains("pointSizeMax")) c.pointSizeMax = float(number(j, "pointSizeMax", 1, maxSize));
+  if (j.contains("pointShape")) c.pointShape = choice(j, "pointShape", kShapes);
+  if (j.contains("pointSizeMode")) c.pointSizeMode = choice(j, "pointSizeMode", kSizeModes);
+  if (j.contains("dilate")) c.dilate = uint32_t(integer(j, "dilate", 0, shared::kMaxDilateRadius));
+  if (j.contains("edlStrength")) c.edlStrength = float(number(j, "edlStrength", 0, kMaxEdlStrength));
+  if (j.contains("edlRadius")) {
+    c.edlRadius = float(number(j, "edlRadius", 0, 16));
+    if (!(*c.edlRadius > 0)) refuse("\"edlRadius\" is out of range");
+  }
+  if (j.contains("minNodePx")) c.minNodePx = number(j, "minNodePx", 0, kMaxMinNodePx);
+  if (j.contains("pointBudget")) c.pointBudget = integer(j, "pointBudget", 0, kMaxPointBudget);
+  if (j.contains("gpuMemory")) c.gpuMemory = integer(j, "gpuMemory", 0, kMaxGpuMemory);
+  // Only "t" and "seq" besides: a message that names no setting changes nothing.
+  if (j.size() <= (j.contains("seq") ? 2u : 1u)) refuse("\"settings\" changes nothing");
 }
 
 void options(const Json& j, ClientMessage& m) {
@@ -234,6 +298,30 @@ template <typename T> T get(const uint8_t*& in) {
 }
 
 } // namespace
+
+ViewSettings applySettings(const ViewSettings& settings, const SettingsChange& c) {
+  ViewSettings s = settings;
+  if (c.method) s.method = *c.method;
+  if (c.background) s.background = *c.background;
+  if (c.depth) s.depth = *c.depth;
+  if (c.color) {
+    if (s.colorSource != c.colorSource) s.colorRange.reset();
+    s.colorSource = c.colorSource;
+  }
+  if (c.range) s.colorRange = c.colorRange;
+  if (c.pointSize) s.post.pointSize = *c.pointSize;
+  if (c.pointSizeMax) s.post.maxPointSize = *c.pointSizeMax;
+  if (c.pointShape) s.post.shape = *c.pointShape;
+  if (c.pointSizeMode) s.post.sizeMode = *c.pointSizeMode;
+  if (c.dilate) s.post.dilate = *c.dilate;
+  if (c.edlStrength) s.post.edlStrength = *c.edlStrength;
+  if (c.edlRadius) s.post.edlRadius = *c.edlRadius;
+  if (c.minNodePx) s.minNodePx = *c.minNodePx;
+  if (c.pointBudget) s.pointBudget = *c.pointBudget;
+  if (c.gpuMemory) s.gpuMemory = *c.gpuMemory;
+  validateSettings(s);
+  return s;
+}
 
 std::optional<Key> keyFromName(std::string_view name) {
   for (const KeyName& k : kKeyNames)

@@ -23,7 +23,7 @@
 
 namespace pointrast::view::web {
 
-// The longest valid message is about 150 bytes; anything over this is refused unread.
+// The longest valid message is about 400 bytes; anything over this is refused unread.
 constexpr size_t kMaxMessageBytes = 1024;
 // A resize may ask for at most this many pixels per side; --max-size then bounds what is rendered.
 constexpr uint32_t kMaxCanvasSide = 16384;
@@ -40,7 +40,7 @@ enum class MessageType {
   DoubleClick, // x, y
   Wheel,       // x, y, steps (positive: zoom in)
   Key,         // key (a Key's name), down, shift
-  Settings,    // method and/or background [r, g, b]
+  Settings,    // any of the SettingsChange fields below, at least one
   Options,     // supersample (1, 2, 4) and/or keyframeSeconds
   Stream,      // motionScale (0.25..1), quality and/or motionQuality (10..100)
   Action,      // name: clearKeyframes, downloadPath
@@ -48,6 +48,37 @@ enum class MessageType {
 };
 
 enum class ClientAction { ClearKeyframes, DownloadPath };
+
+// A "settings" message: the view settings it changes, each held to render's range for its option.
+//   method          a method this device runs, by name
+//   background      [r, g, b], 0..255
+//   depth           "float" or "int40"
+//   color           "auto" or a color source (colorSourceName)
+//   colorRange      [lo, hi], finite, lo < hi, or null for the percentiles
+//   pointSize       1..kMaxPointSize;  pointSizeMax likewise;  pointShape "square"/"disc"
+//   pointSizeMode   "fixed" or "attenuated"
+//   dilate          0..kMaxDilateRadius (integer)
+//   edlStrength     0..kMaxEdlStrength (0: off);  edlRadius (0, 16]
+//   minNodePx       0..kMaxMinNodePx;  pointBudget 0..kMaxPointBudget;  gpuMemory 0..kMaxGpuMemory (bytes)
+struct SettingsChange {
+  std::optional<Method> method;
+  std::optional<uint32_t> background; // RGBA8, alpha 255
+  std::optional<DepthMode> depth;
+  bool color = false; // colorSource is given (nullopt: auto)
+  std::optional<DisplayColorMode::Source> colorSource;
+  bool range = false; // colorRange is given (nullopt: the percentiles)
+  std::optional<ColorRange> colorRange;
+  std::optional<float> pointSize, pointSizeMax, edlStrength, edlRadius;
+  std::optional<PointShape> pointShape;
+  std::optional<PointSizeMode> pointSizeMode;
+  std::optional<uint32_t> dilate;
+  std::optional<double> minNodePx;
+  std::optional<uint64_t> pointBudget, gpuMemory;
+};
+
+// The settings with the change applied; a new color source without a range drops the old range. Throws
+// InputError (validateSettings) when the result is not a valid whole, e.g. a range for the RGB colors.
+ViewSettings applySettings(const ViewSettings& settings, const SettingsChange& change);
 
 struct ClientMessage {
   MessageType type = MessageType::Move;
@@ -58,8 +89,7 @@ struct ClientMessage {
   Key key = Key::Forward;
   bool down = false, shift = false;
   uint32_t width = 0, height = 0;
-  std::optional<Method> method;
-  std::optional<uint32_t> background; // RGBA8, alpha 255
+  SettingsChange settings;
   std::optional<uint32_t> supersample;
   std::optional<double> keyframeSeconds;
   std::optional<double> motionScale;
