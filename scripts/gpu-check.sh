@@ -44,7 +44,7 @@ fi
 echo "== machine"
 nvidia-smi -L 2>/dev/null || true
 # A machine that ran a hung kernel stays busy with no process and hangs graphics work from then on
-# (bench/NOTES.md): say so at once instead of producing stalls.
+# (docs/performance.md): say so at once instead of producing stalls.
 busy=$(nvidia-smi --query-gpu=utilization.gpu --format=csv,noheader,nounits 2>/dev/null | head -1)
 if [ -n "$busy" ] && [ "$busy" -gt 50 ] && [ -z "$(nvidia-smi --query-compute-apps=pid --format=csv,noheader 2>/dev/null)" ]; then
   echo "WARNING: GPU ${busy}% busy with no process: probably wedged by an earlier hang; use a fresh machine"

@@ -36,7 +36,7 @@ const float kCullMargin = 1e-5;
 // The map yields X/Z - 1/2, and adding 1.5 x 2^23 rounds that to the nearest integer in the mantissa:
 // floor(X/Z) except where X/Z is an odd integer exactly (then one less), one full-rate add where a
 // float-to-int conversion is a quarter-rate instruction on NVIDIA GPUs (1.5 % faster on the H200:
-// bench/NOTES.md, session 4).
+// docs/performance.md).
 
 // What a workgroup decided about its batch.
 struct BatchView {

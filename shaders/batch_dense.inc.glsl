@@ -17,7 +17,7 @@
 // relative) extensions.
 
 // Points a thread walks at a time; 80 / kDenseRun steps cover a batch. On the H200, 8 took 3.63 ms for the
-// 1 G overview where 4 took 4.7 (twice the scans) and 16 took 4.5-7.2 (bench/NOTES.md, session 9).
+// 1 G overview where 4 took 4.7 (twice the scans) and 16 took 4.5-7.2 (docs/performance.md).
 const uint kDenseRun = 8u;
 const uint kDenseQuads = kDenseRun / 4u;
 

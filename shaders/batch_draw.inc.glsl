@@ -11,7 +11,7 @@
 // wait for one another. A point on the same pixel as the thread's previous point of the four takes the
 // closer of the two words and the previous one is dropped before its read (fewer atomics where consecutive
 // points share pixels, as in Morton order). The variants timed before choosing this shape are in
-// bench/NOTES.md (session 4).
+// docs/performance.md.
 #extension GL_EXT_control_flow_attributes : require
 
 const uint GROUP = 4u; // points in flight per thread

@@ -33,7 +33,7 @@ uint viewIndex(uint batch, uint eye, uint eyes) {
 // The decision (culling, precision, the folded screen map) of batch `batch` of the part for eye `eye`:
 // batch_views.comp computed every batch's before the drawing passes, so a workgroup reads its own with one
 // load. (Computed in the workgroup instead, by one thread between two barriers, the batch kernel was 2.3 %
-// slower on the H200: bench/NOTES.md, session 7.)
+// slower on the H200: docs/performance.md.)
 BatchView viewBatch(uint batch, uint eye) {
   FrameRef frame = FrameRef(pc.frame);
   return loadView(BatchViews(frame.f.views).v[viewIndex(batch, eye, frame.f.eyes)]);

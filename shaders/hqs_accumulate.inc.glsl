@@ -7,7 +7,7 @@
 // consecutive points per pixel (hqsMergeFour), then lanes add within the subgroup, one round per distinct pixel (a ballot picks the lowest pending lane, every lane
 // on its pixel adds to it), for at most kHqsRounds pixels; lanes still pending after that add alone. One
 // atomic (hqs1r) or two (hqs) per distinct pixel of a subgroup's 4 x 32 points instead of one or two per point. On the H200
-// this beat VK_NV_shader_subgroup_partitioned by far (bench/NOTES.md), and it runs on every device.
+// this beat VK_NV_shader_subgroup_partitioned by far (docs/performance.md), and it runs on every device.
 
 // Distinct pixels a subgroup combines before the rest add alone: bounds the rounds where a subgroup's points
 // scatter (shuffled orders), while ordered clouds rarely have more pixels per subgroup.
@@ -17,7 +17,7 @@ const uint kHqsRounds = 4u;
 // neighbouring points into the same pixels: their atomics would queue on the same accumulator words. So the
 // accumulation passes hand workgroup g the chunk (g % 16) * (n / 16) + g / 16 of the n chunks (the last n % 16
 // keep their place): workgroups running together draw chunks a sixteenth of the part apart. On the H200 this
-// took hqs1r from 8.4 to 7.0 ms on a 796 M Morton overview, with the same atomics (bench/NOTES.md, session 7).
+// took hqs1r from 8.4 to 7.0 ms on a 796 M Morton overview, with the same atomics (docs/performance.md).
 const uint kHqsInterleave = 16u;
 uint hqsInterleavedChunk(uint group, uint groups) {
   uint per = groups / kHqsInterleave;
@@ -62,7 +62,7 @@ void hqsAccumulateTwo(Uint64Array acc, uint pixel, uint r, uint g, uint b, uint 
 // A round's sums are two subgroup adds, not four: r | g << 16 and b | count << 16. A subgroup of up to 64
 // lanes with up to 4 points each sums at most 64 x 4 x 255 = 65,280 per field, so the 16-bit fields never
 // carry into each other; wider subgroups (none known) take the four 32-bit adds. Subgroup adds are the
-// bulk of the rounds' work on NVIDIA (bench/NOTES.md, "HQS: what the accumulation pass spends").
+// bulk of the rounds' work on NVIDIA (docs/performance.md, "HQS: what the accumulation pass spends").
 const uint kHqsLanePoints = 4u;
 void hqsSubgroupSums(uint pixel, inout uint r, inout uint g, inout uint b, inout uint count, out bool writes) {
   bool pending = pixel != 0xFFFFFFFFu;

@@ -3,7 +3,7 @@
 // per point, 1-pixel points, the fixed-function depth test. The baseline the compute methods are measured
 // against, so it is the plain pipeline a viewer would use: no culling, no tricks.
 //
-// Image contract (DESIGN.md) through the fixed-function stages:
+// Image contract (docs/design.md) through the fixed-function stages:
 //   x, y   Vulkan's viewport maps NDC x = -1 to the left edge and NDC y = -1 to the top row, so
 //          (c.x, -c.y, ., c.w) puts the point at fx = (c.x/c.w + 1)/2 W, fy = (1 - c.y/c.w)/2 H, and a
 //          1-pixel point square covers the pixel (floor(fx), floor(fy)) up to subpixel snapping at borders.

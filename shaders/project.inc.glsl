@@ -1,4 +1,4 @@
-// The image contract of DESIGN.md, in one place for every point method:
+// The image contract of docs/design.md, in one place for every point method:
 //   px = floor((c.x / c.w + 1) / 2 * W),  py = floor((1 - c.y / c.w) / 2 * H),  row 0 at the top;
 //   a point is dropped if c.w <= near or the pixel is outside the image; the closest c.w wins.
 // Returns false for a dropped point; otherwise the pixel index and the depth bits for the high word. The

@@ -33,7 +33,7 @@ layout(constant_id = 4) const uint POINTS_PER_THREAD = 1;
 #include "point.inc.glsl"
 
 // Subgroup operations on 64-bit words built from 32-bit ones. The H200 (NVIDIA 580) hung, at random,
-// in kernels that used 64-bit subgroup arithmetic (bench/NOTES.md); 32-bit operations are what every
+// in kernels that used 64-bit subgroup arithmetic (docs/performance.md); 32-bit operations are what every
 // device implements natively, and they need no shaderSubgroupExtendedTypes.
 uint64_t joinWord(uint hi, uint lo) {
   return (uint64_t(hi) << 32) | uint64_t(lo);

@@ -8,7 +8,7 @@
 // A thread draws 4 consecutive points (three 16-byte position loads; the colors, one 16-byte load, only if one
 // of them blends): it adds them per pixel before the subgroup does (hqsMergeFour), so a subgroup step covers
 // 128 consecutive points and makes a few atomics for them. That, not the loads, decides the pass's speed in
-// dense views (bench/NOTES.md, "HQS: what the accumulation pass spends").
+// dense views (docs/performance.md, "HQS: what the accumulation pass spends").
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_ballot : require

@@ -2,7 +2,7 @@
 // fragment shaders of the hardware pipelines later). src/render/spheres/cpu_spheres.cpp evaluates the
 // same formulas in double precision as the independent reference; change both together.
 //
-// Camera (DESIGN.md, "Camera and image"): view space is right-handed, looking down -z. The view ray of a
+// Camera (docs/design.md, "Camera and image"): view space is right-handed, looking down -z. The view ray of a
 // pixel position p (pixel centers at +0.5, row 0 at the top) is dir = (p.x * sx + ox, p.y * sy + oy, -1)
 // from the eye, which is the inverse of px = (c.x / c.w + 1) / 2 * W, py = (1 - c.y / c.w) / 2 * H of the
 // point methods. With dir.z = -1 the point t * dir lies at view depth t: the ray parameter of a hit *is*

@@ -1,5 +1,5 @@
 // The device's buffer-copy bandwidth, measured in the same run as a benchmark so that every method's
-// effective bandwidth can be stated as a fraction of what the memory system delivers (DESIGN.md,
+// effective bandwidth can be stated as a fraction of what the memory system delivers (docs/design.md,
 // "Measuring performance"). Two copies between two device-local buffers, each timed with timestamp
 // queries after a warm-up, median over the repeats: vkCmdCopyBuffer, and a compute shader moving 16 bytes
 // per invocation. The faster is the device's copy bandwidth (on NVIDIA vkCmdCopyBuffer uses a copy

@@ -1,4 +1,4 @@
-// The camera contract of DESIGN.md: right-handed, OpenGL-style view; eye/target/up in the input's own
+// The camera contract of docs/design.md: right-handed, OpenGL-style view; eye/target/up in the input's own
 // coordinates; vertical field of view in degrees; clip w = linear view depth; points with w <= near are
 // dropped. Matrices handed to the GPU are built in double relative to a scene origin and rounded once.
 #pragma once

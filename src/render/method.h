@@ -40,7 +40,7 @@ struct Frame {
   std::span<const Camera> views;
   // Whether the frame gathers the method's counts (readStats). Renderer::render counts its last timed frame
   // only: the batch methods draw the others with pipelines that count nothing, since counting costs ~5 %
-  // of a frame on an H200 (bench/NOTES.md, session 7).
+  // of a frame on an H200 (docs/performance.md).
   bool counted = true;
 };
 
@@ -54,7 +54,7 @@ public:
 };
 
 // Points per thread of the raster_closest and raster_hqs shaders (POINTS_PER_THREAD): a thread loads 4
-// positions before projecting any, four loads in flight instead of one (bench/NOTES.md has the measurements).
+// positions before projecting any, four loads in flight instead of one (docs/performance.md has the measurements).
 constexpr uint32_t kPointsPerThread = 4;
 
 // Calls draw(push, grid) for every part of every scene, with `base` completed for that part: the matrix

@@ -28,7 +28,7 @@ public:
         gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
                     oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
     // The depth pass is the fastest closest-point shader on the H200 (reduce-earlyz, 4 points per thread;
-    // bench/NOTES.md), reading positions only.
+    // docs/performance.md), reading positions only.
     depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
                                  {{/* EARLY_Z= */ 0, 1},
                                   {/* REDUCE= */ 1, 1},

@@ -42,7 +42,7 @@ enum class MethodFamily {
 
 // What the method leaves in the framebuffer, which decides what tests and reports compare.
 enum class MethodOutput {
-  Closest,   // the canonical closest-point words: bit-identical across the family (DESIGN.md,
+  Closest,   // the canonical closest-point words: bit-identical across the family (docs/design.md,
              // "Equivalence"); the batch rows quantize to 30 bits, same point on >= 99.9 % of pixels
   AnyPoint,  // canonical words of some point of the pixel, not the closest (justset)
   Blend,     // an average of the points near the closest depth (HQS); no canonical words

@@ -1,5 +1,5 @@
 // Draws GPU scenes with one of the methods of the four papers and resolves to an RGBA8 image. All
-// closest-point methods write the same framebuffer words for the same input and camera (DESIGN.md,
+// closest-point methods write the same framebuffer words for the same input and camera (docs/design.md,
 // "Equivalence"); they differ only in how they get there, which is what the benchmarks compare.
 #pragma once
 

@@ -3,7 +3,7 @@
 // math on the Camera of render/camera.h (no GPU, no window), shared by every front end.
 //
 // Conventions: pixels are (x right, y down) in the viewport, continuous (the center of pixel (i, j) is
-// (i + 0.5, j + 0.5)), as in DESIGN.md's pixel contract. The scene's vertical axis is the camera's `up`
+// (i + 0.5, j + 0.5)), as in docs/design.md's pixel contract. The scene's vertical axis is the camera's `up`
 // (z by default). Drags are absolute: the camera during a drag is a function of the start camera and the
 // cursor's total offset, so the result never depends on how many motion events the window system sent.
 #pragma once

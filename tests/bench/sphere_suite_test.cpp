@@ -1,5 +1,5 @@
 // The sphere suite's orbit cameras (bench/views.h), checked on the CPU with the camera contract of
-// DESIGN.md on the generated particle scenes: the short orbit's eyes are inside the spheres' bounds and
+// docs/design.md on the generated particle scenes: the short orbit's eyes are inside the spheres' bounds and
 // see part of the set, the long orbit's are outside and see every sphere whole; both are a function of
 // the bounds alone. Plus the spheres2023 suite's data sets and combinations, and how a combination's
 // errors become results (measureGuarded, shared with the point runner).

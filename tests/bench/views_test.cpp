@@ -1,4 +1,4 @@
-// The benchmark's viewpoints, checked on the CPU with the camera contract of DESIGN.md: a point lands in
+// The benchmark's viewpoints, checked on the CPU with the camera contract of docs/design.md: a point lands in
 // the image when its clip w exceeds near and its pixel is inside. overview frames the whole cloud,
 // closeup keeps a minority of the points, outside none; all of it a function of the bounds alone.
 #include <cmath>

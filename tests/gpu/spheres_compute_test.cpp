@@ -372,7 +372,7 @@ TEST_F(GpuTest, SphereComputeTileBoundsSkipHiddenLargeSpheresAndKeepTheFrame) {
 
 namespace pointrast::test {
 
-// Not a check: the work counts behind the choice of kSphereTileCutPixels (bench/NOTES.md), printed per
+// Not a check: the work counts behind the choice of kSphereTileCutPixels (docs/performance.md), printed per
 // threshold for generated riemann-like and laser-like scenes on the short orbit's first camera, scaled so
 // that spheres cover about as many pixels as in the spheres2023 suite at full scale (1920x1080). Run with
 // --gtest_also_run_disabled_tests; about two minutes on lavapipe (2 cores).

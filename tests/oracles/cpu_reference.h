@@ -1,4 +1,4 @@
-// The CPU reference renderer: the image contract of DESIGN.md evaluated in double precision, one point
+// The CPU reference renderer: the image contract of docs/design.md evaluated in double precision, one point
 // at a time, with the same framebuffer encoding as the GPU methods (float bits of the linear depth << 32 |
 // RGBA8, minimum wins). It is the independent check of every GPU method.
 #pragma once

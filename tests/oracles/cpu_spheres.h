@@ -1,5 +1,5 @@
 // The CPU reference of the sphere renderers: an independent ray caster in double precision. For every
-// pixel, the ray through its center (DESIGN.md's camera contract, built from the camera's basis rather
+// pixel, the ray through its center (docs/design.md's camera contract, built from the camera's basis rather
 // than from the GPU's matrices) is intersected with every sphere that may cover it, the nearest hit wins
 // (lower index on equal depth, like the GPU's visibility word), and the hit is shaded with the formula of
 // shaders/sphere_shade.inc.glsl. Culling follows the GPU's rule: a sphere is drawn only if it lies

@@ -51,7 +51,7 @@ TEST(Navigation, ProjectInvertsUnproject) {
 }
 
 TEST(Navigation, ProjectAgreesWithTheRendererMatrix) {
-  // DESIGN.md: px = (x/w + 1)/2 * W, py = (1 - y/w)/2 * H from viewProjection.
+  // docs/design.md: px = (x/w + 1)/2 * W, py = (1 - y/w)/2 * H from viewProjection.
   Viewport vp{320, 240};
   Camera c = lookingAlongY();
   c.eye = {1, -5, 2};

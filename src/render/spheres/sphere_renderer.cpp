@@ -106,7 +106,7 @@ constexpr SphereMethodInfo kSphereMethods[] = {
 // As the point renderer: 16384 x 16384 pixels, 2 GiB of visibility words.
 constexpr uint32_t kMaxSide = 16384;
 
-// The frame constants of a camera (DESIGN.md's contract): view = lookAt relative to the particles' origin,
+// The frame constants of a camera (docs/design.md's contract): view = lookAt relative to the particles' origin,
 // computed in double and rounded once; the ray of pixel position (x, y) is (x sx + ox, y sy + oy, -1),
 // the inverse of px = (c.x / c.w + 1) / 2 W, py = (1 - c.y / c.w) / 2 H with the projection of
 // viewProjection() (c.x / c.w = x_view / (depth tanX), c.y / c.w = y_view / (depth tanY)).

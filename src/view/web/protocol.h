@@ -1,7 +1,7 @@
 // The browser viewer's wire protocol. A client sends small JSON text messages (input, settings, acks);
 // the server answers with JSON text messages (what the page shows) and binary frames (a fixed header and a
 // JPEG or PNG). Every client message is parsed and validated here, before anything acts on it: a message
-// that is not exactly one of the shapes below is refused whole (DESIGN.md, "Serving": input from the
+// that is not exactly one of the shapes below is refused whole (docs/design.md, "Serving": input from the
 // network is validated and bounded like file input).
 //
 // Positions are normalized to the canvas (0..1 from the left and top edge): the server scales them to its
