@@ -71,7 +71,8 @@ int convertOctree(const ConvertArgs& a) {
 
 } // namespace
 
-// LAS (or LAZ, by the extension) 1.2 point format 3 unless the count needs LAS 1.4's 64-bit counts (or --las 1.4 asks for it).
+// LAS (or LAZ, by the extension) 1.2 point format 3 unless the count needs LAS 1.4's 64-bit counts (or
+// --las 1.4 asks for it).
 io::LasFlavor lasFlavorFor(const std::string& output, uint64_t points) {
   const std::filesystem::path ext = std::filesystem::path(output).extension();
   if (ext != ".las" && ext != ".laz")
@@ -81,7 +82,8 @@ io::LasFlavor lasFlavorFor(const std::string& output, uint64_t points) {
 
 Command addConvert(CLI::App& app) {
   auto a = std::make_shared<ConvertArgs>();
-  CLI::App* cmd = app.add_subcommand("convert", "Read a point cloud, optionally reorder it, write LAS or LAZ");
+  CLI::App* cmd =
+      app.add_subcommand("convert", "Read a point cloud, optionally reorder it, write LAS or LAZ");
   cmd->footer(
       "\nOrders (the 2021 paper's vertex orders): original, morton (Z-order over the cubic bounds, 21 bits\n"
       "per axis), shuffled (random permutation), shuffled-morton (Morton, then runs of 128 points\n"
@@ -98,7 +100,8 @@ Command addConvert(CLI::App& app) {
       "  pointrast convert lion.copc.laz lion.laz\n"
       "  pointrast convert octree/ all.laz");
   cmd->add_option("IN", a->input,
-                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) + ") or Potree 2.0 octree folder")
+                  "Point cloud file (" + io::formatList(io::FormatUse::Cloud) +
+                      ") or Potree 2.0 octree folder")
       ->required();
   cmd->add_option("OUT", a->output, "LAS or LAZ file to write")->required();
   cmd->add_option("--order", a->order, "Vertex order")->capture_default_str();
@@ -119,7 +122,8 @@ Command addConvert(CLI::App& app) {
     const io::FormatInfo* format = io::detectFormat(a->input);
     if (a->chunkSize == 0) throw InputError("--chunk-size must be at least 1 point");
     if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
-    if (a->pointFormat != -1 && (a->pointFormat < 0 || !((a->pointFormat <= 3) || (a->pointFormat >= 6 && a->pointFormat <= 8))))
+    if (a->pointFormat != -1 &&
+        (a->pointFormat < 0 || !((a->pointFormat <= 3) || (a->pointFormat >= 6 && a->pointFormat <= 8))))
       throw InputError("--point-format expects 0, 1, 2, 3, 6, 7 or 8");
     if (a->order == "original" && isLasFamily(format)) return convertLasFamily(*a);
     if (a->pointFormat != -1)

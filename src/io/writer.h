@@ -27,10 +27,11 @@ bool isLazPath(const std::filesystem::path& path);
 // can hold at most 2^32 - 1 points; more needs Las14Pf7 (InputError otherwise).
 void writeLas(const std::filesystem::path& path, const PointCloud& cloud, LasFlavor flavor);
 
-// Streams point records into a LAS (or, by the extension, LAZ) file: the records' integers with the given scale/offset, their 16-bit
-// colors and point source ids as stored, the fields' attributes (zero where a field is off; return
-// number 1). For exports that do not hold the whole cloud at once. The header, with counts and bounds
-// from the points, is written by commit(); without commit() nothing is left behind.
+// Streams point records into a LAS (or, by the extension, LAZ) file: the records' integers with the
+// given scale/offset, their 16-bit colors and point source ids as stored, the fields' attributes (zero
+// where a field is off; return number 1). For exports that do not hold the whole cloud at once. The
+// header, with counts and bounds from the points, is written by commit(); without commit() nothing is
+// left behind.
 class LasRecordWriter {
 public:
   LasRecordWriter(const std::filesystem::path& path, const glm::dvec3& scale, const glm::dvec3& offset,
@@ -54,8 +55,8 @@ private:
 // scale/offset must be finite (InputError otherwise). LAZ: chunks of chunkSize points (or one chunk
 // per writeChunk() call with kVariableChunkSize), encoded in parallel on all cores.
 struct LasFileSetup {
-  std::vector<uint8_t> header;            // the public header block, 227 bytes or more
-  std::vector<std::vector<uint8_t>> vlrs; // each VLR's 54-byte header and payload (no LASzip VLR)
+  std::vector<uint8_t> header;             // the public header block, 227 bytes or more
+  std::vector<std::vector<uint8_t>> vlrs;  // each VLR's 54-byte header and payload (no LASzip VLR)
   std::vector<std::vector<uint8_t>> evlrs; // LAS 1.4: each EVLR's 60-byte header and payload
   int pointFormat = 3;
   uint16_t recordLength = 34; // the format's size plus extra bytes
@@ -101,11 +102,12 @@ struct LasConvertOptions {
 uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::path& out,
                         const LasConvertOptions& options = {});
 
-// Exports every point of an octree as LAS through LasRecordWriter, exactly (the source's integers,
-// scale/offset and 16-bit colors): nodes in forEachNode order, decoded on all cores a batch at a time, so
-// memory stays a few batches of nodes whatever the octree's size. Returns the points written.
+// Exports every point of an octree as LAS (LAZ by the extension) through LasRecordWriter, exactly (the
+// source's integers, scale/offset and 16-bit colors): nodes in forEachNode order, decoded on all cores a
+// batch at a time, so memory stays a few batches of nodes whatever the octree's size. Returns the points
+// written.
 uint64_t writeLasFromOctree(const std::filesystem::path& path, lod::NodeSource& source, LasFlavor flavor,
-                        bool progress);
+                            bool progress);
 
 // Writes RGBA8 pixels (row 0 = top) as an 8-bit RGB PNG (alpha dropped).
 void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, const uint32_t* rgba);

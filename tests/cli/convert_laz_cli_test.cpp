@@ -45,6 +45,7 @@ void expectOneLineFailure(const CliResult& r, const fs::path& out) {
 }
 
 TEST(ConvertLazCli, CopcToLasKeepsEveryRecordByte) {
+  POINTRAST_REQUIRE_DATA("laz/lone-star.copc.laz");
   const fs::path in = kData / "laz/lone-star.copc.laz";
   const fs::path out = pointrast::test::cliTempDir() / "lone-star.las";
   fs::remove(out);
@@ -56,9 +57,10 @@ TEST(ConvertLazCli, CopcToLasKeepsEveryRecordByte) {
 }
 
 TEST(ConvertLazCli, LasToLazToLasComesBackByteForByte) {
+  POINTRAST_REQUIRE_DATA();
   const fs::path dir = pointrast::test::cliTempDir();
-  for (const char* name : {"las/autzen_trim_7.las", "las/extrabytes.las", "las/las_with_several_extra_byte_bloc.las",
-                           "las/test1_4.las"}) {
+  for (const char* name : {"las/autzen_trim_7.las", "las/extrabytes.las",
+                           "las/las_with_several_extra_byte_bloc.las", "las/test1_4.las"}) {
     SCOPED_TRACE(name);
     const fs::path in = kData / name;
     const fs::path laz = dir / "round.laz", las = dir / "round.las";
@@ -77,6 +79,7 @@ TEST(ConvertLazCli, LasToLazToLasComesBackByteForByte) {
 }
 
 TEST(ConvertLazCli, LasVersionAndPointFormatConvertTheRecords) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   const fs::path dir = pointrast::test::cliTempDir();
   const fs::path in = kData / "las/1.2-with-color.las";
   const fs::path up = dir / "up.laz", back = dir / "back.las";
@@ -89,13 +92,15 @@ TEST(ConvertLazCli, LasVersionAndPointFormatConvertTheRecords) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(recordsOf(back), recordsOf(in));
   // Colors do not fit format 1: refused, not dropped.
-  expectOneLineFailure(runPointrast("convert -q --point-format 1 " + in.string() + " " + (dir / "pf1.las").string()),
-                       dir / "pf1.las");
+  expectOneLineFailure(
+      runPointrast("convert -q --point-format 1 " + in.string() + " " + (dir / "pf1.las").string()),
+      dir / "pf1.las");
 }
 
 TEST(ConvertLazCli, OctreeExportsToLazAsToLas) {
   const fs::path dir = pointrast::test::cliTempDir();
-  const potreetest::Tree tree = potreetest::makeTree({.points = 5000, .depth = 4, .color16 = true, .seed = 5});
+  const potreetest::Tree tree =
+      potreetest::makeTree({.points = 5000, .depth = 4, .color16 = true, .seed = 5});
   fs::remove_all(dir / "laz-octree");
   io::PotreeWriteOptions o;
   potreetest::writeTree(tree, dir / "laz-octree", o);
@@ -110,6 +115,7 @@ TEST(ConvertLazCli, OctreeExportsToLazAsToLas) {
 }
 
 TEST(ConvertLazCli, DamagingConversionsFailWithOneLine) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   const fs::path dir = pointrast::test::cliTempDir();
   // A point count that lies.
   std::vector<uint8_t> bytes = iotest::readBytes(kData / "las/1.2-with-color.las");
@@ -117,15 +123,17 @@ TEST(ConvertLazCli, DamagingConversionsFailWithOneLine) {
   io::detail::storeLE<uint32_t>(bytes.data() + io::detail::las::kLegacyCount, count * 2);
   iotest::writeBytes(dir / "lying.las", bytes);
   fs::remove(dir / "lying.laz");
-  expectOneLineFailure(runPointrast("convert -q " + (dir / "lying.las").string() + " " + (dir / "lying.laz").string()),
-                       dir / "lying.laz");
+  expectOneLineFailure(
+      runPointrast("convert -q " + (dir / "lying.las").string() + " " + (dir / "lying.laz").string()),
+      dir / "lying.laz");
 
   // A NaN offset.
   bytes = iotest::readBytes(kData / "las/1.2-with-color.las");
   io::detail::storeLE<double>(bytes.data() + io::detail::las::kOffset + 8, std::nan(""));
   iotest::writeBytes(dir / "nan.las", bytes);
-  expectOneLineFailure(runPointrast("convert -q " + (dir / "nan.las").string() + " " + (dir / "nan.laz").string()),
-                       dir / "nan.laz");
+  expectOneLineFailure(
+      runPointrast("convert -q " + (dir / "nan.las").string() + " " + (dir / "nan.laz").string()),
+      dir / "nan.laz");
 
   // A waveform format: refused unless --drop-waveforms.
   bytes = iotest::readBytes(kData / "las/1.2-with-color.las");
@@ -140,7 +148,8 @@ TEST(ConvertLazCli, DamagingConversionsFailWithOneLine) {
   }
   iotest::writeBytes(dir / "wave.las", wave);
   fs::remove(dir / "wave.laz");
-  const CliResult refused = runPointrast("convert -q " + (dir / "wave.las").string() + " " + (dir / "wave.laz").string());
+  const CliResult refused =
+      runPointrast("convert -q " + (dir / "wave.las").string() + " " + (dir / "wave.laz").string());
   expectOneLineFailure(refused, dir / "wave.laz");
   EXPECT_NE(refused.err.find("--drop-waveforms"), std::string::npos) << refused.err;
   const CliResult dropped = runPointrast("convert -q --drop-waveforms " + (dir / "wave.las").string() + " " +
@@ -153,7 +162,8 @@ TEST(ConvertLazCli, DamagingConversionsFailWithOneLine) {
     ASSERT_EQ(0, std::memcmp(got.data() + i * 28, plain.data() + i * 34, 28)) << "record " << i;
 
   // Neither LAS nor LAZ.
-  const CliResult ext = runPointrast("convert -q " + (kData / "laz/simple.laz").string() + " " + (dir / "x.ply").string());
+  const CliResult ext =
+      runPointrast("convert -q " + (kData / "laz/simple.laz").string() + " " + (dir / "x.ply").string());
   expectOneLineFailure(ext, dir / "x.ply");
 }
 

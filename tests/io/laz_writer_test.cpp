@@ -5,11 +5,11 @@
 #include <random>
 
 #include "io/io_test_util.h"
-#include "io/laz_random_records.h"
 #include "io/las/las_format.h"
 #include "io/las/laz_chunk.h"
 #include "io/las/laz_encoder.h"
 #include "io/las/laz_reader.h"
+#include "io/laz_random_records.h"
 #include "io/writer.h"
 
 using pointrast::InputError;
@@ -20,7 +20,8 @@ using pointrast::io::detail::storeLE;
 
 namespace {
 
-std::vector<uint8_t> decodeChunk(const laz::Layout& layout, const std::vector<uint8_t>& bytes, uint64_t count) {
+std::vector<uint8_t> decodeChunk(const laz::Layout& layout, const std::vector<uint8_t>& bytes,
+                                 uint64_t count) {
   laz::ChunkDecoder decoder(layout);
   std::vector<uint8_t> out;
   decoder.decode(bytes.data(), bytes.size(), count, out);
@@ -72,7 +73,8 @@ TEST_P(LazEncoderFormats, RandomRecordsRoundTripThroughTheDecoder) {
     for (uint32_t seed = 1; seed <= 3; ++seed) {
       const std::vector<uint8_t> records = iotest::randomRecords(c.pointFormat, rl, n, seed);
       const std::vector<uint8_t> bytes = encoder.encode(records.data(), n);
-      ASSERT_EQ(decodeChunk(layout, bytes, n), records) << "format " << c.pointFormat << ", " << n << " points";
+      ASSERT_EQ(decodeChunk(layout, bytes, n), records)
+          << "format " << c.pointFormat << ", " << n << " points";
     }
   }
   // Constant records: every layer but XY written empty.
@@ -83,10 +85,10 @@ TEST_P(LazEncoderFormats, RandomRecordsRoundTripThroughTheDecoder) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllFormats, LazEncoderFormats,
-                         ::testing::Values(FormatCase{0, 0}, FormatCase{1, 0}, FormatCase{2, 0}, FormatCase{3, 0},
-                                           FormatCase{3, 5}, FormatCase{0, 1}, FormatCase{6, 0},
-                                           FormatCase{7, 0}, FormatCase{8, 0}, FormatCase{6, 3},
-                                           FormatCase{7, 12}));
+                         ::testing::Values(FormatCase{0, 0}, FormatCase{1, 0}, FormatCase{2, 0},
+                                           FormatCase{3, 0}, FormatCase{3, 5}, FormatCase{0, 1},
+                                           FormatCase{6, 0}, FormatCase{7, 0}, FormatCase{8, 0},
+                                           FormatCase{6, 3}, FormatCase{7, 12}));
 
 // A file of random records through LasFileWriter, fixed and variable chunks, read back by readLazRecords.
 TEST(LazWriter, FixedAndVariableChunksReadBack) {
@@ -131,6 +133,7 @@ TEST(LazWriter, FixedAndVariableChunksReadBack) {
 // Every LAS/LAZ file of the shared data to LAZ and to LAS: the same records, byte for byte, the same
 // VLRs (but LASzip's and COPC's), the same header fields.
 TEST(LazWriter, SharedDataConvertsLosslessly) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   int converted = 0;
   for (const char* folder : {"las", "laz"}) {
@@ -168,10 +171,12 @@ TEST(LazWriter, SharedDataConvertsLosslessly) {
 }
 
 TEST(LazWriter, HostileInputsGiveOneError) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   iotest::TempDir dir;
   // A header whose point count promises more records than the file holds.
   std::vector<uint8_t> bytes = iotest::readBytes(iotest::data("las/1.2-with-color.las"));
-  storeLE<uint32_t>(bytes.data() + las::kLegacyCount, loadLE<uint32_t>(bytes.data() + las::kLegacyCount) + 1000);
+  storeLE<uint32_t>(bytes.data() + las::kLegacyCount,
+                    loadLE<uint32_t>(bytes.data() + las::kLegacyCount) + 1000);
   iotest::writeBytes(dir / "lying.las", bytes);
   EXPECT_THROW(convertLasFile(dir / "lying.las", dir / "lying.laz"), InputError);
   EXPECT_FALSE(std::filesystem::exists(dir / "lying.laz"));
@@ -255,6 +260,7 @@ namespace {
 // Point format conversions: legacy formats through LAS 1.4's and back come back byte for byte; 1.4
 // formats into legacy ones either come back byte for byte or are refused for what would be lost.
 TEST(LazWriter, PointFormatConversionsAreExactOrRefused) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   static const int kTo14[] = {6, 6, 7, 7, 6, 7, 6, 7, 8, 6, 8};
   static const int kTo12[] = {0, 1, 2, 3, 1, 3, 1, 3, 3, 1, 3};

@@ -164,7 +164,8 @@ LasFileWriter::LasFileWriter(const std::filesystem::path& path, LasFileSetup set
   }
   if (st.laz) {
     if (!laz::canEncodePointFormat(st.pointFormat))
-      fail(path, strFormat("point format %d cannot be written as LAZ (formats 0-3 and 6-8 can)", st.pointFormat));
+      fail(path,
+           strFormat("point format %d cannot be written as LAZ (formats 0-3 and 6-8 can)", st.pointFormat));
     if (st.chunkSize == 0) fail(path, "a LAZ chunk size of 0 points");
     s.layout = laz::encoderLayout(st.pointFormat, st.recordLength, st.chunkSize);
     const std::vector<uint8_t> vlr =
@@ -315,7 +316,8 @@ std::vector<std::vector<uint8_t>> readEvlrs(const InputFile& file, const LasHead
     const uint64_t length = loadLE<uint64_t>(e.data() + 20);
     if (length > file.size() - at - kEvlrHeader)
       fail(file.path(), strFormat("EVLR %u of %u runs past the end of the file", i + 1, hd.evlrCount));
-    const std::string userId(reinterpret_cast<const char*>(e.data() + 2), strnlen(reinterpret_cast<const char*>(e.data() + 2), 16));
+    const std::string userId(reinterpret_cast<const char*>(e.data() + 2),
+                             strnlen(reinterpret_cast<const char*>(e.data() + 2), 16));
     if (userId != "copc") {
       e.resize(kEvlrHeader + length);
       file.readAt(at + kEvlrHeader, e.data() + kEvlrHeader, size_t(length));
@@ -454,7 +456,8 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
     setup.header[las::kVersionMinor] = 4;
     storeLE<uint16_t>(setup.header.data() + las::kHeaderSizeField, uint16_t(setup.header.size()));
     const uint16_t ge = loadLE<uint16_t>(setup.header.data() + las::kGlobalEncoding);
-    if (las::isExtended(format)) storeLE<uint16_t>(setup.header.data() + las::kGlobalEncoding, uint16_t(ge | 0x10));
+    if (las::isExtended(format))
+      storeLE<uint16_t>(setup.header.data() + las::kGlobalEncoding, uint16_t(ge | 0x10));
   }
   setup.pointFormat = format;
   setup.recordLength = uint16_t(baseBytes + extraBytes);

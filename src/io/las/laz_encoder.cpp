@@ -38,7 +38,8 @@ constexpr GpsSymbols kGpsV3{false, 0, 0, 1, 2, 0, 511, 512};
 
 // A 32-bit difference d coded against the sequence's last difference (nonzero): the multiplier closest
 // to d / last, then the corrector against that multiple; the decoder's readSameDiff / readMultiple.
-void writeMultiple(ArithmeticEncoder& enc, SymbolModel& multiModel, IntegerCodec& ic, GpsSequences& s, int32_t d) {
+void writeMultiple(ArithmeticEncoder& enc, SymbolModel& multiModel, IntegerCodec& ic, GpsSequences& s,
+                   int32_t d) {
   const int32_t last = s.diff[s.last];
   const double ratio = double(d) / double(last);
   const int64_t multi = std::isfinite(ratio) ? int64_t(std::llround(std::clamp(ratio, -1e6, 1e6))) : 0;
@@ -77,8 +78,8 @@ void writeMultiple(ArithmeticEncoder& enc, SymbolModel& multiModel, IntegerCodec
 // One GPS time (the double's bits) into the sequences; the decoder's read loop in reverse. A switch to
 // another sequence happens only when that sequence's time is within 32 bits, so it is never followed by
 // another switch.
-void writeGpsTime(ArithmeticEncoder& enc, const GpsSymbols& sym, SymbolModel& zeroModel, SymbolModel& multiModel,
-                  IntegerCodec& ic, GpsSequences& s, uint64_t t) {
+void writeGpsTime(ArithmeticEncoder& enc, const GpsSymbols& sym, SymbolModel& zeroModel,
+                  SymbolModel& multiModel, IntegerCodec& ic, GpsSequences& s, uint64_t t) {
   for (int hop = 0; hop < 2; ++hop) {
     const bool zeroDiff = s.diff[s.last] == 0;
     SymbolModel& model = zeroDiff ? zeroModel : multiModel;
@@ -383,7 +384,8 @@ public:
     const Point14 p = Point14::parse(item);
     Point14* last = &contexts_[current_]->last;
     Context& old = *contexts_[current_];
-    const uint32_t lpr = (last->returnNumber == 1 ? 1 : 0) + (last->returnNumber >= last->numberOfReturns ? 2 : 0) +
+    const uint32_t lpr = (last->returnNumber == 1 ? 1 : 0) +
+                         (last->returnNumber >= last->numberOfReturns ? 2 : 0) +
                          (last->gpsTimeChange ? 4 : 0);
     const uint32_t previous = current_;
     const bool channelChange = p.scannerChannel != current_;
@@ -402,8 +404,9 @@ public:
     const bool returnsChange = p.numberOfReturns != last->numberOfReturns;
     const uint32_t rDiff = (uint32_t(p.returnNumber) - last->returnNumber) & 15;
     const uint32_t rCode = rDiff == 0 ? 0 : rDiff == 1 ? 1 : rDiff == 15 ? 2 : 3;
-    const uint32_t changed = (channelChange ? 64 : 0) | (pointSourceChange ? 32 : 0) | (gpsTimeChange ? 16 : 0) |
-                             (scanAngleChange ? 8 : 0) | (returnsChange ? 4 : 0) | rCode;
+    const uint32_t changed = (channelChange ? 64 : 0) | (pointSourceChange ? 32 : 0) |
+                             (gpsTimeChange ? 16 : 0) | (scanAngleChange ? 8 : 0) | (returnsChange ? 4 : 0) |
+                             rCode;
     ArithmeticEncoder& xy = layers_[kXY].enc;
     xy.encodeSymbol(old.changedValues[lpr], changed);
     if (channelChange) xy.encodeSymbol(old.scannerChannel, (p.scannerChannel + 3 - previous) % 4);
@@ -438,7 +441,8 @@ public:
     layers_[kClassification].enc.encodeSymbol(c.classification[ccc], p.classification);
     layers_[kClassification].changed |= p.classification != last->classification;
 
-    const uint32_t lastFlags = (last->edgeOfFlightLine << 5) | (last->scanDirection << 4) | last->classificationFlags;
+    const uint32_t lastFlags =
+        (last->edgeOfFlightLine << 5) | (last->scanDirection << 4) | last->classificationFlags;
     const uint32_t flags = (p.edgeOfFlightLine << 5) | (p.scanDirection << 4) | p.classificationFlags;
     layers_[kFlags].enc.encodeSymbol(c.flags[lastFlags], flags);
     layers_[kFlags].changed |= flags != lastFlags;

@@ -1,5 +1,5 @@
-// Octree -> LAS export (writer.h): every node's records straight into LasRecordWriter, nodes decoded on
-// all cores a batch at a time and written in forEachNode order.
+// Octree -> LAS or LAZ export (writer.h): every node's records straight into LasRecordWriter, nodes
+// decoded on all cores a batch at a time and written in forEachNode order.
 #include <optional>
 
 #include "base/parallel.h"
