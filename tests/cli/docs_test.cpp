@@ -1,5 +1,5 @@
-// The README's lists against the product's own: the lists in `--help` are generated from the method and
-// format tables, so a README row missing, extra or out of order fails here.
+// The documentation's lists against the product's own: the lists in `--help` are generated from the method
+// and format tables, so a row of docs/methods.md or docs/formats.md missing, extra or out of order fails here.
 #include <algorithm>
 #include <regex>
 #include <sstream>
@@ -14,8 +14,8 @@ namespace pointrast::test {
 
 namespace {
 
-std::string readme() {
-  const std::filesystem::path path = std::filesystem::path(POINTRAST_SOURCE_DIR) / "README.md";
+std::string doc(const char* file) {
+  const std::filesystem::path path = std::filesystem::path(POINTRAST_SOURCE_DIR) / "docs" / file;
   return std::filesystem::exists(path) ? slurp(path) : std::string();
 }
 
@@ -93,9 +93,9 @@ std::vector<std::string> helpList(const std::string& help, const std::string& ti
 
 } // namespace
 
-TEST(Docs, ReadmeMethodsTableListsEveryPointMethodInTableOrder) {
-  const std::string text = readme();
-  if (text.empty()) GTEST_SKIP() << "no README.md beside this build";
+TEST(Docs, MethodsTableListsEveryPointMethodInTableOrder) {
+  const std::string text = doc("methods.md");
+  ASSERT_FALSE(text.empty()) << "docs/methods.md is missing";
   CliResult help = runPointrast("render --help");
   ASSERT_EQ(help.exitCode, 0) << help.err;
   const std::vector<std::string> methods = helpList(help.out, "Point methods (--method):");
@@ -103,9 +103,9 @@ TEST(Docs, ReadmeMethodsTableListsEveryPointMethodInTableOrder) {
   EXPECT_EQ(backticked(tableFirstCells(text, "## Methods (`--method`)")), methods);
 }
 
-TEST(Docs, ReadmeFormatsTableListsEveryFormatInTableOrder) {
-  const std::string text = readme();
-  if (text.empty()) GTEST_SKIP() << "no README.md beside this build";
+TEST(Docs, FormatsTableListsEveryFormatInTableOrder) {
+  const std::string text = doc("formats.md");
+  ASSERT_FALSE(text.empty()) << "docs/formats.md is missing";
   CliResult help = runPointrast("info --help");
   ASSERT_EQ(help.exitCode, 0) << help.err;
   // The names, which may hold a space ("Potree 2.0"): the first column of the help list, 11 wide.
@@ -115,7 +115,7 @@ TEST(Docs, ReadmeFormatsTableListsEveryFormatInTableOrder) {
     formats.push_back(name.substr(0, name.find_last_not_of(' ') + 1));
   }
   ASSERT_GE(formats.size(), 4u) << help.out;
-  // The README's rows start with the format's name; rows of what is only written (PNG) have no row in
+  // The table's rows start with the format's name; rows of what is only written (PNG) have no row in
   // the format table.
   std::vector<std::string> rows;
   for (const std::string& cell : tableFirstCells(text, "## Formats"))
