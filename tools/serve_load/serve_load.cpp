@@ -5,8 +5,13 @@
 // frame while moving and at rest. Each frame is decoded (TurboJPEG) before it is acknowledged, as a page
 // draws it before acknowledging, unless --no-decode.
 //
+// With --flight (an octree drawn with level of detail) it flies instead: the camera goes low over the cloud
+// (wheel steps towards the middle) and pans across it for --seconds by continuous strokes, then jumps
+// (standard views, and zooms towards other places) and counts the frames until the server reports the
+// view converged (every selected node resident and drawn).
+//
 //   serve_load --port 8080 [--host 127.0.0.1] [--token T] [--width 1920] [--height 1080] [--seconds 10]
-//              [--rate 120] [--isolated 30] [--no-decode] [-o result.json] [--markdown result.md]
+//              [--rate 120] [--isolated 30] [--flight] [--no-decode] [-o result.json] [--markdown result.md]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,7 +44,7 @@ struct Args {
   uint16_t port = 8080;
   uint32_t width = 1920, height = 1080, isolated = 30;
   double seconds = 10, rate = 120;
-  bool decode = true;
+  bool decode = true, flight = false;
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -60,6 +65,7 @@ struct Frame {
   view::web::FrameHeader header;
   size_t bytes = 0;
   double arrived = 0;
+  bool converged = false; // the state sent with it says the level-of-detail view converged
 };
 
 class Load {
@@ -75,6 +81,9 @@ private:
   uint32_t send(Json message);
   Json motionPhase(double scale);
   Json isolatedLatency();
+  Json flightPhase();
+  Json jumps();
+  int runFlight(const Frame& first, Json result);
 
   const Args& args_;
   wsclient::Client ws_;
@@ -84,6 +93,7 @@ private:
   std::vector<double> latencies_;     // ms, of the inputs shown since the last reset
   std::vector<Frame> frames_;         // received since the last reset
   std::vector<uint32_t> rgba_;
+  std::map<uint32_t, bool> convergedByFrame_; // frame id -> its state's lod.converged
 };
 
 uint32_t Load::send(Json message) {
@@ -113,7 +123,12 @@ void Load::pump(double until) {
     if (m->opcode == 1) {
       Json j = Json::parse(m->text(), nullptr, false);
       if (j.is_object() && j.value("t", "") == "info") info_ = j;
-      if (j.is_object() && j.value("t", "") == "state") state_ = j;
+      if (j.is_object() && j.value("t", "") == "state") {
+        state_ = j;
+        const Json& lod = j.value("stats", Json::object()).value("lod", Json::object());
+        if (j.contains("frame") && j["frame"].is_number_unsigned())
+          convergedByFrame_[j["frame"].get<uint32_t>()] = lod.value("converged", false);
+      }
       continue;
     }
     if (m->opcode != 2 || m->data.size() < view::web::kFrameHeaderBytes) continue;
@@ -128,6 +143,10 @@ void Load::pump(double until) {
           h, rgba_);
     }
     f.arrived = clockSeconds();
+    if (auto it = convergedByFrame_.find(f.header.frame); it != convergedByFrame_.end()) {
+      f.converged = it->second;
+      convergedByFrame_.erase(convergedByFrame_.begin(), std::next(it));
+    }
     ws_.sendText(Json{{"t", "ack"}, {"frame", f.header.frame}}.dump());
     // Every input up to the frame's sequence number is shown by it.
     for (auto it = sentAt_.begin(); it != sentAt_.end() && it->first <= f.header.seq;) {
@@ -275,6 +294,148 @@ bool writeFile(const std::string& path, const std::string& text) {
   return false;
 }
 
+// Low over the cloud, then across it: wheel steps towards a point below the middle of the canvas bring the
+// camera down, and strokes of a pan drag (right button) from the bottom of the canvas to the top carry it
+// forward over new ground for --seconds, a pointer move every 1/rate s. Every node the flight needs is
+// streamed while it flies; a frame never waits for one.
+Json Load::flightPhase() {
+  send({{"t", "stream"}, {"motionScale", 0.5}});
+  for (int i = 0; i < 6; ++i) {
+    uint32_t s = send({{"t", "wheel"}, {"x", 0.5}, {"y", 0.6}, {"steps", 2}});
+    waitFrame(30.0, s, false);
+  }
+  pump(clockSeconds() + 0.5);
+  frames_.clear();
+  latencies_.clear();
+  sentAt_.clear();
+  double start = clockSeconds(), next = start;
+  const double stroke = 1.5; // seconds a stroke
+  bool down = false;
+  double strokeStart = start;
+  while (clockSeconds() - start < args_.seconds) {
+    double now = clockSeconds();
+    if (!down) {
+      send({{"t", "down"}, {"b", 2}, {"x", 0.5}, {"y", 0.9}});
+      down = true;
+      strokeStart = now;
+    }
+    double u = std::min(1.0, (now - strokeStart) / stroke);
+    send({{"t", "move"}, {"x", 0.5 + 0.05 * std::sin(u * M_PI)}, {"y", 0.9 - 0.8 * u}});
+    if (u >= 1.0) {
+      send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
+      down = false;
+    }
+    next += 1.0 / args_.rate;
+    pump(next);
+  }
+  if (down) send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
+  double elapsed = clockSeconds() - start;
+  std::vector<Frame> flown = frames_;
+  std::vector<double> latencies = latencies_;
+  size_t converged = 0;
+  for (const Frame& f : flown)
+    converged += f.converged;
+  return {{"seconds", elapsed},
+          {"frames", flown.size()},
+          {"frames_per_second", double(flown.size()) / elapsed},
+          {"frames_converged", converged},
+          {"input_to_frame_ms", summary(latencies)}};
+}
+
+// Jumps: a standard view (a key), then a zoom towards another place (wheel steps); after each, the frames
+// the server sends until one says the view converged. A frame at rest is sent only while the view changes,
+// so the count is the number of frames it took to refine.
+Json Load::jumps() {
+  struct Jump {
+    const char* name;
+    Json message;
+  };
+  const std::vector<Jump> list = {
+      {"top view", {{"t", "key"}, {"key", "ViewTop"}, {"down", true}}},
+      {"zoom at 0.3,0.3", {{"t", "wheel"}, {"x", 0.3}, {"y", 0.3}, {"steps", 12}}},
+      {"front view", {{"t", "key"}, {"key", "ViewFront"}, {"down", true}}},
+      {"zoom at 0.7,0.6", {{"t", "wheel"}, {"x", 0.7}, {"y", 0.6}, {"steps", 12}}},
+      {"left view", {{"t", "key"}, {"key", "ViewLeft"}, {"down", true}}},
+      {"zoom at 0.5,0.7", {{"t", "wheel"}, {"x", 0.5}, {"y", 0.7}, {"steps", 14}}},
+      {"overview", {{"t", "key"}, {"key", "ViewIso"}, {"down", true}}},
+      {"zoom at 0.6,0.4", {{"t", "wheel"}, {"x", 0.6}, {"y", 0.4}, {"steps", 14}}},
+  };
+  Json out = Json::array();
+  for (const Jump& jump : list) {
+    pump(clockSeconds() + 0.3);
+    frames_.clear();
+    double sent = clockSeconds();
+    uint32_t s = send(jump.message);
+    if (jump.message["t"] == "key")
+      send({{"t", "key"}, {"key", jump.message["key"]}, {"down", false}});
+    // Frames until one that shows the jump and says the view converged; 30 s is the failure bound.
+    std::optional<size_t> convergedAt;
+    double deadline = sent + 30.0;
+    size_t seen = 0;
+    while (!convergedAt && clockSeconds() < deadline && ws_.open()) {
+      pump(std::min(deadline, clockSeconds() + 0.05));
+      for (; seen < frames_.size(); ++seen) {
+        const Frame& f = frames_[seen];
+        if (f.header.seq >= s && f.converged) {
+          convergedAt = seen;
+          break;
+        }
+      }
+    }
+    size_t shown = 0;
+    for (size_t i = 0; i < frames_.size() && (!convergedAt || i <= *convergedAt); ++i)
+      shown += frames_[i].header.seq >= s;
+    Json r = {{"jump", jump.name}, {"converged", bool(convergedAt)}, {"frames_to_converge", shown}};
+    if (convergedAt) r["ms_to_converge"] = (frames_[*convergedAt].arrived - sent) * 1e3;
+    out.push_back(r);
+  }
+  return out;
+}
+
+int Load::runFlight(const Frame& first, Json result) {
+  (void)first;
+  Json flight = flightPhase();
+  Json jumped = jumps();
+  result["flight"] = flight;
+  result["jumps"] = jumped;
+  size_t worst = 0;
+  bool all = true;
+  for (const Json& j : jumped) {
+    worst = std::max(worst, j["frames_to_converge"].get<size_t>());
+    all = all && j["converged"].get<bool>();
+  }
+  result["jumps_all_converged"] = all;
+  result["jump_frames_to_converge_max"] = worst;
+  std::string text = result.dump(2);
+  std::printf("%s\n", text.c_str());
+  std::fprintf(stderr,
+               "flight: %.1f frames/s at %ux%u, input to frame p50 %.1f ms p95 %.1f ms; jumps: %s, at most %zu "
+               "frames to converge\n",
+               flight["frames_per_second"].get<double>(), args_.width, args_.height,
+               flight["input_to_frame_ms"]["p50"].get<double>(), flight["input_to_frame_ms"]["p95"].get<double>(),
+               all ? "all converged" : "NOT all converged", worst);
+  if (!args_.output.empty() && !writeFile(args_.output, text + "\n")) return 1;
+  if (!args_.markdown.empty()) {
+    std::string md = "# pointrast serve: a flight with level of detail, one client at " +
+                     std::to_string(args_.width) + "x" + std::to_string(args_.height) + "\n\n";
+    md += "Device " + result["device"].get<std::string>() + ", " + result["input"].get<std::string>() +
+          ", method " + result["method"].get<std::string>() +
+          "; `serve_load --flight` over loopback: low over the cloud, pan strokes across it at " +
+          format("%.0f", args_.rate) + " pointer moves/s, then jumps.\n\n";
+    md += "| phase | frames/s | input to frame p50 (ms) | p95 (ms) |\n| --- | ---: | ---: | ---: |\n";
+    md += "| flight | " + format("%.1f", flight["frames_per_second"].get<double>()) + " | " +
+          format("%.1f | %.1f", flight["input_to_frame_ms"]["p50"].get<double>(),
+                 flight["input_to_frame_ms"]["p95"].get<double>()) +
+          " |\n\n| jump | converged | frames to converge | ms |\n| --- | --- | ---: | ---: |\n";
+    for (const Json& j : jumped)
+      md += "| " + j["jump"].get<std::string>() + " | " + (j["converged"].get<bool>() ? "yes" : "no") + " | " +
+            std::to_string(j["frames_to_converge"].get<size_t>()) + " | " +
+            format("%.0f", j.value("ms_to_converge", 0.0)) + " |\n";
+    if (!writeFile(args_.markdown, md)) return 1;
+  }
+  return all ? 0 : 1;
+}
+
 int Load::run() {
   if (!connect()) return 1;
   std::optional<Frame> first = waitFrame(300.0, 0, true);
@@ -293,6 +454,7 @@ int Load::run() {
                  {"decode", args_.decode},
                  {"input_rate_hz", args_.rate},
                  {"first_frame_bytes", first->bytes}};
+  if (args_.flight) return runFlight(*first, result);
   Json phases = Json::array();
   for (double scale : {0.5, 1.0})
     phases.push_back(motionPhase(scale));
@@ -333,6 +495,8 @@ bool parse(int argc, char** argv, Args& a) {
       a.rate = std::stod(value());
     else if (k == "--isolated")
       a.isolated = uint32_t(std::stoul(value()));
+    else if (k == "--flight")
+      a.flight = true;
     else if (k == "--no-decode")
       a.decode = false;
     else if (k == "-o" || k == "--output")
@@ -353,7 +517,7 @@ int main(int argc, char** argv) {
     if (!parse(argc, argv, args)) {
       std::fprintf(stderr,
                    "usage: serve_load --port P [--host H] [--token T] [--width W] [--height H] [--seconds S] "
-                   "[--rate HZ] [--isolated N] [--no-decode] [-o result.json] [--markdown result.md]\n");
+                   "[--rate HZ] [--isolated N] [--flight] [--no-decode] [-o result.json] [--markdown result.md]\n");
       return 1;
     }
   } catch (const std::exception&) {
