@@ -186,6 +186,23 @@ for what in "$@"; do
       --datasets aerial1g --methods batch-prefetch,lod,lod-hqs --frames "${SUITE_FRAMES:-15}" --budget "${SUITE_BUDGET:-2}" \
       --octree-cache "${OCTREE_CACHE:-/tmp/octrees}" --out "$OUT" --name lod2022 --json > "$OUT/lod2022.jsonl" || status=1
     ;;
+  rendertime)
+    # What a newcomer sees first: `render` of the 1 G overview (batch-prefetch, 2560x1140) as the first
+    # process of the machine, then `bench` of the same method and view; the two medians belong side by side.
+    echo "== render against bench: 1 G terrain, batch-prefetch, overview, 2560x1140"
+    POINTRAST_VALIDATION=0 $pr render terrain --points 1G --order morton --method batch-prefetch --width 2560 \
+      --height 1140 --frames 30 -o "$OUT/render-1g.png" --json | tee "$OUT/render-1g.json" || status=1
+    POINTRAST_VALIDATION=0 $pr bench terrain --points 1G --orders morton --views overview --width 2560 \
+      --height 1140 --methods batch-prefetch --frames 30 --out "$OUT" --name render-vs-bench --json \
+      > "$OUT/render-vs-bench.jsonl" || status=1
+    ;;
+  servelod)
+    # The browser viewer with level of detail: the 1 G stand-in's octree, a node cache of 1/8 of it, one
+    # loopback client flying low and jumping (scripts/bench-serve-lod.sh); writes serve-lod.json and .md.
+    echo "== serve with LOD: ${SERVE_POINTS:-1G} points as an octree, one client at 1920x1080"
+    POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT POINTRAST_BIN=$pr \
+      timeout 560 scripts/bench-serve-lod.sh "${SERVE_POINTS:-1G}" || status=1
+    ;;
   serve)
     # The browser viewer: `serve` on 1 G generated points (SERVE_POINTS, SERVE_METHOD), one loopback client
     # at 1920x1080 (serve_load); writes serve.json and serve.md.
@@ -194,7 +211,7 @@ for what in "$@"; do
       timeout 540 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, vr2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

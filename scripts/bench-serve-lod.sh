@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# The browser viewer with level of detail, measured on a GPU machine (scripts/gpu-check.sh servelod):
+# the 1,000 M stand-in (generated terrain, as the lod suite's) written as LAS, built into an octree by
+# `pointrast lod`, then `pointrast serve OCTREE` with a node cache of 1/8 of the octree, and the loopback
+# client `serve_load --flight` as one browser tab: low over the cloud and across it, then jumps. Writes
+# $OUT/serve-lod.{json,md}, the server's events and log. The LAS is removed once the octree is built (the
+# two together are about 50 GB).
+#   POINTRAST_BIN=... SERVE_LOAD=... OUT=... WORK=/tmp/servelod scripts/bench-serve-lod.sh [POINTS]
+set -euo pipefail
+points=${1:-1G}
+pr=${POINTRAST_BIN:?the pointrast binary}
+load=${SERVE_LOAD:?the serve_load binary}
+out=${OUT:?the result folder}
+work=${WORK:-/tmp/servelod}
+size=${SERVE_SIZE:-1920x1080}
+mkdir -p "$out" "$work"
+octree="$work/terrain-$points"
+
+if [ ! -f "$octree/metadata.json" ]; then
+  start=$(date +%s)
+  "$pr" generate terrain --points "$points" --point-format 2 -o "$work/terrain.las" -q
+  "$pr" lod "$work/terrain.las" -o "$octree" --json -q > "$out/serve-lod-build.json"
+  rm -f "$work/terrain.las"
+  echo "bench-serve-lod: generated and built $points points in $(( $(date +%s) - start )) s"
+fi
+bytes=$(du -sb "$octree" | cut -f1)
+budget=$(( bytes / 8 ))
+echo "bench-serve-lod: octree $bytes bytes, node cache $budget bytes (1/8)"
+# Cold start: the octree's files leave the page cache, as on a first open.
+sync; echo 1 > /proc/sys/vm/drop_caches 2>/dev/null || echo "bench-serve-lod: the page cache could not be dropped"
+
+events="$out/serve-lod-events.jsonl"
+"$pr" serve "$octree" --gpu-memory "$budget" --port 0 --events -q >"$events" 2>"$out/serve-lod-server.log" &
+server=$!
+stop_server() { kill -TERM "$server" 2>/dev/null || true; }
+trap stop_server EXIT
+port=""
+for ((i = 0; i < 240; ++i)); do
+  port=$(sed -n 's/.*"event":"listening".*"port":\([0-9]*\).*/\1/p' "$events" | head -1)
+  [ -n "$port" ] && break
+  kill -0 "$server" 2>/dev/null || break
+  sleep 0.5
+done
+if [ -z "$port" ]; then
+  echo "bench-serve-lod: the server did not listen" >&2
+  cat "$out/serve-lod-server.log" >&2
+  exit 1
+fi
+status=0
+"$load" --port "$port" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" --flight \
+  -o "$out/serve-lod.json" --markdown "$out/serve-lod.md" || status=1
+trap - EXIT
+kill -TERM "$server"
+wait "$server" || { echo "bench-serve-lod: the server exited with $?" >&2; status=1; }
+cat "$out/serve-lod-server.log"
+[ -f "$out/serve-lod.md" ] && cat "$out/serve-lod.md"
+exit $status
