@@ -15,8 +15,6 @@
 #include "base/error.h"
 #include "base/progress.h"
 #include "base/text.h"
-#include "bench/lod_report.h"
-#include "bench/report.h"
 #include "cli_util.h"
 #include "cloud/attribute_colors.h"
 #include "cloud/generate.h"
@@ -31,6 +29,7 @@
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
 #include "render_path.h"
+#include "report/stats_json.h"
 
 namespace pointrast::app {
 
@@ -475,8 +474,8 @@ nlohmann::json octreeJson(const gpu::Context& context, const RenderSettings& set
   j["precision"] = a.precision;
   j["min_node_px"] = settings.minNodePx;
   j["point_budget"] = settings.pointBudget;
-  j["batch_stats"] = bench::batchStatsJson(*stats.batch);
-  j["lod_stats"] = bench::lodStatsJson(*stats.lod);
+  j["batch_stats"] = report::batchStatsJson(*stats.batch);
+  j["lod_stats"] = report::lodStatsJson(*stats.lod);
   if (settings.foveation.enabled)
     j["foveation"] = {{"radius", settings.foveation.radius}, {"periphery", settings.foveation.periphery}};
   if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
@@ -626,7 +625,7 @@ nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& sett
   j["parts"] = a.parts;
   if (stats.batch) {
     j["precision"] = a.precision;
-    j["batch_stats"] = bench::batchStatsJson(*stats.batch);
+    j["batch_stats"] = report::batchStatsJson(*stats.batch);
   }
   if (colors) j["color"] = colorSourceName(colors->source);
   if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);

@@ -9,12 +9,12 @@
 
 #include "base/error.h"
 #include "base/progress.h"
-#include "bench/report_parts.h"
-#include "bench/view_report.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "input.h"
+#include "report/run_json.h"
 #include "view/desktop/viewer.h"
+#include "view/stats_report.h"
 
 namespace pointrast::app {
 
@@ -45,18 +45,18 @@ void checkStatsFile(const std::string& stats) {
 // line on stdout for `-`).
 void writeStats(const ViewArgs& a, const PointCloud& cloud, const view::FrameLog& log,
                 const view::ViewerOptions& options) {
-  bench::ReportInfo info;
+  report::ReportInfo info;
   std::filesystem::path file(a.stats);
   info.name = a.stats == "-" ? "view" : file.stem().string();
   info.title = "pointrast view: " + cloud.source;
   info.commandLine = commandLine("pointrast view");
-  info.date = bench::utcNow();
+  info.date = report::utcNow();
   const nlohmann::json j =
-      bench::viewStatsJson(log, {cloud.source, cloud.size(), options.vsync, options.panel}, info);
+      view::viewStatsJson(log, {cloud.source, cloud.size(), options.vsync, options.panel}, info);
   if (a.stats == "-")
     std::printf("%s\n", jsonText(j).c_str());
   else
-    bench::writeAtomically(file, bench::jsonFileText(j));
+    report::writeAtomically(file, report::jsonFileText(j));
 }
 
 int runView(const ViewArgs& a) {

@@ -27,27 +27,7 @@ const Result* bruteForceOf(const BenchRun& run, const Result& lod) {
 
 } // namespace
 
-nlohmann::json lodStatsJson(const lod::LodStats& s) {
-  return {{"nodes_selected", s.nodesSelected},
-          {"points_selected", s.pointsSelected},
-          {"budget_reached", s.budgetReached},
-          {"nodes_drawn", s.nodesDrawn},
-          {"points_drawn", s.pointsDrawn},
-          {"pages_drawn", s.pagesDrawn},
-          {"passes", s.passes},
-          {"converged", s.converged},
-          {"stream_seconds", s.streamSeconds},
-          {"nodes_loaded", s.nodesLoaded},
-          {"bytes_streamed", s.bytesStreamed},
-          {"bytes_uploaded", s.bytesUploaded},
-          {"nodes_evicted", s.nodesEvicted},
-          {"hierarchy_reads", s.hierarchyReads},
-          {"resident_bytes", s.residentBytes},
-          {"cache_bytes", s.cacheBytes}};
-}
-
-void markdownOctrees(std::ostream& md,
-                     const std::vector<std::pair<std::string, DatasetOctree>>& octrees) {
+void markdownOctrees(std::ostream& md, const std::vector<std::pair<std::string, DatasetOctree>>& octrees) {
   md << "| data set | points | bytes | build s | reused | phases |\n| --- | ---: | ---: | ---: | --- | --- "
         "|\n";
   for (const auto& [dataset, o] : octrees)
@@ -255,13 +235,6 @@ void streamMarkdown(std::ostringstream& md, const LodSuiteRun& run, const LodStr
 }
 
 } // namespace
-
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const size_t rank = size_t(std::ceil(std::clamp(p, 0.0, 1.0) * double(values.size())));
-  return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
 
 nlohmann::json lodStreamJson(const LodStreamResult& s) {
   nlohmann::json j;

@@ -16,10 +16,9 @@
 
 namespace pointrast::bench {
 
-nlohmann::json lodStatsJson(const lod::LodStats& stats);
+using report::lodStatsJson;
 // The octrees' table (data set, points, bytes, build time, reused, phases) for a Markdown report.
-void markdownOctrees(std::ostream& md,
-                     const std::vector<std::pair<std::string, DatasetOctree>>& octrees);
+void markdownOctrees(std::ostream& md, const std::vector<std::pair<std::string, DatasetOctree>>& octrees);
 
 nlohmann::json octreesJson(const std::vector<std::pair<std::string, DatasetOctree>>& octrees);
 
@@ -35,8 +34,7 @@ namespace pointrast::bench {
 struct LodSuiteRun;
 struct LodStreamResult;
 
-// Percentile p (0..1) of values, nearest rank; 0 for none.
-double percentile(std::vector<double> values, double p);
+using report::percentile;
 
 // The lod suite's reports: the run as JSON (every frame of the streaming runs included), a Markdown report
 // (render time against the point budget and --min-node-px, the streaming runs against the targets: every

@@ -51,19 +51,6 @@ View mainView(const BenchConfig& c) {
 
 } // namespace
 
-nlohmann::json batchStatsJson(const BatchStats& b) {
-  return {{"batches_processed", b.batchesProcessed},
-          {"batches_rendered", b.batchesRendered},
-          {"points_processed", b.pointsProcessed},
-          {"points_rendered", b.pointsRendered},
-          {"points_blended", b.pointsBlended},
-          {"points_by_words", {b.pointsByWords[0], b.pointsByWords[1], b.pointsByWords[2]}},
-          {"batches_dense", b.batchesDense},
-          {"points_taken_back", b.pointsTakenBack},
-          {"batches_redrawn", b.batchesRedrawn},
-          {"bytes_read", b.bytesRead}};
-}
-
 nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   nlohmann::json j;
   j["dataset"] = r.dataset;

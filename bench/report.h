@@ -12,18 +12,18 @@
 
 #include "bench/runner.h"
 #include "bench/sphere_runner.h"
+#include "report/run_json.h"
+#include "report/stats_json.h"
 
 namespace pointrast::bench {
 
-struct ReportInfo {
-  std::string name;        // file stem: <name>.json, <name>.md, <name>.svg
-  std::string title;       // "paper2021 (scale 0.001)", "terrain-20k"
-  std::string commandLine; // as typed, to reproduce the run
-  std::string date;        // ISO 8601, UTC
-};
+// Shared with every JSON a run writes (src/report), named here as the bench has always named them.
+using report::batchStatsJson;
+using report::formatMs;
+using report::ReportInfo;
+using report::sanitizeName;
+using report::utcNow;
 
-// The counters of a batched method's frame as every JSON output writes them (reports, `render --json`).
-nlohmann::json batchStatsJson(const BatchStats& stats);
 // One result as a flat object (also the line `pointrast bench --json` prints per result).
 nlohmann::json resultJson(const BenchRun& run, const Result& result);
 nlohmann::json runJson(const BenchRun& run, const ReportInfo& info);
@@ -50,12 +50,5 @@ std::string sphereMarkdownReport(const SphereBenchRun& run, const ReportInfo& in
 std::string sphereSvgChart(const SphereBenchRun& run, const ReportInfo& info);
 WrittenFiles writeSphereReports(const SphereBenchRun& run, const ReportInfo& info,
                                 const std::filesystem::path& dir);
-
-// "NVIDIA H200" -> "nvidia-h200": lower case, runs of anything but letters and digits become one '-'.
-std::string sanitizeName(std::string_view text);
-// Median milliseconds with three significant digits and no exponent: 1234, 12.3, 1.23, 0.123, 0.0123.
-std::string formatMs(double ms);
-// Now, as 2024-05-01T12:34:56Z.
-std::string utcNow();
 
 } // namespace pointrast::bench

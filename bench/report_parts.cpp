@@ -17,11 +17,6 @@ namespace pointrast::bench {
 
 namespace {
 
-std::string apiVersion(uint32_t v) {
-  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
-         std::to_string(VK_API_VERSION_PATCH(v));
-}
-
 std::string xmlEscape(std::string_view text) {
   std::string out;
   for (char c : text) {
@@ -68,42 +63,6 @@ std::string mdCell(std::string_view text) {
   return out;
 }
 
-void writeAtomically(const std::filesystem::path& path, const std::string& content) {
-  std::filesystem::path partial = path;
-  partial += ".partial";
-  {
-    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-    out << content;
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(partial, ec);
-      throw InputError(path.string() + ": cannot write the file");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(partial, path, ec);
-  if (ec) {
-    std::filesystem::remove(partial, ec);
-    throw InputError(path.string() + ": cannot write the file");
-  }
-}
-
-nlohmann::json identityJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
-                            double seconds) {
-  nlohmann::json j;
-  j["name"] = info.name;
-  j["title"] = info.title;
-  j["command_line"] = info.commandLine;
-  j["date"] = info.date;
-  j["commit"] = buildCommit();
-  j["wall_seconds"] = seconds;
-  j["device"] = {{"name", device.name},          {"type", device.typeName},
-                 {"driver", device.driver},      {"vulkan", apiVersion(device.apiVersion)},
-                 {"vendor_id", device.vendorId}, {"device_local_bytes", deviceLocalBytes}};
-  return j;
-}
-
 // What every report's JSON starts with: the run's identity, the device and the copy bandwidth.
 nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
                              const gpu::CopyBandwidth& copy, double seconds) {
@@ -141,7 +100,7 @@ void markdownHeader(std::ostringstream& md, const ReportInfo& info, const gpu::D
                     uint64_t deviceLocalBytes, const gpu::CopyBandwidth& copy, const std::string& stopped) {
   md << "# pointrast bench: " << info.title << "\n\n";
   md << "- Device: **" << device.name << "** (" << device.typeName << ", driver " << device.driver
-     << ", Vulkan " << apiVersion(device.apiVersion) << "), " << bytesText(deviceLocalBytes)
+     << ", Vulkan " << vulkanVersionText(device.apiVersion) << "), " << bytesText(deviceLocalBytes)
      << " of device-local memory\n";
   md << "- Copy bandwidth: **" << printf1("%.1f", copy.bytesPerSecond * 1e-9)
      << " GB/s**, measured in this run: the faster of vkCmdCopyBuffer ("
@@ -311,10 +270,6 @@ std::string svgBars(const BarChart& chart) {
   return s.str();
 }
 
-std::string jsonFileText(const nlohmann::json& j) {
-  return j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-}
-
 WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::string& name,
                               const std::string& json, const std::string& markdown, const std::string& svg) {
   std::error_code ec;
@@ -326,37 +281,6 @@ WrittenFiles writeReportFiles(const std::filesystem::path& dir, const std::strin
   writeAtomically(files.markdown, markdown);
   writeAtomically(files.svg, svg);
   return files;
-}
-
-std::string sanitizeName(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (std::isalnum(static_cast<unsigned char>(c))) {
-      out += char(std::tolower(static_cast<unsigned char>(c)));
-    } else if (!out.empty() && out.back() != '-') {
-      out += '-';
-    }
-  }
-  while (!out.empty() && out.back() == '-')
-    out.pop_back();
-  return out.empty() ? "device" : out;
-}
-
-std::string formatMs(double ms) {
-  if (!(ms > 0) || !std::isfinite(ms)) return "0";
-  int decimals = std::clamp(2 - int(std::floor(std::log10(ms))), 0, 9);
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", decimals, ms);
-  return text;
-}
-
-std::string utcNow() {
-  std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
 }
 
 } // namespace pointrast::bench

@@ -15,18 +15,16 @@
 
 namespace pointrast::bench {
 
+using report::identityJson;
+using report::jsonFileText;
+using report::vulkanVersionText;
+using report::writeAtomically;
+
 // The data sets that were measured (not skipped), in run order.
 std::vector<const DatasetOutcome*> measuredDatasets(const std::vector<DatasetOutcome>& datasets);
 // Table cells must not break the row: '|' is escaped, newlines flattened.
 std::string mdCell(std::string_view text);
 
-// Writes `content` through a ".partial" file renamed into place. Throws InputError naming the file.
-void writeAtomically(const std::filesystem::path& path, const std::string& content);
-
-// The run's identity (name, title, command line, date, commit, wall seconds) and the device: the start of
-// every report's JSON, also of reports that measure no copy bandwidth (the viewer's statistics).
-nlohmann::json identityJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
-                            double seconds);
 // What every report's JSON starts with: the run's identity, the device and the copy bandwidth.
 nlohmann::json runHeaderJson(const ReportInfo& info, const gpu::DeviceInfo& device, uint64_t deviceLocalBytes,
                              const gpu::CopyBandwidth& copy, double seconds);
@@ -52,10 +50,6 @@ struct BarChart {
 };
 constexpr double kNoBar = -1, kNotMeasured = -2;
 std::string svgBars(const BarChart& chart);
-
-// A report's JSON, indented; text that is not UTF-8 (a file name in another encoding) is replaced rather
-// than failing the report of a finished run.
-std::string jsonFileText(const nlohmann::json& j);
 
 // Writes the three files of a report through ".partial" files renamed into place; everything is rendered
 // by the caller before the first file is written, so a failure leaves no mixed set.

@@ -8,10 +8,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/report.h"
+#include "report/run_json.h"
 #include "view/frame_log.h"
 
-namespace pointrast::bench {
+namespace pointrast::view {
 
 // What the session showed, beside its frames.
 struct ViewSession {
@@ -21,6 +21,6 @@ struct ViewSession {
   bool panel = true; // the panel was shown at the start (its drawing is part of the present pass)
 };
 
-nlohmann::json viewStatsJson(const view::FrameLog& log, const ViewSession& session, const ReportInfo& info);
+nlohmann::json viewStatsJson(const FrameLog& log, const ViewSession& session, const report::ReportInfo& info);
 
-} // namespace pointrast::bench
+} // namespace pointrast::view

@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/build_info.h"
-#include "bench/view_report.h"
+#include "view/stats_report.h"
 
 namespace {
 
@@ -24,10 +24,10 @@ view::FrameLog madeUpLog() {
   return log;
 }
 
-TEST(ViewReport, MedianAndTailOfEveryPassAndOfTheFrame) {
-  bench::ReportInfo info{"view-test", "pointrast view: terrain", "pointrast view terrain --stats x.json",
-                         "2026-01-01T00:00:00Z"};
-  nlohmann::json j = bench::viewStatsJson(madeUpLog(), {"terrain", 1'000'000, false, true}, info);
+TEST(ViewStatsReport, MedianAndTailOfEveryPassAndOfTheFrame) {
+  report::ReportInfo info{"view-test", "pointrast view: terrain", "pointrast view terrain --stats x.json",
+                          "2026-01-01T00:00:00Z"};
+  nlohmann::json j = view::viewStatsJson(madeUpLog(), {"terrain", 1'000'000, false, true}, info);
   EXPECT_EQ(j["name"], "view-test");
   EXPECT_EQ(j["commit"], buildCommit());
   EXPECT_EQ(j["device"]["name"], "Made-up GPU 9000");
@@ -36,6 +36,7 @@ TEST(ViewReport, MedianAndTailOfEveryPassAndOfTheFrame) {
   EXPECT_EQ(j["frames"], 21);
   EXPECT_EQ(j["points"], 1'000'000);
   EXPECT_EQ(j["vsync"], false);
+  EXPECT_EQ(j["clocks_settled"], false); // a viewer renders on demand: nothing settles its clocks
   EXPECT_EQ(j["methods"], nlohmann::json({"atomicmin", "earlyz"}));
   EXPECT_EQ(j["sizes"], nlohmann::json({"1280x720", "640x480"}));
   // Render times 1..20 and 3: sorted, the 11th of 21 is 10 (nearest rank), the 20th (ceil 0.95 * 21) is 19.
@@ -51,8 +52,8 @@ TEST(ViewReport, MedianAndTailOfEveryPassAndOfTheFrame) {
   EXPECT_TRUE(j["timing"].is_string());
 }
 
-TEST(ViewReport, NoFramesGiveZerosNotNonsense) {
-  nlohmann::json j = bench::viewStatsJson(view::FrameLog{}, {"terrain", 1, true, true}, {});
+TEST(ViewStatsReport, NoFramesGiveZerosNotNonsense) {
+  nlohmann::json j = view::viewStatsJson(view::FrameLog{}, {"terrain", 1, true, true}, {});
   EXPECT_EQ(j["frames"], 0);
   EXPECT_EQ(j["passes"]["render"]["median_ms"].get<double>(), 0);
   EXPECT_EQ(j["frame"]["host"]["p95_ms"].get<double>(), 0);
