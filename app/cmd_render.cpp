@@ -25,6 +25,7 @@
 #include "input.h"
 #include "io/format_table.h"
 #include "io/writer.h"
+#include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
@@ -424,6 +425,8 @@ int runRenderSpheres(const RenderArgs& a) {
 
   SphereRenderer renderer(context, a.width, a.height);
   GpuParticles particles(context, set, upload);
+  settleClocksWith(context, settings,
+                   [&](const SphereSettings& s) { return renderer.render(particles, camera, s); });
   const SphereStats stats = renderer.render(particles, camera, settings);
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(
@@ -690,6 +693,7 @@ int runRender(const RenderArgs& a) {
     if (cameraPath.empty()) cameraPath = view::orbitPath(camera);
     return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
   }
+  settleClocksWith(context, settings, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); });
   const FrameStats stats = renderer.render(drawn, camera, settings);
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(

@@ -1,6 +1,6 @@
 // The benchmark runner: for each data set, each vertex order, each view and each method, GPU time of
 // whole frames (clear + render + resolve) from timestamp queries after a warm-up, with the device's
-// buffer-copy bandwidth measured in the same run (DESIGN.md, "Measuring performance").
+// buffer-copy bandwidth measured in the same run (docs/design.md, "Measuring performance").
 //
 // Memory: the host holds the data set in its original order (16 B/point: positions and display colors;
 // a file's other attributes are dropped once its colors are decided) plus one reordered copy and its
@@ -24,6 +24,7 @@
 #include "cloud/order.h"
 #include "gpu/bandwidth.h"
 #include "gpu/context.h"
+#include "render/clock_settle.h"
 #include "render/renderer.h"
 
 namespace pointrast::bench {
@@ -70,22 +71,14 @@ std::string printf1(const char* format, double value);
 // write, 953.7 MiB copied, median of 10)".
 std::string copyBandwidthText(const gpu::CopyBandwidth& copy);
 
-// GPU clocks fall to idle while the host prepares a data set for seconds (an H200 idles at 345 MHz and
-// boosts to 1980), and they may stay there through a whole submission: on the H200, a method timed first
-// after such a pause ran 5.7x slow in all 17 frames of its one submission (bench/NOTES.md). So before the
-// first combination of each scene, renderMs(frames) (which renders that many frames in one submission and
-// returns their median ms) is called in rounds of about 30 ms of GPU work until the last two rounds are both
-// within 3 % of the fastest round so far, after at least 0.2 s; or until 3 s or 100 rounds have passed. Two
-// equally slow rounds after a faster one do not settle it. Returns the wall seconds it took. `clock`
-// (seconds, monotonic) is the steady clock unless a test passes its own, so that its rounds do not depend on
-// the machine's load.
-constexpr double kSettleRoundMs = 30;
-constexpr double kSettleTolerance = 0.03;
-constexpr double kSettleMinSeconds = 0.2;
-constexpr double kSettleMaxSeconds = 3;
-constexpr int kSettleMaxRounds = 100; // also where rounds are short (200 frames of under 0.15 ms)
-double settleClocks(const std::function<double(uint32_t frames)>& renderMs,
-                    const std::function<double()>& clock = {});
+// Clocks are settled before the first combination of each scene (render/clock_settle.h).
+using pointrast::kSettleMaxRounds;
+using pointrast::kSettleMaxSeconds;
+using pointrast::kSettleMinSeconds;
+using pointrast::kSettleRoundMs;
+using pointrast::kSettleTolerance;
+using pointrast::settleClocks;
+using pointrast::settlesClocks;
 
 // Untimed frames before the timed ones: a tenth of them, at least two (pipeline creation, clocks).
 uint32_t warmupFrames(uint32_t frames);
@@ -214,10 +207,6 @@ std::string deviceFaultText(const DeviceFault& fault);
 template <class Combinations>
 void runRecorded(gpu::Context& context, RunRecord& run, uint64_t copyBytes, int copyRepeats,
                  std::chrono::steady_clock::time_point start, const Note& note, Combinations&& combinations);
-
-// Whether settleClocks is worth its time before a data set's first combination: GPUs lower their clocks
-// while the host prepares data; a CPU device (lavapipe) has no GPU clocks to raise.
-bool settlesClocks(const gpu::Context& context);
 
 // Renders the combination's scene from its camera with `settings` (method, frames, warm-up) and returns
 // the frames' statistics: how the timing helpers below reach a Renderer and whatever scene it draws.
