@@ -5,8 +5,11 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <new>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -52,15 +55,7 @@ int runCommand(int argc, char** argv) {
   app.set_version_flag("--version", std::string("pointrast 0.1.0 (") + buildCommit() + ")");
   app.footer("Run `pointrast COMMAND --help` for a command's options. Exit status: 0 success, 1 error.");
 
-  app::Command info = app::addInfo(app);
-  app::Command render = app::addRender(app);
-  app::Command convert = app::addConvert(app);
-  app::Command generate = app::addGenerate(app);
-  app::Command bench = app::addBench(app);
-  app::Command benchIo = app::addBenchIo(app);
-  app::Command view = app::addView(app);
-  app::Command lod = app::addLod(app);
-  app::Command serve = app::addServe(app);
+  const std::vector<app::RegisteredCommand> commands = app::addCommands(app);
 
   try {
     app.parse(argc, argv);
@@ -77,17 +72,9 @@ int runCommand(int argc, char** argv) {
   }
 
   try {
-    for (CLI::App* sub : app.get_subcommands()) {
-      if (sub->get_name() == "info") return info();
-      if (sub->get_name() == "render") return render();
-      if (sub->get_name() == "convert") return convert();
-      if (sub->get_name() == "generate") return generate();
-      if (sub->get_name() == "bench") return bench();
-      if (sub->get_name() == "bench-io") return benchIo();
-      if (sub->get_name() == "view") return view();
-      if (sub->get_name() == "lod") return lod();
-      if (sub->get_name() == "serve") return serve();
-    }
+    for (CLI::App* sub : app.get_subcommands())
+      for (const app::RegisteredCommand& command : commands)
+        if (command.subcommand == sub) return command.run();
     return 1;
   } catch (const InputError& e) {
     printError(e.what());
@@ -109,6 +96,27 @@ int runCommand(int argc, char** argv) {
 }
 
 } // namespace
+
+namespace pointrast::app {
+
+std::vector<RegisteredCommand> addCommands(CLI::App& app) {
+  std::vector<RegisteredCommand> commands;
+  // Each add<Name> adds exactly one subcommand: the newest is the one it made.
+  auto add = [&](Command (*addCommand)(CLI::App&)) {
+    Command run = addCommand(app);
+    const std::vector<CLI::App*> all = app.get_subcommands(std::function<bool(CLI::App*)>());
+    commands.push_back({all.back(), std::move(run)});
+  };
+#define POINTRAST_COMMAND(Name) add(add##Name);
+  POINTRAST_COMMAND_ROWS
+#ifdef POINTRAST_TEST_COMMAND_ROWS
+#include POINTRAST_TEST_COMMAND_ROWS
+#endif
+#undef POINTRAST_COMMAND
+  return commands;
+}
+
+} // namespace pointrast::app
 
 int main(int argc, char** argv) {
   return checkStdout(runCommand(argc, argv));
