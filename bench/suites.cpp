@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 
 #include "base/error.h"
 
@@ -62,15 +63,65 @@ constexpr SphereSuiteEntry kSpheres2023[] = {
 
 constexpr uint64_t kMinScaledPoints = 1000;
 
-std::span<const SuiteEntry> entriesOf(std::string_view suite) {
-  if (suite == "paper2021") return kPaper2021;
-  if (suite == "paper2022") return kPaper2022;
-  if (suite == "lod") return kLod;
-  if (suite == "vr2022") return kVr2022;
-  if (suite == "spheres2023")
-    throw InputError("spheres2023 is a particle suite: it has no point data sets or methods");
-  throw InputError("unknown suite '" + std::string(suite) +
-                   "'; choose paper2021, paper2022, lod, vr2022 or spheres2023");
+// The suites' defaults beyond their data sets (methods, orders, views, image size).
+void paper2021Defaults(SuiteDefaults& d) {
+  // The 2021 family and its hardware baseline: every method that reads the float layout. The batch
+  // methods are the 2022 suite's (they can still be asked for with --methods).
+  for (Method m : allMethods())
+    if (m.info().layout == SceneLayout::Float) d.methods.push_back(m);
+}
+
+void paper2022Defaults(SuiteDefaults& d) {
+  // The paper's comparison: the hardware baseline, its three batch methods and its two LOD methods on the
+  // octrees of the same data, and the best 2021 methods.
+  d.methods = {pointMethod("hw-points"), pointMethod("batch"),  pointMethod("batch-prefetch"),
+               pointMethod("batch-hqs"), pointMethod("dedup"),  pointMethod("hqs"),
+               pointMethod("lod"),       pointMethod("lod-hqs")};
+  d.orders = {Order::Morton, Order::Original};
+  d.views = {View::Overview, View::Closeup};
+  d.width = 2560;
+  d.height = 1140;
+}
+
+void lodDefaults(SuiteDefaults& d) {
+  d.methods = {pointMethod("lod")};
+  d.views = {View::Overview, View::Closeup};
+  d.width = 2560;
+  d.height = 1140;
+}
+
+void vr2022Defaults(SuiteDefaults& d) {
+  d.methods = {pointMethod("lod-hqs"), pointMethod("lod")};
+  d.views = {View::Closeup, View::Overview};
+  d.width = 2478; // each eye's
+  d.height = 2740;
+}
+
+// Every suite, in the order help and errors list them: a new suite is one row here (its data sets above,
+// and a runner of its kind).
+const Suite kSuites[] = {
+    {"paper2021", SuiteKind::Points, kPaper2021, {}, paper2021Defaults, false},
+    {"paper2022", SuiteKind::Points, kPaper2022, {}, paper2022Defaults, true},
+    {"lod", SuiteKind::Lod, kLod, {}, lodDefaults, false},
+    {"vr2022", SuiteKind::Vr, kVr2022, {}, vr2022Defaults, false},
+    {"spheres2023", SuiteKind::Spheres, {}, kSpheres2023, nullptr, false},
+};
+
+// The suite named `name`; InputError naming every suite when there is none.
+const Suite& suiteOf(std::string_view name) {
+  if (const Suite* suite = findSuite(name)) return *suite;
+  std::string names;
+  for (size_t k = 0; k < std::size(kSuites); ++k)
+    names += (k == 0 ? "" : k + 1 == std::size(kSuites) ? " or " : ", ") + std::string(kSuites[k].name);
+  throw InputError("unknown suite '" + std::string(name) + "'; choose " + names);
+}
+
+// The point data sets of a suite; InputError for a particle suite.
+std::span<const SuiteEntry> entriesOf(std::string_view name) {
+  const Suite& suite = suiteOf(name);
+  if (suite.kind == SuiteKind::Spheres)
+    throw InputError(std::string(suite.name) + " is a particle suite: it has no point data sets or methods");
+  return suite.points;
 }
 
 uint64_t scaled(uint64_t size, double scale) {
@@ -95,8 +146,21 @@ std::span<const SuiteEntry> paper2022Suite() {
   return kPaper2022;
 }
 
+std::span<const Suite> suites() {
+  return kSuites;
+}
+
+const Suite* findSuite(std::string_view name) {
+  for (const Suite& suite : kSuites)
+    if (suite.name == name) return &suite;
+  return nullptr;
+}
+
 std::vector<std::string> suiteNames() {
-  return {"paper2021", "paper2022", "lod", "vr2022", "spheres2023"};
+  std::vector<std::string> names;
+  for (const Suite& suite : kSuites)
+    names.push_back(suite.name);
+  return names;
 }
 
 std::span<const SphereSuiteEntry> spheres2023Suite() {
@@ -104,21 +168,25 @@ std::span<const SphereSuiteEntry> spheres2023Suite() {
 }
 
 bool isLodSuite(std::string_view suite) {
-  return suite == "lod";
+  const Suite* found = findSuite(suite);
+  return found && found->kind == SuiteKind::Lod;
 }
 
 bool isVrSuite(std::string_view suite) {
-  return suite == "vr2022";
+  const Suite* found = findSuite(suite);
+  return found && found->kind == SuiteKind::Vr;
 }
 
 bool isSphereSuite(std::string_view suite) {
-  return suite == "spheres2023";
+  const Suite* found = findSuite(suite);
+  return found && found->kind == SuiteKind::Spheres;
 }
 
 std::vector<Dataset> sphereSuiteDatasets(std::string_view suite, double scale, uint64_t seed) {
-  if (!isSphereSuite(suite)) entriesOf(suite); // throws, naming the suites
+  const Suite& found = suiteOf(suite);
+  if (found.kind != SuiteKind::Spheres) throw InputError(std::string(found.name) + " is no particle suite");
   std::vector<Dataset> datasets;
-  for (const SphereSuiteEntry& e : kSpheres2023) {
+  for (const SphereSuiteEntry& e : found.spheres) {
     Dataset d;
     d.source = particleSceneName(e.scene);
     d.seed = seed;
@@ -132,37 +200,8 @@ std::vector<Dataset> sphereSuiteDatasets(std::string_view suite, double scale, u
 
 SuiteDefaults suiteDefaults(std::string_view suite) {
   SuiteDefaults d;
-  if (isSphereSuite(suite)) return d;
-  entriesOf(suite); // throws for an unknown name
-  if (suite == "paper2021") {
-    // The 2021 family and its hardware baseline: every method that reads the float layout. The batch
-    // methods are the 2022 suite's (they can still be asked for with --methods).
-    for (Method m : allMethods())
-      if (m.info().layout == SceneLayout::Float) d.methods.push_back(m);
-  }
-  if (suite == "vr2022") {
-    d.methods = {pointMethod("lod-hqs"), pointMethod("lod")};
-    d.views = {View::Closeup, View::Overview};
-    d.width = 2478; // each eye's
-    d.height = 2740;
-  }
-  if (suite == "lod") {
-    d.methods = {pointMethod("lod")};
-    d.views = {View::Overview, View::Closeup};
-    d.width = 2560;
-    d.height = 1140;
-  }
-  if (suite == "paper2022") {
-    // The paper's comparison: the hardware baseline, its three batch methods and its two LOD methods on the
-    // octrees of the same data, and the best 2021 methods.
-    d.methods = {pointMethod("hw-points"), pointMethod("batch"),   pointMethod("batch-prefetch"),
-                 pointMethod("batch-hqs"), pointMethod("dedup"),   pointMethod("hqs"),
-                 pointMethod("lod"),       pointMethod("lod-hqs")};
-    d.orders = {Order::Morton, Order::Original};
-    d.views = {View::Overview, View::Closeup};
-    d.width = 2560;
-    d.height = 1140;
-  }
+  const Suite& found = suiteOf(suite);
+  if (found.defaults) found.defaults(d);
   return d;
 }
 
@@ -189,7 +228,7 @@ std::string shortCount(uint64_t points) {
 std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_t seed,
                                    const std::vector<std::string>& replacements) {
   const std::span<const SuiteEntry> entries = entriesOf(suite);
-  const bool paper2022 = suite == "paper2022";
+  const bool perDataset = suiteOf(suite).perDatasetOrdersAndViews;
   std::vector<Dataset> datasets;
   for (const SuiteEntry& e : entries) {
     Dataset d;
@@ -198,7 +237,7 @@ std::vector<Dataset> suiteDatasets(std::string_view suite, double scale, uint64_
     d.points = scaled(e.points, scale);
     d.name = std::string(e.name) + (e.scanOrder ? "" : "-like");
     d.label = d.name + " (" + sceneName(e.scene) + ", " + shortCount(d.points) + ")";
-    if (paper2022) {
+    if (perDataset) {
       d.orders = e.scanOrder ? std::vector<Order>{Order::Original, Order::Morton}
                              : std::vector<Order>{Order::Morton};
       d.views =

@@ -32,7 +32,6 @@ struct SuiteEntry {
 
 std::span<const SuiteEntry> paper2021Suite();
 std::span<const SuiteEntry> paper2022Suite();
-std::vector<std::string> suiteNames();
 
 // A particle data set of a sphere suite and the particle scene that stands in for it.
 struct SphereSuiteEntry {
@@ -42,6 +41,36 @@ struct SphereSuiteEntry {
   const char* resembles; // what the original holds, the reason for the generator
 };
 std::span<const SphereSuiteEntry> spheres2023Suite();
+
+// What a suite measures besides its data sets; the CLI takes these where no option says otherwise.
+// Empty lists: every method, order or view.
+struct SuiteDefaults {
+  std::vector<Method> methods; // the columns of its tables
+  std::vector<Order> orders;   // every order some data set is measured in
+  std::vector<View> views;
+  uint32_t width = 1920, height = 1080;
+};
+
+// Which runner measures a suite and writes its reports: the point runner (bench/runner.h, bench/report.h),
+// the sphere runner (bench/sphere_runner.h), the lod suite's (bench/lod_suite.h) or the VR suite's
+// (bench/vr_suite.h).
+enum class SuiteKind { Points, Spheres, Lod, Vr };
+
+// One suite: a row of the table in suites.cpp, all that names it anywhere.
+struct Suite {
+  const char* name;
+  SuiteKind kind;
+  std::span<const SuiteEntry> points;        // its point data sets (not Spheres)
+  std::span<const SphereSuiteEntry> spheres; // its particle data sets (Spheres)
+  void (*defaults)(SuiteDefaults&);          // its methods, orders, views and image size; null: none
+  // Each data set carries its own orders and views (SuiteEntry::inside, scanOrder), as paper2022's do.
+  bool perDatasetOrdersAndViews;
+};
+// Every suite, in the order help and errors list them.
+std::span<const Suite> suites();
+// The suite named `name`, null for none.
+const Suite* findSuite(std::string_view name);
+std::vector<std::string> suiteNames();
 // Whether `suite` is the lod suite (bench/lod_suite.h: sweeps and streaming on octrees, its own runner).
 bool isLodSuite(std::string_view suite);
 // Whether `suite` is the vr2022 suite (bench/vr_suite.h: stereo frames on an octree, its own runner).
@@ -53,14 +82,6 @@ bool isSphereSuite(std::string_view suite);
 // scale.
 std::vector<Dataset> sphereSuiteDatasets(std::string_view suite, double scale, uint64_t seed);
 
-// What a suite measures besides its data sets; the CLI takes these where no option says otherwise.
-// Empty lists: every method, order or view.
-struct SuiteDefaults {
-  std::vector<Method> methods; // the columns of its tables
-  std::vector<Order> orders;   // every order some data set is measured in
-  std::vector<View> views;
-  uint32_t width = 1920, height = 1080;
-};
 // Throws InputError for an unknown suite. A sphere suite has no point methods, orders or views.
 SuiteDefaults suiteDefaults(std::string_view suite);
 
