@@ -86,6 +86,7 @@ TEST(Cli, UsageErrorsExitOne) {
 }
 
 TEST(Cli, BadFilesFailCleanlyForInfoAndRender) {
+  POINTRAST_REQUIRE_DATA("las/permutations/1.2-no-points.las");
   std::mt19937 rng(5);
   std::string random(4096, '\0');
   for (char& c : random)
@@ -108,6 +109,7 @@ TEST(Cli, BadFilesFailCleanlyForInfoAndRender) {
 }
 
 TEST(Cli, RenderAutzenWritesPngAndJson) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   fs::path png = tempDir() / "autzen.png";
   fs::remove(png);
   Result r = run("render " + (kData / "las/autzen_trim.las").string() + " -o " + png.string() +
@@ -123,6 +125,7 @@ TEST(Cli, RenderAutzenWritesPngAndJson) {
 }
 
 TEST(Cli, InfoDescribesLas) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   Result r = run("info " + (kData / "las/autzen_trim.las").string() + " --json");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("\"points\":110000"), std::string::npos) << r.out;

@@ -80,6 +80,7 @@ TEST(CliHostilePaths, NamedPipeIsRefusedAtOnce) {
 }
 
 TEST(CliHostilePaths, ControlCharactersInNamesStayOnOneLine) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   fs::path dir = freshDir("names");
   const std::string name = (dir / "two\nlines\t\x1b[31m.las").string();
   std::ofstream(name) << "not a point cloud";
@@ -120,6 +121,7 @@ TEST(CliHostilePaths, LinkLoopsAndLongNamesAreNamedInOneLine) {
 }
 
 TEST(CliHostilePaths, UnwritableStdoutIsAnError) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
   const std::string las = (pointrast::test::dataDir() / "las/1.2-with-color.las").string();
   CliOptions full{kTimeout, "/dev/full"};
@@ -132,6 +134,7 @@ TEST(CliHostilePaths, UnwritableStdoutIsAnError) {
 }
 
 TEST(CliHostilePaths, CloudsTooLargeForTheDeviceAreRefusedBeforeReading) {
+  POINTRAST_REQUIRE_DATA("las/test1_4.las");
   // A LAS 1.4 header stating 100 G points of 30 B in a sparse 3 TB file: the count passes the reader's
   // check against the file's size, no device holds the 1.6 TB the points need, and reading them would
   // take hours. The refusal must come from the header, at once.

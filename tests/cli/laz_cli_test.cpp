@@ -24,6 +24,7 @@ std::string binary(const fs::path& p) {
 }
 
 TEST(LazCli, RenderOfLazIsBitIdenticalToRenderOfItsLasTwin) {
+  POINTRAST_REQUIRE_DATA("laz/autzen_trim.laz");
   const fs::path dir = pointrast::test::cliTempDir();
   const fs::path laz = dir / "autzen_laz.png", las = dir / "autzen_las.png";
   const std::string args = " --width 320 --height 240 --frames 1";
@@ -37,6 +38,7 @@ TEST(LazCli, RenderOfLazIsBitIdenticalToRenderOfItsLasTwin) {
 }
 
 TEST(LazCli, InfoDescribesTheCompression) {
+  POINTRAST_REQUIRE_DATA("laz/autzen_trim.laz");
   auto r = runPointrast("info " + (kData / "laz/autzen_trim.laz").string() + " --json");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   for (const char* key :
@@ -46,6 +48,7 @@ TEST(LazCli, InfoDescribesTheCompression) {
 }
 
 TEST(LazCli, UndecodedEncodingsFailWithOneLine) {
+  POINTRAST_REQUIRE_DATA("laz/simple-laszip-compressor-version-1.2r0.laz");
   auto r = runPointrast("info " + (kData / "laz/simple-laszip-compressor-version-1.2r0.laz").string());
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_FALSE(r.signaled);

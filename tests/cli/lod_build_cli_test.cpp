@@ -41,6 +41,7 @@ bool onlyEntry(const fs::path& dir, const std::string& name) {
 }
 
 TEST(LodBuildCli, JsonSummaryHasEveryPhase) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   const fs::path out = fresh("lod_json");
   const auto r = runPointrast("lod " + kAutzen.string() + " -o " + out.string() + " --json --leaf-points 5k");
   ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -97,6 +98,7 @@ TEST(LodBuildCli, SameBytesFromOneAndTwoThreadsAndWithLittleMemory) {
 }
 
 TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   const fs::path dir = fresh("lod_errors");
   fs::create_directories(dir / "exists");
   const std::string out = " -o " + (dir / "o").string();

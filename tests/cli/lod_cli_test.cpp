@@ -86,6 +86,7 @@ TEST(LodCli, RendersEveryPointOfAnOctreeInOnePassOrMany) {
 }
 
 TEST(LodCli, WrongInputsAndOptionsFailWithOneLine) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   writeOctree("wrong");
   const fs::path png = pointrast::test::cliTempDir() / "wrong.png";
   const std::string out = " -o " + png.string() + " -q";

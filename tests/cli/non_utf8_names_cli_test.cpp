@@ -36,6 +36,7 @@ nlohmann::json parsed(const CliResult& r) {
 const std::string kReplacement = "\xef\xbf\xbd"; // U+FFFD in UTF-8
 
 TEST(NonUtf8Names, BenchIoWritesItsReportsWithTheCommit) {
+  POINTRAST_REQUIRE_DATA("laz/simple.laz");
   const fs::path dir = nonUtf8Dir("io");
   const fs::path laz = dir / "simple\xff.laz";
   fs::copy_file(dataDir() / "laz" / "simple.laz", laz);
@@ -54,6 +55,7 @@ TEST(NonUtf8Names, BenchIoWritesItsReportsWithTheCommit) {
 }
 
 TEST(NonUtf8Names, LodPrintsItsJsonAndWritesTheOctree) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   const fs::path dir = nonUtf8Dir("lod");
   const fs::path las = dir / "thin\xff.las";
   fs::copy_file(dataDir() / "las" / "1.2-with-color.las", las);

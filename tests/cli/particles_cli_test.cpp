@@ -53,6 +53,7 @@ TEST(ParticlesCli, HelpTeachesTheParticleScenesAndMmpld) {
 }
 
 TEST(ParticlesCli, InfoDescribesMmpld) {
+  POINTRAST_REQUIRE_DATA("mmpld/test_xyz_double_int_double.mmpld");
   const std::string file = (kData / "mmpld/test_xyz_double_int_double.mmpld").string();
   const CliResult text = runPointrast("info " + file);
   ASSERT_EQ(text.exitCode, 0) << text.err;
@@ -122,6 +123,7 @@ TEST(ParticlesCli, GenerateRefusesMismatchedOptions) {
 }
 
 TEST(ParticlesCli, BadMmpldFilesFailCleanly) {
+  POINTRAST_REQUIRE_DATA("mmpld/test_xyz_double_none.mmpld");
   const std::string bytes = pointrast::test::slurp(kData / "mmpld/test_xyz_double_none.mmpld");
   const fs::path cut = temp("cut.mmpld");
   { std::ofstream(cut, std::ios::binary) << bytes.substr(0, 200); }

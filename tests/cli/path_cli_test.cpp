@@ -47,6 +47,7 @@ bool ffmpegMissingOutsideCi() {
 }
 
 TEST(RenderPath, VideoHasEveryFrameAtTheRequestedSize) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   if (ffmpegMissingOutsideCi()) GTEST_SKIP() << "no ffmpeg on this machine (CI runs this test)";
   auto video = cliTempDir() / "fly.mp4";
   std::filesystem::remove(video);
@@ -62,6 +63,7 @@ TEST(RenderPath, VideoHasEveryFrameAtTheRequestedSize) {
 }
 
 TEST(RenderPath, FirstFrameEqualsRenderOfTheFirstKeyframe) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto frames = cliTempDir() / "frames";
   std::filesystem::remove_all(frames);
   CliResult r = runPointrast("render '" + autzen() + "' --path '" + writePath().string() +
@@ -81,6 +83,7 @@ TEST(RenderPath, FirstFrameEqualsRenderOfTheFirstKeyframe) {
 }
 
 TEST(RenderPath, FailuresLeaveNoVideo) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto video = cliTempDir() / "broken.mp4";
   std::filesystem::remove(video);
   std::string path = writePath().string();
@@ -99,6 +102,7 @@ TEST(RenderPath, FailuresLeaveNoVideo) {
 }
 
 TEST(RenderPath, FfmpegMissingFromThePathSaysSoInOneLine) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto video = cliTempDir() / "no-ffmpeg.mp4";
   std::filesystem::remove(video);
   std::string path = writePath().string();
@@ -118,6 +122,7 @@ TEST(RenderPath, FfmpegMissingFromThePathSaysSoInOneLine) {
 }
 
 TEST(RenderPath, RefusesBadOptionsBeforeLoading) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   std::string path = writePath().string();
   struct Case {
     std::string args, words;

@@ -34,6 +34,7 @@ int errorLines(const std::string& err) {
 }
 
 TEST(PostCli, EveryColorModeDrawsAutzenDifferently) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   fs::path dir = pointrast::test::cliTempDir();
   std::set<std::string> hashes;
   for (std::string mode : {"rgb", "intensity", "classification", "elevation", "return", "source"}) {
@@ -57,6 +58,7 @@ TEST(PostCli, EveryColorModeDrawsAutzenDifferently) {
 }
 
 TEST(PostCli, ResolveStageReportsItsPasses) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   fs::path png = pointrast::test::cliTempDir() / "post.png";
   for (std::string method : {"atomicmin", "batch-prefetch", "hqs1r"}) {
     Result r = run("render " + data("las/autzen_trim.las") + " --method " + method +
@@ -82,6 +84,7 @@ TEST(PostCli, ResolveStageReportsItsPasses) {
 }
 
 TEST(PostCli, WhatCannotBeDoneIsOneLine) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   fs::path png = pointrast::test::cliTempDir() / "refused.png";
   const std::string autzen = data("las/autzen_trim.las");
   const std::string ply = data("ply/simple_binary.ply");

@@ -81,6 +81,7 @@ TEST(RenderCli, JsonOfAPathThatIsNotUtf8IsPrinted) {
 }
 
 TEST(RenderCli, EmptyCloudsDrawTheBackground) {
+  POINTRAST_REQUIRE_DATA("las/no-points.las");
   const std::vector<fs::path> empty = {
       pointrast::test::dataDir() / "las/no-points.las",
       writeFile("none.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
@@ -104,6 +105,7 @@ TEST(RenderCli, EmptyCloudsDrawTheBackground) {
 }
 
 TEST(RenderCli, CoordinatesBeyondRangeNameTheData) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   std::string las = slurp(pointrast::test::dataDir() / "las/1.2-with-color.las");
   ASSERT_GT(las.size(), 227u);
   for (int axis = 0; axis < 3; ++axis) { // the header's x, y, z offsets (LAS 1.2, bytes 155..178)

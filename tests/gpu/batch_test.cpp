@@ -238,6 +238,7 @@ TEST_F(GpuTest, BatchedUploadWritesTheBatchWordsOfEveryBatch) {
 }
 
 TEST_F(GpuTest, BatchAtFullPrecisionMatchesAtomicMin) {
+  POINTRAST_REQUIRE_DATA();
   // Colors are point indices, so that both methods break depth ties alike (atomicmin by the smaller color,
   // batch by the smaller visibility index) and an equal pixel means the same point won: in dense views
   // many pixels hold two points of equal float depth.
@@ -278,6 +279,7 @@ TEST_F(GpuTest, BatchAtFullPrecisionMatchesAtomicMin) {
 }
 
 TEST_F(GpuTest, AdaptivePrecisionMovesNoPointByMoreThanOnePixel) {
+  POINTRAST_REQUIRE_DATA();
   // Colors name points, so the pixel of every point visible in both images can be compared between
   // adaptive precision and the full 30 bits. A sparse random cloud (almost every point visible) and dense
   // ones (terrain, autzen: the points that win their pixel in both).
@@ -341,6 +343,7 @@ TEST_F(GpuTest, AdaptivePrecisionMovesNoPointByMoreThanOnePixel) {
 }
 
 TEST_F(GpuTest, BatchCullingNeverDropsAVisiblePoint) {
+  POINTRAST_REQUIRE_DATA();
   uint32_t w = 240, h = 160;
   for (auto& [cloudName, original] : testClouds()) {
     for (Order order : {Order::Original, Order::Morton}) {

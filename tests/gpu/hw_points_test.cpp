@@ -141,6 +141,7 @@ TEST_F(GpuTest, HwPointsAgreesWithAtomicMinOnTerrain) {
 }
 
 TEST_F(GpuTest, HwPointsAgreesWithAtomicMinOnAutzen) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   std::filesystem::path file = dataDir() / "las/autzen_trim.las";
   ASSERT_TRUE(std::filesystem::exists(file)) << file << " is missing (../shared/data)";
   io::ReadOptions read;

@@ -119,6 +119,7 @@ TEST_F(GpuTest, GeneratedTerrainMatchesCpuReference) {
 }
 
 TEST_F(GpuTest, AutzenMatchesCpuReference) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   std::filesystem::path file = dataDir() / "las/autzen_trim.las";
   ASSERT_TRUE(std::filesystem::exists(file)) << file << " is missing (../shared/data)";
   io::ReadOptions read;

@@ -30,6 +30,7 @@ std::vector<NodeInfo> allNodes(pointrast::lod::NodeSource& source) {
 }
 
 TEST(Copc, MetadataFromTheInfoVlr) {
+  POINTRAST_REQUIRE_DATA("laz/autzen_trim.laz");
   const auto source = openCopc(data(kCopc));
   const auto& m = source->metadata();
   EXPECT_EQ(m.format, "COPC 1.0");
@@ -45,6 +46,7 @@ TEST(Copc, MetadataFromTheInfoVlr) {
 }
 
 TEST(Copc, EachNodeDecodedAloneEqualsTheSequentialDecode) {
+  POINTRAST_REQUIRE_DATA();
   const auto source = openCopc(data(kCopc));
   const std::vector<uint8_t> records = readLazRecords(data(kCopc), 1);
   detail::InputFile file(data(kCopc));
@@ -81,6 +83,7 @@ TEST(Copc, EachNodeDecodedAloneEqualsTheSequentialDecode) {
 }
 
 TEST(Copc, NodesReadFromManyThreadsAgree) {
+  POINTRAST_REQUIRE_DATA();
   const auto source = openCopc(data(kCopc));
   const std::vector<NodeInfo> nodes = allNodes(*source);
   std::vector<std::vector<PointRecord>> sequential;
@@ -158,6 +161,7 @@ size_t entryAtLevel(CopcBytes& c, int32_t want) {
 }
 
 TEST(Copc, HierarchyCyclesAreRefused) {
+  POINTRAST_REQUIRE_DATA();
   CopcBytes c = loadCopc();
   // A level-1 node's entry turned into a reference to the root page itself.
   uint8_t* e = c.entry(entryAtLevel(c, 1));
@@ -168,6 +172,7 @@ TEST(Copc, HierarchyCyclesAreRefused) {
 }
 
 TEST(Copc, HierarchyEntriesOutOfRangeAreRefused) {
+  POINTRAST_REQUIRE_DATA();
   {
     CopcBytes c = loadCopc();
     put<uint64_t>(c.entry(entryAtLevel(c, 1)) + 16, uint64_t(c.bytes.size()) + 1000);
@@ -228,6 +233,7 @@ TEST(Copc, HierarchyEntriesOutOfRangeAreRefused) {
 }
 
 TEST(Copc, CountsThatLieAreRefused) {
+  POINTRAST_REQUIRE_DATA();
   CopcBytes c = loadCopc();
   uint8_t* e = c.entry(entryAtLevel(c, 2));
   int32_t count;

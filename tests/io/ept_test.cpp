@@ -35,6 +35,7 @@ std::map<NodeKey, NodeInfo> nodesOf(pointrast::lod::NodeSource& source) {
 class EptEncodings : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(EptEncodings, EveryNodeEqualsTheCopcNode) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   const fs::path json = iotest::writeEpt(data(kCopc), dir / "ept", GetParam());
   const auto ept = openEpt(json);
@@ -78,6 +79,7 @@ TEST_P(EptEncodings, EveryNodeEqualsTheCopcNode) {
 }
 
 TEST_P(EptEncodings, ReadCloudAndProbe) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   const fs::path json = iotest::writeEpt(data(kCopc), dir / "ept", GetParam());
   EXPECT_EQ(iotest::formatOf(json), "EPT");
@@ -269,6 +271,7 @@ namespace {
 
 // A one-node dataset from a LAS file: unscaled double X/Y/Z (quantized on reading), 16-bit color.
 TEST(Ept, FloatCoordinatesAndColor) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   const PointCloud las = readCloud(data("las/autzen_trim.las"), quiet());
   iotest::TempDir dir;
   const fs::path root = dir / "ept";

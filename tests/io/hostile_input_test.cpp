@@ -72,6 +72,7 @@ std::vector<uint8_t> smallLas(LasFlavor flavor, int points) {
 }
 
 TEST(HostileInput, LasPrefixes) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   auto real = iotest::readBytes(data("las/1.2-with-color.las"));
   sweepPrefixes(real, "t.las", 229 + 3 * 34, 97, true);
   auto pf7 = smallLas(LasFlavor::Las14Pf7, 40);
@@ -81,6 +82,7 @@ TEST(HostileInput, LasPrefixes) {
 }
 
 TEST(HostileInput, LasHeaderFlips) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   const std::vector<uint8_t> values = {0x00, 0xFF, 0x7F, 0x01};
   auto real = iotest::readBytes(data("las/1.2-with-color.las"));
   flipBytes(real, "f.las", 0, 229, values);
@@ -145,6 +147,7 @@ std::vector<uint8_t> binaryPlyWithElements() {
 }
 
 TEST(HostileInput, PlyPrefixes) {
+  POINTRAST_REQUIRE_DATA("ply/simple_binary.ply");
   auto simple = iotest::readBytes(data("ply/simple_binary.ply"));
   sweepPrefixes(simple, "t.ply", simple.size(), 1, true);
   auto withElements = binaryPlyWithElements();
@@ -170,6 +173,7 @@ TEST(HostileInput, PlyPrefixes) {
 }
 
 TEST(HostileInput, LazPrefixes) {
+  POINTRAST_REQUIRE_DATA("laz/simple.laz");
   // A prefix loses the chunk table (written last) or part of it. Only the table's trailing zero padding
   // may go missing unnoticed: the decoder reads zeros there anyway, and decodes the same points.
   auto simple = iotest::readBytes(data("laz/simple.laz"));
@@ -182,6 +186,7 @@ TEST(HostileInput, LazPrefixes) {
 }
 
 TEST(HostileInput, PlyHeaderFlips) {
+  POINTRAST_REQUIRE_DATA("ply/simple_binary.ply");
   const std::vector<uint8_t> values = {'0', '9', ' ', '\n', '\r', 'x', 0x00, 0xFF};
   auto simple = iotest::readBytes(data("ply/simple_binary.ply"));
   flipBytes(simple, "f.ply", 0, 208, values);
@@ -192,6 +197,7 @@ TEST(HostileInput, PlyHeaderFlips) {
 }
 
 TEST(HostileInput, XyzPrefixesAndFlips) {
+  POINTRAST_REQUIRE_DATA("xyz/autzen.pts");
   auto pts = iotest::readBytes(data("xyz/autzen.pts"));
   sweepPrefixes(pts, "t.pts", pts.size(), 1, false);
   flipBytes(pts, "f.pts", 0, pts.size(), {'0', ' ', '\n', ',', '.', '-', 'e', 'x', 0x00, 0xFF});

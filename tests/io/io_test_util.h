@@ -17,11 +17,14 @@
 #include "base/progress.h"
 #include "io/format_table.h"
 #include "io/reader.h"
+#include "test_data.h"
 
 namespace iotest {
 
+// A file or folder of the shared test data (tests/test_data.h: tests that read it start with
+// POINTRAST_REQUIRE_DATA()).
 inline std::filesystem::path data(const std::string& relative) {
-  return std::filesystem::path(POINTRAST_DATA_DIR) / relative;
+  return pointrast::test::dataDir() / relative;
 }
 
 // The name of the format row that recognises the file ("LAS", "XYZ"...), empty when none does.

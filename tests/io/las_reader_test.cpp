@@ -115,6 +115,7 @@ const LasCase kCases[] = {
 class LasFiles : public ::testing::TestWithParam<LasCase> {};
 
 TEST_P(LasFiles, CountBoundsAndColors) {
+  POINTRAST_REQUIRE_DATA();
   const LasCase& c = GetParam();
   PointCloud cloud = readCloud(data(c.file), quiet());
   EXPECT_EQ(cloud.size(), c.count);
@@ -170,6 +171,7 @@ void expectSamePoints(const PointCloud& a, const PointCloud& b) {
 }
 
 TEST(LasReader, Pf7TwinEqualsPf3PointByPoint) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   PointCloud pf3 = readLas(data("las/autzen_trim.las"), quiet());
   PointCloud pf7 = readLas(data("las/autzen_trim_7.las"), quiet());
   expectSamePoints(pf3, pf7);
@@ -182,6 +184,7 @@ TEST(LasReader, Pf7TwinEqualsPf3PointByPoint) {
 }
 
 TEST(LasReader, ExtraBytesStepByRecordLength) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   PointCloud plain = readLas(data("las/1.2-with-color.las"), quiet());
   PointCloud extra = readLas(data("las/extrabytes.las"), quiet());
   expectSamePoints(plain, extra);
@@ -193,6 +196,7 @@ TEST(LasReader, ExtraBytesStepByRecordLength) {
 }
 
 TEST(LasReader, Epsg4326BoundsToMicroDegrees) {
+  POINTRAST_REQUIRE_DATA("las/epsg_4326.las");
   PointCloud cloud = readLas(data("las/epsg_4326.las"), quiet());
   EXPECT_NEAR(cloud.bounds.min.x, -94.683465, 1e-6);
   EXPECT_NEAR(cloud.bounds.min.y, 31.036734, 1e-6);
@@ -202,6 +206,7 @@ TEST(LasReader, Epsg4326BoundsToMicroDegrees) {
 }
 
 TEST(LasReader, Pf6OddScalesKeptExactly) {
+  POINTRAST_REQUIRE_DATA("las/test1_4.las");
   PointCloud cloud = readLas(data("las/test1_4.las"), quiet());
   EXPECT_EQ(cloud.scale.x, 1.16451354e-06);
   EXPECT_EQ(cloud.offset.x, 1692500.352);
@@ -211,6 +216,7 @@ TEST(LasReader, Pf6OddScalesKeptExactly) {
 }
 
 TEST(LasReader, NoPointsLoadsEmpty) {
+  POINTRAST_REQUIRE_DATA("las/no-points.las");
   PointCloud cloud = readCloud(data("las/no-points.las"), quiet());
   EXPECT_EQ(cloud.size(), 0u);
   EXPECT_TRUE(cloud.bounds.empty());
@@ -218,6 +224,7 @@ TEST(LasReader, NoPointsLoadsEmpty) {
 }
 
 TEST(LasReader, VersionAndFormatPermutations) {
+  POINTRAST_REQUIRE_DATA("las/permutations/1.0_0.las");
   const char* files[] = {"1.0_0", "1.0_1", "1.1_0", "1.1_1", "1.2_0", "1.2_1", "1.2_2", "1.2_3"};
   for (const char* name : files) {
     SCOPED_TRACE(name);
@@ -239,6 +246,7 @@ TEST(LasReader, VersionAndFormatPermutations) {
 }
 
 TEST(LasReader, HeaderClaimingMissingPointsIsRefused) {
+  POINTRAST_REQUIRE_DATA("las/permutations/1.2-no-points.las");
   try {
     readCloud(data("las/permutations/1.2-no-points.las"), quiet());
     FAIL() << "expected InputError";
@@ -252,6 +260,7 @@ TEST(LasReader, HeaderClaimingMissingPointsIsRefused) {
 }
 
 TEST(LasReader, AttributesKeptOrDropped) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   PointCloud with = readLas(data("las/1.2-with-color.las"), quiet());
   ASSERT_EQ(with.intensity.size(), with.size());
   ASSERT_EQ(with.classification.size(), with.size());
@@ -270,6 +279,7 @@ TEST(LasReader, AttributesKeptOrDropped) {
 }
 
 TEST(LasReader, ProbeDescribesHeader) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   FileInfo info = probeFile(data("las/autzen_trim.las"));
   EXPECT_EQ(info.formatDetail, "LAS 1.2, point format 3 (34 B records)");
   EXPECT_EQ(info.scale, glm::dvec3(0.01));
@@ -287,6 +297,7 @@ TEST(LasReader, ProbeDescribesHeader) {
 // Small chunks cross chunk boundaries (and the read-ahead thread) with the real files, and the 8-bit
 // -> 16-bit decision taken late in a file must recolor the earlier chunks.
 TEST(LasReader, ChunkBoundariesGiveTheSameCloud) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   PointCloud whole = readLas(data("las/autzen_trim.las"), quiet());
   PointCloud sample16 = readLas(data("las/sample_c.las"), quiet());
   // Record-multiple and odd sizes; 1 byte still reads one record per chunk.
@@ -343,6 +354,7 @@ TEST(LasReader, LateSixteenBitValueRecolorsEarlierChunks) {
 }
 
 TEST(LasReader, CompressedFilesGoToTheLazReader) {
+  POINTRAST_REQUIRE_DATA();
   for (const char* file : {"laz/autzen_trim.laz", "laz/simple.laz", "laz/lone-star.copc.laz"}) {
     SCOPED_TRACE(file);
     EXPECT_EQ(formatOf(data(file)), std::string(file).find("copc") != std::string::npos ? "COPC" : "LAZ");
@@ -361,6 +373,7 @@ TEST(LasReader, CompressedFilesGoToTheLazReader) {
 }
 
 TEST(LasReader, ContentDecidesNotTheExtension) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   iotest::TempDir dir;
   std::filesystem::copy_file(data("las/1.2-with-color.las"), dir / "looks.laz");
   EXPECT_EQ(formatOf(dir / "looks.laz"), "LAS");
@@ -374,6 +387,7 @@ TEST(LasReader, ContentDecidesNotTheExtension) {
 }
 
 TEST(LasReader, LyingCountsAreRefusedBeforeAllocating) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   iotest::TempDir dir;
   auto bytes = iotest::readBytes(data("las/1.2-with-color.las"));
   auto patched = bytes;

@@ -75,6 +75,7 @@ INSTANTIATE_TEST_SUITE_P(
                       FlavorCase{LasFlavor::Las14Pf7, "LAS 1.4, point format 7 (36 B records)", 15, 255}));
 
 TEST(LasWriter, RealFileRoundTripsThroughEveryFlavor) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   PointCloud original = readLas(iotest::data("las/autzen_trim.las"), quiet());
   for (LasFlavor flavor : {LasFlavor::Las12Pf2, LasFlavor::Las12Pf3, LasFlavor::Las14Pf7}) {

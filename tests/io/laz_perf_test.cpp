@@ -70,6 +70,7 @@ protected:
 };
 
 TEST_F(LazPerf, DecodesEverySharedFileConvertedToLaz) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   int checked = 0;
   for (const char* folder : {"las", "laz"}) {

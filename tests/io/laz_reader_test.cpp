@@ -44,6 +44,7 @@ const Twin kTwins[] = {
 };
 
 TEST(LazReader, DecodesToTheRecordsOfTheLasTwin) {
+  POINTRAST_REQUIRE_DATA();
   for (const Twin& t : kTwins) {
     SCOPED_TRACE(t.laz);
     const std::vector<uint8_t> decoded = readLazRecords(data(t.laz));
@@ -78,6 +79,7 @@ void expectSamePoints(const PointCloud& a, const PointCloud& b, uint64_t n) {
 }
 
 TEST(LazReader, ReadCloudEqualsTheLasTwin) {
+  POINTRAST_REQUIRE_DATA();
   for (const Twin& t : kTwins) {
     SCOPED_TRACE(t.laz);
     const PointCloud laz = readCloud(data(t.laz), quiet());
@@ -92,6 +94,7 @@ TEST(LazReader, ReadCloudEqualsTheLasTwin) {
 }
 
 TEST(LazReader, SameOutputOnOneAndManyThreads) {
+  POINTRAST_REQUIRE_DATA();
   for (const char* file : {"laz/autzen_trim.laz", "laz/las_with_several_extra_byte_bloc.laz"}) {
     SCOPED_TRACE(file);
     EXPECT_EQ(readLazRecords(data(file), 1), readLazRecords(data(file), 7));
@@ -108,6 +111,7 @@ TEST(LazReader, SameOutputOnOneAndManyThreads) {
 }
 
 TEST(LazReader, PointSourceServesChunksInFileOrderFromManyThreads) {
+  POINTRAST_REQUIRE_DATA();
   const char* file = "laz/las_with_several_extra_byte_bloc.laz";
   const std::unique_ptr<PointSource> source = openPointSource(data(file));
   const PointSourceInfo& info = source->info();
@@ -146,6 +150,7 @@ TEST(LazReader, PointSourceServesChunksInFileOrderFromManyThreads) {
 }
 
 TEST(LazReader, ProbeDescribesTheCompression) {
+  POINTRAST_REQUIRE_DATA("laz/las_with_several_extra_byte_bloc.laz");
   const FileInfo info = probeFile(data("laz/las_with_several_extra_byte_bloc.laz"));
   EXPECT_STREQ(info.format->name, "LAZ");
   EXPECT_EQ(info.pointCount, 697721u);
@@ -161,6 +166,7 @@ TEST(LazReader, ProbeDescribesTheCompression) {
 }
 
 TEST(LazReader, RefusesWhatItDoesNotDecodeWithOneLine) {
+  POINTRAST_REQUIRE_DATA("laz/simple-laszip-compressor-version-1.2r0.laz");
   try {
     readCloud(data("laz/simple-laszip-compressor-version-1.2r0.laz"), quiet());
     ADD_FAILURE() << "expected InputError";

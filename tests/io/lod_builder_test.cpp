@@ -55,6 +55,7 @@ lod::LodGrid gridOfFile(const std::vector<PointRecord>& records, const io::LodBu
 }
 
 TEST(LodBuilder, AutzenInMemoryAndOutOfCoreGiveTheSameBytes) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   const std::filesystem::path input = data("las/autzen_trim.las");
   const std::vector<PointRecord> records = readRecords(input);
@@ -127,6 +128,7 @@ void writePart(const std::filesystem::path& from, const std::filesystem::path& t
 }
 
 TEST(LodBuilder, FilesMergeIntoOneOctree) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   const std::filesystem::path input = data("las/autzen_trim.las");
   writePart(input, dir / "a.las", 0, 60'000);
@@ -142,6 +144,7 @@ TEST(LodBuilder, FilesMergeIntoOneOctree) {
 }
 
 TEST(LodBuilder, DifferentScalesMergeOnTheFinerOne) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   const std::filesystem::path input = data("las/autzen_trim.las");
   writePart(input, dir / "a.las", 0, 20'000, 0.02); // autzen's scale is 0.01: these points move
@@ -172,6 +175,7 @@ TEST(LodBuilder, DifferentScalesMergeOnTheFinerOne) {
 }
 
 TEST(LodBuilder, EightAndSixteenBitColorsMergeAtSixteenBits) {
+  POINTRAST_REQUIRE_DATA("las/sample_c.las");
   iotest::TempDir dir;
   const std::filesystem::path input = data("las/sample_c.las"); // 16-bit colors
   writePart(data("las/autzen_trim.las"), dir / "a.las", 0, 1'000);
@@ -197,6 +201,7 @@ TEST(LodBuilder, EightAndSixteenBitColorsMergeAtSixteenBits) {
 }
 
 TEST(LodBuilder, InterruptedBuildLeavesNothing) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   std::atomic<bool> cancel{false};
   io::LodBuildOptions options;
@@ -212,6 +217,7 @@ TEST(LodBuilder, InterruptedBuildLeavesNothing) {
 }
 
 TEST(LodBuilder, NoPointsIsAnInputError) {
+  POINTRAST_REQUIRE_DATA("las/no-points.las");
   iotest::TempDir dir;
   io::LodBuildOptions options;
   options.progress = false;

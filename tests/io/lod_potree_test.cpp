@@ -69,6 +69,7 @@ bool sameFiles(const std::filesystem::path& a, const std::filesystem::path& b) {
 class LodPotree : public ::testing::TestWithParam<io::PotreeEncoding> {};
 
 TEST_P(LodPotree, AutzenOnDiskHoldsEveryPointOnceAndRoundTrips) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   const std::filesystem::path input = data("las/autzen_trim.las");
   const std::vector<PointRecord> records = readRecords(input);
@@ -176,6 +177,7 @@ INSTANTIATE_TEST_SUITE_P(Encodings, LodPotree,
                          });
 
 TEST(LodPotreeBuild, FailureLeavesNoFolder) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   iotest::TempDir dir;
   std::filesystem::create_directory(dir / "exists");
   io::LodBuildOptions options;

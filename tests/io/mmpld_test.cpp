@@ -191,6 +191,7 @@ std::vector<Expected> expectedParticles(const Reference& r) {
 class ReferenceFile : public ::testing::TestWithParam<Reference> {};
 
 TEST_P(ReferenceFile, HeadersAreAsStated) {
+  POINTRAST_REQUIRE_DATA();
   const Reference& r = GetParam();
   const MmpldInfo info = probeMmpld(referencePath(r));
   EXPECT_EQ(formatOf(referencePath(r)), "MMPLD");
@@ -224,6 +225,7 @@ TEST_P(ReferenceFile, HeadersAreAsStated) {
 }
 
 TEST_P(ReferenceFile, ParticlesRadiiAndColors) {
+  POINTRAST_REQUIRE_DATA();
   const Reference& r = GetParam();
   const ParticleSet set = readMmpld(referencePath(r), quietFrame());
   const std::vector<Expected> expected = expectedParticles(r);
@@ -248,6 +250,7 @@ TEST_P(ReferenceFile, ParticlesRadiiAndColors) {
 }
 
 TEST_P(ReferenceFile, ScanAgreesWithTheParticles) {
+  POINTRAST_REQUIRE_DATA();
   const Reference& r = GetParam();
   const MmpldStats stats = scanMmpld(referencePath(r), quietFrame());
   const bool isDouble = r.vertex == MmpldVertex::DoubleXyz;
@@ -263,6 +266,7 @@ INSTANTIATE_TEST_SUITE_P(Mmpld, ReferenceFile, ::testing::ValuesIn(kReferences),
                          [](const auto& param) { return std::string(param.param.name); });
 
 TEST(MmpldReader, EveryReferenceFileIsThere) {
+  POINTRAST_REQUIRE_DATA("mmpld");
   // The data folder's seventeen files, each covered above.
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(data("mmpld")))
@@ -271,6 +275,7 @@ TEST(MmpldReader, EveryReferenceFileIsThere) {
 }
 
 TEST(MmpldReader, ChunksOfOneParticleReadTheSame) {
+  POINTRAST_REQUIRE_DATA();
   for (const char* name :
        {"mmpld/test_xyz_double_rgba_short.mmpld", "mmpld/test_xyzr_float_int_float.mmpld"}) {
     const ParticleSet whole = readMmpld(data(name), quietFrame());
@@ -284,6 +289,7 @@ TEST(MmpldReader, ChunksOfOneParticleReadTheSame) {
 }
 
 TEST(MmpldReader, PointReadersRefuseParticleFiles) {
+  POINTRAST_REQUIRE_DATA("mmpld/test_xyz_float_none.mmpld");
   try {
     readCloud(data("mmpld/test_xyz_float_none.mmpld"), iotest::quiet());
     FAIL() << "no exception";
@@ -666,6 +672,7 @@ std::vector<std::vector<uint8_t>> hostileSeeds() {
 }
 
 TEST(MmpldHostile, EveryPrefixIsRefused) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   for (const auto& bytes : hostileSeeds()) {
     for (size_t len = 0; len < bytes.size(); ++len) {
@@ -678,6 +685,7 @@ TEST(MmpldHostile, EveryPrefixIsRefused) {
 }
 
 TEST(MmpldHostile, FlippedBytesReadOrRefuse) {
+  POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;
   for (const auto& bytes : hostileSeeds()) {
     std::vector<uint8_t> copy = bytes;

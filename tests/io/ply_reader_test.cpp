@@ -38,6 +38,7 @@ void expectPoints(const PointCloud& cloud, const std::vector<glm::dvec3>& points
 const std::vector<glm::dvec3> kSimple = {{-1, 0, 0}, {0, 1, 0}, {1, 0, 0}};
 
 TEST(PlyReader, SimpleTextAndBinaryAgree) {
+  POINTRAST_REQUIRE_DATA("ply/simple_text.ply");
   PointCloud text = readCloud(data("ply/simple_text.ply"), quiet());
   PointCloud binary = readCloud(data("ply/simple_binary.ply"), quiet());
   expectPoints(text, kSimple);
@@ -53,6 +54,7 @@ TEST(PlyReader, SimpleTextAndBinaryAgree) {
 }
 
 TEST(PlyReader, MugBinary) {
+  POINTRAST_REQUIRE_DATA("ply/table_scene_mug_stereo_textured.ply");
   PointCloud cloud = readCloud(data("ply/table_scene_mug_stereo_textured.ply"), quiet());
   ASSERT_EQ(cloud.size(), 209280u);
   const double lo[3] = {-0.45643, -0.51074, 0.69001}, hi[3] = {0.71518, 0.17923, 2.59270};
@@ -77,6 +79,7 @@ TEST(PlyReader, MugBinary) {
 }
 
 TEST(PlyReader, Ascii20kMatchesTheBinaryFile) {
+  POINTRAST_REQUIRE_DATA("ply/table_scene_mug_stereo_textured.ply");
   PointCloud binary = readCloud(data("ply/table_scene_mug_stereo_textured.ply"), quiet());
   PointCloud ascii = readCloud(data("ply/table_scene_mug_stereo_textured_ascii20k.ply"), quiet());
   ASSERT_EQ(ascii.size(), 20000u);

@@ -55,6 +55,7 @@ struct PieceSize {
 class LasSourceFiles : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LasSourceFiles, PiecesDecodeToTheRecordsOfTheFile) {
+  POINTRAST_REQUIRE_DATA();
   const std::filesystem::path path = data(GetParam());
   PieceSize small(777); // pieces that end mid-file and a short last piece
   std::unique_ptr<PointSource> source = openPointSource(path);
@@ -111,6 +112,7 @@ INSTANTIATE_TEST_SUITE_P(Data, LasSourceFiles,
                          });
 
 TEST(PointSource, SixteenBitColorsStayRaw) {
+  POINTRAST_REQUIRE_DATA("las/sample_c.las");
   std::unique_ptr<PointSource> source = openPointSource(data("las/sample_c.las"));
   std::vector<PointRecord> records = readAll(*source);
   uint16_t lo = UINT16_MAX, hi = 0;
@@ -125,12 +127,14 @@ TEST(PointSource, SixteenBitColorsStayRaw) {
 }
 
 TEST(PointSource, NoPointsGivesNoPieces) {
+  POINTRAST_REQUIRE_DATA("las/no-points.las");
   std::unique_ptr<PointSource> source = openPointSource(data("las/no-points.las"));
   EXPECT_EQ(source->info().pointCount, 0u);
   EXPECT_TRUE(source->pieces().empty());
 }
 
 TEST(PointSource, PlyAndXyzAreServedFromOneRead) {
+  POINTRAST_REQUIRE_DATA();
   for (const char* name : {"ply/simple_binary.ply", "ply/simple_text.ply"}) {
     PieceSize small(3);
     std::unique_ptr<PointSource> source = openPointSource(data(name));
@@ -157,6 +161,7 @@ TEST(PointSource, PlyAndXyzAreServedFromOneRead) {
 }
 
 TEST(PointSource, NonPointFilesAreRefusedWithOneSentence) {
+  POINTRAST_REQUIRE_DATA();
   for (const char* name : {"mmpld/test_xyz_float_none.mmpld", "README.md"}) {
     try {
       openPointSource(data(name));
@@ -176,6 +181,7 @@ namespace {
 // Every prefix of a LAS file either opens and reads to the records it claims, or is refused with an
 // InputError; never a crash or an overread (run under ASan in the sanitizer build).
 TEST(PointSource, TruncatedLasIsReadOrRefused) {
+  POINTRAST_REQUIRE_DATA("las/1.2-with-color.las");
   const std::vector<uint8_t> bytes = iotest::readBytes(data("las/1.2-with-color.las"));
   iotest::TempDir dir;
   size_t opened = 0, refused = 0;

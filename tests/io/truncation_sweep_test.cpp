@@ -68,12 +68,14 @@ void readEveryNode(const std::filesystem::path& path) {
 }
 
 TEST(TruncationSweep, LazPiecesAreReadOrRefused) {
+  POINTRAST_REQUIRE_DATA("laz/simple.laz");
   // A prefix cuts the chunk table (written last): open refuses it, or a piece is refused when it is read.
   const auto bytes = iotest::readBytes(data("laz/simple.laz"));
   sweep(bytes, "t.laz", bytes.size() - 600, 37, false, readEveryPiece);
 }
 
 TEST(TruncationSweep, CopcNodesAreReadOrRefused) {
+  POINTRAST_REQUIRE_DATA("laz/lone-star.copc.laz");
   // The hierarchy page sits in the EVLR at the end: every prefix loses part of it and must be refused
   // when opened, before any node is read. Dense over the EVLR and the last chunk, strided before.
   const auto bytes = iotest::readBytes(data("laz/lone-star.copc.laz"));

@@ -29,6 +29,7 @@ std::string refusal(const std::string& text, const std::string& name = "t.csv") 
 }
 
 TEST(XyzReader, GriddedDem) {
+  POINTRAST_REQUIRE_DATA("xyz/data.xyz");
   EXPECT_EQ(formatOf(data("xyz/data.xyz")), "XYZ");
   PointCloud cloud = readCloud(data("xyz/data.xyz"), quiet());
   ASSERT_EQ(cloud.size(), 400u);
@@ -48,6 +49,7 @@ TEST(XyzReader, GriddedDem) {
 }
 
 TEST(XyzReader, LeicaPts) {
+  POINTRAST_REQUIRE_DATA("xyz/autzen.pts");
   PointCloud cloud = readCloud(data("xyz/autzen.pts"), quiet());
   ASSERT_EQ(cloud.size(), 10u);
   const double lo[3] = {636102.84, 848968.80, 427.92}, hi[3] = {636126.40, 849345.20, 512.14};
@@ -165,6 +167,7 @@ namespace {
 
 // FileInfo::extra is also printed as a JSON object by `pointrast info --json`: keys must be unique.
 TEST(Probe, ExtraKeysAreUniqueForEveryReadableFile) {
+  POINTRAST_REQUIRE_DATA();
   for (const char* folder : {"las", "las/permutations", "ply", "xyz"})
     for (const auto& entry : std::filesystem::directory_iterator(data(folder))) {
       if (!entry.is_regular_file() || entry.path().extension() == ".py") continue;

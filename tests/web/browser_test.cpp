@@ -58,6 +58,7 @@ void expectNear(const glm::dvec3& a, const glm::dvec3& b, double tolerance, cons
 }
 
 TEST_F(Browser, ThePageShowsTheFrameRenderShowsWithinJpegTolerance) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " " + kAutzenCamera);
   ASSERT_TRUE(server.listening()) << server.stderrText();
   auto dir = scratchDir("browser_frame");
@@ -83,6 +84,7 @@ TEST_F(Browser, ThePageShowsTheFrameRenderShowsWithinJpegTolerance) {
 // the camera exactly as Navigation computes for the same pixels (the desktop viewer's tests check the
 // same core against an X11 drag).
 TEST_F(Browser, ADragOrbitsByWhatTheSessionCoreComputes) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " " + kAutzenCamera);
   ASSERT_TRUE(server.listening()) << server.stderrText();
   const glm::dvec2 from(450, 240), to(560, 300); // right of the panel
@@ -105,6 +107,7 @@ TEST_F(Browser, ADragOrbitsByWhatTheSessionCoreComputes) {
 }
 
 TEST_F(Browser, AResizeChangesTheFrameSize) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen());
   ASSERT_TRUE(server.listening()) << server.stderrText();
   Json r = browser("resize", server.url(), scratchDir("browser_resize"), {{"width", 800}, {"height", 500}});
@@ -118,6 +121,7 @@ TEST_F(Browser, AResizeChangesTheFrameSize) {
 }
 
 TEST_F(Browser, TwoTabsHaveIndependentCameras) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " " + kAutzenCamera);
   ASSERT_TRUE(server.listening()) << server.stderrText();
   Json r =
@@ -134,6 +138,7 @@ TEST_F(Browser, TwoTabsHaveIndependentCameras) {
 
 // 127.0.0.2 is a loopback address that counts as non-local for the token rule.
 TEST_F(Browser, AWrongOrMissingTokenIsRefusedInTheBrowser) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " --bind 127.0.0.2");
   ASSERT_TRUE(server.listening()) << server.stderrText();
   std::string url = server.url();

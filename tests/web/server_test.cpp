@@ -58,6 +58,7 @@ int healthz(uint16_t port, const std::string& host = "127.0.0.1", const std::str
 }
 
 TEST(Serve, ServesItsPageAndHealthAndNothingElse) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen());
   ASSERT_TRUE(server.listening()) << server.stderrText();
   EXPECT_EQ(server.url(), "http://127.0.0.1:" + std::to_string(server.port()) + "/");
@@ -94,6 +95,7 @@ TEST(Serve, ServesItsPageAndHealthAndNothingElse) {
 }
 
 TEST(Serve, BoundLocallyItRefusesForeignHostsAndOrigins) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen());
   ASSERT_TRUE(server.listening()) << server.stderrText();
   // httpRequest sends Host: 127.0.0.1:port; a DNS-rebinding page's request names its own host.
@@ -109,6 +111,7 @@ TEST(Serve, BoundLocallyItRefusesForeignHostsAndOrigins) {
 
 // 127.0.0.2 is a loopback address of this machine that counts as non-local for the token rule.
 TEST(Serve, BoundElsewhereItNeedsTheTokenForEveryRequestAndUpgrade) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " --bind 127.0.0.2");
   ASSERT_TRUE(server.listening()) << server.stderrText();
   const std::string url = server.url();
@@ -149,6 +152,7 @@ TEST(Serve, BoundElsewhereItNeedsTheTokenForEveryRequestAndUpgrade) {
 }
 
 TEST(Serve, AFrameAtRestEqualsRenderWithinJpegTolerance) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " " + kAutzenCamera);
   ASSERT_TRUE(server.listening()) << server.stderrText();
   Viewer viewer;
@@ -173,6 +177,7 @@ TEST(Serve, AFrameAtRestEqualsRenderWithinJpegTolerance) {
 // Random bytes, JSON of every wrong shape, frames no browser sends: each costs the client that sends it its
 // connection (the server closes it), and the server keeps serving the next one.
 TEST(Serve, TenThousandHostileMessagesLeaveItAnswering) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " --max-clients 2");
   ASSERT_TRUE(server.listening()) << server.stderrText();
   std::mt19937 random(12345);
@@ -275,6 +280,7 @@ TEST(Serve, TenThousandHostileMessagesLeaveItAnswering) {
 // A declared length of 2^62 bytes, a flood past the message budget, a client gone in the middle of a
 // frame: each costs that client its connection and nothing else.
 TEST(Serve, LiesFloodsAndVanishingClients) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen());
   ASSERT_TRUE(server.listening()) << server.stderrText();
   Client liar;
@@ -306,6 +312,7 @@ TEST(Serve, LiesFloodsAndVanishingClients) {
 }
 
 TEST(Serve, MaxClientsTellsTheNextOneAndFreesSlots) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen() + " --max-clients 1");
   ASSERT_TRUE(server.listening()) << server.stderrText();
   Viewer first;
@@ -328,6 +335,7 @@ TEST(Serve, MaxClientsTellsTheNextOneAndFreesSlots) {
 }
 
 TEST(Serve, StopsCleanlyOnSigintWithClientsConnected) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen());
   ASSERT_TRUE(server.listening()) << server.stderrText();
   Viewer viewer;
@@ -353,6 +361,7 @@ TEST(Serve, StopsCleanlyOnSigintWithClientsConnected) {
 // The load client that measures serve on the GPU machine, here briefly on lavapipe: it drags, gets motion
 // frames and a full one at rest, and writes its JSON and Markdown.
 TEST(Serve, TheLoadClientMeasuresADrag) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   ServeProcess server(autzen());
   ASSERT_TRUE(server.listening()) << server.stderrText();
   auto dir = scratchDir("load");

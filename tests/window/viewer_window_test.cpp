@@ -137,6 +137,7 @@ protected:
 Xvfb* ViewerWindow::xvfb_ = nullptr;
 
 TEST_F(ViewerWindow, ShowsTheSameImageAsRender) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
   ASSERT_TRUE(first_);
   EXPECT_EQ((*first_)["width"].get<uint32_t>(), kWidth);
@@ -156,6 +157,7 @@ TEST_F(ViewerWindow, ShowsTheSameImageAsRender) {
 }
 
 TEST_F(ViewerWindow, DragOrbitsAroundThePivotByTheExpectedAngle) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
   ASSERT_TRUE(first_);
   size_t from = viewer->eventCount();
@@ -193,6 +195,7 @@ TEST_F(ViewerWindow, DragOrbitsAroundThePivotByTheExpectedAngle) {
 }
 
 TEST_F(ViewerWindow, DoubleClickSetsThePivotOnTheClickedPoint) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
   ASSERT_TRUE(first_);
   viewer->xdotool("mousemove --window $W 240 200 click --repeat 2 --delay 60 1");
@@ -220,6 +223,7 @@ TEST_F(ViewerWindow, DoubleClickSetsThePivotOnTheClickedPoint) {
 }
 
 TEST_F(ViewerWindow, PanelControlChangesTheImage) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera);
   ASSERT_TRUE(first_);
   ASSERT_TRUE((*first_)["panel"].get<bool>());
@@ -248,6 +252,7 @@ TEST_F(ViewerWindow, PanelControlChangesTheImage) {
 }
 
 TEST_F(ViewerWindow, ResizingKeepsRenderingTheSameCamera) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
   ASSERT_TRUE(first_);
   size_t from = viewer->eventCount();
@@ -266,6 +271,7 @@ TEST_F(ViewerWindow, ResizingKeepsRenderingTheSameCamera) {
 }
 
 TEST_F(ViewerWindow, KeysRecordKeyframesAndScreenshots) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   std::filesystem::remove(tempDir() / "path.json");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
   ASSERT_TRUE(first_);
@@ -299,6 +305,7 @@ bool renderFrames(Viewer& viewer, int frames) {
 }
 
 TEST_F(ViewerWindow, StatsFileHasTheGpuTimeOfEveryPassOverTheFramesRendered) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   constexpr int kFrames = 12;
   std::filesystem::path stats = tempDir() / "stats.json";
   std::filesystem::remove(stats);
@@ -341,6 +348,7 @@ TEST_F(ViewerWindow, StatsFileHasTheGpuTimeOfEveryPassOverTheFramesRendered) {
 }
 
 TEST_F(ViewerWindow, StatsGoToStdoutAsOneLineAfterTheExit) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel --stats -");
   ASSERT_TRUE(first_);
   ASSERT_TRUE(renderFrames(*viewer, 3)) << viewer->errors();
@@ -353,6 +361,7 @@ TEST_F(ViewerWindow, StatsGoToStdoutAsOneLineAfterTheExit) {
 }
 
 TEST_F(ViewerWindow, StatsThatCannotBeWrittenFailBeforeTheWindowOpens) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   // A folder that is not there, and a folder where the file should be.
   for (std::string stats : {std::string("/nonexistent/folder/stats.json"), tempDir().string()}) {
     std::string command = "DISPLAY=" + display() + " '" + pointrastBinary() + "' view '" + autzen() +
@@ -365,6 +374,7 @@ TEST_F(ViewerWindow, StatsThatCannotBeWrittenFailBeforeTheWindowOpens) {
 }
 
 TEST(ViewerWithoutDisplay, SaysSoInOneLineAndExits1) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY '" + pointrastBinary() + "' view '" + autzen() +
                         "' 2>&1; echo \"exit=$?\"";
   std::string out = shellOutput(command);
