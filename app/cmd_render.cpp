@@ -23,6 +23,7 @@
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
 #include "input.h"
+#include "options.h"
 #include "io/format_table.h"
 #include "io/writer.h"
 #include "render/clock_settle.h"
@@ -40,10 +41,7 @@ struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
   std::string precision = "adaptive"; // batch methods
-  double minNodePx = 100;             // LOD methods
-  std::string pointBudget = "0";      // LOD methods; 0: no limit
-  std::string gpuMemory;              // LOD methods: node cache budget; empty: half the device
-  bool lodOptionsGiven = false;       // one of the three above was given
+  LodArgs lod;                        // LOD methods
   std::string layout = "auto";        // sphere methods
   std::string billboard;              // sphere methods that rasterize billboards; empty: screen
   bool conservative = false;          // the same: VK_EXT_conservative_rasterization
@@ -57,13 +55,7 @@ struct RenderArgs {
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
   PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
-  // Point methods: coloring and the resolve stage.
-  std::string color = "auto", colorRange;
-  float pointSize = 1, pointSizeMax = 16;
-  std::string pointShape = "square", pointSizeMode = "fixed";
-  uint32_t dilate = 0;
-  bool edl = false;
-  std::optional<float> edlStrength, edlRadius;
+  LookArgs look; // point methods: coloring and the resolve stage
   // Stereo (batch and LOD methods) and foveated LOD.
   bool stereo = false;
   std::optional<double> ipd;
@@ -256,55 +248,16 @@ std::string hashText(const std::vector<uint32_t>& pixels) {
 }
 
 // Whether any option of the resolve stage or of coloring was given (the sphere methods take none).
-bool postOrColorGiven(const RenderArgs& a) {
+bool postOrColorGiven(const RenderArgs& r) {
+  const LookArgs& a = r.look;
   return a.color != "auto" || !a.colorRange.empty() || a.pointSize != 1 || a.pointSizeMax != 16 ||
          a.pointShape != "square" || a.pointSizeMode != "fixed" || a.dilate != 0 || a.edl || a.edlStrength ||
          a.edlRadius;
 }
 
-// --point-size, --point-shape, --point-size-mode, --point-size-max, --dilate, --edl*.
-PostSettings postSettings(const RenderArgs& a) {
-  PostSettings post;
-  post.pointSize = a.pointSize;
-  post.shape = parsePointShape(a.pointShape);
-  post.sizeMode = parsePointSizeMode(a.pointSizeMode);
-  post.maxPointSize = a.pointSizeMax;
-  post.dilate = a.dilate;
-  // --edl-strength or --edl-radius alone turn eye-dome lighting on, with Potree's defaults for the other.
-  if (a.edl || a.edlStrength || a.edlRadius) {
-    post.edlStrength = a.edlStrength.value_or(1.0f);
-    post.edlRadius = a.edlRadius.value_or(post.edlRadius);
-  }
-  validatePostSettings(post);
-  return post;
-}
-
-// --color and --color-range as given: no source for auto (displayColorMode's choice).
-struct ColorChoice {
-  std::optional<DisplayColorMode::Source> source;
-  std::optional<ColorRange> range;
-};
-
-ColorChoice colorChoice(const RenderArgs& a) {
-  ColorChoice choice;
-  if (a.color == "auto") {
-    if (!a.colorRange.empty()) throw InputError("--color-range applies to --color intensity and elevation");
-    return choice;
-  }
-  choice.source = parseColorSource(a.color);
-  if (!a.colorRange.empty()) {
-    if (choice.source != DisplayColorMode::Source::Intensity &&
-        choice.source != DisplayColorMode::Source::Elevation)
-      throw InputError("--color-range applies to --color intensity and elevation, not " + a.color);
-    auto [lo, hi] = parseRange(a.colorRange, "--color-range");
-    choice.range = ColorRange{lo, hi};
-  }
-  return choice;
-}
-
 // The color mode of a loaded cloud: nullopt for auto.
 std::optional<DisplayColorMode> colorMode(const RenderArgs& a, const PointCloud& cloud) {
-  const ColorChoice choice = colorChoice(a);
+  const ColorChoice choice = colorChoice(a.look);
   if (!choice.source) return std::nullopt;
   return displayColorMode(cloud, *choice.source, choice.range);
 }
@@ -497,19 +450,19 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   if (a.order != "original" || a.parts != 1 || a.depth != "float")
     throw InputError("--order, --parts and --depth do not apply to " + a.method +
                      ", which draws an octree's nodes in their stored order");
-  if (!(a.minNodePx >= 0)) throw InputError("--min-node-px must be 0 or more");
-  settings.minNodePx = a.minNodePx;
-  settings.pointBudget = parseCount(a.pointBudget, "--point-budget");
-  settings.post = postSettings(a);
+  const LodValues lod = lodValues(a.lod);
+  settings.minNodePx = lod.minNodePx;
+  settings.pointBudget = lod.pointBudget;
+  settings.post = postSettings(a.look);
   settings.stereo = stereoSettings(a);
   settings.foveation = foveation(a);
-  const ColorChoice colors = colorChoice(a);
+  const ColorChoice colors = colorChoice(a.look);
   if (a.input.empty() || isSceneName(a.input))
     throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
                      a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
                      "): build one with `pointrast lod FILE -o DIR`");
   lod::LodOptions options;
-  if (!a.gpuMemory.empty()) options.gpuBytes = parseBytes(a.gpuMemory, "--gpu-memory");
+  options.gpuBytes = lod.gpuBytes;
   options.colorSource = colors.source;
   options.colorRange = colors.range;
   std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
@@ -570,10 +523,10 @@ RenderSettings pointSettings(const RenderArgs& a) {
   if (a.foveated || a.foveaRadius || a.foveaPeriphery)
     throw InputError("--foveated applies to the LOD methods (" + methodNamesReading(SceneLayout::Octree) +
                      "), which choose octree nodes by their size on screen");
-  if (a.lodOptionsGiven)
+  if (a.lod.given)
     throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
                      methodNamesReading(SceneLayout::Octree) + ")");
-  settings.post = postSettings(a);
+  settings.post = postSettings(a.look);
   settings.stereo = stereoSettings(a);
   if (settings.post.enabled() && settings.method.info().output == MethodOutput::ColorOnly)
     throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
@@ -796,21 +749,7 @@ void addMethodOptions(CLI::App& cmd, RenderArgs& a) {
                  "Batch methods: coordinate words per point, adaptive (the fewest that keep each batch's "
                  "error under half a pixel) or 1, 2, 3 (3 = full 30-bit precision)")
       ->capture_default_str();
-  auto lodOption = [&a](const std::string&) { a.lodOptionsGiven = true; };
-  cmd.add_option(
-         "--min-node-px", a.minNodePx,
-         "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
-         "sphere) is smaller, with their subtrees; 0 draws every point")
-      ->capture_default_str()
-      ->each(lodOption);
-  cmd.add_option("--point-budget", a.pointBudget,
-                 "LOD methods: most points drawn, largest nodes first (e.g. 100M; 0: no limit)")
-      ->capture_default_str()
-      ->each(lodOption);
-  cmd.add_option("--gpu-memory", a.gpuMemory,
-                 "LOD methods: GPU memory for the node cache (e.g. 8G; default: half the device's); a larger "
-                 "selection is drawn in several passes")
-      ->each(lodOption);
+  addLodOptions(cmd, a.lod);
   cmd.add_option("--seed", a.seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd.add_option("--points", a.points, "Points of a generated scene (e.g. 1M, 1.2G)")->capture_default_str();
   cmd.add_option("--frames", a.frames, "Timed frames; the median GPU time is reported")
@@ -840,38 +779,6 @@ void addSphereOptions(CLI::App& cmd, RenderArgs& a) {
                "and launches mesh workgroups only for the rest");
 }
 
-// Colors, point size, hole filling and eye-dome lighting.
-void addLookOptions(CLI::App& cmd, RenderArgs& a) {
-  cmd.add_option("--color", a.color,
-                 "Point colors: auto (RGB if the file has it, else intensity, else elevation), rgb, "
-                 "intensity, classification (ASPRS classes), elevation, return (return number), source "
-                 "(point source id)")
-      ->capture_default_str();
-  cmd.add_option("--color-range", a.colorRange,
-                 "lo,hi mapped to the ends of the intensity or elevation ramp (default: the 0.5 % and 99.5 % "
-                 "percentiles)");
-  cmd.add_option("--point-size", a.pointSize,
-                 "Point size in pixels (1..32); the closest point still wins every pixel")
-      ->capture_default_str();
-  cmd.add_option("--point-shape", a.pointShape, "Shape of points larger than a pixel: square or disc")
-      ->capture_default_str();
-  cmd.add_option("--point-size-mode", a.pointSizeMode,
-                 "fixed (every point --point-size pixels) or attenuated (--point-size pixels at the target's "
-                 "distance, larger nearer and smaller farther, at most --point-size-max)")
-      ->capture_default_str();
-  cmd.add_option("--point-size-max", a.pointSizeMax, "Attenuated point sizes: the largest, pixels (1..32)")
-      ->capture_default_str();
-  cmd.add_option("--dilate", a.dilate,
-                 "Fill holes up to R pixels wide with the closest point around them (0..8; 0: off); a far "
-                 "point never covers a near one, and convex outlines do not grow")
-      ->capture_default_str();
-  cmd.add_flag("--edl", a.edl,
-               "Eye-dome lighting (as Potree): shade each point by how far it lies behind "
-               "its neighbours");
-  cmd.add_option("--edl-strength", a.edlStrength, "Eye-dome lighting strength (default 1; implies --edl)");
-  cmd.add_option("--edl-radius", a.edlRadius,
-                 "Eye-dome lighting: distance of the 8 neighbours in pixels (default 1.4; implies --edl)");
-}
 
 // Stereo and foveated level of detail.
 void addStereoOptions(CLI::App& cmd, RenderArgs& a) {
@@ -908,7 +815,7 @@ Command addRender(CLI::App& app) {
   addViewOptions(*cmd, *a);
   addMethodOptions(*cmd, *a);
   addSphereOptions(*cmd, *a);
-  addLookOptions(*cmd, *a);
+  addLookOptions(*cmd, a->look);
   addStereoOptions(*cmd, *a);
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");

@@ -10,6 +10,8 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "input.h"
+#include "options.h"
+#include "io/format_table.h"
 #include "view/web/server.h"
 
 namespace pointrast::app {
@@ -18,13 +20,14 @@ namespace {
 
 struct ServeArgs {
   std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
-  std::string method = "atomicmin", points = "1M", bind = "127.0.0.1", token, maxSize = "3840x2160";
+  std::string method, points = "1M", bind = "127.0.0.1", token, maxSize = "3840x2160";
   uint32_t port = 8080, maxClients = view::web::kDefaultMaxClients;
   double fov = 60, motionScale = 0.5;
   int quality = 90, motionQuality = 60;
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool events = false, quiet = false;
+  DrawArgs draw; // look, level of detail, depth: as render's
 };
 
 // "1920x1080" -> viewport.
@@ -46,10 +49,9 @@ int runServe(const ServeArgs& a) {
   o.maxClients = a.maxClients;
   o.maxSize = parseSize(a.maxSize);
   o.fovY = a.fov;
-  o.settings.method = parseMethod(a.method);
-  if (methodInfo(o.settings.method).layout == SceneLayout::Octree)
-    throw InputError("serve draws a loaded cloud; " + a.method + " draws octrees, with `pointrast render`");
+  if (!a.method.empty()) o.method = parseMethod(a.method);
   o.settings.background = parseRgb(a.background, "--background");
+  applyDrawOptions(a.draw, o.settings);
   if (!(a.motionScale >= 0.25 && a.motionScale <= 1)) throw InputError("--motion-scale takes 0.25 to 1");
   if (a.quality < 10 || a.quality > 100 || a.motionQuality < 10 || a.motionQuality > 100)
     throw InputError("--quality and --motion-quality take 10 to 100");
@@ -59,10 +61,16 @@ int runServe(const ServeArgs& a) {
   o.quiet = a.quiet;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
   view::web::checkServerOptions(o);
+  const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
+  checkSceneMethod(spec, o.method);
 
-  PointCloud cloud = loadInput(inputSpec(a.input, a.points, a.seed, a.order, a.quiet));
-  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, cloud.bounds.center())) o.camera = camera;
-  return view::web::runServer(cloud, o);
+  SceneOptions scene;
+  scene.method = o.method;
+  scene.gpuBudget = o.settings.gpuMemory;
+  scene.onNote = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  view::SceneInput input = openScene(spec, scene);
+  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center())) o.camera = camera;
+  return view::web::runServer(input, o);
 }
 
 } // namespace
@@ -78,13 +86,20 @@ Command addServe(CLI::App& app) {
       "reverse proxy. The page navigates like `pointrast view`: left drag orbits, right or middle drag "
       "pans,\n"
       "the wheel zooms, a double-click sets the pivot, W A S D Q E fly, 8 2 5 0 4 6 1 views, F frames all;\n"
-      "on touch screens one finger orbits, two pan and pinch zooms. Ctrl-C (SIGINT) or SIGTERM stops it.\n\n"
+      "on touch screens one finger orbits, two pan and pinch zooms. Ctrl-C (SIGINT) or SIGTERM stops it.\n"
+      "Limits: a client's frame is at most 3840x2160 samples (width x height x supersample^2: 4K at 1,\n"
+      "1080p at 2, 960x540 at 4); a connection that sends no request within 3 s is closed, and up to 128\n"
+      "such connections delay no page load.\n\n"
       "Examples:\n"
       "  pointrast serve autzen.las                                   # http://127.0.0.1:8080/\n"
+      "  pointrast serve lone-star.copc.laz                           # an octree, streamed (lod)\n"
       "  pointrast serve terrain --points 1G --method batch-prefetch --port 9000\n"
       "  pointrast serve cloud.las --bind 0.0.0.0 --max-clients 8     # prints http://HOST:8080/?token=...");
   cmd->add_option("FILE", a->input,
-                  "LAS/PLY/XYZ file, or a scene name (terrain, tls); default: the demo scene");
+                  "A cloud file (" + io::formatList(io::FormatUse::Cloud) + "), an octree (" +
+                      io::formatList(io::FormatUse::Octree) +
+                      ", streamed with level of detail), or a scene name (terrain, tls); default: the demo "
+                      "scene");
   cmd->add_option("--port", a->port, "TCP port (0: any free port, printed)")->capture_default_str();
   cmd->add_option("--bind", a->bind,
                   "Address to listen on; anything but 127.0.0.1, ::1 or localhost needs a token")
@@ -103,9 +118,11 @@ Command addServe(CLI::App& app) {
   cmd->add_option("--target", a->target, "Point looked at x,y,z (default: center of the bounds)");
   cmd->add_option("--up", a->up, "Up direction x,y,z")->capture_default_str();
   cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
-  cmd->add_option("--method", a->method, "Rasterization method (changeable in the page)")
-      ->capture_default_str();
+  cmd->add_option("--method", a->method,
+                  "Rasterization method (changeable in the page); default: lod for an octree, else the "
+                  "fastest for the device (batch-prefetch on a discrete GPU, atomicmin elsewhere)");
   cmd->add_option("--background", a->background, "Background color r,g,b (0..255)")->capture_default_str();
+  addDrawOptions(*cmd, a->draw);
   cmd->add_option("--order", a->order, "Vertex order: original, morton, shuffled, shuffled-morton")
       ->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 100M)")

@@ -9,12 +9,14 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "report/run_json.h"
+#include "view/stats_report.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "input.h"
-#include "report/run_json.h"
+#include "options.h"
+#include "io/format_table.h"
 #include "view/desktop/viewer.h"
-#include "view/stats_report.h"
 
 namespace pointrast::app {
 
@@ -22,12 +24,13 @@ namespace {
 
 struct ViewArgs {
   std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
-  std::string method = "atomicmin", points = "1M", path = "path.json", screenshots = ".", stats;
+  std::string method, points = "1M", path = "path.json", screenshots = ".", stats;
   uint32_t width = 1280, height = 720;
   double fov = 60;
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool noPanel = false, noVsync = false, events = false, quiet = false;
+  DrawArgs draw; // look, level of detail, depth: as render's
 };
 
 // Said before the window opens, so a session's statistics are not lost to a folder that is not there.
@@ -43,16 +46,16 @@ void checkStatsFile(const std::string& stats) {
 
 // The statistics of every frame the session rendered, as one JSON document (a file written whole, or one
 // line on stdout for `-`).
-void writeStats(const ViewArgs& a, const PointCloud& cloud, const view::FrameLog& log,
+void writeStats(const ViewArgs& a, const view::SceneInput& input, const view::FrameLog& log,
                 const view::ViewerOptions& options) {
   report::ReportInfo info;
   std::filesystem::path file(a.stats);
   info.name = a.stats == "-" ? "view" : file.stem().string();
-  info.title = "pointrast view: " + cloud.source;
+  info.title = "pointrast view: " + input.name;
   info.commandLine = commandLine("pointrast view");
   info.date = report::utcNow();
   const nlohmann::json j =
-      view::viewStatsJson(log, {cloud.source, cloud.size(), options.vsync, options.panel}, info);
+      view::viewStatsJson(log, {input.name, input.points, options.vsync, options.panel}, info);
   if (a.stats == "-")
     std::printf("%s\n", jsonText(j).c_str());
   else
@@ -72,24 +75,29 @@ int runView(const ViewArgs& a) {
   options.panel = !a.noPanel;
   options.events = a.events;
   options.fovY = a.fov;
-  options.settings.method = parseMethod(a.method);
-  if (methodInfo(options.settings.method).layout == SceneLayout::Octree)
-    throw InputError("view draws a loaded cloud; " + a.method + " draws octrees, with `pointrast render`");
+  if (!a.method.empty()) options.method = parseMethod(a.method);
   options.settings.background = parseRgb(a.background, "--background");
+  applyDrawOptions(a.draw, options.settings);
   options.pathFile = a.path;
   options.screenshotDir = a.screenshots;
   options.device = a.device;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
   checkStatsFile(a.stats);
+  const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
+  checkSceneMethod(spec, options.method);
   view::FrameLog log;
   if (!a.stats.empty()) options.frameLog = &log;
 
-  PointCloud cloud = loadInput(inputSpec(a.input, a.points, a.seed, a.order, a.quiet));
-  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, cloud.bounds.center()))
+  SceneOptions scene;
+  scene.method = options.method;
+  scene.gpuBudget = options.settings.gpuMemory;
+  scene.onNote = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  view::SceneInput input = openScene(spec, scene);
+  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center()))
     options.camera = camera;
-  options.title = "pointrast - " + cloud.source;
-  const int status = view::runViewer(cloud, options);
-  if (!a.stats.empty()) writeStats(a, cloud, log, options);
+  options.title = "pointrast - " + input.name;
+  const int status = view::runViewer(input, options);
+  if (!a.stats.empty()) writeStats(a, input, log, options);
   return status;
 }
 
@@ -113,20 +121,27 @@ Command addView(CLI::App& app) {
       "Without a display, use `pointrast serve` (a browser) or `pointrast render` (images).\n\n"
       "Examples:\n"
       "  pointrast view autzen.las\n"
+      "  pointrast view autzen_octree/              # an octree: streamed with level of detail (lod)\n"
+      "  pointrast view lone-star.copc.laz --method lod-hqs\n"
       "  pointrast view terrain --points 10M --method batch-prefetch\n"
       "  pointrast view autzen.las --eye 636000,848900,700 --target 636600,849200,450 --no-panel\n"
       "  pointrast view terrain --points 10M --no-vsync --stats view.json  # then drag, and Escape");
   cmd->add_option("FILE", a->input,
-                  "LAS/PLY/XYZ file, or a scene name (terrain, tls); default: the demo scene");
+                  "A cloud file (" + io::formatList(io::FormatUse::Cloud) + "), an octree (" +
+                      io::formatList(io::FormatUse::Octree) +
+                      ", streamed with level of detail), or a scene name (terrain, tls); default: the demo "
+                      "scene");
   cmd->add_option("--width", a->width, "Window width in pixels")->capture_default_str();
   cmd->add_option("--height", a->height, "Window height in pixels")->capture_default_str();
   cmd->add_option("--eye", a->eye, "Starting camera position x,y,z (default: overview)");
   cmd->add_option("--target", a->target, "Point looked at x,y,z (default: center of the bounds)");
   cmd->add_option("--up", a->up, "Up direction x,y,z")->capture_default_str();
   cmd->add_option("--fov", a->fov, "Vertical field of view in degrees")->capture_default_str();
-  cmd->add_option("--method", a->method, "Rasterization method (changeable in the panel)")
-      ->capture_default_str();
+  cmd->add_option("--method", a->method,
+                  "Rasterization method (changeable in the panel); default: lod for an octree, else the "
+                  "fastest for the device (batch-prefetch on a discrete GPU, atomicmin elsewhere)");
   cmd->add_option("--background", a->background, "Background color r,g,b (0..255)")->capture_default_str();
+  addDrawOptions(*cmd, a->draw);
   cmd->add_option("--order", a->order, "Vertex order: original, morton, shuffled, shuffled-morton")
       ->capture_default_str();
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 100M)")

@@ -1,11 +1,15 @@
 #include "input.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "base/error.h"
+#include "bench/octree_cache.h"
 #include "cli_util.h"
 #include "cloud/generate.h"
+#include "cloud/octree.h"
 #include "cloud/particles_generate.h"
 #include "io/format_table.h"
 #include "io/particles/particles_io.h"
@@ -38,6 +42,89 @@ PointCloud loadInput(const InputSpec& spec) {
   }
   reorder(cloud, spec.order, spec.seed);
   return cloud;
+}
+
+namespace {
+
+// What a LOD method, or a cloud too large for the budget, opens.
+enum class Opens { Cloud, Octree, BuiltOctree };
+
+// How the input opens. Throws InputError for a LOD method and an input that no octree can be had from (a
+// generated scene), and for a method that draws uploaded clouds and an octree that is nothing else.
+Opens howOpens(const InputSpec& spec, const SceneOptions& options) {
+  const std::optional<Method>& method = options.method;
+  const bool lodMethod = method && methodInfo(*method).layout == SceneLayout::Octree;
+  const std::string source = spec.source.empty() ? kDemoScene : spec.source;
+  const io::FormatInfo* format = pathExists(source) ? io::detectFormat(source) : nullptr;
+  const bool octree = format && format->openNodes;
+  if (octree) {
+    if (method && !lodMethod && !format->read)
+      throw InputError(source + " is an octree (" + format->name + "), drawn by the LOD methods (" +
+                       methodNamesReading(SceneLayout::Octree) + "), not " + methodName(*method));
+    return !method || lodMethod ? Opens::Octree : Opens::Cloud;
+  }
+  const bool cloudFile = format && format->read && format->content == io::FormatContent::Points;
+  if (lodMethod && !cloudFile)
+    throw InputError(std::string(methodName(*method)) + " draws octrees (" +
+                     io::formatList(io::FormatUse::Octree) + "); " +
+                     (spec.source.empty() ? std::string("the demo scene") : spec.source) +
+                     " is a generated scene: build one with `pointrast lod FILE -o DIR`");
+  if (!cloudFile || (method && !lodMethod)) return Opens::Cloud;
+  if (lodMethod) return Opens::BuiltOctree;
+  if (options.gpuBudget == 0) return Opens::Cloud;
+  const std::optional<uint64_t> points = io::statedPointCount(source);
+  constexpr uint64_t kUploadBytesPerPoint = 16; // float xyz + RGBA8 (SceneLayout::Float)
+  return points && *points > options.gpuBudget / kUploadBytesPerPoint ? Opens::BuiltOctree : Opens::Cloud;
+}
+
+} // namespace
+
+std::string fileOctreeKey(const std::filesystem::path& file) {
+  std::error_code error;
+  const std::filesystem::path absolute = std::filesystem::absolute(file, error);
+  const uint64_t size = std::filesystem::file_size(file, error);
+  const auto modified = std::filesystem::last_write_time(file, error).time_since_epoch().count();
+  const std::string identity =
+      absolute.string() + "\n" + std::to_string(size) + "\n" + std::to_string(int64_t(modified));
+  uint64_t hash = 14695981039346656037ull; // FNV-1a, 64 bits
+  for (unsigned char c : identity)
+    hash = (hash ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  std::string stem = file.filename().string();
+  for (char& c : stem)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  return "file-" + stem + "-" + hex;
+}
+
+void checkSceneMethod(const InputSpec& spec, std::optional<Method> method) {
+  SceneOptions options;
+  options.method = method;
+  if (howOpens(spec, options) == Opens::Octree && spec.order != Order::Original)
+    throw InputError("--order does not apply to " + spec.source + ", an octree drawn in its nodes' order");
+}
+
+view::SceneInput openScene(const InputSpec& spec, const SceneOptions& options) {
+  checkSceneMethod(spec, options.method);
+  switch (howOpens(spec, options)) {
+  case Opens::Octree:
+    return view::SceneInput::fromOctree(io::openNodeSource(spec.source));
+  case Opens::BuiltOctree: {
+    bench::OctreeCacheOptions cache;
+    cache.dir = options.octreeCache.empty() ? bench::defaultOctreeCacheDir() : options.octreeCache;
+    cache.progress = spec.progress;
+    cache.onNote = options.onNote;
+    std::optional<PointCloud> cloud;
+    const bench::DatasetOctree octree = bench::octreeCache(cache)(fileOctreeKey(spec.source), [&]() -> const PointCloud& {
+      cloud = loadInput(spec);
+      return *cloud;
+    });
+    return view::SceneInput::fromOctree(io::openNodeSource(octree.path));
+  }
+  case Opens::Cloud:
+    break;
+  }
+  return view::SceneInput::fromCloud(loadInput(spec));
 }
 
 std::optional<uint64_t> statedPoints(const InputSpec& spec) {

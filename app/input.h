@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -10,6 +12,7 @@
 #include "cloud/order.h"
 #include "cloud/particles.h"
 #include "render/camera.h"
+#include "view/scene_source.h"
 
 namespace pointrast::app {
 
@@ -39,6 +42,28 @@ constexpr uint64_t kDemoPoints = 1'000'000;
 // naming the path when the question has no answer (a symbolic link loop, a name too long, a folder that
 // may not be searched).
 bool pathExists(const std::string& path);
+
+// What the viewers open: an octree (a folder or file the format table serves nodes from: our octrees,
+// Potree 2.0, COPC, EPT) as a node source streamed by the LOD methods, anything else read as loadInput
+// does. A method, when named, decides for a file that is both (COPC is also a LAZ file): a LOD method
+// streams it, any other reads it whole. Throws InputError as loadInput, for a LOD method named for an input
+// that is no octree, and for --order with an octree (whose nodes keep their order).
+//
+// A cloud file that does not fit `gpuBudget` bytes (when given; 16 bytes a point uploaded), or that a LOD
+// method was named for, is not refused: its octree is built once into the octree cache (`octreeCache`,
+// the one `bench` uses; keyed by the file's path, size and modification time) with progress lines, and
+// then streamed; a later open reuses it. `onNote` receives the cache's lines (a build, a damaged entry).
+struct SceneOptions {
+  std::optional<Method> method;
+  uint64_t gpuBudget = 0; // 0: no limit checked here
+  std::filesystem::path octreeCache; // empty: bench::defaultOctreeCacheDir()
+  std::function<void(const std::string&)> onNote;
+};
+view::SceneInput openScene(const InputSpec& spec, const SceneOptions& options = {});
+// The refusals of openScene that need no reading, said before a device starts or a file is read.
+void checkSceneMethod(const InputSpec& spec, std::optional<Method> method);
+// The octree cache's key of a file: its name and a hash of its absolute path, size and modification time.
+std::string fileOctreeKey(const std::filesystem::path& file);
 
 // Reads the file or generates the scene, then applies the order. Throws InputError for a source that is
 // neither an existing file nor a scene name.

@@ -21,7 +21,9 @@ RenderSettings pickSettings(const ViewSettings& view) {
   RenderSettings settings = renderSettings(view);
   const MethodInfo& info = methodInfo(view.method);
   if (info.output != MethodOutput::Closest)
-    settings.method = info.layout == SceneLayout::Batched ? pointMethod("batch") : pointMethod("atomicmin");
+    settings.method = info.layout == SceneLayout::Octree    ? pointMethod("lod")
+                      : info.layout == SceneLayout::Batched ? pointMethod("batch")
+                                                            : pointMethod("atomicmin");
   settings.depth = DepthMode::Float;
   settings.captureWords = true;
   return settings;
@@ -76,15 +78,46 @@ GpuCloud::~GpuCloud() = default;
 
 const GpuScene& GpuCloud::scene(SceneLayout layout) {
   if (layout == SceneLayout::Octree)
-    throw InputError("the octree methods draw octrees streamed from disk, not an uploaded cloud");
+    throw InputError("the LOD methods draw octrees streamed from disk, not an uploaded cloud");
   std::unique_ptr<GpuScene>& slot = scenes_[int(layout)];
   if (!slot) {
     UploadOptions upload;
     upload.layout = layout;
     upload.progress = progress_;
+    upload.colors = colors_;
     slot = std::make_unique<GpuScene>(context_, cloud_, upload);
   }
   return *slot;
+}
+
+std::optional<std::string> GpuCloud::setColors(std::optional<DisplayColorMode::Source> source,
+                                               std::optional<ColorRange> range) {
+  auto sameRange = [](const std::optional<ColorRange>& a, const std::optional<ColorRange>& b) {
+    return a.has_value() == b.has_value() && (!a || (a->lo == b->lo && a->hi == b->hi));
+  };
+  if (source == colorSource_ && sameRange(range, colorRange_)) return std::nullopt;
+  std::optional<DisplayColorMode> mode;
+  try {
+    mode = source ? displayColorMode(cloud_, *source, range) : displayColorMode(cloud_);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  colorSource_ = source;
+  colorRange_ = range;
+  colors_ = mode;
+  for (auto& scene : scenes_)
+    if (scene) scene->recolor(context_, cloud_, *mode);
+  return std::nullopt;
+}
+
+const std::string& GpuCloud::name() const {
+  return cloud_.source;
+}
+
+FrameStats GpuCloud::draw(Renderer& renderer, const Camera& camera, const RenderSettings& rs,
+                          const ViewSettings& settings, std::string& status) {
+  if (std::optional<std::string> why = setColors(settings.colorSource, settings.colorRange)) status = *why;
+  return renderer.render(scene(methodInfo(rs.method).layout), camera, rs);
 }
 
 const Bounds& GpuCloud::bounds() const {
@@ -102,12 +135,12 @@ uint64_t GpuCloud::bytes() const {
   return bytes;
 }
 
-SceneView::SceneView(gpu::Context& context, GpuCloud& cloud) : context_(context), cloud_(cloud) {}
+SceneView::SceneView(gpu::Context& context, SceneSource& source) : context_(context), source_(source) {}
 
 SceneView::~SceneView() = default;
 
 uint64_t SceneView::gpuBytes() const {
-  uint64_t bytes = cloud_.bytes();
+  uint64_t bytes = source_.bytes();
   // Framebuffer (8 B), image (4 B) and, once a pick asked for them, canonical words (8 B) per pixel.
   if (renderer_) bytes += uint64_t(renderer_->width()) * renderer_->height() * 20;
   return bytes;
@@ -123,12 +156,13 @@ FrameReport SceneView::render(const Camera& camera, const ViewSettings& settings
   auto start = std::chrono::steady_clock::now();
   ensureRenderer(viewport);
   RenderSettings rs = renderSettings(settings);
-  const GpuScene& s = scene(methodInfo(settings.method).layout);
-  FrameStats stats = renderer_->render(s, camera, rs);
   FrameReport report;
+  FrameStats stats = source_.draw(*renderer_, camera, rs, settings, report.status);
   report.renderMs = stats.medianMs;
   report.points = stats.points;
   report.batch = stats.batch;
+  report.post = stats.post;
+  report.lod = stats.lod;
   report.gpuBytes = gpuBytes();
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
@@ -140,7 +174,8 @@ std::optional<SceneView::Picked> SceneView::pickPoint(const Camera& camera, cons
     return std::nullopt;
   ensureRenderer(viewport);
   RenderSettings rs = pickSettings(settings);
-  renderer_->render(scene(methodInfo(rs.method).layout), camera, rs);
+  std::string status;
+  source_.draw(*renderer_, camera, rs, settings, status);
   int px = int(position.x), py = int(position.y), r = int(kPickRadius);
   int x0 = std::max(0, px - r), y0 = std::max(0, py - r);
   int x1 = std::min(int(viewport.width) - 1, px + r), y1 = std::min(int(viewport.height) - 1, py + r);
@@ -185,7 +220,8 @@ std::vector<uint32_t> SceneView::screenshot(const Camera& camera, const ViewSett
     return renderer_->image();
   }
   Renderer big(context_, viewport.width * supersample, viewport.height * supersample);
-  big.render(scene(methodInfo(settings.method).layout), camera, renderSettings(settings));
+  std::string status;
+  source_.draw(big, camera, renderSettings(settings), settings, status);
   std::vector<uint32_t> pixels = big.image();
   return boxDownsample(pixels, big.width(), big.height(), supersample);
 }

@@ -1,20 +1,23 @@
-// The GPU side of an interactive session, shared by the front ends: a cloud uploaded in the layouts its
-// methods read (each on first use, GpuCloud), and per view one Renderer at the viewport's size, picking
-// the point under a pixel from the framebuffer words, and screenshots (optionally supersampled). Views
-// of one GpuCloud share its uploads: the browser viewer's clients each have a SceneView (their own
-// camera and image size) drawing one GpuCloud. Like the rest of the gpu layer, one thread at a time.
+// The GPU side of an interactive session, shared by the front ends: the input on the GPU (a SceneSource,
+// scene_source.h: GpuCloud below for a cloud uploaded in the layouts its methods read, each on first use, or
+// a GpuOctree streamed through the node cache), and per view one Renderer at the viewport's size, picking
+// the point under a pixel from the framebuffer words, and screenshots (optionally supersampled). Views of
+// one source share it: the browser viewer's clients each have a SceneView (their own camera and image
+// size) drawing one source. Like the rest of the gpu layer, one thread at a time.
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "render/renderer.h"
 #include "view/navigation.h"
+#include "view/scene_source.h"
 #include "view/session.h"
 
 namespace pointrast {
@@ -38,29 +41,41 @@ constexpr uint32_t kPickRadius = 2;
 std::vector<uint32_t> boxDownsample(std::span<const uint32_t> rgba, uint32_t width, uint32_t height,
                                     uint32_t factor);
 
-class GpuCloud {
+class GpuCloud : public SceneSource {
 public:
   // Keeps a reference to the cloud (it must outlive this) to upload a layout when a method first needs
   // it. Uploads throw UnsupportedError when the device lacks the memory.
   GpuCloud(gpu::Context& context, const PointCloud& cloud, bool progress = true);
-  ~GpuCloud();
+  ~GpuCloud() override;
   const GpuScene& scene(SceneLayout layout);
-  const Bounds& bounds() const;
-  uint64_t pointCount() const;
+  // Colors the uploaded layouts, and those uploaded later, as render --color and --color-range would (no
+  // source: the automatic choice). Rewrites only the colors, and only when the choice changed. Returns
+  // the sentence why not when the cloud lacks the attribute; the colors then stay as they were.
+  std::optional<std::string> setColors(std::optional<DisplayColorMode::Source> source,
+                                       std::optional<ColorRange> range);
+  const std::string& name() const override;
+  const Bounds& bounds() const override;
+  uint64_t pointCount() const override;
+  bool streamed() const override { return false; }
   // Bytes of GPU memory of the layouts uploaded so far.
-  uint64_t bytes() const;
+  uint64_t bytes() const override;
+  FrameStats draw(Renderer& renderer, const Camera& camera, const RenderSettings& rs,
+                  const ViewSettings& settings, std::string& status) override;
 
 private:
   gpu::Context& context_;
   const PointCloud& cloud_;
   bool progress_;
-  std::unique_ptr<GpuScene> scenes_[2]; // by SceneLayout
+  std::unique_ptr<GpuScene> scenes_[2];    // by SceneLayout
+  std::optional<DisplayColorMode> colors_; // nullopt: displayColorMode(cloud)
+  std::optional<DisplayColorMode::Source> colorSource_;
+  std::optional<ColorRange> colorRange_;
 };
 
 class SceneView : public ContentSource {
 public:
-  // The cloud must outlive the view.
-  SceneView(gpu::Context& context, GpuCloud& cloud);
+  // The source must outlive the view.
+  SceneView(gpu::Context& context, SceneSource& source);
   ~SceneView() override;
 
   // Renders a frame; recreates the renderer when the viewport changed.
@@ -82,14 +97,12 @@ public:
   std::vector<uint32_t> screenshot(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                    uint32_t supersample);
 
-  // The scenes a method reads, uploaded on first use.
-  const GpuScene& scene(SceneLayout layout) { return cloud_.scene(layout); }
+  SceneSource& source() { return source_; }
   // Bytes of GPU memory of the uploaded scenes and this view's targets.
   uint64_t gpuBytes() const;
 
-  // The level-of-detail hook: the brute-force scenes never change; an octree source will answer whether
-  // nodes arrived since the last frame.
-  bool changedSinceLastFrame() override { return false; }
+  // The level-of-detail hook: an octree source answers whether nodes are still arriving.
+  bool changedSinceLastFrame() override { return source_.changed(); }
 
 private:
   struct Picked {
@@ -100,7 +113,7 @@ private:
   std::optional<Picked> pickPoint(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                   glm::dvec2 position);
   gpu::Context& context_;
-  GpuCloud& cloud_;
+  SceneSource& source_;
   std::unique_ptr<Renderer> renderer_;
 };
 

@@ -100,7 +100,7 @@ std::filesystem::path screenshotName(const std::filesystem::path& folder) {
 
 class Viewer {
 public:
-  Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Context& context, GLFWwindow* window,
+  Viewer(SceneInput& input, const ViewerOptions& options, gpu::Context& context, GLFWwindow* window,
          gpu::Swapchain& swapchain);
   int run();
 
@@ -112,12 +112,11 @@ private:
   void saveKeyframes();
   ImDrawData* buildPanelFrame(double seconds);
 
-  const PointCloud& cloud_;
   const ViewerOptions& options_;
   gpu::Context& context_;
   GLFWwindow* window_;
   gpu::Swapchain& swapchain_;
-  GpuCloud gpuCloud_;
+  std::unique_ptr<SceneSource> source_;
   SceneView scene_;
   Session session_;
   DesktopInput input_;
@@ -131,9 +130,19 @@ private:
   bool running_ = true;
 };
 
-Camera startCamera(const PointCloud& cloud, const ViewerOptions& options, Viewport viewport) {
+Camera startCamera(const SceneInput& input, const ViewerOptions& options, Viewport viewport) {
   if (options.camera) return *options.camera;
-  return overviewCamera(cloud.bounds, viewport.aspect(), options.fovY);
+  return overviewCamera(input.bounds, viewport.aspect(), options.fovY);
+}
+
+// The settings the session starts with: the options', with the method the source and device call for
+// unless one was named. Throws InputError for a named method that does not draw this input.
+ViewSettings startSettings(const SceneSource& source, const ViewerOptions& options,
+                           const gpu::Context& context) {
+  ViewSettings settings = options.settings;
+  settings.method = options.method ? *options.method : defaultMethod(source, context);
+  if (!source.draws(settings.method)) throw InputError(notDrawn(source, settings.method));
+  return settings;
 }
 
 Viewport framebufferViewport(GLFWwindow* window) {
@@ -142,12 +151,12 @@ Viewport framebufferViewport(GLFWwindow* window) {
   return {uint32_t(std::max(w, 1)), uint32_t(std::max(h, 1))};
 }
 
-Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Context& context,
-               GLFWwindow* window, gpu::Swapchain& swapchain)
-    : cloud_(cloud), options_(options), context_(context), window_(window), swapchain_(swapchain),
-      gpuCloud_(context, cloud), scene_(context, gpuCloud_),
-      session_(cloud.bounds, startCamera(cloud, options, {swapchain.width(), swapchain.height()}),
-               {swapchain.width(), swapchain.height()}, options.settings),
+Viewer::Viewer(SceneInput& input, const ViewerOptions& options, gpu::Context& context, GLFWwindow* window,
+               gpu::Swapchain& swapchain)
+    : options_(options), context_(context), window_(window), swapchain_(swapchain),
+      source_(makeSceneSource(context, input, options.settings, true)), scene_(context, *source_),
+      session_(input.bounds, startCamera(input, options, {swapchain.width(), swapchain.height()}),
+               {swapchain.width(), swapchain.height()}, startSettings(*source_, options, context)),
       input_(window, session_), presenter_(context, swapchain) {
   session_.options().panel = options.panel;
   session_.setContentSource(&scene_);
@@ -158,11 +167,10 @@ Viewer::Viewer(const PointCloud& cloud, const ViewerOptions& options, gpu::Conte
     savedKeyframes_ = loaded.keyframes().size();
   }
   info_.device = context.info().name;
-  info_.input = cloud.source;
-  info_.points = cloud.size();
+  info_.input = input.name;
+  info_.points = input.points;
   info_.pathFile = options.pathFile.string();
-  for (Method m : allMethods()) // the methods that draw an uploaded cloud (not the octree methods)
-    if (m.info().layout != SceneLayout::Octree && Renderer::supports(context, m)) info_.methods.push_back(m);
+  info_.methods = methodsFor(*source_, context);
 }
 
 ImDrawData* Viewer::buildPanelFrame(double seconds) {
@@ -289,6 +297,13 @@ void Viewer::showFrame() {
                           {"panel", session_.options().panel},
                           {"render_ms", report.renderMs},
                           {"present_ms", report.presentMs}};
+  if (report.lod)
+    event["lod"] = {{"converged", report.lod->converged},
+                    {"nodes_drawn", report.lod->nodesDrawn},
+                    {"points_drawn", report.lod->pointsDrawn},
+                    {"nodes_loaded", report.lod->nodesLoaded},
+                    {"nodes_evicted", report.lod->nodesEvicted}};
+  if (!report.status.empty()) event["status"] = report.status;
   if (session_.options().panel) {
     nlohmann::json items = nlohmann::json::object();
     for (const auto& [label, rect] : items_)
@@ -356,9 +371,9 @@ bool hasDisplay() {
   return (x11 && *x11) || (wayland && *wayland);
 }
 
-int runViewer(const PointCloud& cloud, const ViewerOptions& options) {
+int runViewer(SceneInput& input, const ViewerOptions& options) {
   if (options.width == 0 || options.height == 0) throw InputError("--width and --height must be at least 1");
-  if (cloud.size() == 0) throw InputError(cloud.source + ": no points to view");
+  if (input.points == 0) throw InputError(input.name + ": no points to view");
   GlfwLibrary library;
   gpu::Context context = createContext(options);
   Window window(options.width, options.height, options.title);
@@ -367,7 +382,7 @@ int runViewer(const PointCloud& cloud, const ViewerOptions& options) {
   Viewport fb = framebufferViewport(window.handle);
   gpu::Swapchain swapchain(context, surface, fb.width, fb.height, options.vsync);
   ImGuiContextScope imgui;
-  Viewer viewer(cloud, options, context, window.handle, swapchain);
+  Viewer viewer(input, options, context, window.handle, swapchain);
   return viewer.run();
 }
 

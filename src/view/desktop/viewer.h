@@ -11,11 +11,9 @@
 #include "view/frame_log.h"
 #include "view/session.h"
 
-namespace pointrast {
-struct PointCloud;
-}
-
 namespace pointrast::view {
+
+struct SceneInput;
 
 struct ViewerOptions {
   uint32_t width = 1280, height = 720; // the window's initial size in pixels
@@ -26,7 +24,8 @@ struct ViewerOptions {
   bool events = false;
   std::optional<Camera> camera; // starting camera; the overview when absent
   double fovY = 60;             // of the overview
-  ViewSettings settings;
+  ViewSettings settings;           // settings.method is ignored: `method` below chooses
+  std::optional<Method> method;    // absent: defaultMethod() for the input and the device
   std::filesystem::path pathFile = "path.json"; // keyframes: loaded when it exists, saved on every K
   std::filesystem::path screenshotDir = ".";    // F12 writes pointrast-NNNN.png here
   std::optional<uint32_t> device;
@@ -38,9 +37,10 @@ struct ViewerOptions {
 // Whether a display is there to open a window on: X11 (DISPLAY) or Wayland (WAYLAND_DISPLAY).
 bool hasDisplay();
 
-// Runs the viewer until the window is closed or Escape is pressed. Returns the exit code (1 when the
-// validation layer reported errors). Throws UnsupportedError without GLFW, a display or a presenting
-// device, InputError for bad options.
-int runViewer(const PointCloud& cloud, const ViewerOptions& options);
+// Runs the viewer on the input (a cloud uploaded whole or an octree streamed, scene_source.h) until the
+// window is closed or Escape is pressed. Returns the exit code (1 when the validation layer reported
+// errors). Throws UnsupportedError without GLFW, a display or a presenting device, InputError for bad
+// options.
+int runViewer(SceneInput& input, const ViewerOptions& options);
 
 } // namespace pointrast::view

@@ -223,7 +223,8 @@ std::optional<double> WebClient::step(double now) {
     stream_.submitState(stateJson(nullptr));
     stateChanged_ = false;
   }
-  if (session_->animating()) return now + kFlyStepSeconds;
+  // Held fly keys, or octree nodes still arriving: draw again soon.
+  if (session_->animating() || full_.changedSinceLastFrame()) return now + kFlyStepSeconds;
   return quality_.refineAt();
 }
 

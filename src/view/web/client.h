@@ -28,7 +28,7 @@ struct StreamSettings {
 // What every client starts from.
 struct ClientSetup {
   gpu::Context* context = nullptr;
-  GpuCloud* cloud = nullptr;
+  SceneSource* cloud = nullptr;    // the input on the GPU, shared by every client
   std::span<const Method> methods; // this device runs them
   std::optional<Camera> camera;    // starting camera; the overview when absent
   double fovY = 60;                // of the overview

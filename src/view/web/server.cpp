@@ -117,7 +117,7 @@ private:
 
 class Server {
 public:
-  Server(const PointCloud& cloud, const ServerOptions& options);
+  Server(SceneInput& input, const ServerOptions& options);
   ~Server();
   int run();
 
@@ -145,11 +145,11 @@ private:
   void emit(const Json& event);
   std::string url() const;
 
-  const PointCloud& cloud_;
+  SceneInput& input_;
   ServerOptions options_;
   AccessPolicy access_;
   gpu::Context context_;
-  GpuCloud gpuCloud_;
+  std::unique_ptr<SceneSource> source_;
   std::vector<Method> methods_;
   ClientSetup setup_;
   std::string info_;
@@ -179,23 +179,25 @@ gpu::Context makeContext(const ServerOptions& options) {
   return gpu::Context(o);
 }
 
-Server::Server(const PointCloud& cloud, const ServerOptions& options)
-    : cloud_(cloud), options_(options), context_(makeContext(options)),
-      gpuCloud_(context_, cloud, !options.quiet) {
+Server::Server(SceneInput& input, const ServerOptions& options)
+    : input_(input), options_(options), context_(makeContext(options)),
+      source_(makeSceneSource(context_, input, options.settings, !options.quiet)) {
   access_.token = options.token;
-  // The octree methods stream nodes from disk; a client's page offers what draws the loaded cloud.
-  for (Method m : allMethods())
-    if (m.info().layout != SceneLayout::Octree && Renderer::supports(context_, m)) methods_.push_back(m);
-  if (std::find(methods_.begin(), methods_.end(), options.settings.method) == methods_.end())
-    throw UnsupportedError(std::string("this device cannot run ") + methodName(options.settings.method));
+  // A client's page offers the methods that draw what was opened (an uploaded cloud, or an octree).
+  methods_ = methodsFor(*source_, context_);
+  ViewSettings settings = options.settings;
+  settings.method = options.method ? *options.method : defaultMethod(*source_, context_);
+  if (!source_->draws(settings.method)) throw InputError(notDrawn(*source_, settings.method));
+  if (std::find(methods_.begin(), methods_.end(), settings.method) == methods_.end())
+    throw UnsupportedError(std::string("this device cannot run ") + methodName(settings.method));
   // The first client should not wait for the upload of the starting method's scene.
-  gpuCloud_.scene(methodInfo(options.settings.method).layout);
+  if (auto* cloud = dynamic_cast<GpuCloud*>(source_.get())) cloud->scene(methodInfo(settings.method).layout);
   setup_.context = &context_;
-  setup_.cloud = &gpuCloud_;
+  setup_.cloud = source_.get();
   setup_.methods = methods_;
   setup_.camera = options.camera;
   setup_.fovY = options.fovY;
-  setup_.settings = options.settings;
+  setup_.settings = settings;
   setup_.maxSize = options.maxSize;
   setup_.stream = options.stream;
   Json methods = Json::array();
@@ -203,8 +205,8 @@ Server::Server(const PointCloud& cloud, const ServerOptions& options)
     methods.push_back({{"name", methodName(m)}, {"help", methodInfo(m).help}});
   info_ = Json{{"t", "info"},
                {"device", context_.info().name},
-               {"input", cloud.source},
-               {"points", cloud.size()},
+               {"input", input.name},
+               {"points", input.points},
                {"methods", methods},
                {"maxSize", {options.maxSize.width, options.maxSize.height}},
                {"maxClients", options.maxClients},
@@ -551,8 +553,8 @@ int Server::run() {
   std::string link = url();
   emit({{"event", "listening"}, {"url", link}, {"port", port_}, {"bind", options_.bind}});
   if (!options_.events && !options_.quiet)
-    std::printf("pointrast serve: %s  (%s, %s points; Ctrl-C stops)\n", link.c_str(), cloud_.source.c_str(),
-                humanCount(double(cloud_.size())).c_str());
+    std::printf("pointrast serve: %s  (%s, %s points; Ctrl-C stops)\n", link.c_str(), input_.name.c_str(),
+                humanCount(double(input_.points)).c_str());
   std::fflush(stdout);
   int signal = 0;
   sigwait(&signals, &signal);
@@ -600,9 +602,9 @@ void checkServerOptions(const ServerOptions& o) {
     throw InputError("--token takes 16 to 100 letters, digits, '-' or '_'");
 }
 
-int runServer(const PointCloud& cloud, ServerOptions options) {
+int runServer(SceneInput& input, ServerOptions options) {
   checkServerOptions(options);
-  if (cloud.size() == 0) throw InputError(cloud.source + ": no points to view");
+  if (input.points == 0) throw InputError(input.name + ": no points to view");
   cw::load();
   if (options.token.empty() && !isLocalBind(options.bind)) options.token = generateToken();
   // SIGINT and SIGTERM are taken by sigwait in Server::run, never by a handler on some thread: blocked
@@ -610,7 +612,7 @@ int runServer(const PointCloud& cloud, ServerOptions options) {
   sigset_t signals = stopSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
-  Server server(cloud, options);
+  Server server(input, options);
   return server.run();
 }
 

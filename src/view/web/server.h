@@ -27,7 +27,8 @@ struct ServerOptions {
   uint32_t maxClients = kDefaultMaxClients;
   std::optional<Camera> camera; // every client's starting camera; the overview when absent
   double fovY = 60;
-  ViewSettings settings;
+  ViewSettings settings;        // settings.method is ignored: `method` below chooses
+  std::optional<Method> method; // absent: defaultMethod() for the input and the device
   Viewport maxSize = kDefaultMaxSize;
   StreamSettings stream;
   std::optional<uint32_t> device;
@@ -41,6 +42,6 @@ void checkServerOptions(const ServerOptions& options);
 
 // Checks the options (InputError with one sentence), generates the token a non-local bind needs, and
 // serves until a signal. Returns the exit code: 1 when the validation layer reported errors.
-int runServer(const PointCloud& cloud, ServerOptions options);
+int runServer(SceneInput& input, ServerOptions options);
 
 } // namespace pointrast::view::web
