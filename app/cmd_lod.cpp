@@ -1,7 +1,11 @@
 // pointrast lod IN... -o DIR: a level-of-detail octree (Potree 2.0) from point files.
+#include <array>
 #include <atomic>
+#include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -9,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include "base/error.h"
 #include "base/parallel.h"
@@ -30,9 +35,10 @@ struct LodArgs {
   bool json = false, quiet = false;
 };
 
-// Ctrl-C (or a termination request) asks the build to stop: it unwinds, and the writer removes its
-// temporary folder with the chunk files in it. The handler only sets a flag (all a signal handler may
-// do); SA_RESETHAND makes a second Ctrl-C end the process at once, for a user who will not wait.
+// Ctrl-C, a termination request, a closed terminal (SIGHUP) or a closed pipe (SIGPIPE) asks the build to
+// stop: it unwinds, and the writer removes its temporary folder with the chunk files in it. The handler
+// only sets a flag (all a signal handler may do); SA_RESETHAND makes a second Ctrl-C end the process at
+// once, for a user who will not wait: what that leaves, the next build of the same folder removes.
 std::atomic<bool> gInterrupted{false};
 extern "C" void onInterrupt(int) {
   gInterrupted.store(true);
@@ -45,20 +51,39 @@ public:
     action.sa_handler = onInterrupt;
     action.sa_flags = SA_RESETHAND;
     sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &oldInt_);
-    sigaction(SIGTERM, &action, &oldTerm_);
+    for (size_t i = 0; i < kSignals.size(); ++i)
+      sigaction(kSignals[i], &action, &old_[i]);
   }
   ~InterruptGuard() {
-    sigaction(SIGINT, &oldInt_, nullptr);
-    sigaction(SIGTERM, &oldTerm_, nullptr);
+    for (size_t i = 0; i < kSignals.size(); ++i)
+      sigaction(kSignals[i], &old_[i], nullptr);
   }
   InterruptGuard(const InterruptGuard&) = delete;
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 
 private:
-  struct sigaction oldInt_ {
-  }, oldTerm_{};
+  static constexpr std::array<int, 4> kSignals{SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+  std::array<struct sigaction, 4> old_{};
 };
+
+// The octree's folder is new, in a folder that exists and may be written to: said before any point is read.
+void checkOutputFolder(std::string& output) {
+  if (output.empty()) throw InputError("-o: give the name of a new folder for the octree");
+  while (output.size() > 1 && output.back() == '/') // "new/" names the folder "new"
+    output.pop_back();
+  std::error_code ec;
+  if (std::filesystem::exists(std::filesystem::symlink_status(output, ec)))
+    throw InputError(output + ": already exists (an octree is written into a new folder)");
+  const std::filesystem::path parent = std::filesystem::absolute(output, ec).parent_path();
+  const auto status = std::filesystem::status(parent, ec);
+  if (status.type() == std::filesystem::file_type::not_found)
+    throw InputError(output + ": the folder " + parent.string() + " does not exist");
+  if (status.type() != std::filesystem::file_type::directory)
+    throw InputError(output + ": " + parent.string() + " is not a folder");
+  if (::access(parent.c_str(), W_OK | X_OK) != 0)
+    throw InputError(output + ": cannot write in the folder " + parent.string() + " (" +
+                     std::strerror(errno) + ")");
+}
 
 double perSecond(double count, double seconds) {
   return seconds > 0 ? count / seconds : 0;
@@ -118,7 +143,7 @@ void printSummary(const LodArgs& a, const io::PotreeBuildReport& r) {
   }
 }
 
-int runLod(const LodArgs& a) {
+int runLod(LodArgs a) {
   io::LodBuildOptions options;
   options.spacing = a.spacing;
   options.leafPoints = parseCount(a.leafPoints, "--leaf-points");
@@ -134,14 +159,9 @@ int runLod(const LodArgs& a) {
     write.encoding = io::PotreeEncoding::Brotli;
   else if (a.encoding != "default")
     throw InputError("--encoding expects default or brotli, got '" + a.encoding + "'");
-  if (a.spacing < 0) throw InputError("--spacing expects a positive length");
+  if (!(a.spacing >= 0) || !std::isfinite(a.spacing)) throw InputError("--spacing expects a positive length");
   // Refused before any point is read: a mistake in the output's name should not cost a read of the input.
-  std::error_code ec;
-  if (std::filesystem::exists(std::filesystem::symlink_status(a.output, ec)))
-    throw InputError(a.output + ": already exists (an octree is written into a new folder)");
-  const std::filesystem::path parent = std::filesystem::absolute(a.output, ec).parent_path();
-  if (!std::filesystem::is_directory(parent, ec))
-    throw InputError(a.output + ": the folder " + parent.string() + " does not exist");
+  checkOutputFolder(a.output);
 
   std::vector<std::filesystem::path> inputs(a.inputs.begin(), a.inputs.end());
   gInterrupted = false;

@@ -1,7 +1,9 @@
 #include "io/io_util.h"
+#include "io/stale_partials.h"
 
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdarg>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -147,14 +149,37 @@ void BufferedReader::skip(uint64_t n, const char* what) {
 
 // ---- PartialFile -----------------------------------------------------------------------------------
 
+// "<target>.partial-<pid>": a process killed outright leaves its partial file, and the next writer of
+// the same path removes it (its pid is gone) without touching another live writer's.
 std::filesystem::path partialPath(const std::filesystem::path& target) {
   std::filesystem::path p = target;
-  p += ".partial";
+  p += ".partial-" + std::to_string(::getpid());
   return p;
+}
+
+void removeStalePartials(const std::filesystem::path& target) {
+  const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+  const std::string prefix = target.filename().string() + ".partial-";
+  std::error_code ec;
+  std::filesystem::directory_iterator it(dir, ec), end;
+  std::vector<std::filesystem::path> stale;
+  for (; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = pid_t(std::stol(digits));
+    // kill(pid, 0) fails with ESRCH only for a pid no process has (EPERM: one runs, of another user).
+    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    stale.push_back(it->path());
+  }
+  for (const auto& path : stale)
+    std::filesystem::remove_all(path, ec);
 }
 
 PartialFile::PartialFile(std::filesystem::path target)
     : target_(std::move(target)), partial_(partialPath(target_)) {
+  removeStalePartials(target_);
   file_ = std::fopen(partial_.c_str(), "wb");
   if (!file_) fail(target_, strFormat("cannot write: %s", std::strerror(errno)));
 }

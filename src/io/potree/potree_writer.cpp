@@ -10,6 +10,7 @@
 
 #include "io/io_util.h"
 #include "io/potree/potree_format.h"
+#include "io/stale_partials.h"
 
 namespace pointrast::io {
 
@@ -222,7 +223,8 @@ PotreeWriter::PotreeWriter(std::filesystem::path dir, const lod::OctreeMetadata&
   if (std::filesystem::exists(std::filesystem::symlink_status(s.dir, ec)))
     fail(s.dir, "already exists (an octree is written into a new folder)");
   // A name of this process: a folder left by a killed build (another pid) never blocks a new one.
-  s.work = s.dir.parent_path() / (s.dir.filename().string() + ".partial-" + std::to_string(::getpid()));
+  s.work = partialPath(s.dir);
+  removeStalePartials(s.dir); // those of killed builds
   std::filesystem::remove_all(s.work, ec);
   if (!std::filesystem::create_directory(s.work, ec))
     fail(s.dir, "cannot create: " + (ec ? ec.message() : std::string("a folder of that name exists")));
