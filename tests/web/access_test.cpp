@@ -54,6 +54,30 @@ TEST(Access, WithATokenEveryRequestMustCarryIt) {
   EXPECT_EQ(checkRequest(policy, r), Verdict::Allow);
 }
 
+// With a token, a browser's WebSocket (it sends Origin) must come from the server's own page: the cookie
+// would otherwise let any page the user opens drive the viewer.
+TEST(Access, WithATokenAWebSocketFromAnotherPageIsRefused) {
+  AccessPolicy policy;
+  policy.token = "0123456789abcdef0123";
+  RequestFacts r;
+  r.host = "10.0.0.5:8080";
+  r.cookieToken = policy.token;
+  r.websocket = true;
+  r.origin = "http://10.0.0.5:8080";
+  EXPECT_EQ(checkRequest(policy, r), Verdict::Allow);
+  r.origin = "http://evil.example";
+  EXPECT_EQ(checkRequest(policy, r), Verdict::ForeignOrigin);
+  r.origin = "http://10.0.0.5:8081";
+  EXPECT_EQ(checkRequest(policy, r), Verdict::ForeignOrigin);
+  r.origin = "null";
+  EXPECT_EQ(checkRequest(policy, r), Verdict::ForeignOrigin);
+  r.origin = {}; // tools send no Origin
+  EXPECT_EQ(checkRequest(policy, r), Verdict::Allow);
+  r.origin = "http://evil.example"; // the page itself (no upgrade) is not a cross-site read
+  r.websocket = false;
+  EXPECT_EQ(checkRequest(policy, r), Verdict::Allow);
+}
+
 TEST(Access, WithoutATokenOnlyLoopbackHostsAndOrigins) {
   AccessPolicy policy;
   RequestFacts r;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <arpa/inet.h>
+#include <cctype>
 #include <cstdio>
 #include <stdexcept>
 
@@ -70,15 +71,27 @@ std::string_view originHost(std::string_view origin) {
   return {};
 }
 
+bool sameHost(std::string_view a, std::string_view b) {
+  return !a.empty() && a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+    return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+  });
+}
+
 } // namespace
 
 Verdict checkRequest(const AccessPolicy& policy, const RequestFacts& request) {
   if (!policy.token.empty()) {
     if (request.queryToken.empty() && request.cookieToken.empty() && request.bearerToken.empty())
       return Verdict::NoToken;
+    bool matched = false;
     for (std::string_view given : {request.queryToken, request.cookieToken, request.bearerToken})
-      if (tokenMatches(given, policy.token)) return Verdict::Allow;
-    return Verdict::WrongToken;
+      matched = matched || tokenMatches(given, policy.token);
+    if (!matched) return Verdict::WrongToken;
+    // The cookie goes along with a WebSocket that any page opens: an upgrade that a browser made (it
+    // says its Origin) must come from this server's own page.
+    if (request.websocket && !request.origin.empty() && !sameHost(originHost(request.origin), request.host))
+      return Verdict::ForeignOrigin;
+    return Verdict::Allow;
   }
   if (!isLoopbackHost(request.host)) return Verdict::ForeignHost;
   if (request.websocket && !request.origin.empty() && !isLoopbackHost(originHost(request.origin)))

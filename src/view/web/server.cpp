@@ -46,6 +46,12 @@ constexpr uint16_t kCloseTooBig = 1009;
 constexpr uint16_t kCloseTryAgain = 1013;
 // How long a shutdown waits for the clients' close frames to be written.
 constexpr double kCloseGraceSeconds = 2.0;
+// civetweb gives each connection a worker thread from the moment it is accepted, before a byte of the
+// request arrives: connections that say nothing hold workers until the request timeout. The workers
+// beyond the clients' let this many such connections be open while pages, /healthz and handshakes still
+// find a free worker at once; the timeout (also the longest a write may make no progress) frees them.
+constexpr uint32_t kIdleConnectionAllowance = 128;
+constexpr const char* kRequestTimeoutMs = "3000";
 
 // The headers of every answer: nothing cached, nothing framed, no referrer (the token may be in the URL),
 // and scripts, styles and connections only from this server.
@@ -75,7 +81,9 @@ struct Connection : MessageSink {
   std::unique_ptr<FrameStream> stream;
   std::mutex inboxMutex;
   std::vector<ClientMessage> inbox;
-  MessageBudget budget; // civetweb's thread only
+  MessageBudget budget;  // civetweb's thread only
+  Viewport canvas{0, 0}; // civetweb's thread only: the frame size its last resize asked for, clamped
+  uint32_t supersample = 1;
   std::atomic<bool> ready{false}, closed{false};
 
   bool sendText(std::string_view text) override {
@@ -126,6 +134,7 @@ private:
   static Server& of(const mg_connection* conn);
   static int beginRequest(mg_connection* conn);
   static int logMessage(const mg_connection* conn, const char* message);
+  static int httpError(mg_connection* conn, int status, const char* message);
   static int handleHttp(mg_connection* conn, void* self);
   static int wsConnect(const mg_connection* conn, void* self);
   static void wsReady(mg_connection* conn, void* self);
@@ -135,6 +144,7 @@ private:
   int gate(mg_connection* conn);
   int serveHttp(mg_connection* conn);
   int refuseMessage(Connection& c, uint16_t code, const std::string& why);
+  bool boundSamples(Connection& c, ClientMessage& m);
   int receive(Connection& c, int bits, const char* data, size_t length);
 
   void start();
@@ -232,6 +242,26 @@ void Server::emit(const Json& event) {
 int Server::logMessage(const mg_connection* conn, const char* message) {
   if (conn) of(conn).log_.line(std::string("civetweb: ") + message);
   return 1; // handled: civetweb writes no log of its own
+}
+
+// civetweb's own error replies (a malformed request line, an unknown HTTP version, headers too long) would
+// quote the request; ours carry only the status, so no byte of the request comes back (no header injected
+// into the reply by a request holding line breaks).
+int Server::httpError(mg_connection* conn, int status, const char*) {
+  if (status < 400 || status > 599) return 1; // not an error: civetweb's own handling
+  const char* text = status == 400   ? "Bad Request"
+                     : status == 413 ? "Payload Too Large"
+                     : status == 431 ? "Request Header Fields Too Large"
+                     : status == 505 ? "HTTP Version Not Supported"
+                     : status < 500  ? "Client Error"
+                                     : "Server Error";
+  std::string body = std::to_string(status) + " " + text + "\n";
+  std::string head = "HTTP/1.1 " + std::to_string(status) + " " + text +
+                     "\r\nContent-Type: text/plain; charset=utf-8\r\nConnection: close\r\n" +
+                     kSecurityHeaders + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n";
+  cw::mg_write(conn, head.data(), head.size());
+  cw::mg_write(conn, body.data(), body.size());
+  return 0; // handled
 }
 
 // Every request, HTTP or WebSocket upgrade, passes here first: the access rules, and nothing but GET.
@@ -353,6 +383,46 @@ void Server::wsReady(mg_connection* conn, void* selfPointer) {
   self.wakeRenderer();
 }
 
+// What one client may make the server hold scales with its frame's samples (size x supersample^2): the
+// renderers, the screenshot's readback and its PNG. A supersample that would pass kMaxClientSamples is
+// refused with a message (the client stays); a resize under a supersample lowers the supersample first.
+bool Server::boundSamples(Connection& c, ClientMessage& m) {
+  auto samples = [](Viewport v, uint32_t s) { return uint64_t(v.width) * v.height * s * s; };
+  auto largestSupersample = [&](Viewport v) {
+    uint32_t s = 4;
+    while (s > 1 && samples(v, s) > kMaxClientSamples)
+      s /= 2;
+    return s;
+  };
+  if (m.type == MessageType::Resize) {
+    c.canvas = clampViewport(m.width, m.height, options_.maxSize);
+    uint32_t s = largestSupersample(c.canvas);
+    if (s < c.supersample) {
+      c.supersample = s;
+      ClientMessage lower;
+      lower.type = MessageType::Options;
+      lower.supersample = s;
+      lower.received = now();
+      std::lock_guard lock(c.inboxMutex);
+      c.inbox.push_back(std::move(lower)); // before the resize that needs it
+    }
+    return true;
+  }
+  if (m.type != MessageType::Options || !m.supersample) return true;
+  if (samples(c.canvas, *m.supersample) > kMaxClientSamples) {
+    std::string why = "supersample " + std::to_string(*m.supersample) + " at " +
+                      std::to_string(c.canvas.width) + "x" + std::to_string(c.canvas.height) +
+                      " would pass the server's " + std::to_string(kMaxClientSamples) +
+                      " samples per client; supersample " + std::to_string(largestSupersample(c.canvas)) +
+                      " is the most at this size";
+    c.stream->submitText(Json{{"t", "error"}, {"message", why}}.dump());
+    m.supersample.reset();
+    return m.keyframeSeconds.has_value();
+  }
+  c.supersample = *m.supersample;
+  return true;
+}
+
 int Server::refuseMessage(Connection& c, uint16_t code, const std::string& why) {
   log_.line("client " + std::to_string(c.id) + " cut off: " + why);
   emit({{"event", "refused"}, {"id", c.id}, {"why", why}, {"websocket", true}});
@@ -381,6 +451,7 @@ int Server::receive(Connection& c, int bits, const char* data, size_t length) {
   if (auto* why = std::get_if<std::string>(&parsed))
     return refuseMessage(c, kClosePolicy, "invalid message: " + *why);
   ClientMessage& m = std::get<ClientMessage>(parsed);
+  if (!boundSamples(c, m)) return 1;
   if (m.type == MessageType::Ack) {
     if (!c.stream->acknowledge(m.frame))
       return refuseMessage(c, kClosePolicy, "acknowledged a frame not sent");
@@ -507,14 +578,15 @@ void Server::start() {
   std::string address = options_.bind == "localhost" ? "127.0.0.1" : options_.bind;
   std::string ports = (address.find(':') != std::string::npos ? "[" + address + "]" : address) + ":" +
                       std::to_string(options_.port);
-  // Each WebSocket holds a worker thread for its life: the clients, plus some for page loads and refusals.
-  std::string threads = std::to_string(options_.maxClients + 4);
+  // Each WebSocket holds a worker thread for its life: the clients, plus some for page loads and refusals,
+  // plus the idle connections' allowance.
+  std::string threads = std::to_string(options_.maxClients + 4 + kIdleConnectionAllowance);
   const char* civetOptions[] = {"listening_ports",
                                 ports.c_str(),
                                 "num_threads",
                                 threads.c_str(),
                                 "request_timeout_ms",
-                                "10000",
+                                kRequestTimeoutMs,
                                 "websocket_timeout_ms",
                                 "30000",
                                 "enable_websocket_ping_pong",
@@ -525,6 +597,7 @@ void Server::start() {
   mg_callbacks callbacks{};
   callbacks.begin_request = &Server::beginRequest;
   callbacks.log_message = &Server::logMessage;
+  callbacks.http_error = &Server::httpError;
   civet_ = cw::mg_start(&callbacks, this, civetOptions);
   if (!civet_)
     throw InputError("cannot listen on " + ports +

@@ -19,6 +19,9 @@ namespace pointrast::view::web {
 // Frames larger than this per side are not rendered unless --max-size says so.
 constexpr Viewport kDefaultMaxSize{3840, 2160};
 constexpr uint32_t kDefaultMaxClients = 4;
+// The most samples (frame width x height x supersample^2) one client may have drawn: 3840x2160 at
+// supersample 1, 1920x1080 at 2, 960x540 at 4. A client's renderers and screenshot scale with it.
+constexpr uint64_t kMaxClientSamples = 3840ull * 2160;
 
 struct ServerOptions {
   std::string bind = "127.0.0.1"; // an IP address or localhost
