@@ -15,6 +15,8 @@ packages=(
   # headless chromium
   libcivetweb-dev libturbojpeg0-dev chromium
   clang libclang-rt-dev llvm # libFuzzer targets (scripts/fuzz.sh): the fuzzer runtime and llvm-symbolizer
+  # the Python module (python/, for Debian's python3) and its tests; pip installs it from the checkout
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-setuptools python3-wheel python3-venv python3-pip
 )
 
 missing=()

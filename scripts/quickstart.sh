@@ -3,7 +3,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPOINTRAST_TESTS=OFF
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPOINTRAST_TESTS=OFF \
+  -DPOINTRAST_PYTHON=ON -DPython_EXECUTABLE=/usr/bin/python3 # import pointrast: PYTHONPATH=build/python
 cmake --build build -j"$(nproc)"
 # XDG_RUNTIME_DIR silences a Mesa warning on machines without a login session.
 XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}" ./build/pointrast render -o demo.png

@@ -20,7 +20,8 @@ if [ "${CI:-}" = true ]; then export POINTRAST_REQUIRE_DATA=1; fi
 
 echo "== tests (warnings as errors, validation layer on)"
 # Optimized, but with asserts on (no -DNDEBUG): the push-constant size checks are asserts.
-cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g" -DPOINTRAST_WERROR=ON
+cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g" -DPOINTRAST_WERROR=ON \
+  -DPOINTRAST_PYTHON=ON -DPython_EXECUTABLE=/usr/bin/python3
 cmake --build build-test -j"$jobs"
 
 echo "== parser and cloud tests under AddressSanitizer"
@@ -33,6 +34,10 @@ echo "== all tests"
 cd build-test
 ctest --output-on-failure -j"$jobs" --timeout 900
 cd ..
+
+echo "== the Python module (pytest, Debian's python3, validation layer on)"
+# Exit status 5 (no tests collected) fails as any other non-zero status does.
+PYTHONPATH="$PWD/build-test/python" POINTRAST_VALIDATION=1 /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
 
 echo "== sphere pipelines on Mesa 25 lavapipe (mesh shaders, ray tracing)"
 (

@@ -1,0 +1,207 @@
+#include "arrays.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
+#include "io/io_util.h"
+
+namespace pointrast::python {
+
+namespace {
+
+std::string dtypeName(const py::array& a) {
+  return py::str(a.dtype()).cast<std::string>();
+}
+
+// An (N,) array of one of the given dtypes with n elements, or TypeError / ValueError naming `what`.
+void checkVector(const py::array& a, const char* what, uint64_t n, bool (*dtypeOk)(const py::dtype&),
+                 const char* dtypes) {
+  if (!dtypeOk(a.dtype()))
+    throw py::type_error(std::string(what) + " must be " + dtypes + ", not " + dtypeName(a));
+  if (a.ndim() != 1) throw py::value_error(std::string(what) + " must be one-dimensional (N,)");
+  if (uint64_t(a.shape(0)) != n)
+    throw py::value_error(std::string(what) + " has " + std::to_string(a.shape(0)) + " values for " +
+                          std::to_string(n) + " points");
+}
+
+bool isUint8(const py::dtype& d) { return d.is(py::dtype::of<uint8_t>()); }
+bool isUint16(const py::dtype& d) { return d.is(py::dtype::of<uint16_t>()); }
+bool isUint8or16(const py::dtype& d) { return isUint8(d) || isUint16(d); }
+bool isInt32(const py::dtype& d) { return d.is(py::dtype::of<int32_t>()); }
+
+// Element i of a one-dimensional array of T, whatever its stride.
+template <typename T>
+T at(const py::array& a, uint64_t i) {
+  return *reinterpret_cast<const T*>(static_cast<const char*>(a.data()) + py::ssize_t(i) * a.strides(0));
+}
+
+template <typename T>
+std::vector<T> copyVector(const py::array& a) {
+  std::vector<T> v(a.shape(0));
+  for (uint64_t i = 0; i < v.size(); ++i)
+    v[i] = at<T>(a, i);
+  return v;
+}
+
+template <typename Src>
+void quantizeRows(PointCloud& cloud, const Src* src, uint64_t n, const io::detail::Quantization& q) {
+  int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  for (uint64_t i = 0; i < 3 * n; ++i) {
+    const int a = int(i % 3);
+    const int32_t v = io::detail::quantize(double(src[i]), q.scale[a], q.offset[a]);
+    cloud.positions[i] = v;
+    qmin[a] = std::min(qmin[a], v);
+    qmax[a] = std::max(qmax[a], v);
+  }
+  if (n > 0) cloud.bounds = io::detail::boundsFromQuantized(qmin, qmax, cloud.scale, cloud.offset);
+}
+
+template <typename Src>
+std::shared_ptr<PointCloud> quantizeXyz(const Src* src, uint64_t n) {
+  Bounds raw;
+  for (uint64_t i = 0; i < n; ++i) {
+    const glm::dvec3 p(src[3 * i], src[3 * i + 1], src[3 * i + 2]);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw py::value_error("xyz row " + std::to_string(i) + " is not finite (NaN or infinity)");
+    raw.expand(p);
+  }
+  auto cloud = std::make_shared<PointCloud>();
+  cloud->source = "array";
+  // The readers' rule (io/io_util.h): offset = the minimum, scale = the power of ten that spans the extent.
+  const io::detail::Quantization q = io::detail::chooseQuantization("xyz", raw);
+  cloud->scale = q.scale;
+  cloud->offset = q.offset;
+  cloud->positions.resize(3 * n);
+  quantizeRows(*cloud, src, n, q);
+  return cloud;
+}
+
+} // namespace
+
+std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz) {
+  const bool f32 = xyz.dtype().is(py::dtype::of<float>());
+  const bool f64 = xyz.dtype().is(py::dtype::of<double>());
+  if (!f32 && !f64) throw py::type_error("xyz must be float32 or float64, not " + dtypeName(xyz));
+  if (xyz.ndim() != 2 || xyz.shape(1) != 3) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < xyz.ndim(); ++d)
+      shape += (d ? ", " : "") + std::to_string(xyz.shape(d));
+    throw py::value_error("xyz must have the shape (N, 3), not " + shape + (xyz.ndim() == 1 ? ",)" : ")"));
+  }
+  if (!(xyz.flags() & py::array::c_style))
+    throw py::value_error("xyz must be C-contiguous (rows of x, y, z side by side); "
+                          "numpy.ascontiguousarray(xyz) makes such a copy");
+  const uint64_t n = uint64_t(xyz.shape(0));
+  py::gil_scoped_release release; // the array stays referenced by the caller
+  return f32 ? quantizeXyz(static_cast<const float*>(xyz.data()), n)
+             : quantizeXyz(static_cast<const double*>(xyz.data()), n);
+}
+
+std::shared_ptr<PointCloud> cloudFromQuantized(const py::array& x, const py::array& y, const py::array& z,
+                                               const glm::dvec3& scale, const glm::dvec3& offset) {
+  const uint64_t n = uint64_t(x.ndim() == 1 ? x.shape(0) : 0);
+  checkVector(x, "X", n, isInt32, "int32");
+  checkVector(y, "Y", n, isInt32, "int32");
+  checkVector(z, "Z", n, isInt32, "int32");
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(scale[a]) || scale[a] == 0 || !std::isfinite(offset[a]))
+      throw py::value_error("scales must be finite and non-zero, offsets finite");
+  auto cloud = std::make_shared<PointCloud>();
+  cloud->source = "array";
+  cloud->scale = scale;
+  cloud->offset = offset;
+  cloud->positions.resize(3 * n);
+  {
+    py::gil_scoped_release release;
+    for (uint64_t i = 0; i < n; ++i) {
+      cloud->positions[3 * i] = at<int32_t>(x, i);
+      cloud->positions[3 * i + 1] = at<int32_t>(y, i);
+      cloud->positions[3 * i + 2] = at<int32_t>(z, i);
+    }
+    computeBounds(*cloud);
+  }
+  return cloud;
+}
+
+void setColors(PointCloud& cloud, const py::object& red, const py::object& green, const py::object& blue) {
+  if (red.is_none() && green.is_none() && blue.is_none()) return;
+  if (red.is_none() || green.is_none() || blue.is_none())
+    throw py::value_error("colors need all three channels: red, green and blue");
+  const py::array channels[3] = {red.cast<py::array>(), green.cast<py::array>(), blue.cast<py::array>()};
+  const char* names[3] = {"red", "green", "blue"};
+  const uint64_t n = cloud.size();
+  bool wide = false; // 16-bit data: a value above 255 in any channel
+  for (int c = 0; c < 3; ++c) {
+    checkVector(channels[c], names[c], n, isUint8or16, "uint8 or uint16");
+    if (isUint16(channels[c].dtype()))
+      for (uint64_t i = 0; i < n && !wide; ++i)
+        wide = at<uint16_t>(channels[c], i) > 255;
+  }
+  cloud.colors.resize(n);
+  for (uint64_t i = 0; i < n; ++i) {
+    uint32_t v[3];
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t raw = isUint8(channels[c].dtype()) ? at<uint8_t>(channels[c], i) : at<uint16_t>(channels[c], i);
+      v[c] = wide ? raw >> 8 : raw;
+    }
+    cloud.colors[i] = packRgba(v[0], v[1], v[2]);
+  }
+}
+
+void setAttribute(PointCloud& cloud, const std::string& name, const py::object& values) {
+  if (values.is_none()) return;
+  const py::array a = values.cast<py::array>();
+  const uint64_t n = cloud.size();
+  if (name == "intensity") {
+    checkVector(a, "intensity", n, isUint8or16, "uint8 or uint16");
+    cloud.intensity.resize(n);
+    for (uint64_t i = 0; i < n; ++i)
+      cloud.intensity[i] = isUint8(a.dtype()) ? at<uint8_t>(a, i) : at<uint16_t>(a, i);
+  } else if (name == "classification" || name == "return_number") {
+    checkVector(a, name.c_str(), n, isUint8, "uint8");
+    (name == "classification" ? cloud.classification : cloud.returnNumber) = copyVector<uint8_t>(a);
+  } else if (name == "point_source_id") {
+    checkVector(a, "point_source_id", n, isUint16, "uint16");
+    cloud.pointSourceId = copyVector<uint16_t>(a);
+  } else {
+    throw py::value_error("unknown attribute " + name);
+  }
+}
+
+py::array positionView(const PointCloud& cloud, int axis, const py::object& owner) {
+  return py::array(py::dtype::of<int32_t>(), {py::ssize_t(cloud.size())}, {py::ssize_t(3 * sizeof(int32_t))},
+                   cloud.positions.data() + axis, owner);
+}
+
+py::array colorView(const PointCloud& cloud, int channel, const py::object& owner) {
+  if (cloud.colors.empty()) return py::array(py::dtype::of<uint8_t>(), {py::ssize_t(0)}, {py::ssize_t(1)});
+  return py::array(py::dtype::of<uint8_t>(), {py::ssize_t(cloud.size())}, {py::ssize_t(sizeof(uint32_t))},
+                   reinterpret_cast<const uint8_t*>(cloud.colors.data()) + channel, owner);
+}
+
+py::object attributeView(const PointCloud& cloud, const std::string& name, const py::object& owner) {
+  auto view = [&](const auto& v) -> py::object {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    if (v.empty()) return py::none();
+    return py::array(py::dtype::of<T>(), {py::ssize_t(v.size())}, {py::ssize_t(sizeof(T))}, v.data(), owner);
+  };
+  if (name == "intensity") return view(cloud.intensity);
+  if (name == "classification") return view(cloud.classification);
+  if (name == "return_number") return view(cloud.returnNumber);
+  if (name == "point_source_id") return view(cloud.pointSourceId);
+  throw py::value_error("unknown attribute " + name);
+}
+
+py::array worldCoordinates(const PointCloud& cloud, int axis) {
+  py::array_t<double> out(py::ssize_t(cloud.size()));
+  double* dst = out.mutable_data();
+  const double scale = cloud.scale[axis], offset = cloud.offset[axis];
+  for (uint64_t i = 0; i < cloud.size(); ++i)
+    dst[i] = cloud.positions[3 * i + axis] * scale + offset;
+  return out;
+}
+
+} // namespace pointrast::python

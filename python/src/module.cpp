@@ -1,0 +1,527 @@
+// pointrast._core: the compiled half of the Python module (python/pointrast/__init__.py holds the API and
+// its docstrings). It does what `pointrast render` does for one frame: a cloud (cloud/cloud.h) or an octree
+// (a NodeSource) drawn by a Renderer on one gpu::Context, with the CLI's camera contract and option checks.
+// The GIL is released while the GPU works; errors of the library become Python exceptions carrying the
+// same sentence as the CLI's one line (InputError: ValueError, a device that cannot: RuntimeError).
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "arrays.h"
+#include "base/error.h"
+#include "cloud/attribute_colors.h"
+#include "cloud/octree.h"
+#include "gpu/context.h"
+#include "io/format_table.h"
+#include "io/reader.h"
+#include "render/camera.h"
+#include "render/lod/lod_scene.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+namespace pointrast::python {
+
+namespace {
+
+struct Cloud {
+  std::shared_ptr<PointCloud> cloud;
+};
+
+struct Octree {
+  std::shared_ptr<lod::NodeSource> source;
+};
+
+glm::dvec3 vec3(const py::handle& value, const char* what) {
+  try {
+    const auto v = value.cast<std::vector<double>>();
+    if (v.size() == 3) return {v[0], v[1], v[2]};
+  } catch (const py::cast_error&) {
+  }
+  throw py::value_error(std::string("camera ") + what + " must be three numbers (x, y, z)");
+}
+
+// The render options of the CLI, by their Python names (python/pointrast/__init__.py fills every key).
+struct Options {
+  uint32_t width = 1920, height = 1080;
+  std::string method = "auto", depth = "float", precision = "adaptive";
+  uint32_t background = 0xFF000000u;
+  std::string color = "auto";
+  std::optional<ColorRange> colorRange;
+  PostSettings post;
+  double minNodePx = 100;
+  uint64_t pointBudget = 0, gpuMemory = 0;
+  lod::Foveation foveation;
+  bool lodOptionsGiven = false;
+};
+
+Options parseOptions(const py::dict& d) {
+  Options o;
+  auto get = [&](const char* key) { return d[key]; };
+  auto given = [&](const char* key) { return d.contains(key) && !d[key].is_none(); };
+  const int64_t width = get("width").cast<int64_t>(), height = get("height").cast<int64_t>();
+  if (width < 1 || height < 1) throw InputError("width and height must be at least 1");
+  if (width > 65536 || height > 65536) throw InputError("width and height must be at most 65536");
+  o.width = uint32_t(width);
+  o.height = uint32_t(height);
+  o.method = get("method").cast<std::string>();
+  o.depth = get("depth").cast<std::string>();
+  o.precision = py::str(get("precision")).cast<std::string>();
+  const auto bg = get("background").cast<std::vector<int>>();
+  if (bg.size() != 3 || *std::min_element(bg.begin(), bg.end()) < 0 || *std::max_element(bg.begin(), bg.end()) > 255)
+    throw InputError("background must be three values 0..255 (r, g, b)");
+  o.background = packRgba(bg[0], bg[1], bg[2]);
+  o.color = get("color").cast<std::string>();
+  if (given("color_range")) {
+    const auto r = get("color_range").cast<std::vector<double>>();
+    if (r.size() != 2 || !(r[0] < r[1])) throw InputError("color_range must be (lo, hi) with lo < hi");
+    o.colorRange = ColorRange{r[0], r[1]};
+  }
+  // --point-size and the rest of the resolve stage, as the CLI's postSettings().
+  o.post.pointSize = get("point_size").cast<float>();
+  o.post.shape = parsePointShape(get("point_shape").cast<std::string>());
+  o.post.sizeMode = parsePointSizeMode(get("point_size_mode").cast<std::string>());
+  o.post.maxPointSize = get("point_size_max").cast<float>();
+  const int64_t dilate = get("dilate").cast<int64_t>();
+  if (dilate < 0) throw InputError("dilate must be 0 or more");
+  o.post.dilate = uint32_t(dilate);
+  if (get("edl").cast<bool>() || given("edl_strength") || given("edl_radius")) {
+    o.post.edlStrength = given("edl_strength") ? get("edl_strength").cast<float>() : 1.0f;
+    if (given("edl_radius")) o.post.edlRadius = get("edl_radius").cast<float>();
+  }
+  validatePostSettings(o.post);
+  o.lodOptionsGiven = given("min_node_px") || given("point_budget") || given("gpu_memory");
+  if (given("min_node_px")) o.minNodePx = get("min_node_px").cast<double>();
+  if (!(o.minNodePx >= 0)) throw InputError("min_node_px must be 0 or more");
+  if (given("point_budget")) o.pointBudget = get("point_budget").cast<uint64_t>();
+  if (given("gpu_memory")) o.gpuMemory = get("gpu_memory").cast<uint64_t>();
+  o.foveation.enabled = get("foveated").cast<bool>();
+  if (!o.foveation.enabled && (given("fovea_radius") || given("fovea_periphery")))
+    throw InputError("fovea_radius and fovea_periphery need foveated=True");
+  if (given("fovea_radius")) o.foveation.radius = get("fovea_radius").cast<double>();
+  if (given("fovea_periphery")) o.foveation.periphery = get("fovea_periphery").cast<double>();
+  if (!(o.foveation.radius >= 0 && o.foveation.radius <= 1))
+    throw InputError("fovea_radius must be between 0 and 1");
+  if (!(o.foveation.periphery >= 1) || !std::isfinite(o.foveation.periphery))
+    throw InputError("fovea_periphery must be a factor >= 1");
+  return o;
+}
+
+// The camera of a render: the overview of `bounds` unless `camera` (a dict with eye, target, up, fov,
+// near, each optional) says otherwise; target defaults to the center of the bounds, as `--target` does.
+Camera resolveCamera(const py::object& camera, const Bounds& bounds, const std::string& source,
+                     const Options& o) {
+  checkCoordinateRange(bounds, source);
+  py::dict d = camera.is_none() ? py::dict() : camera.cast<py::dict>();
+  auto given = [&](const char* key) { return d.contains(key) && !d[key].is_none(); };
+  const double fov = given("fov") ? d["fov"].cast<double>() : 60.0;
+  if (!(fov > 0 && fov < 180)) throw InputError("camera fov must be between 0 and 180 degrees");
+  Camera c = overviewCamera(bounds, double(o.width) / double(o.height), fov);
+  if (given("target") && !given("eye")) throw InputError("a camera target needs an eye");
+  if (given("eye")) {
+    c.eye = vec3(d["eye"], "eye");
+    c.target = given("target") ? vec3(d["target"], "target") : bounds.center();
+    c.up = given("up") ? vec3(d["up"], "up") : glm::dvec3(0, 0, 1);
+  }
+  if (given("near")) c.nearW = d["near"].cast<double>();
+  if (!(c.nearW >= 0) || !std::isfinite(c.nearW)) throw InputError("camera near must be a number >= 0");
+  if (auto problem = findCameraProblem(c))
+    throw InputError(given("eye") ? std::string("camera: ") + describeCameraProblem(*problem)
+                                  : source + ": no overview camera: " + describeCameraProblem(*problem));
+  return c;
+}
+
+py::dict cameraDict(const Camera& c) {
+  py::dict d;
+  d["eye"] = py::make_tuple(c.eye.x, c.eye.y, c.eye.z);
+  d["target"] = py::make_tuple(c.target.x, c.target.y, c.target.z);
+  d["up"] = py::make_tuple(c.up.x, c.up.y, c.up.z);
+  d["fov"] = c.fovY;
+  d["near"] = c.nearW;
+  return d;
+}
+
+py::tuple boundsTuple(const Bounds& b) {
+  return py::make_tuple(py::make_tuple(b.min.x, b.min.y, b.min.z), py::make_tuple(b.max.x, b.max.y, b.max.z));
+}
+
+// The device, the Renderer and what was uploaded to it, kept between renders.
+class Session {
+public:
+  explicit Session(std::optional<uint32_t> device) {
+    gpu::ContextOptions options;
+    options.deviceIndex = device;
+    options.announce = false;
+    context_ = std::make_unique<gpu::Context>(options);
+  }
+  ~Session() {
+    // Scenes and node caches hold buffers of the context: freed before it.
+    lod_.reset();
+    scene_.reset();
+    indexScene_.reset();
+    renderer_.reset();
+  }
+
+  std::string deviceName() const { return context_->info().name; }
+
+  py::dict render(const py::object& input, const py::object& camera, const py::dict& optionsDict,
+                  bool wantDepth, bool wantIndex) {
+    const Options o = parseOptions(optionsDict);
+    std::lock_guard lock(mutex_);
+    if (py::isinstance<Octree>(input)) {
+      if (wantDepth || wantIndex) throw InputError("return_depth and return_index apply to clouds, not octrees");
+      return renderOctree(input.cast<const Octree&>(), camera, o);
+    }
+    return renderCloud(input.cast<const Cloud&>(), camera, o, wantDepth, wantIndex);
+  }
+
+private:
+  RenderSettings settings(const Options& o, const std::string& methodName) {
+    RenderSettings s;
+    s.method = parseMethod(methodName);
+    s.depth = parseDepthMode(o.depth);
+    s.precision = parsePrecision(o.precision);
+    s.background = o.background;
+    s.frames = 1;
+    s.warmup = 0; // one frame makes the image; timing is the benchmarks' business
+    s.post = o.post;
+    std::string why;
+    if (!Renderer::supports(*context_, s.method, &why)) throw UnsupportedError(why);
+    return s;
+  }
+
+  Renderer& renderer(const Options& o) {
+    if (!renderer_ || renderer_->width() != o.width || renderer_->height() != o.height)
+      renderer_ = std::make_unique<Renderer>(*context_, o.width, o.height);
+    return *renderer_;
+  }
+
+  void checkValidation() const {
+    if (context_->validationErrors() > 0)
+      throw InternalError("the Vulkan validation layer reported " + std::to_string(context_->validationErrors()) +
+                          " error(s)");
+  }
+
+  py::array imageArray(const std::vector<uint32_t>& pixels, const Options& o) {
+    py::array_t<uint8_t> image({py::ssize_t(o.height), py::ssize_t(o.width), py::ssize_t(4)});
+    std::memcpy(image.mutable_data(), pixels.data(), pixels.size() * sizeof(uint32_t));
+    return image;
+  }
+
+  py::dict result(const std::vector<uint32_t>& pixels, const Options& o, const Camera& c, const FrameStats& st,
+                  const std::string& method) {
+    py::dict r;
+    r["image"] = imageArray(pixels, o);
+    r["camera"] = cameraDict(c);
+    r["method"] = method;
+    r["points"] = st.points;
+    r["gpu_ms"] = st.medianMs;
+    return r;
+  }
+
+  py::dict renderCloud(const Cloud& input, const py::object& camera, const Options& o, bool wantDepth,
+                       bool wantIndex) {
+    const PointCloud& cloud = *input.cloud;
+    const std::string method = o.method == "auto" ? "atomicmin" : o.method;
+    RenderSettings s = settings(o, method);
+    const SceneLayout layout = s.method.info().layout;
+    if (layout == SceneLayout::Octree)
+      throw InputError(method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
+                       "): open one with pointrast.open()");
+    if (o.lodOptionsGiven || o.foveation.enabled)
+      throw InputError("min_node_px, point_budget, gpu_memory and foveated apply to the LOD methods (octrees)");
+    if (s.post.enabled() && s.method.info().output == MethodOutput::ColorOnly)
+      throw InputError("point_size, dilate and edl need a compute method; " + method +
+                       " keeps no depth per pixel to work on");
+    std::optional<DisplayColorMode> colors;
+    if (o.color != "auto") colors = displayColorMode(cloud, parseColorSource(o.color), o.colorRange);
+    else if (o.colorRange) throw InputError("color_range applies to color='intensity' and 'elevation'");
+    const Camera c = resolveCamera(camera, cloud.bounds, cloud.source, o);
+
+    std::vector<uint32_t> pixels;
+    FrameStats stats;
+    std::vector<uint64_t> words;
+    {
+      py::gil_scoped_release release;
+      // One uploaded scene per layout and color mode of the cloud last drawn.
+      const bool same = scene_ && sceneCloud_.lock() == input.cloud && sceneLayout_ == layout &&
+                        sameColors(sceneColors_, colors);
+      if (!same) {
+        scene_.reset();
+        UploadOptions upload;
+        upload.layout = layout;
+        upload.progress = false;
+        upload.colors = colors;
+        scene_ = std::make_unique<GpuScene>(*context_, cloud, upload);
+        sceneCloud_ = input.cloud;
+        sceneLayout_ = layout;
+        sceneColors_ = colors;
+      }
+      Renderer& r = renderer(o);
+      stats = r.render(*scene_, c, s);
+      pixels = r.image();
+      if (wantDepth || wantIndex) words = indexWords(input, c, o);
+    }
+    checkValidation();
+    py::dict out = result(pixels, o, c, stats, method);
+    if (wantDepth || wantIndex) addDepthIndex(out, words, o, wantDepth, wantIndex);
+    return out;
+  }
+
+  static bool sameColors(const std::optional<DisplayColorMode>& a, const std::optional<DisplayColorMode>& b) {
+    if (a.has_value() != b.has_value()) return false;
+    return !a || (a->source == b->source && a->lo == b->lo && a->hi == b->hi);
+  }
+
+  // The canonical words (depth << 32 | point index) of the closest point at each pixel: atomicmin with
+  // float depth on a copy of the cloud whose colors are the points' indices, with the same resolve stage
+  // (eye-dome lighting aside: it shades colors only). Every closest-point method picks the same depth.
+  std::vector<uint64_t> indexWords(const Cloud& input, const Camera& c, const Options& o) {
+    const PointCloud& cloud = *input.cloud;
+    if (cloud.size() > kMaxIndexed)
+      throw InputError("return_index and return_depth take clouds of at most 16,777,215 points");
+    if (!indexScene_ || indexCloud_.lock() != input.cloud) {
+      indexScene_.reset();
+      PointCloud indexed;
+      indexed.positions = cloud.positions;
+      indexed.scale = cloud.scale;
+      indexed.offset = cloud.offset;
+      indexed.bounds = cloud.bounds;
+      indexed.source = cloud.source;
+      indexed.colors.resize(cloud.size());
+      for (uint32_t i = 0; i < indexed.colors.size(); ++i)
+        indexed.colors[i] = i;
+      UploadOptions upload;
+      upload.progress = false;
+      upload.colors = DisplayColorMode{DisplayColorMode::Source::Rgb};
+      indexScene_ = std::make_unique<GpuScene>(*context_, indexed, upload);
+      indexCloud_ = input.cloud;
+    }
+    RenderSettings s;
+    s.method = pointMethod("atomicmin");
+    s.frames = 1;
+    s.warmup = 0;
+    s.captureWords = true;
+    s.post = o.post;
+    s.post.edlStrength = 0;
+    Renderer& r = renderer(o);
+    r.render(*indexScene_, c, s);
+    return r.framebufferWords();
+  }
+
+  static void addDepthIndex(py::dict& out, const std::vector<uint64_t>& words, const Options& o, bool wantDepth,
+                            bool wantIndex) {
+    const std::vector<py::ssize_t> shape = {py::ssize_t(o.height), py::ssize_t(o.width)};
+    py::array_t<float> depth(shape);
+    py::array_t<int64_t> index(shape);
+    float* d = depth.mutable_data();
+    int64_t* ix = index.mutable_data();
+    for (size_t i = 0; i < words.size(); ++i) {
+      const uint64_t w = words[i];
+      if (w == ~uint64_t(0)) {
+        d[i] = std::numeric_limits<float>::infinity();
+        ix[i] = -1;
+        continue;
+      }
+      const uint32_t bits = uint32_t(w >> 32);
+      std::memcpy(&d[i], &bits, sizeof bits);
+      ix[i] = int64_t(w & 0xFFFFFFu);
+    }
+    if (wantDepth) out["depth"] = depth;
+    if (wantIndex) out["index"] = index;
+  }
+
+  py::dict renderOctree(const Octree& input, const py::object& camera, const Options& o) {
+    const lod::OctreeMetadata& meta = input.source->metadata();
+    const std::string method = o.method == "auto" ? "lod" : o.method;
+    RenderSettings s = settings(o, method);
+    if (s.method.info().layout != SceneLayout::Octree)
+      throw InputError(method + " draws a loaded cloud; octrees are drawn by the LOD methods (lod, lod-hqs), or "
+                                "read whole with pointrast.open(path, lod=False)");
+    if (o.depth != "float")
+      throw InputError("depth does not apply to " + method + ", which draws an octree's nodes in their stored order");
+    s.minNodePx = o.minNodePx;
+    s.pointBudget = o.pointBudget;
+    s.foveation = o.foveation;
+    lod::LodOptions options;
+    options.gpuBytes = o.gpuMemory;
+    if (o.color != "auto") options.colorSource = parseColorSource(o.color);
+    else if (o.colorRange) throw InputError("color_range applies to color='intensity' and 'elevation'");
+    options.colorRange = o.colorRange;
+    const Camera c = resolveCamera(camera, meta.bounds.empty() ? meta.cube : meta.bounds, meta.source, o);
+    std::vector<uint32_t> pixels;
+    FrameStats stats;
+    {
+      py::gil_scoped_release release;
+      const bool same = lod_ && lodSource_.lock() == input.source && lodColor_ == options.colorSource &&
+                        lodGpuBytes_ == options.gpuBytes && sameRange(lodRange_, options.colorRange);
+      if (!same) {
+        lod_.reset();
+        lod_ = std::make_unique<lod::LodScene>(*context_, *input.source, options);
+        lodSource_ = input.source;
+        lodColor_ = options.colorSource;
+        lodRange_ = options.colorRange;
+        lodGpuBytes_ = options.gpuBytes;
+      }
+      Renderer& r = renderer(o);
+      stats = r.render(*lod_, c, s);
+      pixels = r.image();
+    }
+    checkValidation();
+    return result(pixels, o, c, stats, method);
+  }
+
+  static bool sameRange(const std::optional<ColorRange>& a, const std::optional<ColorRange>& b) {
+    return a.has_value() == b.has_value() && (!a || (a->lo == b->lo && a->hi == b->hi));
+  }
+
+  static constexpr uint64_t kMaxIndexed = 0xFFFFFF; // indices travel in the 24 color bits of a word
+
+  std::mutex mutex_;
+  std::unique_ptr<gpu::Context> context_;
+  std::unique_ptr<Renderer> renderer_;
+  std::unique_ptr<GpuScene> scene_;
+  std::weak_ptr<PointCloud> sceneCloud_;
+  SceneLayout sceneLayout_ = SceneLayout::Float;
+  std::optional<DisplayColorMode> sceneColors_;
+  std::unique_ptr<GpuScene> indexScene_;
+  std::weak_ptr<PointCloud> indexCloud_;
+  std::unique_ptr<lod::LodScene> lod_;
+  std::weak_ptr<lod::NodeSource> lodSource_;
+  std::optional<DisplayColorMode::Source> lodColor_;
+  std::optional<ColorRange> lodRange_;
+  uint64_t lodGpuBytes_ = 0;
+};
+
+Cloud readCloud(const std::string& path) {
+  io::ReadOptions options;
+  options.progress = false;
+  PointCloud cloud;
+  {
+    py::gil_scoped_release release;
+    cloud = io::readCloud(path, options);
+  }
+  return Cloud{std::make_shared<PointCloud>(std::move(cloud))};
+}
+
+Octree openOctree(const std::string& path) {
+  std::unique_ptr<lod::NodeSource> source;
+  {
+    py::gil_scoped_release release;
+    source = io::openNodeSource(path);
+  }
+  return Octree{std::shared_ptr<lod::NodeSource>(std::move(source))};
+}
+
+// What pointrast.open() can make of a path: {"format": name, "cloud": bool, "octree": bool}.
+py::dict probe(const std::string& path) {
+  const io::FormatInfo* format = io::detectFormat(path);
+  if (!format)
+    throw InputError(path + ": not a format pointrast reads (" + io::formatList(io::FormatUse::Cloud) + "; octrees: " +
+                     io::formatList(io::FormatUse::Octree) + ")");
+  py::dict d;
+  d["format"] = format->name;
+  d["cloud"] = format->read != nullptr;
+  d["octree"] = format->openNodes != nullptr;
+  d["particles"] = format->content == io::FormatContent::Particles;
+  return d;
+}
+
+} // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "The compiled half of pointrast: see help(pointrast).";
+
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const Interrupted&) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+    } catch (const UnsupportedError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const DeviceFault& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const InternalError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    }
+  });
+
+  py::class_<Cloud>(m, "Cloud")
+      .def("__len__", [](const Cloud& c) { return c.cloud->size(); })
+      .def_property_readonly("source", [](const Cloud& c) { return c.cloud->source; })
+      .def_property_readonly("bounds", [](const Cloud& c) { return boundsTuple(c.cloud->bounds); })
+      .def_property_readonly("scales", [](const Cloud& c) {
+        return py::make_tuple(c.cloud->scale.x, c.cloud->scale.y, c.cloud->scale.z);
+      })
+      .def_property_readonly("offsets", [](const Cloud& c) {
+        return py::make_tuple(c.cloud->offset.x, c.cloud->offset.y, c.cloud->offset.z);
+      })
+      .def("quantized", [](py::object self, int axis) { return positionView(*self.cast<const Cloud&>().cloud, axis, self); })
+      .def("world", [](const Cloud& c, int axis) { return worldCoordinates(*c.cloud, axis); })
+      .def("color", [](py::object self, int channel) { return colorView(*self.cast<const Cloud&>().cloud, channel, self); })
+      .def_property_readonly("has_color", [](const Cloud& c) { return c.cloud->hasColor(); })
+      .def("attribute", [](py::object self, const std::string& name) {
+        return attributeView(*self.cast<const Cloud&>().cloud, name, self);
+      })
+      .def("point", [](const Cloud& c, int64_t i) {
+        if (i < 0 || uint64_t(i) >= c.cloud->size()) throw py::index_error("point index out of range");
+        const glm::dvec3 p = c.cloud->world(uint64_t(i));
+        return py::make_tuple(p.x, p.y, p.z);
+      });
+
+  py::class_<Octree>(m, "Octree")
+      .def_property_readonly("source", [](const Octree& o) { return o.source->metadata().source; })
+      .def_property_readonly("format", [](const Octree& o) { return o.source->metadata().format; })
+      .def_property_readonly("point_count", [](const Octree& o) { return o.source->metadata().pointCount; })
+      .def_property_readonly("bounds", [](const Octree& o) { return boundsTuple(o.source->metadata().bounds); })
+      .def_property_readonly("cube", [](const Octree& o) { return boundsTuple(o.source->metadata().cube); })
+      .def_property_readonly("spacing", [](const Octree& o) { return o.source->metadata().spacing; })
+      .def_property_readonly("depth", [](const Octree& o) { return o.source->metadata().depth; });
+
+  m.def("cloud_from_xyz", [](const py::array& xyz) { return Cloud{cloudFromXyz(xyz)}; });
+  m.def("cloud_from_quantized", [](const py::array& x, const py::array& y, const py::array& z,
+                                   std::vector<double> scale, std::vector<double> offset) {
+    if (scale.size() != 3 || offset.size() != 3) throw py::value_error("scales and offsets need three values");
+    return Cloud{cloudFromQuantized(x, y, z, {scale[0], scale[1], scale[2]}, {offset[0], offset[1], offset[2]})};
+  });
+  m.def("set_colors", [](Cloud& c, const py::object& r, const py::object& g, const py::object& b) {
+    setColors(*c.cloud, r, g, b);
+  });
+  m.def("set_attribute", [](Cloud& c, const std::string& name, const py::object& values) {
+    setAttribute(*c.cloud, name, values);
+  });
+  m.def("read_cloud", &readCloud);
+  m.def("open_octree", &openOctree);
+  m.def("probe", &probe);
+  m.def("overview_camera", [](const py::tuple& bounds, double aspect, double fov) {
+    Bounds b;
+    b.min = vec3(bounds[0], "bounds min");
+    b.max = vec3(bounds[1], "bounds max");
+    if (!(fov > 0 && fov < 180)) throw InputError("camera fov must be between 0 and 180 degrees");
+    return cameraDict(overviewCamera(b, aspect, fov));
+  });
+  m.def("method_names", [] {
+    std::vector<std::string> names;
+    for (Method method : allMethods())
+      names.push_back(method.name());
+    return names;
+  });
+
+  py::class_<Session>(m, "Session")
+      .def(py::init<std::optional<uint32_t>>(), py::arg("device") = py::none())
+      .def_property_readonly("device_name", &Session::deviceName)
+      .def("render", &Session::render);
+}
+
+} // namespace pointrast::python
