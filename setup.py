@@ -2,7 +2,8 @@
 # and installs python/pointrast with it:
 #   python3 -m venv --system-site-packages env && env/bin/pip install --no-build-isolation .
 # Needs what scripts/install-deps.sh installs (python3-dev, pybind11-dev, the Vulkan and glslc packages).
-# POINTRAST_BUILD_DIR reuses a build folder; CMAKE_BUILD_PARALLEL_LEVEL sets the jobs (default: all cores).
+# POINTRAST_BUILD_DIR names the build folder: one already configured with -DPOINTRAST_PYTHON=ON for the
+# same python3 is built as it is. CMAKE_BUILD_PARALLEL_LEVEL sets the jobs (default: all cores).
 import os
 import shutil
 import subprocess
@@ -21,7 +22,8 @@ class CMakeBuild(build_ext):
                      "-DPOINTRAST_PYTHON=ON", "-DPython_EXECUTABLE=" + sys.executable]
         if shutil.which("ccache"):
             configure.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")
-        subprocess.check_call(configure)
+        if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
+            subprocess.check_call(configure)
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
         subprocess.check_call(["cmake", "--build", build, "--target", "pointrast_python", "-j", jobs])
         package = os.path.join(build, "python", "pointrast")

@@ -38,6 +38,13 @@ cd ..
 echo "== the Python module (pytest, Debian's python3, validation layer on)"
 # Exit status 5 (no tests collected) fails as any other non-zero status does.
 PYTHONPATH="$PWD/build-test/python" POINTRAST_VALIDATION=1 /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
+# pip install from the checkout into a fresh environment over Debian's packages (the extension from the tree
+# built above), then a render from outside the checkout.
+rm -rf build-test/venv
+/usr/bin/python3 -m venv --system-site-packages build-test/venv
+POINTRAST_BUILD_DIR="$PWD/build-test" build-test/venv/bin/pip install -q --no-build-isolation .
+(cd /tmp && "$OLDPWD/build-test/venv/bin/python" -c 'import numpy, pointrast
+assert pointrast.render(numpy.random.default_rng(1).random((1000, 3)), width=64, height=48)[..., :3].any()')
 
 echo "== sphere pipelines on Mesa 25 lavapipe (mesh shaders, ray tracing)"
 (
