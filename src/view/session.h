@@ -168,6 +168,7 @@ public:
   const glm::dvec3& pivot() const { return navigation_.pivot(); }
   Viewport viewport() const { return viewport_; }
   Navigation& navigation() { return navigation_; }
+  const Navigation& navigation() const { return navigation_; }
   void setCamera(const Camera& camera);
 
   const ViewSettings& settings() const { return settings_; }

@@ -133,6 +133,32 @@ const scenarios = {
     }
     return results;
   },
+  // The panel's controls changed one after another (args.steps: {id, value} sets an input or select, {id,
+  // check} a checkbox, then a "change" event as a user's edit fires): after each, the full frame drawn with
+  // the settings that step asked for (the state's render options equal step.expect), as step-N.png.
+  async settings(context) {
+    const { page, errors } = await open(context, url);
+    await waitFull(page);
+    const shown = [];
+    for (const [i, step] of args.steps.entries()) {
+      if ('check' in step) await page.setChecked('#' + step.id, step.check);
+      else await page.evaluate(([id, value]) => {
+        const element = document.getElementById(id);
+        element.value = String(value);
+        element.dispatchEvent(new Event('change', { bubbles: true }));
+      }, [step.id, step.value]);
+      await page.waitForFunction((expect) => {
+        const p = window.pointrast;
+        return p.state && p.state.settings.options === expect && p.lastFrame && p.lastFrame.full &&
+               p.lastFrame.seq >= p.sentSeq && p.state.frame === p.lastFrame.frame;
+      }, step.expect, { timeout: TIMEOUT, polling: 50 });
+      await canvasPng(page, join(outdir, `step-${i}.png`));
+      shown.push(await page.evaluate(() => window.pointrast.state.settings.options));
+    }
+    if (args.file) await page.screenshot({ path: args.file });
+    const refusals = await page.evaluate(() => window.pointrast.refusals);
+    return { errors, shown, refusals };
+  },
   // A picture of the page (panel and frame) for the README.
   async pageshot(context) {
     const { page, errors } = await open(context, url);

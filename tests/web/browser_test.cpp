@@ -136,6 +136,48 @@ TEST_F(Browser, TwoTabsHaveIndependentCameras) {
   expectCleanExit(server);
 }
 
+// Each panel control changes the streamed image as `render` with its option does: the frame after each
+// step matches render with that step's options (within JPEG's tolerance), and is farther from the image
+// before the step than from its own reference, so a control that changed nothing would fail.
+TEST_F(Browser, PanelControlsChangeTheImageAsRenderOptionsDo) {
+  ServeProcess server(autzen() + " " + kAutzenCamera);
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  auto dir = scratchDir("browser_settings");
+  const Json steps = Json::array({
+      {{"id", "color"}, {"value", "intensity"}, {"expect", "--color intensity"}},
+      {{"id", "pointSize"}, {"value", 3}, {"expect", "--color intensity --point-size 3"}},
+      {{"id", "edl"}, {"check", true}, {"expect", "--color intensity --point-size 3 --edl"}},
+      {{"id", "dilate"}, {"value", 2}, {"expect", "--color intensity --point-size 3 --dilate 2 --edl"}},
+      {{"id", "color"},
+       {"value", "classification"},
+       {"expect", "--color classification --point-size 3 --dilate 2 --edl"}},
+  });
+  Json r = browser("settings", server.url(), dir, {{"steps", steps}});
+  ASSERT_TRUE(r.contains("shown"));
+  EXPECT_EQ(r["errors"], Json::array());
+  EXPECT_EQ(r["refusals"], Json::array());
+  std::string previous = (dir / "ref-start.png").string();
+  commandOutput("'" + pointrastBinary() + "' render '" + autzen() + "' " + kAutzenCamera +
+                " --width 640 --height 480 -q -o '" + previous + "'");
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const std::string options = steps[i]["expect"];
+    EXPECT_EQ(r["shown"][i], options);
+    std::string ref = (dir / ("ref-" + std::to_string(i) + ".png")).string();
+    commandOutput("'" + pointrastBinary() + "' render '" + autzen() + "' " + kAutzenCamera + " " + options +
+                  " --width 640 --height 480 -q -o '" + ref + "'");
+    std::string shown = (dir / ("step-" + std::to_string(i) + ".png")).string();
+    ImageDifference own = comparePngs(shown, ref), before = comparePngs(shown, previous);
+    ASSERT_TRUE(own.sameSize) << options;
+    EXPECT_GE(own.psnr, kJpegPsnr) << options << ": mean abs " << own.meanAbs;
+    EXPECT_LE(own.meanAbs, kJpegMeanAbs) << options;
+    EXPECT_GT(before.meanAbs, own.meanAbs + 1.0) << options << ": the image did not change as render's does";
+    std::printf("%s: PSNR %.2f dB to render, mean abs %.3f (%.3f to the image before)\n", options.c_str(),
+                own.psnr, own.meanAbs, before.meanAbs);
+    previous = ref;
+  }
+  expectCleanExit(server);
+}
+
 // 127.0.0.2 is a loopback address that counts as non-local for the token rule.
 TEST_F(Browser, AWrongOrMissingTokenIsRefusedInTheBrowser) {
   POINTRAST_REQUIRE_DATA("las/autzen_trim.las");

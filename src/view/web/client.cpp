@@ -304,6 +304,7 @@ std::string WebClient::stateJson(const FrameHeader* frame) const {
             {"viewport", {s.viewport().width, s.viewport().height}},
             {"camera", {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", c.fovY}}},
             {"pivot", vec(s.pivot())},
+            {"bounds", {{"min", vec(s.navigation().bounds().min)}, {"max", vec(s.navigation().bounds().max)}}},
             {"settings", settingsJson(s.settings())},
             {"options",
              {{"panel", s.options().panel},

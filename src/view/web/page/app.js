@@ -27,7 +27,7 @@ const $ = (id) => document.getElementById(id);
 // What tests and scripts read: the server's last info and state, and the frames drawn.
 const pointrast = window.pointrast = {
   info: null, state: null, frames: 0, fullFrames: 0, lastFrame: null, lastPick: null, cameraText: null,
-  errors: [], closed: null, sentSeq: 0,
+  errors: [], refusals: [], closed: null, sentSeq: 0,
 };
 
 let socket = null;
@@ -133,7 +133,8 @@ function receiveText(message) {
     case 'info': pointrast.info = message; buildPanel(message); break;
     case 'state': pointrast.state = message; showState(message); break;
     case 'pick': pointrast.lastPick = message; break;
-    case 'camera': pointrast.cameraText = message.text; $('cameraText').textContent = 'render ' + message.text; break;
+    case 'camera': pointrast.cameraText = message.text; $('cameraText').textContent = 'pointrast render FILE ' + message.text; break;
+    case 'refused': pointrast.refusals.push(message.text); status(message.text, true); break;
     case 'path': download(new Blob([JSON.stringify(message.path, null, 1)], { type: 'application/json' }), 'path.json'); break;
     case 'error': pointrast.errors.push(message.message); status(message.message, true); break;
   }
@@ -198,9 +199,27 @@ function showState(s) {
     `frame (host) ${fmt(st.hostMs, 2).padStart(7)} ms, ${st.frames} frames`,
     `points drawn ${human(st.points)}, ${human(st.pointsPerSecond)} points/s`,
   ];
-  if (st.batch) lines.push(`batches ${human(st.batch.batchesRendered)} of ${human(st.batch.batchesProcessed)} rendered, ${human(st.batch.pointsRendered)} points passed early-z`);
+  if (st.post) lines.push(`  resolve stage: splat ${fmt(st.post.splatMs, 3)}, dilate ${fmt(st.post.dilateMs, 3)}, compose ${fmt(st.post.composeMs, 3)} ms`);
+  if (st.batch && !st.lod) lines.push(`batches ${human(st.batch.batchesRendered)} of ${human(st.batch.batchesProcessed)} rendered, ${human(st.batch.pointsRendered)} points passed early-z`);
+  const lod = st.lod;
+  if (lod) {
+    lines.push(`nodes drawn ${human(lod.nodesDrawn)} of ${human(lod.nodesSelected)} selected (${human(lod.pointsDrawn)} points)${lod.budgetReached ? ', budget reached' : ''}`);
+    lines.push(`nodes loaded ${human(lod.nodesLoaded)}, evicted ${human(lod.nodesEvicted)}, ${lod.passes} passes`);
+    lines.push(`streamed ${fmt(lod.bytesPerSecond / 1e6, 1)} MB/s, ${fmt(lod.bytesStreamed / 1048576, 1)} MiB in all`);
+    lines.push(`node cache ${fmt(lod.residentBytes / 1048576, 1)} of ${fmt(lod.cacheBytes / 1048576, 1)} MiB`);
+  }
   lines.push(`GPU memory ${fmt(st.gpuBytes / 1048576, 1)} MiB (scene + targets)`);
   $('stats').textContent = lines.join('\n');
+  const lodStatus = $('lodStatus');
+  lodStatus.textContent = '';
+  if (lod) {
+    const state = document.createElement('span');
+    state.className = lod.converged ? 'converged' : 'refining';
+    state.textContent = lod.converged ? 'converged' : 'refining';
+    lodStatus.appendChild(state);
+  }
+  if (st.status) lodStatus.appendChild(document.createTextNode((lod ? '  ' : '') + st.status));
+  showSettings(s.settings);
   $('camera').textContent = `eye    ${vec(s.camera.eye)}\ntarget ${vec(s.camera.target)}\npivot  ${vec(s.pivot)}`;
   $('keyframes').textContent = `${s.keyframes.count} keyframes, ${fmt(s.keyframes.duration, 1)} s`;
   if (document.activeElement !== $('keyframeSeconds')) $('keyframeSeconds').value = s.options.keyframeSeconds;
@@ -210,7 +229,79 @@ function showState(s) {
   if (document.activeElement !== $('motionQuality')) $('motionQuality').value = s.stream.motionQuality;
 }
 
+// The controls show the server's settings, except the one being edited.
+function show(id, value, property = 'value') {
+  const element = $(id);
+  if (document.activeElement !== element) element[property] = value;
+}
+
+function showSettings(v) {
+  for (const r of document.querySelectorAll('input[name=depth]')) { r.checked = r.value === v.depth; r.disabled = !v.takesInt40; }
+  show('color', v.color);
+  const ramp = v.color === 'intensity' || v.color === 'elevation';
+  $('colorRangeRow').hidden = !ramp;
+  show('colorRange', v.colorRange !== null, 'checked');
+  $('colorLo').disabled = $('colorHi').disabled = v.colorRange === null;
+  if (v.colorRange !== null) { show('colorLo', v.colorRange[0]); show('colorHi', v.colorRange[1]); }
+  $('post').disabled = !v.takesPost;
+  $('postNote').textContent = v.takesPost ? '' : `${v.method} keeps no depth per pixel: no point size, dilation or EDL`;
+  show('pointSize', v.pointSize);
+  $('pointSizeText').textContent = `${v.pointSize} px`;
+  for (const r of document.querySelectorAll('input[name=pointShape]')) r.checked = r.value === v.pointShape;
+  show('attenuated', v.pointSizeMode === 'attenuated', 'checked');
+  $('pointSizeMaxRow').hidden = v.pointSizeMode !== 'attenuated';
+  show('pointSizeMax', v.pointSizeMax);
+  show('dilate', v.dilate);
+  $('dilateText').textContent = v.dilate ? `${v.dilate} px` : 'off';
+  show('edl', v.edlStrength > 0, 'checked');
+  $('edlRow').hidden = !(v.edlStrength > 0);
+  if (v.edlStrength > 0) show('edlStrength', v.edlStrength);
+  show('edlRadius', v.edlRadius);
+  $('lod').disabled = !v.octree;
+  show('minNodePx', v.minNodePx);
+  show('pointBudget', v.pointBudget);
+  show('gpuMemory', Math.round(v.gpuMemory / 1048576));
+}
+
 // --- panel controls -------------------------------------------------------------------------------------
+
+// A number typed into a field, sent when it is within [lo, hi]; anything else puts the server's value back.
+function numberControl(id, lo, hi, message) {
+  $(id).addEventListener('change', (e) => {
+    const v = Number(e.target.value);
+    if (e.target.value !== '' && v >= lo && v <= hi) send({ t: 'settings', ...message(v) });
+    else if (pointrast.state) showSettings(pointrast.state.settings);
+  });
+}
+
+for (const r of document.querySelectorAll('input[name=depth]'))
+  r.addEventListener('change', () => send({ t: 'settings', depth: r.value }));
+$('color').addEventListener('change', (e) => send({ t: 'settings', color: e.target.value }));
+$('colorRange').addEventListener('change', (e) => {
+  if (!e.target.checked) return send({ t: 'settings', colorRange: null });
+  // Start from the ramp's usual ends: the cloud's heights, or the 16-bit intensity scale.
+  const b = pointrast.state && pointrast.state.bounds;
+  const range = $('color').value === 'elevation' && b ? [b.min[2], b.max[2]] : [0, 65535];
+  send({ t: 'settings', colorRange: range });
+});
+for (const id of ['colorLo', 'colorHi'])
+  $(id).addEventListener('change', () => {
+    const lo = Number($('colorLo').value), hi = Number($('colorHi').value);
+    if (Number.isFinite(lo) && Number.isFinite(hi) && lo < hi) send({ t: 'settings', colorRange: [lo, hi] });
+    else if (pointrast.state) showSettings(pointrast.state.settings);
+  });
+numberControl('pointSize', 1, 32, (v) => ({ pointSize: v }));
+for (const r of document.querySelectorAll('input[name=pointShape]'))
+  r.addEventListener('change', () => send({ t: 'settings', pointShape: r.value }));
+$('attenuated').addEventListener('change', (e) => send({ t: 'settings', pointSizeMode: e.target.checked ? 'attenuated' : 'fixed' }));
+numberControl('pointSizeMax', 1, 32, (v) => ({ pointSizeMax: v }));
+numberControl('dilate', 0, 8, (v) => ({ dilate: Math.round(v) }));
+$('edl').addEventListener('change', (e) => send({ t: 'settings', edlStrength: e.target.checked ? 1 : 0 }));
+numberControl('edlStrength', 0.05, 10, (v) => ({ edlStrength: v }));
+numberControl('edlRadius', 0.5, 16, (v) => ({ edlRadius: v }));
+numberControl('minNodePx', 0, 10000, (v) => ({ minNodePx: v }));
+numberControl('pointBudget', 0, 2 ** 40, (v) => ({ pointBudget: Math.round(v) }));
+numberControl('gpuMemory', 0, 2 ** 24, (v) => ({ gpuMemory: Math.round(v) * 1048576 }));
 
 $('method').addEventListener('change', (e) => send({ t: 'settings', method: e.target.value }));
 for (const r of document.querySelectorAll('input[name=background]'))
