@@ -27,19 +27,25 @@ void checkVector(const py::array& a, const char* what, uint64_t n, bool (*dtypeO
                           std::to_string(n) + " points");
 }
 
-bool isUint8(const py::dtype& d) { return d.is(py::dtype::of<uint8_t>()); }
-bool isUint16(const py::dtype& d) { return d.is(py::dtype::of<uint16_t>()); }
-bool isUint8or16(const py::dtype& d) { return isUint8(d) || isUint16(d); }
-bool isInt32(const py::dtype& d) { return d.is(py::dtype::of<int32_t>()); }
+bool isUint8(const py::dtype& d) {
+  return d.is(py::dtype::of<uint8_t>());
+}
+bool isUint16(const py::dtype& d) {
+  return d.is(py::dtype::of<uint16_t>());
+}
+bool isUint8or16(const py::dtype& d) {
+  return isUint8(d) || isUint16(d);
+}
+bool isInt32(const py::dtype& d) {
+  return d.is(py::dtype::of<int32_t>());
+}
 
 // Element i of a one-dimensional array of T, whatever its stride.
-template <typename T>
-T at(const py::array& a, uint64_t i) {
+template <typename T> T at(const py::array& a, uint64_t i) {
   return *reinterpret_cast<const T*>(static_cast<const char*>(a.data()) + py::ssize_t(i) * a.strides(0));
 }
 
-template <typename T>
-std::vector<T> copyVector(const py::array& a) {
+template <typename T> std::vector<T> copyVector(const py::array& a) {
   std::vector<T> v(a.shape(0));
   for (uint64_t i = 0; i < v.size(); ++i)
     v[i] = at<T>(a, i);
@@ -59,8 +65,7 @@ void quantizeRows(PointCloud& cloud, const Src* src, uint64_t n, const io::detai
   if (n > 0) cloud.bounds = io::detail::boundsFromQuantized(qmin, qmax, cloud.scale, cloud.offset);
 }
 
-template <typename Src>
-std::shared_ptr<PointCloud> quantizeXyz(const Src* src, uint64_t n) {
+template <typename Src> std::shared_ptr<PointCloud> quantizeXyz(const Src* src, uint64_t n) {
   Bounds raw;
   for (uint64_t i = 0; i < n; ++i) {
     const glm::dvec3 p(src[3 * i], src[3 * i + 1], src[3 * i + 2]);
@@ -144,7 +149,8 @@ void setColors(PointCloud& cloud, const py::object& red, const py::object& green
   for (uint64_t i = 0; i < n; ++i) {
     uint32_t v[3];
     for (int c = 0; c < 3; ++c) {
-      const uint32_t raw = isUint8(channels[c].dtype()) ? at<uint8_t>(channels[c], i) : at<uint16_t>(channels[c], i);
+      const uint32_t raw =
+          isUint8(channels[c].dtype()) ? at<uint8_t>(channels[c], i) : at<uint16_t>(channels[c], i);
       v[c] = wide ? raw >> 8 : raw;
     }
     cloud.colors[i] = packRgba(v[0], v[1], v[2]);

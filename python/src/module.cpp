@@ -77,7 +77,8 @@ Options parseOptions(const py::dict& d) {
   o.depth = get("depth").cast<std::string>();
   o.precision = py::str(get("precision")).cast<std::string>();
   const auto bg = get("background").cast<std::vector<int>>();
-  if (bg.size() != 3 || *std::min_element(bg.begin(), bg.end()) < 0 || *std::max_element(bg.begin(), bg.end()) > 255)
+  if (bg.size() != 3 || *std::min_element(bg.begin(), bg.end()) < 0 ||
+      *std::max_element(bg.begin(), bg.end()) > 255)
     throw InputError("background must be three values 0..255 (r, g, b)");
   o.background = packRgba(bg[0], bg[1], bg[2]);
   o.color = get("color").cast<std::string>();
@@ -178,7 +179,8 @@ public:
     const Options o = parseOptions(optionsDict);
     std::lock_guard lock(mutex_);
     if (py::isinstance<Octree>(input)) {
-      if (wantDepth || wantIndex) throw InputError("return_depth and return_index apply to clouds, not octrees");
+      if (wantDepth || wantIndex)
+        throw InputError("return_depth and return_index apply to clouds, not octrees");
       return renderOctree(input.cast<const Octree&>(), camera, o);
     }
     return renderCloud(input.cast<const Cloud&>(), camera, o, wantDepth, wantIndex);
@@ -207,8 +209,8 @@ private:
 
   void checkValidation() const {
     if (context_->validationErrors() > 0)
-      throw InternalError("the Vulkan validation layer reported " + std::to_string(context_->validationErrors()) +
-                          " error(s)");
+      throw InternalError("the Vulkan validation layer reported " +
+                          std::to_string(context_->validationErrors()) + " error(s)");
   }
 
   py::array imageArray(const std::vector<uint32_t>& pixels, const Options& o) {
@@ -217,8 +219,8 @@ private:
     return image;
   }
 
-  py::dict result(const std::vector<uint32_t>& pixels, const Options& o, const Camera& c, const FrameStats& st,
-                  const std::string& method) {
+  py::dict result(const std::vector<uint32_t>& pixels, const Options& o, const Camera& c,
+                  const FrameStats& st, const std::string& method) {
     py::dict r;
     r["image"] = imageArray(pixels, o);
     r["camera"] = cameraDict(c);
@@ -238,13 +240,16 @@ private:
       throw InputError(method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
                        "): open one with pointrast.open()");
     if (o.lodOptionsGiven || o.foveation.enabled)
-      throw InputError("min_node_px, point_budget, gpu_memory and foveated apply to the LOD methods (octrees)");
+      throw InputError(
+          "min_node_px, point_budget, gpu_memory and foveated apply to the LOD methods (octrees)");
     if (s.post.enabled() && s.method.info().output == MethodOutput::ColorOnly)
       throw InputError("point_size, dilate and edl need a compute method; " + method +
                        " keeps no depth per pixel to work on");
     std::optional<DisplayColorMode> colors;
-    if (o.color != "auto") colors = displayColorMode(cloud, parseColorSource(o.color), o.colorRange);
-    else if (o.colorRange) throw InputError("color_range applies to color='intensity' and 'elevation'");
+    if (o.color != "auto")
+      colors = displayColorMode(cloud, parseColorSource(o.color), o.colorRange);
+    else if (o.colorRange)
+      throw InputError("color_range applies to color='intensity' and 'elevation'");
     const Camera c = resolveCamera(camera, cloud.bounds, cloud.source, o);
 
     std::vector<uint32_t> pixels;
@@ -318,8 +323,8 @@ private:
     return r.framebufferWords();
   }
 
-  static void addDepthIndex(py::dict& out, const std::vector<uint64_t>& words, const Options& o, bool wantDepth,
-                            bool wantIndex) {
+  static void addDepthIndex(py::dict& out, const std::vector<uint64_t>& words, const Options& o,
+                            bool wantDepth, bool wantIndex) {
     const std::vector<py::ssize_t> shape = {py::ssize_t(o.height), py::ssize_t(o.width)};
     py::array_t<float> depth(shape);
     py::array_t<int64_t> index(shape);
@@ -345,17 +350,21 @@ private:
     const std::string method = o.method == "auto" ? "lod" : o.method;
     RenderSettings s = settings(o, method);
     if (s.method.info().layout != SceneLayout::Octree)
-      throw InputError(method + " draws a loaded cloud; octrees are drawn by the LOD methods (lod, lod-hqs), or "
-                                "read whole with pointrast.open(path, lod=False)");
+      throw InputError(method +
+                       " draws a loaded cloud; octrees are drawn by the LOD methods (lod, lod-hqs), or "
+                       "read whole with pointrast.open(path, lod=False)");
     if (o.depth != "float")
-      throw InputError("depth does not apply to " + method + ", which draws an octree's nodes in their stored order");
+      throw InputError("depth does not apply to " + method +
+                       ", which draws an octree's nodes in their stored order");
     s.minNodePx = o.minNodePx;
     s.pointBudget = o.pointBudget;
     s.foveation = o.foveation;
     lod::LodOptions options;
     options.gpuBytes = o.gpuMemory;
-    if (o.color != "auto") options.colorSource = parseColorSource(o.color);
-    else if (o.colorRange) throw InputError("color_range applies to color='intensity' and 'elevation'");
+    if (o.color != "auto")
+      options.colorSource = parseColorSource(o.color);
+    else if (o.colorRange)
+      throw InputError("color_range applies to color='intensity' and 'elevation'");
     options.colorRange = o.colorRange;
     const Camera c = resolveCamera(camera, meta.bounds.empty() ? meta.cube : meta.bounds, meta.source, o);
     std::vector<uint32_t> pixels;
@@ -426,8 +435,8 @@ Octree openOctree(const std::string& path) {
 py::dict probe(const std::string& path) {
   const io::FormatInfo* format = io::detectFormat(path);
   if (!format)
-    throw InputError(path + ": not a format pointrast reads (" + io::formatList(io::FormatUse::Cloud) + "; octrees: " +
-                     io::formatList(io::FormatUse::Octree) + ")");
+    throw InputError(path + ": not a format pointrast reads (" + io::formatList(io::FormatUse::Cloud) +
+                     "; octrees: " + io::formatList(io::FormatUse::Octree) + ")");
   py::dict d;
   d["format"] = format->name;
   d["cloud"] = format->read != nullptr;
@@ -461,19 +470,23 @@ PYBIND11_MODULE(_core, m) {
       .def("__len__", [](const Cloud& c) { return c.cloud->size(); })
       .def_property_readonly("source", [](const Cloud& c) { return c.cloud->source; })
       .def_property_readonly("bounds", [](const Cloud& c) { return boundsTuple(c.cloud->bounds); })
-      .def_property_readonly("scales", [](const Cloud& c) {
-        return py::make_tuple(c.cloud->scale.x, c.cloud->scale.y, c.cloud->scale.z);
-      })
-      .def_property_readonly("offsets", [](const Cloud& c) {
-        return py::make_tuple(c.cloud->offset.x, c.cloud->offset.y, c.cloud->offset.z);
-      })
-      .def("quantized", [](py::object self, int axis) { return positionView(*self.cast<const Cloud&>().cloud, axis, self); })
+      .def_property_readonly(
+          "scales",
+          [](const Cloud& c) { return py::make_tuple(c.cloud->scale.x, c.cloud->scale.y, c.cloud->scale.z); })
+      .def_property_readonly("offsets",
+                             [](const Cloud& c) {
+                               return py::make_tuple(c.cloud->offset.x, c.cloud->offset.y, c.cloud->offset.z);
+                             })
+      .def("quantized", [](py::object self,
+                           int axis) { return positionView(*self.cast<const Cloud&>().cloud, axis, self); })
       .def("world", [](const Cloud& c, int axis) { return worldCoordinates(*c.cloud, axis); })
-      .def("color", [](py::object self, int channel) { return colorView(*self.cast<const Cloud&>().cloud, channel, self); })
+      .def("color", [](py::object self,
+                       int channel) { return colorView(*self.cast<const Cloud&>().cloud, channel, self); })
       .def_property_readonly("has_color", [](const Cloud& c) { return c.cloud->hasColor(); })
-      .def("attribute", [](py::object self, const std::string& name) {
-        return attributeView(*self.cast<const Cloud&>().cloud, name, self);
-      })
+      .def("attribute",
+           [](py::object self, const std::string& name) {
+             return attributeView(*self.cast<const Cloud&>().cloud, name, self);
+           })
       .def("point", [](const Cloud& c, int64_t i) {
         if (i < 0 || uint64_t(i) >= c.cloud->size()) throw py::index_error("point index out of range");
         const glm::dvec3 p = c.cloud->world(uint64_t(i));
@@ -484,7 +497,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("source", [](const Octree& o) { return o.source->metadata().source; })
       .def_property_readonly("format", [](const Octree& o) { return o.source->metadata().format; })
       .def_property_readonly("point_count", [](const Octree& o) { return o.source->metadata().pointCount; })
-      .def_property_readonly("bounds", [](const Octree& o) { return boundsTuple(o.source->metadata().bounds); })
+      .def_property_readonly("bounds",
+                             [](const Octree& o) { return boundsTuple(o.source->metadata().bounds); })
       .def_property_readonly("cube", [](const Octree& o) { return boundsTuple(o.source->metadata().cube); })
       .def_property_readonly("spacing", [](const Octree& o) { return o.source->metadata().spacing; })
       .def_property_readonly("depth", [](const Octree& o) { return o.source->metadata().depth; });
@@ -492,8 +506,10 @@ PYBIND11_MODULE(_core, m) {
   m.def("cloud_from_xyz", [](const py::array& xyz) { return Cloud{cloudFromXyz(xyz)}; });
   m.def("cloud_from_quantized", [](const py::array& x, const py::array& y, const py::array& z,
                                    std::vector<double> scale, std::vector<double> offset) {
-    if (scale.size() != 3 || offset.size() != 3) throw py::value_error("scales and offsets need three values");
-    return Cloud{cloudFromQuantized(x, y, z, {scale[0], scale[1], scale[2]}, {offset[0], offset[1], offset[2]})};
+    if (scale.size() != 3 || offset.size() != 3)
+      throw py::value_error("scales and offsets need three values");
+    return Cloud{
+        cloudFromQuantized(x, y, z, {scale[0], scale[1], scale[2]}, {offset[0], offset[1], offset[2]})};
   });
   m.def("set_colors", [](Cloud& c, const py::object& r, const py::object& g, const py::object& b) {
     setColors(*c.cloud, r, g, b);
