@@ -251,6 +251,80 @@ TEST_F(ViewerWindow, PanelControlChangesTheImage) {
   finish(*viewer);
 }
 
+// Each panel control changes the image as `render` with its option does: after each click the window,
+// outside the panel, equals render with the options the frame reports, and differs from the image before.
+TEST_F(ViewerWindow, PanelControlsChangeTheImageAsRenderOptionsDo) {
+  constexpr uint32_t kBigWidth = 960, kBigHeight = 720; // room beside the panel
+  auto viewer = std::make_unique<Viewer>(
+      display(), "'" + autzen() + "' " + kCamera + " --width " + std::to_string(kBigWidth) + " --height " +
+                     std::to_string(kBigHeight) + " --path '" + (tempDir() / "path.json").string() + "'");
+  std::optional<nlohmann::json> frame = viewer->waitEvent("frame", 0, 120);
+  ASSERT_TRUE(frame) << viewer->errors();
+  struct Step {
+    const char* item;
+    const char* expect;
+    bool compare = true; // false: a step on the way to the next one, only waited for
+  };
+  const Step steps[] = {
+      {"Intensity", "--color intensity"},
+      {"Point size +", "--color intensity --point-size 2", false},
+      {"Point size +", "--color intensity --point-size 3"},
+      {"EDL", "--color intensity --point-size 3 --edl"},
+      {"Dilation +", "--color intensity --point-size 3 --dilate 1 --edl", false},
+      {"Dilation +", "--color intensity --point-size 3 --dilate 2 --edl"},
+      {"Classification", "--color classification --point-size 3 --dilate 2 --edl"},
+  };
+  std::vector<uint32_t> before = renderReference("'" + autzen() + "' " + kCamera, kBigWidth, kBigHeight);
+  for (const Step& step : steps) {
+    ASSERT_TRUE((*frame)["panel_items"].contains(step.item)) << step.item;
+    std::vector<float> r = (*frame)["panel_items"][step.item].get<std::vector<float>>();
+    std::vector<float> panel = (*frame)["panel_items"]["panel"].get<std::vector<float>>();
+    size_t from = viewer->eventCount();
+    int x = int(r[0] + std::min(8.0f, r[2] / 2)), y = int(r[1] + r[3] / 2);
+    viewer->xdotool("mousemove --window $W " + std::to_string(x) + " " + std::to_string(y) + " click 1");
+    frame = viewer->waitFor(
+        [&](const nlohmann::json& e) {
+          return e.value("event", "") == "frame" && e["options"] == step.expect;
+        },
+        from, 60);
+    ASSERT_TRUE(frame) << step.item << ": no frame with " << step.expect << "\n" << viewer->errors();
+    if (!step.compare) continue;
+    std::vector<uint32_t> expected =
+        renderReference("'" + autzen() + "' " + kCamera + " " + step.expect, kBigWidth, kBigHeight);
+    // Outside the panel (as it was drawn at the click, and is now: the larger of the two).
+    panel[2] = std::max(panel[2], (*frame)["panel_items"]["panel"][2].get<float>());
+    panel[3] = std::max(panel[3], (*frame)["panel_items"]["panel"][3].get<float>());
+    auto outside = [&](const std::vector<uint32_t>& image) {
+      std::vector<uint32_t> pixels;
+      for (uint32_t py = 0; py < kBigHeight; ++py)
+        for (uint32_t px = 0; px < kBigWidth; ++px)
+          if (px > panel[0] + panel[2] + 2 || py > panel[1] + panel[3] + 2)
+            pixels.push_back(image[size_t(py) * kBigWidth + px]);
+      return pixels;
+    };
+    std::vector<uint32_t> want = outside(expected);
+    ASSERT_GT(want.size(), size_t(kBigWidth) * kBigHeight / 4) << "the panel covers most of the window";
+    auto deadline = Clock::now() + std::chrono::seconds(20);
+    double same = 0;
+    do {
+      Capture shown = captureWindow(display(), viewer->window());
+      if (shown.rgba.size() == expected.size()) same = equalFraction(outside(shown.rgba), want);
+      if (same >= 0.999) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    } while (Clock::now() < deadline);
+    EXPECT_GE(same, 0.999) << step.expect;
+    EXPECT_LT(equalFraction(outside(before), want), 0.98) << step.expect << " changed nothing";
+    before = expected;
+  }
+  // C prints the camera and these settings as render options.
+  size_t from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 900 700 key c");
+  auto camera = viewer->waitEvent("camera", from, 30);
+  ASSERT_TRUE(camera);
+  EXPECT_EQ((*camera)["options"], steps[std::size(steps) - 1].expect);
+  finish(*viewer);
+}
+
 TEST_F(ViewerWindow, ResizingKeepsRenderingTheSameCamera) {
   POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
