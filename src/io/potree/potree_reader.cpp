@@ -156,9 +156,8 @@ PotreeSource::Node PotreeSource::checkedNode(const lod::NodeKey& key, const potr
                        static_cast<unsigned long long>(fileSize)));
   node.offset = uint64_t(record.byteOffset);
   node.size = uint64_t(record.byteSize);
-  // PotreeConverter leaves some emptied inner nodes with their old count and no bytes; the viewer reads
-  // them as empty, so do we (for pointrast's own files it is damage).
-  if (node.size == 0 && node.count > 0 && !meta_.fromPointrast()) node.count = 0;
+  // A record that claims points delivers them or is damage, whoever wrote it: reading one without bytes
+  // as empty (as Potree's viewer does) would drop its points from a conversion without a word.
   const uint64_t count = node.count;
   if (meta_.encoding == PotreeEncoding::Default) {
     if (count * meta_.layout.defaultStride != node.size)
