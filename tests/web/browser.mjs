@@ -163,6 +163,13 @@ const scenarios = {
   async pageshot(context) {
     const { page, errors } = await open(context, url);
     await waitFull(page);
+    // An octree: once the frame drew the whole selection.
+    if (args.converged)
+      await page.waitForFunction(() => {
+        const p = window.pointrast;
+        return p.state && p.state.stats.lod && p.state.stats.lod.converged && p.lastFrame &&
+               p.lastFrame.full && p.state.frame === p.lastFrame.frame;
+      }, null, { timeout: TIMEOUT, polling: 100 });
     await page.waitForTimeout(300);
     await page.screenshot({ path: join(outdir, args.file || 'page.png') });
     return { errors };

@@ -255,8 +255,8 @@ function showSettings(v) {
   $('dilateText').textContent = v.dilate ? `${v.dilate} px` : 'off';
   show('edl', v.edlStrength > 0, 'checked');
   $('edlRow').hidden = !(v.edlStrength > 0);
-  if (v.edlStrength > 0) show('edlStrength', v.edlStrength);
-  show('edlRadius', v.edlRadius);
+  if (v.edlStrength > 0) show('edlStrength', Number(v.edlStrength.toFixed(2)));
+  show('edlRadius', Number(v.edlRadius.toFixed(2)));
   $('lod').disabled = !v.octree;
   show('minNodePx', v.minNodePx);
   show('pointBudget', v.pointBudget);
