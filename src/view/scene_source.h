@@ -67,7 +67,7 @@ public:
   // One interactive frame with the settings' method (one the source draws) into `renderer`. The view
   // settings carry what the source itself applies (colors; the node cache's budget). A setting it cannot
   // apply, or a damaged node met while streaming, leaves the frame as it can be drawn and says why in
-  // `status`; nothing here throws for bad data.
+  // `status`; nothing here throws for bad data. A frame not drawn at all returns FrameStats::frames 0.
   virtual FrameStats draw(Renderer& renderer, const Camera& camera, const RenderSettings& rs,
                           const ViewSettings& settings, std::string& status) = 0;
   // Whether a frame drawn now would differ from the last one without any input: nodes still arriving.

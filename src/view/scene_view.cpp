@@ -175,7 +175,8 @@ std::optional<SceneView::Picked> SceneView::pickPoint(const Camera& camera, cons
   ensureRenderer(viewport);
   RenderSettings rs = pickSettings(settings);
   std::string status;
-  source_.draw(*renderer_, camera, rs, settings, status);
+  // A frame the source could not draw (a damaged node) has no words to read: nothing is picked.
+  if (source_.draw(*renderer_, camera, rs, settings, status).frames == 0) return std::nullopt;
   int px = int(position.x), py = int(position.y), r = int(kPickRadius);
   int x0 = std::max(0, px - r), y0 = std::max(0, py - r);
   int x1 = std::min(int(viewport.width) - 1, px + r), y1 = std::min(int(viewport.height) - 1, py + r);
