@@ -80,7 +80,7 @@ TEST_F(SceneViewTest, FramesAndScreenshots) {
   EXPECT_EQ(one[size_t(center.y) * 64 + size_t(center.x)], 0xFF0000FFu) << "the near point hides the far one";
   // Supersampled: the 2x render box-filtered down.
   Renderer big(*context, 128, 96);
-  big.render(view.scene(SceneLayout::Float), camera(), renderSettings(settings));
+  big.render(gpuCloud.scene(SceneLayout::Float), camera(), renderSettings(settings));
   std::vector<uint32_t> bigPixels = big.image();
   EXPECT_EQ(view.screenshot(camera(), settings, viewport, 2), boxDownsample(bigPixels, 128, 96, 2));
   // A resize makes a renderer of the new size.
