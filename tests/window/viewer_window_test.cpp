@@ -14,6 +14,7 @@
 
 #include "cloud/cloud.h"
 #include "io/reader.h"
+#include "io/writer.h"
 #include "viewer_harness.h"
 
 namespace pointrast::test {
@@ -322,6 +323,45 @@ TEST_F(ViewerWindow, PanelControlsChangeTheImageAsRenderOptionsDo) {
   auto camera = viewer->waitEvent("camera", from, 30);
   ASSERT_TRUE(camera);
   EXPECT_EQ((*camera)["options"], steps[std::size(steps) - 1].expect);
+  finish(*viewer);
+}
+
+// An octree with eye-dome lighting: the panel shows and the LOD method converges to an image of the cloud.
+// The window is kept as a PNG (in $POINTRAST_DOCS_DIR as viewer-lod.png when set: the picture in docs/).
+TEST_F(ViewerWindow, AnOctreeWithEdlConvergesWithThePanelShown) {
+  const std::string octree = (dataDir() / "potree" / "autzen_trim_default").string();
+  constexpr uint32_t kShotWidth = 1100, kShotHeight = 760;
+  auto viewer = std::make_unique<Viewer>(display(), "'" + octree + "' " + kCamera + " --edl --width " +
+                                                        std::to_string(kShotWidth) + " --height " +
+                                                        std::to_string(kShotHeight));
+  auto converged = viewer->waitFor(
+      [](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && e.contains("lod") && e["lod"].value("converged", false);
+      },
+      0, 120);
+  ASSERT_TRUE(converged) << viewer->errors();
+  EXPECT_EQ((*converged)["options"], "--method lod --edl");
+  ASSERT_TRUE((*converged)["panel_items"].contains("EDL"));
+  std::vector<float> panel = (*converged)["panel_items"]["panel"].get<std::vector<float>>();
+  // The X server shows the presented image a moment later: wait until points appear beside the panel.
+  Capture shown;
+  size_t lit = 0;
+  auto deadline = Clock::now() + std::chrono::seconds(20);
+  do {
+    shown = captureWindow(display(), viewer->window());
+    lit = 0;
+    for (uint32_t y = 0; y < shown.height; ++y)
+      for (uint32_t x = uint32_t(panel[0] + panel[2]) + 2; x < shown.width; ++x)
+        lit += shown.rgba[size_t(y) * shown.width + x] != 0xFF000000u;
+    if (lit > size_t(kShotWidth) * kShotHeight / 40) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  } while (Clock::now() < deadline);
+  ASSERT_EQ(shown.width, kShotWidth);
+  EXPECT_GT(lit, size_t(kShotWidth) * kShotHeight / 40) << "no cloud beside the panel";
+  std::filesystem::path out = tempDir() / "viewer-lod.png";
+  if (const char* docs = std::getenv("POINTRAST_DOCS_DIR"))
+    out = std::filesystem::path(docs) / "viewer-lod.png";
+  io::writePng(out, shown.width, shown.height, shown.rgba.data());
   finish(*viewer);
 }
 
