@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -101,6 +102,7 @@ TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
   POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   const fs::path dir = fresh("lod_errors");
   fs::create_directories(dir / "exists");
+  std::ofstream(dir / "exists" / "file") << "a file, not a folder";
   const std::string out = " -o " + (dir / "o").string();
   const std::string cases[] = {
       "lod " + (dir / "missing.las").string() + out,
@@ -109,9 +111,15 @@ TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
       "lod " + kAutzen.string() + out + " --encoding zip",
       "lod " + kAutzen.string() + out + " --color-filter median",
       "lod " + kAutzen.string() + out + " --leaf-points 0",
+      "lod " + kAutzen.string() + out + " --spacing -1",
+      "lod " + kAutzen.string() + out + " --spacing nan",
+      "lod " + kAutzen.string() + out + " --spacing inf",
       "lod " + (pointrast::test::dataDir() / "las" / "no-points.las").string() + out,
       "lod " + (pointrast::test::dataDir() / "mmpld" / "test_xyz_float_none.mmpld").string() + out,
       "lod " + kAutzen.string(),
+      "lod " + kAutzen.string() + " -o ''",
+      "lod " + kAutzen.string() + " -o " + (dir / "exists").string() + "/",
+      "lod " + kAutzen.string() + " -o " + (dir / "exists" / "file" / "sub").string(),
   };
   for (const std::string& args : cases) {
     const auto r = runPointrast(args);
@@ -120,6 +128,31 @@ TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
     EXPECT_TRUE(onlyEntry(dir, "exists")) << args;
   }
+  // Each names what is wrong with the output's name.
+  const auto file =
+      runPointrast("lod " + kAutzen.string() + " -o " + (dir / "exists" / "file" / "sub").string());
+  EXPECT_NE(file.err.find("is not a folder"), std::string::npos) << file.err;
+  const auto slash = runPointrast("lod " + kAutzen.string() + " -o " + (dir / "exists").string() + "/");
+  EXPECT_NE(slash.err.find("exists: already exists"), std::string::npos) << slash.err;
+}
+
+// What a build killed outright (SIGKILL, a second Ctrl-C, a file-size limit) left, the next build of the
+// same folder removes: a folder named for a pid no process has.
+TEST(LodBuildCli, TheNextBuildRemovesWhatAKilledOneLeft) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const fs::path dir = fresh("lod_stale");
+  fs::create_directories(dir);
+  const pid_t dead = fork();
+  ASSERT_GE(dead, 0);
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);
+  const fs::path stale = dir / ("o.partial-" + std::to_string(dead));
+  fs::create_directories(stale / "chunks");
+  std::ofstream(stale / "octree.bin") << "half an octree";
+  const auto r = runPointrast("lod " + kAutzen.string() + " -o " + (dir / "o").string() + " -q");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(onlyEntry(dir, "o"));
 }
 
 TEST(LodBuildCli, InterruptLeavesNothingBehind) {
