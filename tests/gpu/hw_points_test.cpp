@@ -3,7 +3,7 @@
 //   0.1 % apart at 1e5 near-plane distances, where a standard 1 - near/w depth would tie), points behind
 //   the eye, before the near plane or outside the image are dropped, the background is exact;
 // - on a random cloud, generated terrain and autzen_trim.las, in four orders and two views, hw-points and
-//   atomicmin agree on >= 99 % of pixels (DESIGN.md, "Equivalence": they differ only by rounding at pixel
+//   atomicmin agree on >= 99 % of pixels (docs/design.md, "Equivalence": they differ only by rounding at pixel
 //   borders, where the hardware snaps to subpixels, and by which of two equally deep points wins).
 #include <cmath>
 #include <cstdio>
