@@ -57,6 +57,6 @@ TEST(FormatTable, ListsComeFromTheRows) {
 }
 
 TEST(FormatTable, AnInputThatIsNoOctreeIsRefusedAsLodSource) {
-  POINTRAST_REQUIRE_DATA("las/simple.las");
-  EXPECT_THROW(openNodeSource(iotest::data("las/simple.las")), InputError);
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  EXPECT_THROW(openNodeSource(iotest::data("las/autzen_trim.las")), InputError);
 }
