@@ -37,6 +37,16 @@ namespace pointrast::app {
 
 namespace {
 
+// Said on stderr when the timed frames still spread like clocks that were rising (timeSettled).
+void warnUnsettled(bool settled, double medianMs, double minMs) {
+  if (settled) return;
+  std::fprintf(stderr,
+               "render: GPU clocks did not settle: median %.3f ms, fastest frame %.3f ms; the median is not the "
+               "device's speed (time it with `pointrast bench`, which settles them)\n",
+               medianMs, minMs);
+}
+
+
 struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
@@ -380,7 +390,10 @@ int runRenderSpheres(const RenderArgs& a) {
   GpuParticles particles(context, set, upload);
   settleClocksWith(context, settings,
                    [&](const SphereSettings& s) { return renderer.render(particles, camera, s); });
-  const SphereStats stats = renderer.render(particles, camera, settings);
+  bool settled = true;
+  const SphereStats stats = timeSettled(
+      context, settings, [&](const SphereSettings& s) { return renderer.render(particles, camera, s); }, settled);
+  warnUnsettled(settled, stats.medianMs, stats.minMs);
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(
       a, context, pixels,
@@ -647,11 +660,18 @@ int runRender(const RenderArgs& a) {
     return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
   }
   settleClocksWith(context, settings, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); });
-  const FrameStats stats = renderer.render(drawn, camera, settings);
+  bool settled = true;
+  const FrameStats stats = timeSettled(
+      context, settings, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); }, settled);
+  warnUnsettled(settled, stats.medianMs, stats.minMs);
   const std::vector<uint32_t> pixels = renderer.image();
   finishImage(
       a, context, pixels,
-      [&] { return pointJson(context, settings, cloud, spec.order, colors, stats, camera, a, pixels); },
+      [&] {
+        nlohmann::json j = pointJson(context, settings, cloud, spec.order, colors, stats, camera, a, pixels);
+        j["clocks_settled"] = settled;
+        return j;
+      },
       [&] { printPointSummary(a, settings, stats); });
   return 0;
 }

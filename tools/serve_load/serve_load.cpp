@@ -325,7 +325,9 @@ Json Load::flightPhase() {
       send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
       down = false;
     }
-    next += 1.0 / args_.rate;
+    // A pump that returned late does not make the next moves come in a burst: a page sends at most one
+    // move per animation frame, and the server cuts off a client that sends faster than a page does.
+    next = std::max(next + 1.0 / args_.rate, clockSeconds());
     pump(next);
   }
   if (down) send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
