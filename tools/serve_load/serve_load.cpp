@@ -326,8 +326,8 @@ Json Load::flightPhase() {
       down = false;
     }
     // A pump that returned late does not make the next moves come in a burst: a page sends at most one
-    // move per animation frame, and the server cuts off a client that sends faster than a page does.
-    next = std::max(next + 1.0 / args_.rate, clockSeconds());
+    // move per animation frame (60 a second here, besides an acknowledgement per frame), and the server cuts off a client that sends faster than a page does.
+    next = std::max(next + 1.0 / std::min(args_.rate, 60.0), clockSeconds());
     pump(next);
   }
   if (down) send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
