@@ -7,6 +7,11 @@
 //   - Clip volumes: a point is "inside" when it lies in at least one volume (the union). Boundaries count
 //     as inside (min <= p <= max). ClipMode::Inside keeps the inside points, Outside the others, Highlight
 //     keeps every point and marks the inside ones. No volume: every point passes the clip.
+//   - Oriented box: |dot(p - center, axes[i])| <= halfExtent[i] for i = 0, 1, 2.
+//   - Polygon: zMin <= z <= zMax and the even-odd crossing rule in x/y, evaluated exactly as
+//         inside = false; for each edge (a = v[j], b = v[i]), j = i - 1 (j = n - 1 for i = 0):
+//           if ((b.y > y) != (a.y > y) && x < (a.x - b.x) * (y - b.y) / (a.y - b.y) + b.x) inside = !inside
+//     (a point exactly on an edge may fall either way; a node's or batch's verdict never depends on it).
 //   - Attribute filters combine with AND; each one that is unset passes every point.
 //   - Returns: First is return number 1; Last is return number == number of returns; Only is a single
 //     return (number of returns 1). A return number of 0 (files that do not record it) fails First, Last
