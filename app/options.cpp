@@ -1,5 +1,9 @@
 #include "options.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
 #include "base/error.h"
 #include "cli_util.h"
 
@@ -72,9 +76,10 @@ ColorChoice colorChoice(const LookArgs& a) {
 
 void addLodOptions(CLI::App& cmd, LodArgs& a) {
   auto given = [&a](const std::string&) { a.given = true; };
-  cmd.add_option("--min-node-px", a.minNodePx,
-                 "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
-                 "sphere) is smaller, with their subtrees; 0 draws every point")
+  cmd.add_option(
+         "--min-node-px", a.minNodePx,
+         "LOD methods: skip octree nodes whose projected size (the pixel radius of the node's bounding "
+         "sphere) is smaller, with their subtrees; 0 draws every point")
       ->capture_default_str()
       ->each(given);
   cmd.add_option("--point-budget", a.pointBudget,
@@ -115,6 +120,163 @@ void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings) {
   settings.minNodePx = lod.minNodePx;
   settings.pointBudget = lod.pointBudget;
   settings.gpuMemory = lod.gpuBytes;
+}
+
+namespace {
+
+// "1,2.5,-3" -> numbers; InputError naming the option unless every item is a finite number.
+std::vector<double> numberList(const std::string& text, const char* option, const char* expects) {
+  std::vector<double> values;
+  size_t at = 0;
+  for (;;) {
+    const size_t comma = text.find(',', at);
+    const std::string item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v))
+      throw InputError(std::string(option) + " expects " + expects + ", got '" + text + "'");
+    values.push_back(v);
+    if (comma == std::string::npos) return values;
+    at = comma + 1;
+  }
+}
+
+// "2,6,9" or "3-5,9": integers 0..max, each alone or as an inclusive range.
+std::vector<uint32_t> integerList(const std::string& text, const char* option, uint32_t max) {
+  const std::string expects = std::string(option) + " expects integers 0.." + std::to_string(max) +
+                              " and ranges lo-hi separated by commas (e.g. 2,6,9 or 3-5), got '" + text + "'";
+  auto number = [&](const std::string& item) {
+    if (item.empty() || item.size() > 6 || item.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError(expects);
+    const unsigned long v = std::stoul(item);
+    if (v > max) throw InputError(expects);
+    return uint32_t(v);
+  };
+  std::vector<uint32_t> values;
+  size_t at = 0;
+  for (;;) {
+    const size_t comma = text.find(',', at);
+    const std::string item = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    const size_t dash = item.find('-');
+    if (dash == std::string::npos) {
+      values.push_back(number(item));
+    } else {
+      const uint32_t lo = number(item.substr(0, dash)), hi = number(item.substr(dash + 1));
+      if (lo > hi) throw InputError(expects);
+      for (uint32_t v = lo; v <= hi; ++v)
+        values.push_back(v);
+    }
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+  return values;
+}
+
+std::pair<double, double> closedRange(const std::string& text, const char* option) {
+  const std::vector<double> v = numberList(text, option, "lo,hi (two numbers, lo <= hi)");
+  if (v.size() != 2 || !(v[0] <= v[1]))
+    throw InputError(std::string(option) + " expects lo,hi (two numbers, lo <= hi), got '" + text + "'");
+  return {v[0], v[1]};
+}
+
+} // namespace
+
+void addFilterOptions(CLI::App& cmd, FilterArgs& a) {
+  const char* group = "Filters";
+  cmd.add_option("--clip-box", a.clipBoxes,
+                 "Keep the points inside an axis-aligned box, xmin,ymin,zmin,xmax,ymax,zmax in the file's "
+                 "coordinates (boundaries inside); repeat it for several boxes (their union), e.g. "
+                 "--clip-box 100,200,0,150,260,40")
+      ->group(group);
+  cmd.add_option("--clip-polygon", a.clipPolygons,
+                 "Keep the points inside a polygon in x/y, x1,y1,x2,y2,x3,y3[,...] (at least three "
+                 "vertices, closed automatically, even-odd rule), extruded over every z unless --clip-z; "
+                 "repeatable, e.g. --clip-polygon 0,0,10,0,5,8")
+      ->group(group);
+  cmd.add_option("--clip-z", a.clipZ, "zmin,zmax: the height range of every --clip-polygon")->group(group);
+  cmd.add_option("--clip-mode", a.clipMode,
+                 "inside (keep what the clip volumes hold), outside (keep the rest) or highlight (keep every "
+                 "point; viewers mark the inside ones)")
+      ->capture_default_str()
+      ->group(group);
+  cmd.add_option("--classes", a.classes,
+                 "Keep these classification values, e.g. 2,6,9 or 1-5,9 (ASPRS: 2 ground, 6 building, 9 "
+                 "water)")
+      ->group(group);
+  cmd.add_option("--returns", a.returns,
+                 "all, first (return number 1), last (return number = number of returns) or only (single "
+                 "returns); points without a return number fail first, last and only")
+      ->capture_default_str()
+      ->group(group);
+  cmd.add_option("--intensity", a.intensity, "Keep intensities lo <= i <= hi, e.g. --intensity 100,4000")
+      ->group(group);
+  cmd.add_option("--gps-time", a.gpsTime, "Keep GPS times lo <= t <= hi, as the file stores them")
+      ->group(group);
+  cmd.add_option("--source-ids", a.sourceIds,
+                 "Keep these point source ids (flight lines), e.g. 1,4,7 or 10-12")
+      ->group(group);
+}
+
+PointFilter pointFilter(const FilterArgs& a) {
+  PointFilter f;
+  for (const std::string& text : a.clipBoxes) {
+    const char* expects = "xmin,ymin,zmin,xmax,ymax,zmax (six numbers, each min <= max)";
+    const std::vector<double> v = numberList(text, "--clip-box", expects);
+    if (v.size() != 6 || !(v[0] <= v[3] && v[1] <= v[4] && v[2] <= v[5]))
+      throw InputError(std::string("--clip-box expects ") + expects + ", got '" + text + "'");
+    f.boxes.push_back({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}});
+  }
+  for (const std::string& text : a.clipPolygons) {
+    const char* expects = "x1,y1,x2,y2,x3,y3[,...] (at least three x,y vertices)";
+    const std::vector<double> v = numberList(text, "--clip-polygon", expects);
+    if (v.size() < 6 || v.size() % 2 != 0)
+      throw InputError(std::string("--clip-polygon expects ") + expects + ", got '" + text + "'");
+    ClipPolygon poly;
+    for (size_t i = 0; i < v.size(); i += 2)
+      poly.vertices.emplace_back(v[i], v[i + 1]);
+    f.polygons.push_back(std::move(poly));
+  }
+  if (!a.clipZ.empty()) {
+    if (f.polygons.empty()) throw InputError("--clip-z applies to --clip-polygon, which was not given");
+    const auto [lo, hi] = closedRange(a.clipZ, "--clip-z");
+    for (ClipPolygon& poly : f.polygons) {
+      poly.zMin = lo;
+      poly.zMax = hi;
+    }
+  }
+  if (a.clipMode == "inside")
+    f.clipMode = ClipMode::Inside;
+  else if (a.clipMode == "outside")
+    f.clipMode = ClipMode::Outside;
+  else if (a.clipMode == "highlight")
+    f.clipMode = ClipMode::Highlight;
+  else
+    throw InputError("--clip-mode expects inside, outside or highlight, got '" + a.clipMode + "'");
+  if (!a.classes.empty()) {
+    f.classes.emplace();
+    for (uint32_t c : integerList(a.classes, "--classes", 255))
+      f.classes->set(c);
+  }
+  if (a.returns == "all")
+    f.returns = ReturnFilter::All;
+  else if (a.returns == "first")
+    f.returns = ReturnFilter::First;
+  else if (a.returns == "last")
+    f.returns = ReturnFilter::Last;
+  else if (a.returns == "only")
+    f.returns = ReturnFilter::Only;
+  else
+    throw InputError("--returns expects all, first, last or only, got '" + a.returns + "'");
+  if (!a.intensity.empty()) f.intensity = closedRange(a.intensity, "--intensity");
+  if (!a.gpsTime.empty()) f.gpsTime = closedRange(a.gpsTime, "--gps-time");
+  if (!a.sourceIds.empty()) {
+    f.sourceIds.emplace();
+    for (uint32_t id : integerList(a.sourceIds, "--source-ids", 65535))
+      f.sourceIds->push_back(uint16_t(id));
+  }
+  return f;
 }
 
 } // namespace pointrast::app

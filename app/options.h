@@ -4,10 +4,12 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "cloud/attribute_colors.h"
+#include "cloud/point_filter.h"
 #include "render/post/post_settings.h"
 #include "view/session.h"
 
@@ -61,5 +63,17 @@ struct DrawArgs {
 void addDrawOptions(CLI::App& cmd, DrawArgs& a);
 // The options as a viewer's starting settings (the method aside). Throws InputError naming the option.
 void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings);
+
+// Which points to keep (convert, profile) or show (the renderers): clip volumes and attribute filters,
+// one "Filters" group of options. Oriented boxes have no option: they come from annotation files, added
+// to the PointFilter that pointFilter() returns.
+struct FilterArgs {
+  std::vector<std::string> clipBoxes, clipPolygons;
+  std::string clipZ, clipMode = "inside";
+  std::string classes, returns = "all", intensity, gpsTime, sourceIds;
+};
+void addFilterOptions(CLI::App& cmd, FilterArgs& a);
+// The options as a PointFilter; InputError naming the option on bad text.
+PointFilter pointFilter(const FilterArgs& a);
 
 } // namespace pointrast::app

@@ -193,4 +193,43 @@ BoxVerdict clipVerdict(const PointFilter& filter, const Bounds& box) {
   return allInside == (filter.clipMode == ClipMode::Inside) ? BoxVerdict::All : BoxVerdict::None;
 }
 
+FilterNeeds filterFields(const PointCloud& cloud) {
+  FilterNeeds has;
+  has.classification = !cloud.classification.empty();
+  has.returnNumber = !cloud.returnNumber.empty();
+  has.intensity = !cloud.intensity.empty();
+  has.pointSourceId = !cloud.pointSourceId.empty();
+  return has;
+}
+
+void applyFilter(PointCloud& cloud, const PointFilter& filter) {
+  if (!filter.active()) return;
+  const uint64_t n = cloud.size();
+  uint64_t kept = 0;
+  for (uint64_t i = 0; i < n; ++i) {
+    FilterPoint p;
+    p.position = cloud.world(i);
+    if (!cloud.classification.empty()) p.classification = cloud.classification[i];
+    if (!cloud.returnNumber.empty()) p.returnNumber = cloud.returnNumber[i];
+    if (!cloud.intensity.empty()) p.intensity = cloud.intensity[i];
+    if (!cloud.pointSourceId.empty()) p.pointSourceId = cloud.pointSourceId[i];
+    if (!passes(filter, p)) continue;
+    for (int a = 0; a < 3; ++a)
+      cloud.positions[3 * kept + a] = cloud.positions[3 * i + a];
+    if (!cloud.colors.empty()) cloud.colors[kept] = cloud.colors[i];
+    if (!cloud.intensity.empty()) cloud.intensity[kept] = cloud.intensity[i];
+    if (!cloud.classification.empty()) cloud.classification[kept] = cloud.classification[i];
+    if (!cloud.returnNumber.empty()) cloud.returnNumber[kept] = cloud.returnNumber[i];
+    if (!cloud.pointSourceId.empty()) cloud.pointSourceId[kept] = cloud.pointSourceId[i];
+    ++kept;
+  }
+  cloud.positions.resize(3 * kept);
+  if (!cloud.colors.empty()) cloud.colors.resize(kept);
+  if (!cloud.intensity.empty()) cloud.intensity.resize(kept);
+  if (!cloud.classification.empty()) cloud.classification.resize(kept);
+  if (!cloud.returnNumber.empty()) cloud.returnNumber.resize(kept);
+  if (!cloud.pointSourceId.empty()) cloud.pointSourceId.resize(kept);
+  computeBounds(cloud);
+}
+
 } // namespace pointrast

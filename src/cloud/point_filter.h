@@ -109,4 +109,10 @@ bool passes(const PointFilter& filter, const FilterPoint& p);
 enum class BoxVerdict : uint8_t { None, Some, All };
 BoxVerdict clipVerdict(const PointFilter& filter, const Bounds& box);
 
+// The attributes a cloud in memory holds (it keeps neither the number of returns nor GPS times).
+FilterNeeds filterFields(const PointCloud& cloud);
+// Keeps the points of a cloud in memory that pass, in their order; bounds recomputed. The caller has
+// checked filterFields() with requireFilterAttributes().
+void applyFilter(PointCloud& cloud, const PointFilter& filter);
+
 } // namespace pointrast
