@@ -10,6 +10,7 @@
 // for octree nodes (lod.inc.glsl). Every thread of a drawing workgroup reads the same bits.
 #extension GL_KHR_shader_subgroup_basic : require
 #include "common.inc.glsl"
+#include "clip.inc.glsl"
 #include "project.inc.glsl"
 
 layout(local_size_x = kPointGroupSize) in;
@@ -42,6 +43,7 @@ const float kCullMargin = 1e-5;
 struct BatchView {
   uint words;  // coordinate words its points load: 1..3; 0 = culled
   bool inside; // every point of the box projects in front of the near plane and inside the image
+  bool clipTest; // the clip volumes keep some of the box's points: each is tested (at full precision)
   vec3 cx, cy, cz; // screen map: X = cx.x g.x + cx.y g.y + cx.z g.z + offset.x; Y, Z likewise
   vec3 offset;
   vec3 lo, step; // the batch's min corner (relative to the scene origin) and 2^30 quantization steps
@@ -131,20 +133,47 @@ BatchView viewBox(vec3 lo, vec3 hi, BatchCamera cam, uint forcedWords, bool cull
   v.lo = lo;
   v.step = step;
   v.rect = vec4(-1.0);
+  v.clipTest = false;
   if (culling && (left || right || below || above || behind)) v.words = 0u;
   return v;
 }
 
-// A box decision in a buffer (shared.h, LodNodeView), for passes that read it instead of computing it.
+// The clip volumes of the box being drawn (ClipVolumes address): the includer defines it (the part's scene's for
+// a batch, the octree's for a node).
+uint64_t boxClip();
+
+// The clip's decision on top of viewBox's for the box [lo, hi]: a box whose points the clip volumes all drop
+// is culled (`clipped`: it was not culled by the frustum), one they keep in part loads all three words and
+// tests each point's exact position (the position the 2021 methods test, so every method keeps the same points).
+BatchView clipView(BatchView v, vec3 lo, vec3 hi, out bool clipped) {
+  clipped = false;
+  v.clipTest = false;
+  if (v.words == 0u) return v;
+  uint verdict = clipBoxVerdict(boxClip(), lo, hi);
+  if (verdict == kClipBoxNone) {
+    v.words = 0u;
+    clipped = true;
+  } else if (verdict == kClipBoxSome) {
+    v.clipTest = true;
+    v.words = 3u; // whatever the precision: the map of fewer words is left unused (fullPrecisionPosition)
+  }
+  return v;
+}
+
+// A box decision in a buffer (shared.h, LodNodeView), for passes that read it instead of computing it. cy.w
+// holds the flags: 1 inside, 2 clipTest.
 LodNodeView storeView(BatchView v) {
-  return LodNodeView(vec4(v.cx, uintBitsToFloat(v.words)), vec4(v.cy, v.inside ? 1.0 : 0.0), vec4(v.cz, v.rect.x),
+  float flags = (v.inside ? 1.0 : 0.0) + (v.clipTest ? 2.0 : 0.0);
+  return LodNodeView(vec4(v.cx, uintBitsToFloat(v.words)), vec4(v.cy, flags), vec4(v.cz, v.rect.x),
                      vec4(v.offset, v.rect.y), vec4(v.lo, v.rect.z), vec4(v.step, v.rect.w));
 }
 
 BatchView loadView(LodNodeView s) {
   BatchView v;
   v.words = floatBitsToUint(s.cx.w);
-  v.inside = s.cy.w != 0.0;
+  uint flags = uint(s.cy.w);
+  v.inside = (flags & 1u) != 0u;
+  v.clipTest = (flags & 2u) != 0u;
   v.cx = s.cx.xyz;
   v.cy = s.cy.xyz;
   v.cz = s.cz.xyz;
@@ -226,9 +255,16 @@ vec3 fullPrecisionPosition(BatchView v, uint high, uint medium, uint low) {
 // can make it one). `checked`: with the near-plane and image tests (false only for an `inside` batch).
 bool projectBatchPoint(BatchView v, uint words, bool checked, uint high, uint medium, uint low, BatchCamera cam,
                        out uint pixel, out uint depthBits) {
-  if (words == 3u)
-    return projectPointInto(cam.viewProj, fullPrecisionPosition(v, high, medium, low), cam.width, cam.height,
-                            cam.pitch, cam.offset, cam.nearW, pixel, depthBits);
+  if (words == 3u) {
+    vec3 p = fullPrecisionPosition(v, high, medium, low);
+    if (v.clipTest && !clipKeeps(boxClip(), p)) {
+      pixel = kNoPixel;
+      depthBits = 0xFFFFFFFFu;
+      return false;
+    }
+    return projectPointInto(cam.viewProj, p, cam.width, cam.height, cam.pitch, cam.offset, cam.nearW, pixel,
+                            depthBits);
+  }
   vec3 s = screenOf(v, pointFields(words, high, medium, low));
   if (checked) return projectChecked(s, cam, pixel, depthBits);
   projectInside(s, cam, pixel, depthBits);

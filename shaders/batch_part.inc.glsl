@@ -25,6 +25,10 @@ BatchCamera batchCamera(FrameRef frame, uint eye) {
 
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer BatchViews { LodNodeView v[]; };
 
+uint64_t boxClip() {
+  return Uint64Array(FrameRef(pc.frame).f.clips).v[pc.part];
+}
+
 // Where the decision of batch `batch` of the part for eye `eye` is in BatchFrame::views.
 uint viewIndex(uint batch, uint eye, uint eyes) {
   return (pc.firstView + batch) * eyes + eye;

@@ -7,6 +7,10 @@ layout(push_constant) uniform Push { LodPush pc; };
 
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer LodViews { LodNodeView v[]; };
 
+uint64_t boxClip() {
+  return LodFrameRef(pc.frame).f.clip;
+}
+
 // The camera of eye `eye` (0: the left, or the only one; 1: the right of a stereo frame).
 BatchCamera lodCamera(LodFrame f, uint eye) {
   BatchCamera cam;

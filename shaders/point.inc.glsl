@@ -2,6 +2,7 @@
 // DEPTH_INT40 (a #define of the entry file, since double precision needs the Float64 capability):
 //   0: word = floatBits(c.w) << 32 | RGBA8          (order-preserving: c.w > 0)
 //   1: word = uint40(c.w * depthScale) << 24 | RGB24 (the 2019 poster; projection in double precision)
+#include "clip.inc.glsl"
 #include "project.inc.glsl"
 
 #if DEPTH_INT40
@@ -21,12 +22,14 @@ vec3 loadPosition(uint i) {
   return vec3(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2]);
 }
 
-// The depth part of point p's framebuffer word (payload 0) and its pixel; false if the point is dropped.
+// The depth part of point p's framebuffer word (payload 0) and its pixel; false if the point is dropped (by
+// the clip volumes too).
 bool depthWordOf(vec3 p, out uint pixel, out uint64_t word) {
   pixel = 0xFFFFFFFFu; // written on every path (see projectPoint)
   word = 0xFFFFFFFFFFFFFFFFul;
+  if (!clipKeeps(pc.scene, p)) return false;
 #if DEPTH_INT40
-  dvec4 c = DMat4Ref(pc.viewProjD).m * dvec4(dvec3(p), 1.0lf);
+  dvec4 c = DMat4Ref(pc.scene + kSceneMatrixOffset).m * dvec4(dvec3(p), 1.0lf);
   if (!(c.w > double(pc.nearW))) return false;
   double fx = (c.x / c.w + 1.0lf) * 0.5lf * double(pc.width);
   double fy = (1.0lf - c.y / c.w) * 0.5lf * double(pc.height);

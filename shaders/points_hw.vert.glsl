@@ -15,6 +15,7 @@
 //   near   points with c.w <= nearW are moved outside the clip volume; Vulkan discards a point whose vertex
 //          is outside it, as it does for points left or right of the image.
 #include "common.inc.glsl"
+#include "clip.inc.glsl"
 
 layout(push_constant) uniform Push { RasterPush pc; };
 layout(location = 0) flat out uint color;
@@ -22,9 +23,11 @@ layout(location = 0) flat out uint color;
 void main() {
   uint i = gl_VertexIndex;
   FloatArray pos = FloatArray(pc.positions);
-  vec4 c = pc.viewProj * vec4(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2], 1.0);
+  vec3 p = vec3(pos.v[3 * i], pos.v[3 * i + 1], pos.v[3 * i + 2]);
+  vec4 c = pc.viewProj * vec4(p, 1.0);
   color = UintArray(pc.colors).v[i];
   gl_PointSize = 1.0;
-  // !(>) also drops NaN depths.
-  gl_Position = c.w > pc.nearW ? vec4(c.x, -c.y, pc.nearW, c.w) : vec4(2.0, 2.0, 2.0, 1.0);
+  // !(>) also drops NaN depths; a point the clip volumes drop goes outside the clip volume like one behind.
+  bool kept = c.w > pc.nearW && clipKeeps(pc.scene, p);
+  gl_Position = kept ? vec4(c.x, -c.y, pc.nearW, c.w) : vec4(2.0, 2.0, 2.0, 1.0);
 }

@@ -39,6 +39,44 @@ PR_CONST kPixelGroupSize = 256;
 // An empty pixel holds all ones, which no point's word can reach (NaN depth bits are never written).
 PR_CONST64 kEmptyPixel = 0xFFFFFFFFFFFFFFFFul;
 
+// ------------------------------------------------------------------------------------------------------
+// Clip volumes (cloud/point_filter.h, the same rules): a point is inside when it lies in at least one box,
+// oriented box or polygon prism (boundaries inside), and kept by mode kClipInside when inside, by
+// kClipOutside when not. Coordinates are relative to the scene origin, rounded once to float from the
+// filter's doubles (render/clip_volumes.h). The renderer writes one ClipVolumes per scene a frame; every point
+// method tests each point from the position it loads, and the batch and LOD methods first decide whole
+// batches and nodes (clip.inc.glsl, clipBoxVerdict): drawn without a test, culled, or tested point by point.
+// ------------------------------------------------------------------------------------------------------
+PR_CONST kClipNone = 0;    // no clip volume: every point is kept, nothing is read beyond `mode`
+PR_CONST kClipInside = 1;  // keep the points inside the union of the volumes
+PR_CONST kClipOutside = 2; // keep the others
+// Volumes a frame can hold: 16 boxes (32 B each) + 16 oriented boxes (64 B) + 8 polygons (16 B) of 256
+// vertices in all (8 B), 3.7 KB, read through the cache by every thread.
+PR_CONST kMaxClipBoxes = 16;
+PR_CONST kMaxClipOrientedBoxes = 16;
+PR_CONST kMaxClipPolygons = 8;
+PR_CONST kMaxClipVertices = 256;
+
+struct ClipVolumes {
+  uint mode;      // kClipNone, kClipInside, kClipOutside
+  uint boxes;     // axis-aligned boxes: box[2 i] min, box[2 i + 1] max (w unused)
+  uint orientedBoxes; // oriented[4 i] the center, then the three unit axes with the half extent
+                  // along each in w: inside when |dot(axis, p - center)| <= w for all three
+  uint polygons;  // polygon prisms: polygon[i] = (first vertex, vertex count as uint bits, zMin, zMax);
+                  // vertices two to a vec4 (x0, y0, x1, y1); even-odd rule in x/y, zMin <= z <= zMax
+  vec4 box[2 * kMaxClipBoxes];
+  vec4 oriented[4 * kMaxClipOrientedBoxes];
+  vec4 polygon[kMaxClipPolygons];
+  vec4 vertices[kMaxClipVertices / 2];
+};
+
+// The renderer's per-frame table (Targets::scenes): the ClipVolumes address of each visibility part's scene
+// (the batch passes find it by BatchPush::part), then one record per scene of kSceneRecordBytes: its
+// ClipVolumes, then at kSceneMatrixOffset its view-projection in double precision (a dmat4, the int40 path).
+PR_CONST kSceneMatrixOffset = 3840;  // sizeof(ClipVolumes) = 3728, rounded up to a multiple of 128
+PR_CONST kSceneRecordBytes = 3968;   // + 128 B of dmat4
+PR_CONST kSceneTableHeader = 512;    // uint64_t[kMaxVisibilityParts]
+
 // Push constants of the point rasterizers: one dispatch draws one part of a scene (a range of points
 // living in one buffer pair), addressed by buffer device address so parts may be anywhere in memory and
 // scenes may exceed the 4 GiB range of a storage-buffer descriptor. 128 bytes: the minimum every Vulkan
@@ -49,7 +87,8 @@ struct RasterPush {
   uint64_t colors;       // address of uint[pointCount] (RGBA8)
   uint64_t framebuffer;  // address of the method's framebuffer (uint64_t per pixel for most methods)
   uint64_t aux;          // method-specific buffer (HQS accumulators), 0 if none
-  uint64_t viewProjD;    // address of a dmat4: the same matrix in double precision (int40 depth)
+  uint64_t scene;        // address of the scene's record: ClipVolumes, then at kSceneMatrixOffset the same
+                         // matrix in double precision (a dmat4, int40 depth)
   uint pointCount;
   uint width;
   uint height;
@@ -183,7 +222,7 @@ PR_CONST kMaxVisibilityParts = 64;
 // counts and adds them to row (workgroup id % 64), so 64 addresses share the atomics instead of one; the
 // host sums the rows after the frame.
 PR_CONST kBatchStatSlots = 64;
-PR_CONST kBatchStatCount = 10;
+PR_CONST kBatchStatCount = 11;
 PR_CONST kStatBatchesProcessed = 0; // workgroups that ran (every batch of every part)
 PR_CONST kStatBatchesRendered = 1;  // batches not culled
 PR_CONST kStatPointsRendered = 2;   // points that passed early-z and did the atomicMin
@@ -194,6 +233,7 @@ PR_CONST kStatPointsThreeWords = 6;
 PR_CONST kStatBatchesDense = 7;    // batch-hqs: batches drawn in one pass (denseBatch)
 PR_CONST kStatPointsTakenBack = 8; // batch-hqs: their points on flagged pixels, blended again
 PR_CONST kStatBatchesRedrawn = 9;  // batch-hqs: dense batches the accumulation pass draws again
+PR_CONST kStatBatchesClipped = 10; // batches (nodes) culled because no point of their box is kept by the clip
 
 // Bounds of one batch relative to the scene origin, rounded once to float from the exact (double) bounds
 // its points were quantized in. w is unused.
@@ -230,7 +270,7 @@ struct BatchFrame {
   // batch of the frame (BatchPush::firstView + batch) the number of the last frame that drew it again (0:
   // none). Such a batch is not dense for the next kHqsDenseRetry to 2 kHqsDenseRetry - 1 frames.
   uint64_t denseHistory;
-  uint64_t reserved;
+  uint64_t clips; // uint64_t per visibility part: its scene's ClipVolumes (the scene table's header)
 };
 
 // Push constants of the batch passes: one dispatch draws one part, one workgroup per batch.
@@ -323,6 +363,8 @@ struct LodFrame {
                   // + i]), made with rightViewProj (specialization constant STEREO of the passes)
   uint reserved;
   mat4 rightViewProj; // stereo: the right half's view-projection (LodPush::viewProj is the left's)
+  uint64_t clip;      // ClipVolumes of the octree (relative to its origin)
+  uint64_t reserved2;
 };
 
 // Push constants of the LOD passes (a frame's matrix and near plane; the rest is in LodFrame).

@@ -11,7 +11,7 @@ namespace pointrast::shared {
 static_assert(sizeof(RasterPush) == 128); // the push-constant size every device must support
 static_assert(offsetof(RasterPush, positions) == 64);
 static_assert(offsetof(RasterPush, framebuffer) == 80);
-static_assert(offsetof(RasterPush, viewProjD) == 96);
+static_assert(offsetof(RasterPush, scene) == 96);
 static_assert(offsetof(RasterPush, pointCount) == 104);
 static_assert(offsetof(RasterPush, groupsX) == 120);
 static_assert(sizeof(ResolvePush) == 56);
@@ -37,6 +37,14 @@ static_assert(offsetof(BatchFrame, rightViewProj) == 48 + 8 * kMaxVisibilityPart
 static_assert(offsetof(BatchFrame, views) == 48 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
 static_assert(offsetof(BatchFrame, denseTiles) == 64 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
 static_assert(sizeof(BatchFrame) == 96 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
+static_assert(offsetof(BatchFrame, clips) == 88 + 8 * kMaxVisibilityParts + 64 * kMaxVisibilityParts);
+
+// Clip volumes and the renderer's scene table (std430: vec4 arrays at multiples of 16).
+static_assert(sizeof(ClipVolumes) == 3728 && offsetof(ClipVolumes, box) == 16);
+static_assert(offsetof(ClipVolumes, vertices) ==
+              16 + 16 * (2 * kMaxClipBoxes + 4 * kMaxClipOrientedBoxes + kMaxClipPolygons));
+static_assert(kSceneMatrixOffset >= sizeof(ClipVolumes) && kSceneMatrixOffset % 128 == 0 &&
+              kSceneRecordBytes == kSceneMatrixOffset + 128 && kSceneTableHeader == 8 * kMaxVisibilityParts);
 static_assert(kBatchPoints == 10240 && kBatchPrefetchSteps * 4 == kBatchPointsPerThread);
 static_assert(uint64_t(kMaxPartBatches) * kBatchPoints <= kVisibilityLocalMask + 1ull);
 static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 32);
@@ -46,7 +54,7 @@ static_assert(uint64_t(kMaxVisibilityParts) << kVisibilityPartShift == 1ull << 3
 static_assert(sizeof(LodNode) == 48 && offsetof(LodNode, firstIndex) == 32 && offsetof(LodNode, rank) == 44);
 static_assert(sizeof(LodPage) == 16 && offsetof(LodPage, node) == 8);
 static_assert(sizeof(LodNodeView) == 96);
-static_assert(sizeof(LodFrame) == 160 && offsetof(LodFrame, width) == 56 &&
+static_assert(sizeof(LodFrame) == 176 && offsetof(LodFrame, clip) == 160 && offsetof(LodFrame, width) == 56 &&
               offsetof(LodFrame, pageCount) == 76 && offsetof(LodFrame, eyes) == 88 &&
               offsetof(LodFrame, rightViewProj) == 96);
 static_assert(sizeof(LodPush) == 80 && offsetof(LodPush, frame) == 64 && offsetof(LodPush, groupsX) == 76);

@@ -27,9 +27,16 @@ struct Targets {
   gpu::Buffer framebuffer; // 8 B per pixel; methods choose the layout
   gpu::Buffer image;       // RGBA8 per pixel
   gpu::Buffer words;       // canonical depth << 32 | color per pixel, filled when non-empty
-  gpu::Buffer matrices;    // host-visible dmat4 per scene (double-precision projection)
+  // Host-visible scene table (shared.h, kSceneTableHeader): each visibility part's clip volumes address, then
+  // a record per scene: ClipVolumes relative to its origin and its double-precision view-projection.
+  gpu::Buffer scenes;
   uint64_t pixels() const { return uint64_t(width) * height; }
 };
+
+// Byte offset of scene s's record in Targets::scenes.
+inline uint64_t sceneRecordOffset(size_t s) {
+  return shared::kSceneTableHeader + uint64_t(s) * shared::kSceneRecordBytes;
+}
 
 struct Frame {
   VkCommandBuffer cmd;
@@ -58,7 +65,7 @@ public:
 constexpr uint32_t kPointsPerThread = 4;
 
 // Calls draw(push, grid) for every part of every scene, with `base` completed for that part: the matrix
-// relative to the scene's origin (float, and the double copy in targets.matrices), the part's addresses
+// relative to the scene's origin (float, and the scene's record in targets.scenes), the part's addresses
 // and point count, and the workgroup grid. `base` brings the method's framebuffer/aux addresses.
 template <class Draw>
 void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize, shared::RasterPush base,
@@ -69,7 +76,7 @@ void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize,
   for (size_t s = 0; s < frame.scenes.size(); ++s) {
     const GpuScene& scene = *frame.scenes[s];
     base.viewProj = glm::mat4(viewProjection(frame.camera, scene.origin(), aspect));
-    base.viewProjD = targets.matrices.address() + s * sizeof(glm::dmat4);
+    base.scene = targets.scenes.address() + sceneRecordOffset(s);
     base.nearW = float(frame.camera.nearW > 0 ? frame.camera.nearW : defaultNear(scene.bounds()));
     for (const ScenePart& part : scene.parts()) {
       gpu::Grid grid = gpu::gridFor(part.count, groupSize);

@@ -123,6 +123,7 @@ public:
     f.pitch = targets.width;
     f.eyes = eyes_;
     f.views = viewBuffer(frame).address();
+    f.clips = targets.scenes.address();
     const double aspect = double(targets.eyeWidth()) / double(targets.height);
     uint32_t part = 0;
     for (const GpuScene* scene : frame.scenes) {

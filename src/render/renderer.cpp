@@ -8,6 +8,7 @@
 #include "base/error.h"
 #include "gpu/context.h"
 #include "gpu/timer.h"
+#include "render/clip_volumes.h"
 #include "render/lod/lod_render.h"
 #include "render/method.h"
 #include "render/post/post_stage.h"
@@ -194,16 +195,23 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   PointMethod& m = method(settings);
   Targets& t = *targets_;
   if (settings.captureWords) allocateWords();
-  // Double-precision copies of each scene's matrix, for the int40 path.
-  uint64_t matrixBytes = std::max<size_t>(1, scenes.size()) * sizeof(glm::dmat4);
-  if (!t.matrices || t.matrices.size() < matrixBytes)
-    t.matrices =
-        gpu::Buffer(context_, matrixBytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "double matrices");
+  // Each scene's record: its clip volumes and the double-precision copy of its matrix (the int40 path).
+  std::vector<glm::dvec3> origins;
+  for (const GpuScene* scene : scenes)
+    origins.push_back(scene->origin());
+  writeSceneTable(origins, settings);
   const std::vector<Camera> eyes = views(camera, settings);
   double aspect = double(t.eyeWidth()) / double(t.height);
+  char* table = static_cast<char*>(t.scenes.mapped());
+  uint32_t part = 0;
   for (size_t s = 0; s < scenes.size(); ++s) {
     glm::dmat4 vp = viewProjection(eyes[0], scenes[s]->origin(), aspect);
-    std::memcpy(static_cast<char*>(t.matrices.mapped()) + s * sizeof(glm::dmat4), &vp, sizeof vp);
+    std::memcpy(table + sceneRecordOffset(s) + shared::kSceneMatrixOffset, &vp, sizeof vp);
+    // The batch passes find a part's clip volumes by its visibility part number.
+    for (size_t p = 0; p < scenes[s]->parts().size() && part < shared::kMaxVisibilityParts; ++p, ++part) {
+      const uint64_t clip = t.scenes.address() + sceneRecordOffset(s);
+      std::memcpy(table + 8 * part, &clip, sizeof clip);
+    }
   }
   RenderSettings effective = settings;
   if (effective.depth == DepthMode::Int40 && effective.depthScale <= 0)
@@ -296,6 +304,20 @@ std::vector<PostView> Renderer::postViews(const Camera& camera, const RenderSett
   return views;
 }
 
+void Renderer::writeSceneTable(std::span<const glm::dvec3> origins, const RenderSettings& settings) {
+  Targets& t = *targets_;
+  const uint64_t bytes = sceneRecordOffset(std::max<size_t>(1, origins.size()));
+  if (!t.scenes || t.scenes.size() < bytes)
+    t.scenes = gpu::Buffer(context_, bytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "scene table");
+  char* table = static_cast<char*>(t.scenes.mapped());
+  std::memset(table, 0, bytes);
+  for (size_t s = 0; s < std::max<size_t>(1, origins.size()); ++s) {
+    const shared::ClipVolumes clip =
+        gpuClipVolumes(settings.filter, s < origins.size() ? origins[s] : glm::dvec3(0));
+    std::memcpy(table + sceneRecordOffset(s), &clip, sizeof clip);
+  }
+}
+
 FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings,
                                bool resident) {
   validateCamera(camera);
@@ -321,6 +343,8 @@ FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, cons
         post_->record(cmd, eyeViews, settings.post, &*postTimestamps, frame * kPostPasses);
     };
   }
+  const glm::dvec3 origin = octree.origin();
+  writeSceneTable({&origin, 1}, settings); // LodFrame::clip is the first record's
   const std::vector<Camera> eyes = views(camera, settings);
   FrameStats stats = resident
                          ? lod::renderResidentFrame(context_, octree, passes, t, eyes, settings, epilogue)
@@ -388,6 +412,7 @@ BatchStats batchStatsFromRows(const uint64_t (&rows)[shared::kBatchStatSlots][sh
   s.batchesDense = sum[shared::kStatBatchesDense];
   s.pointsTakenBack = sum[shared::kStatPointsTakenBack];
   s.batchesRedrawn = sum[shared::kStatBatchesRedrawn];
+  s.batchesClipped = sum[shared::kStatBatchesClipped];
   // Every batch (or octree node) reads its bounds, every point of a drawn one its words.
   const uint64_t once = s.batchesProcessed * sizeof(shared::BatchBounds) +
                         4 * (s.pointsByWords[0] + 2 * s.pointsByWords[1] + 3 * s.pointsByWords[2]);

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cloud/point_filter.h"
 #include "render/camera.h"
 #include "render/lod/foveation.h"
 #include "render/lod/lod_stats.h"
@@ -58,6 +59,10 @@ struct RenderSettings {
   uint64_t pointBudget = 0;
   lod::Foveation foveation; // LOD methods: larger nodes needed away from the image's centre (off by default)
   StereoSettings stereo;    // a stereo Renderer's eyes (render/stereo.h); ignored by a mono one
+  // Clip volumes (inside or outside), tested per point by every point method after whole batches and nodes
+  // were decided (shared.h, ClipVolumes). The renderer ignores the attribute filters (applied where a cloud
+  // is loaded) and ClipMode::Highlight (a tint of the uploaded colors: UploadOptions::filter).
+  PointFilter filter;
 };
 // "adaptive", "1", "2", "3" -> 0..3; throws InputError naming the choices.
 uint32_t parsePrecision(std::string_view text);
@@ -75,6 +80,9 @@ struct BatchStats {
   uint64_t batchesDense = 0;
   uint64_t pointsTakenBack = 0;
   uint64_t batchesRedrawn = 0;
+  // Batches (nodes) culled because the clip volumes keep none of their box's points (RenderSettings::filter);
+  // part of batchesProcessed - batchesRendered.
+  uint64_t batchesClipped = 0;
   // Bytes of point data read: 4 per coordinate word, 32 per rendered batch's bounds; batch-hqs reads the
   // words twice (depth and accumulation pass) and the color of every blended point, except that a dense
   // batch's words are read once (twice if redrawn) and its colors all in the first pass.
@@ -157,6 +165,8 @@ private:
   std::vector<PostView> postViews(const Camera& camera, const RenderSettings& settings) const;
   // The camera of each half of the image: the given one, or the two eyes in image order.
   std::vector<Camera> views(const Camera& camera, const RenderSettings& settings) const;
+  // Fills Targets::scenes' clip volumes for scenes at these origins (one record at least).
+  void writeSceneTable(std::span<const glm::dvec3> origins, const RenderSettings& settings);
   FrameStats renderLod(lod::LodScene& octree, const Camera& camera, const RenderSettings& settings,
                        bool resident);
   lod::LodPasses& lodPasses(const RenderSettings& settings);

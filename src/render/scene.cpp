@@ -105,6 +105,8 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
   }
   if (count == 0) return;
   const DisplayColorMode colors = options.colors ? *options.colors : displayColorMode(cloud); // once
+  if (options.filter && options.filter->hasClip() && options.filter->clipMode == ClipMode::Highlight)
+    highlight_ = options.filter;
   if (layout_ == SceneLayout::Float)
     uploadFloat(context, cloud, colors, options.progress);
   else
@@ -124,6 +126,7 @@ void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const
       uint64_t n = std::min(kStagingPoints, part.count - at);
       toRelativeFloat(stagingFloats, cloud, part.first + at, n, origin_);
       displayColors(stagingColors, cloud, part.first + at, n, colors);
+      if (highlight_) highlightColors(stagingColors, cloud, part.first + at, n, *highlight_);
       context.submitAndWait([&](VkCommandBuffer cmd) {
         VkBufferCopy pos{0, at * 12, n * 12};
         VkBufferCopy col{kStagingPoints * 12, at * 4, n * 4};
@@ -158,6 +161,7 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
               makeBatch(cloud, part.first + at + local, uint32_t(std::min(kBatchSize, n - local)));
           encodeBatchWords(section[0] + local, section[1] + local, section[2] + local, cloud, batch);
           displayColors(section[3] + local, cloud, batch.first, batch.count, colorMode);
+          if (highlight_) highlightColors(section[3] + local, cloud, batch.first, batch.count, *highlight_);
           const glm::dvec3 lo = batch.bounds.min - origin_, hi = batch.bounds.max - origin_;
           bounds[b] = {glm::vec4(glm::vec3(lo), 0.0f), glm::vec4(glm::vec3(hi), 0.0f)};
         }
@@ -183,8 +187,26 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
   }
 }
 
+uint32_t highlightColor(uint32_t rgba) {
+  constexpr uint32_t kTint[3] = {255, 200, 0};
+  uint32_t out = rgba & 0xFF000000u;
+  for (int c = 0; c < 3; ++c)
+    out |= (((rgba >> (8 * c)) & 0xFFu) + kTint[c] + 1) / 2 << (8 * c);
+  return out;
+}
+
+void highlightColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
+                     const PointFilter& filter) {
+  if (!filter.hasClip() || filter.clipMode != ClipMode::Highlight) return;
+  for (uint64_t i = 0; i < count; ++i)
+    if (insideClip(filter, cloud.world(first + i))) dst[i] = highlightColor(dst[i]);
+}
+
 // Colors of a part are the same in both layouts: one uint per point, in point order.
-void GpuScene::recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode) {
+void GpuScene::recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode,
+                       const std::optional<PointFilter>& filter) {
+  highlight_.reset();
+  if (filter && filter->hasClip() && filter->clipMode == ClipMode::Highlight) highlight_ = filter;
   assert(parts_.empty() || parts_.back().first + parts_.back().count <= cloud.size());
   gpu::Buffer staging(context, kStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload,
                       "recolor staging");
@@ -194,6 +216,7 @@ void GpuScene::recolor(gpu::Context& context, const PointCloud& cloud, const Dis
     for (uint64_t at = 0; at < part.count; at += kChunk) {
       const uint64_t n = std::min(kChunk, part.count - at);
       displayColors(colors, cloud, part.first + at, n, mode);
+      if (highlight_) highlightColors(colors, cloud, part.first + at, n, *highlight_);
       context.submitAndWait([&](VkCommandBuffer cmd) {
         VkBufferCopy copy{0, at * 4, n * 4};
         gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.colors.handle(), 1, &copy);

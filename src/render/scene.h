@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cloud/cloud.h"
+#include "cloud/point_filter.h"
 #include "gpu/buffer.h"
 
 namespace pointrast {
@@ -56,7 +57,17 @@ struct UploadOptions {
   bool progress = true;
   // How points become colors (render --color); nullopt: displayColorMode(cloud), decided once per upload.
   std::optional<DisplayColorMode> colors;
+  // ClipMode::Highlight: the points inside the clip volumes are tinted (highlightColor) in the uploaded
+  // colors, as a color mode is folded in; other modes change nothing here (the renderer clips, per frame).
+  std::optional<PointFilter> filter;
 };
+
+// The tint of a highlighted point: each channel halfway to the highlight color (255, 200, 0), alpha kept.
+uint32_t highlightColor(uint32_t rgba);
+// Tints the colors of points [first, first + count) of `cloud` that lie inside the clip volumes of a
+// ClipMode::Highlight filter; nothing for any other filter.
+void highlightColors(uint32_t* dst, const PointCloud& cloud, uint64_t first, uint64_t count,
+                     const PointFilter& filter);
 
 // Points per part of a layout: `requested` (0: as many as fit) bounded by the layout's maximum and by a
 // device whose largest buffer holds `bufferLimit` bytes; 0 if not even one batch fits.
@@ -86,13 +97,16 @@ public:
 
   // Rewrites the colors of every part from `cloud` (the one uploaded, same subrange) in another mode:
   // 4 B a point instead of a whole upload, so a viewer switches modes without uploading positions again.
-  void recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode);
+  // `filter`: a ClipMode::Highlight filter tints as at upload (UploadOptions::filter).
+  void recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode,
+               const std::optional<PointFilter>& filter = std::nullopt);
 
 private:
   void uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
                    bool progress);
   void uploadBatched(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
                      bool progress);
+  std::optional<PointFilter> highlight_; // the filter whose inside points are tinted, if any
   std::vector<ScenePart> parts_;
   SceneLayout layout_ = SceneLayout::Float;
   uint64_t pointCount_ = 0;

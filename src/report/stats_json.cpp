@@ -12,6 +12,7 @@ nlohmann::json batchStatsJson(const BatchStats& b) {
           {"batches_dense", b.batchesDense},
           {"points_taken_back", b.pointsTakenBack},
           {"batches_redrawn", b.batchesRedrawn},
+          {"batches_clipped", b.batchesClipped},
           {"bytes_read", b.bytesRead}};
 }
 

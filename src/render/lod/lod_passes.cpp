@@ -94,6 +94,7 @@ void LodPasses::writeFrame(const Targets& targets, const LodCamera& camera, cons
   f.pitch = targets.width;
   f.eyes = eyes_;
   f.rightViewProj = camera.rightViewProj;
+  f.clip = targets.scenes.address() + shared::kSceneTableHeader; // the octree's record (Renderer::renderLod)
   f.forcedWords = settings.precision;
   f.culling = settings.batchCulling ? 1 : 0;
   f.nodeCount = nodeCount_;
