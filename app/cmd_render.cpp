@@ -28,8 +28,10 @@
 #include "io/writer.h"
 #include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
+#include "render/pick.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
+#include "render_filter.h"
 #include "render_path.h"
 #include "report/stats_json.h"
 
@@ -66,6 +68,8 @@ struct RenderArgs {
   bool json = false, quiet = false;
   PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
   LookArgs look; // point methods: coloring and the resolve stage
+  FilterArgs filter; // point methods: clip volumes and attribute filters
+  std::string pick;  // --pick X,Y: the point drawn at that pixel, in the JSON
   // Stereo (batch and LOD methods) and foveated LOD.
   bool stereo = false;
   std::optional<double> ipd;
@@ -463,6 +467,7 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   if (a.order != "original" || a.parts != 1 || a.depth != "float")
     throw InputError("--order, --parts and --depth do not apply to " + a.method +
                      ", which draws an octree's nodes in their stored order");
+  checkOctreeFilter(settings.filter, a.method);
   const LodValues lod = lodValues(a.lod);
   settings.minNodePx = lod.minNodePx;
   settings.pointBudget = lod.pointBudget;
@@ -532,6 +537,12 @@ RenderSettings pointSettings(const RenderArgs& a) {
     throw InputError("--stereo renders one frame with -o, not a camera path");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
+  settings.filter = renderFilter(a.filter);
+  if (!a.pick.empty() && (a.stereo || !a.path.path.empty() || layout == SceneLayout::Octree || !a.json))
+    throw InputError("--pick reports the point at a pixel of a mono image of a cloud drawn from memory, in "
+                     "--json output (not with --stereo, --path or a LOD method)");
+  if (!a.pick.empty()) parsePick(a.pick, a.width, a.height);
+  settings.captureWords = settings.captureWords || !a.pick.empty(); // the word at the pixel
   if (layout == SceneLayout::Octree) return settings; // runRenderOctree checks the octree's own options
   if (a.foveated || a.foveaRadius || a.foveaPeriphery)
     throw InputError("--foveated applies to the LOD methods (" + methodNamesReading(SceneLayout::Octree) +
@@ -573,6 +584,7 @@ std::vector<std::unique_ptr<GpuScene>> uploadParts(gpu::Context& context, const 
     upload.layout = layout;
     upload.progress = !a.quiet;
     upload.colors = colors;
+    upload.filter = pointFilter(a.filter); // a highlight tints the colors
     scenes.push_back(std::make_unique<GpuScene>(context, cloud, upload));
   }
   return scenes;
@@ -631,6 +643,28 @@ void printPointSummary(const RenderArgs& a, const RenderSettings& settings, cons
         stats.post->composeMs);
 }
 
+// --pick: the point the last frame drew at the pixel, from its canonical word (render/pick.h).
+nlohmann::json pickAt(Renderer& renderer, const PointCloud& cloud, const std::optional<DisplayColorMode>& colors,
+                      const RenderSettings& settings, const Camera& camera, const RenderArgs& a) {
+  const PixelPos pixel = parsePick(a.pick, a.width, a.height);
+  if (!hasCanonicalWords(methodInfo(settings.method)) && !settings.post.enabled()) {
+    nlohmann::json j;
+    j["pixel"] = {pixel.x, pixel.y};
+    j["point"] = std::string("unavailable: ") + a.method + " keeps no depth per pixel to pick from";
+    return j;
+  }
+  const uint64_t word = renderer.framebufferWords(pixel.x, pixel.y, 1, 1)[0];
+  PickRequest request;
+  request.cloud = &cloud;
+  request.colors = colors ? *colors : displayColorMode(cloud);
+  request.filter = settings.filter;
+  request.camera = camera;
+  request.width = a.width;
+  request.height = a.height;
+  request.depth = settings.post.enabled() ? DepthMode::Float : settings.depth;
+  return pickJson(cloud, pixel, word == shared::kEmptyPixel, pickPoint(request, pixel.x, pixel.y, word));
+}
+
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   checkCommonArgs(a);
@@ -647,7 +681,8 @@ int runRender(const RenderArgs& a) {
   std::string why;
   if (stated && !sceneFits(context, settings.method.info().layout, *stated, &why))
     throw UnsupportedError((a.input.empty() ? kDemoScene : a.input) + ": " + why);
-  const PointCloud cloud = loadInput(spec);
+  PointCloud cloud = loadInput(spec);
+  filterLoadedCloud(cloud, settings.filter);
   const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
   const Camera camera = renderCamera(a, cloud.bounds, cloud.source);
   Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
@@ -670,6 +705,7 @@ int runRender(const RenderArgs& a) {
       [&] {
         nlohmann::json j = pointJson(context, settings, cloud, spec.order, colors, stats, camera, a, pixels);
         j["clocks_settled"] = settled;
+        if (!a.pick.empty()) j["pick"] = pickAt(renderer, cloud, colors, settings, camera, a);
         return j;
       },
       [&] { printPointSummary(a, settings, stats); });
@@ -836,6 +872,9 @@ Command addRender(CLI::App& app) {
   addMethodOptions(*cmd, *a);
   addSphereOptions(*cmd, *a);
   addLookOptions(*cmd, a->look);
+  addFilterOptions(*cmd, a->filter);
+  cmd->add_option("--pick", a->pick,
+                  "With --json: report the point drawn at pixel X,Y (0,0 at the top left) with its attributes");
   addStereoOptions(*cmd, *a);
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");

@@ -6,6 +6,7 @@
 
 #include "base/error.h"
 #include "cli_util.h"
+#include "render/clip_volumes.h"
 
 namespace pointrast::app {
 
@@ -108,6 +109,7 @@ void addDrawOptions(CLI::App& cmd, DrawArgs& a) {
       ->capture_default_str();
   addLookOptions(cmd, a.look);
   addLodOptions(cmd, a.lod);
+  addFilterOptions(cmd, a.filter);
 }
 
 void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings) {
@@ -120,6 +122,15 @@ void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings) {
   settings.minNodePx = lod.minNodePx;
   settings.pointBudget = lod.pointBudget;
   settings.gpuMemory = lod.gpuBytes;
+  // The viewers draw clip volumes per frame; attribute filters and a highlight are folded in when a cloud
+  // is loaded or uploaded, which render does and the viewers do not.
+  settings.filter = pointFilter(a.filter);
+  checkGpuClip(settings.filter);
+  if (settings.filter.hasAttributeFilter() ||
+      (settings.filter.hasClip() && settings.filter.clipMode == ClipMode::Highlight))
+    throw InputError("the viewers draw clip volumes (--clip-box, --clip-polygon, --clip-mode inside or "
+                     "outside); --classes, --returns, --intensity, --gps-time, --source-ids and --clip-mode "
+                     "highlight apply to render");
 }
 
 namespace {

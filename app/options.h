@@ -53,17 +53,6 @@ struct LodValues {
 };
 LodValues lodValues(const LodArgs& a);
 
-// The options every command that draws points shares with render, beyond the input and the camera: the
-// look, level of detail and --depth. The viewers start from them (every one stays changeable in the panel).
-struct DrawArgs {
-  LookArgs look;
-  LodArgs lod;
-  std::string depth = "float";
-};
-void addDrawOptions(CLI::App& cmd, DrawArgs& a);
-// The options as a viewer's starting settings (the method aside). Throws InputError naming the option.
-void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings);
-
 // Which points to keep (convert, profile) or show (the renderers): clip volumes and attribute filters,
 // one "Filters" group of options. Oriented boxes have no option: they come from annotation files, added
 // to the PointFilter that pointFilter() returns.
@@ -75,5 +64,18 @@ struct FilterArgs {
 void addFilterOptions(CLI::App& cmd, FilterArgs& a);
 // The options as a PointFilter; InputError naming the option on bad text.
 PointFilter pointFilter(const FilterArgs& a);
+
+// The options every command that draws points shares with render, beyond the input and the camera: the
+// look, level of detail, --depth and the filters. The viewers start from them (every one stays changeable in
+// the panel).
+struct DrawArgs {
+  LookArgs look;
+  LodArgs lod;
+  std::string depth = "float";
+  FilterArgs filter; // the Filters group: the viewers draw its clip volumes
+};
+void addDrawOptions(CLI::App& cmd, DrawArgs& a);
+// The options as a viewer's starting settings (the method aside). Throws InputError naming the option.
+void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings);
 
 } // namespace pointrast::app

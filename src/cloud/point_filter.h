@@ -37,6 +37,7 @@ namespace pointrast {
 // Axis-aligned box, world coordinates of the file (scale and offset applied).
 struct ClipBox {
   glm::dvec3 min{0}, max{0};
+  bool operator==(const ClipBox&) const = default;
 };
 
 // A box of any orientation: center, three orthonormal axes and the half extent along each.
@@ -44,6 +45,7 @@ struct OrientedClipBox {
   glm::dvec3 center{0};
   std::array<glm::dvec3, 3> axes{glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1)};
   glm::dvec3 halfExtent{0};
+  bool operator==(const OrientedClipBox&) const = default;
 };
 
 // A simple polygon in x/y, extruded along z between zMin and zMax (unbounded by default). Even-odd rule.
@@ -51,6 +53,7 @@ struct ClipPolygon {
   std::vector<glm::dvec2> vertices; // at least 3
   double zMin = -std::numeric_limits<double>::infinity();
   double zMax = std::numeric_limits<double>::infinity();
+  bool operator==(const ClipPolygon&) const = default;
 };
 
 enum class ClipMode : uint8_t { Inside, Outside, Highlight };
@@ -74,6 +77,7 @@ struct PointFilter {
   }
   // Whether any point could be dropped or marked.
   bool active() const { return hasClip() || hasAttributeFilter(); }
+  bool operator==(const PointFilter&) const = default;
 };
 
 // One point as the filter sees it. Fields the input lacks are 0 (the caller checks needs() first).

@@ -42,6 +42,7 @@ RenderSettings renderSettings(const ViewSettings& requested) {
   settings.post = view.post;
   settings.minNodePx = view.minNodePx;
   settings.pointBudget = view.pointBudget;
+  settings.filter = view.filter;
   settings.frames = 1;
   settings.warmup = 0;
   return settings;

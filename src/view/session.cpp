@@ -44,7 +44,7 @@ bool ViewSettings::operator==(const ViewSettings& o) const {
   };
   return method == o.method && background == o.background && depth == o.depth && samePost(post, o.post) &&
          colorSource == o.colorSource && sameRange(colorRange, o.colorRange) && minNodePx == o.minNodePx &&
-         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory;
+         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory && filter == o.filter;
 }
 
 namespace {

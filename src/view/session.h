@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "cloud/cloud.h"
+#include "cloud/point_filter.h"
 #include "render/lod/lod_stats.h"
 #include "render/post/post_settings.h"
 #include "render/renderer.h"
@@ -39,6 +40,9 @@ struct ViewSettings {
   double minNodePx = 100;
   uint64_t pointBudget = 0;
   uint64_t gpuMemory = 0;
+  // Clip volumes drawn per frame (RenderSettings::filter): --clip-box, --clip-polygon, --clip-mode inside or
+  // outside.
+  PointFilter filter;
   bool operator==(const ViewSettings& other) const;
 };
 
