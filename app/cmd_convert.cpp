@@ -13,6 +13,7 @@
 #include "io/format_table.h"
 #include "io/potree/potree.h"
 #include "io/writer.h"
+#include "options.h"
 
 namespace pointrast::app {
 
@@ -24,7 +25,15 @@ struct ConvertArgs {
   uint32_t chunkSize = 50000;
   int pointFormat = -1;
   bool quiet = false, dropWaveforms = false;
+  FilterArgs filters;
+  PointFilter filter; // from filters, when the command runs
 };
+
+void printNodeStats(const ConvertArgs& a, const io::ClipNodeStats& stats) {
+  if (!a.quiet && a.filter.hasClip() && stats.nodes > 0)
+    std::printf("%llu of %llu nodes skipped by the clip\n", static_cast<unsigned long long>(stats.skipped),
+                static_cast<unsigned long long>(stats.nodes));
+}
 
 // A LAS, LAZ or COPC file in its own order and point format: every record byte for byte, with its
 // VLRs and EVLRs.
@@ -35,7 +44,11 @@ int convertLasFamily(const ConvertArgs& a) {
   options.chunkSize = a.chunkSize;
   options.progress = !a.quiet;
   if (a.lasVersion != "auto") options.versionMinor = a.lasVersion == "1.4" ? 4 : 2;
+  io::ClipNodeStats stats;
+  options.filter = &a.filter;
+  options.nodeStats = &stats;
   const uint64_t points = io::convertLasFile(a.input, a.output, options);
+  printNodeStats(a, stats);
   if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(points)).c_str());
   return 0;
 }
@@ -56,15 +69,28 @@ bool needsExtendedFormat(const io::PotreeFolderInfo& folder) {
   return false;
 }
 
-// An octree in its own order: streamed node by node, every integer, scale/offset and 16-bit color as the
-// octree stores it.
-int convertOctree(const ConvertArgs& a) {
-  const io::PotreeFolderInfo folder = io::probePotree(a.input);
-  std::unique_ptr<lod::NodeSource> source = io::openPotree(a.input);
+// What a filter can read of an octree's records: no number of returns, no GPS time.
+FilterNeeds octreeFields(const RecordFields& f) {
+  FilterNeeds has;
+  has.classification = f.classification;
+  has.returnNumber = f.returnNumber;
+  has.intensity = f.intensity;
+  has.pointSourceId = f.pointSourceId;
+  return has;
+}
+
+// An octree (a Potree 2.0 folder, or an EPT dataset when filtering) in its own order: streamed node by
+// node, every integer, scale/offset and 16-bit color as the octree stores it.
+int convertOctree(const ConvertArgs& a, const io::FormatInfo& format) {
+  std::unique_ptr<lod::NodeSource> source = format.openNodes(a.input);
+  requireFilterAttributes(a.filter, octreeFields(source->metadata().fields), source->metadata().source);
   io::LasFlavor flavor = lasFlavorFor(a.output, source->metadata().pointCount);
-  if (a.lasVersion == "1.4" || (a.lasVersion == "auto" && needsExtendedFormat(folder)))
+  if (a.lasVersion == "1.4" || (a.lasVersion == "auto" && format.openNodes == &io::openPotree &&
+                                needsExtendedFormat(io::probePotree(a.input))))
     flavor = io::LasFlavor::Las14Pf7;
-  const uint64_t points = io::writeLasFromOctree(a.output, *source, flavor, !a.quiet);
+  io::ClipNodeStats stats;
+  const uint64_t points = io::writeLasFromOctree(a.output, *source, flavor, !a.quiet, &a.filter, &stats);
+  printNodeStats(a, stats);
   if (!a.quiet) std::printf("%s: %s points\n", a.output.c_str(), humanCount(double(points)).c_str());
   return 0;
 }
@@ -98,7 +124,10 @@ Command addConvert(CLI::App& app) {
       "and 16-bit colors, node after node (LAS 1.4 format 7 when its classes or return numbers need it).\n\n"
       "Examples:\n  pointrast convert scan.ply scan_morton.las --order morton\n"
       "  pointrast convert lion.copc.laz lion.laz\n"
-      "  pointrast convert octree/ all.laz");
+      "  pointrast convert octree/ all.laz\n"
+      "  pointrast convert city.laz ground.laz --classes 2 --clip-box 500,200,0,900,600,100\n\n"
+      "Filters keep exactly the points that pass them, records unchanged; the header's counts and bounds\n"
+      "describe what was written. Octrees and COPC files skip whole nodes outside the clip.");
   cmd->add_option("IN", a->input,
                   "Point cloud file (" + io::formatList(io::FormatUse::Cloud) +
                       ") or Potree 2.0 octree folder")
@@ -113,6 +142,7 @@ Command addConvert(CLI::App& app) {
   cmd->add_flag("--drop-waveforms", a->dropWaveforms,
                 "Convert waveform point formats (4, 5, 9, 10) without their wave packets");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
+  addFilterOptions(*cmd, a->filters);
   return [a] {
     Progress::setEnabled(!a->quiet);
     if (a->lasVersion != "auto" && a->lasVersion != "1.2" && a->lasVersion != "1.4")
@@ -121,11 +151,15 @@ Command addConvert(CLI::App& app) {
     if (!pathExists(a->input)) throw InputError(a->input + ": no such file or folder");
     const io::FormatInfo* format = io::detectFormat(a->input);
     if (a->chunkSize == 0) throw InputError("--chunk-size must be at least 1 point");
-    if (a->order == "original" && format && format->openNodes == &io::openPotree) return convertOctree(*a);
+    a->filter = pointFilter(a->filters);
+    if (a->order == "original" && format && format->openNodes == &io::openPotree)
+      return convertOctree(*a, *format);
     if (a->pointFormat != -1 &&
         (a->pointFormat < 0 || !((a->pointFormat <= 3) || (a->pointFormat >= 6 && a->pointFormat <= 8))))
       throw InputError("--point-format expects 0, 1, 2, 3, 6, 7 or 8");
     if (a->order == "original" && isLasFamily(format)) return convertLasFamily(*a);
+    if (a->order == "original" && format && format->openNodes && a->filter.active())
+      return convertOctree(*a, *format);
     if (a->pointFormat != -1)
       throw InputError("--point-format applies to LAS, LAZ and COPC inputs in their original order");
     InputSpec spec;
@@ -134,6 +168,8 @@ Command addConvert(CLI::App& app) {
     spec.seed = a->seed;
     spec.progress = !a->quiet;
     PointCloud cloud = loadInput(spec);
+    requireFilterAttributes(a->filter, filterFields(cloud), cloud.source);
+    applyFilter(cloud, a->filter);
     io::LasFlavor flavor = lasFlavorFor(a->output, cloud.size());
     if (a->lasVersion == "1.4") flavor = io::LasFlavor::Las14Pf7;
     if (a->lasVersion == "1.2" && flavor == io::LasFlavor::Las14Pf7)

@@ -4,11 +4,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <vector>
 
 #include "cloud/cloud.h"
 #include "cloud/octree.h"
+#include "cloud/point_filter.h"
 #include "cloud/point_record.h"
 
 namespace pointrast::io {
@@ -91,6 +93,15 @@ private:
 // Returns the points written. Throws InputError.
 // pointFormat (0-3, 6-8) converts the records to another format (LAS 1.4 for 6-8), refusing with one
 // line a record whose attributes the target cannot hold (colors into format 1, channels into 3...).
+// How a clip culled the nodes of an octree or COPC input: nodes seen, and skipped without reading their
+// points because their cube holds no point the clip keeps.
+struct ClipNodeStats {
+  uint64_t nodes = 0, skipped = 0;
+};
+// With a filter, only the records that pass it are written (after `keep`, when set, also accepts them);
+// the header's counts and bounds describe what was written. A COPC file's chunks whose cube the clip
+// rejects as a whole are not decoded (counted in nodeStats). An empty output path writes nothing: the
+// records only go to `keep`.
 struct LasConvertOptions {
   int pointFormat = -1;  // -1: the input's (without the waveform packets when they are dropped)
   int versionMinor = -1; // LAS 1.x: -1 the input's (1.4 when the format needs it), 2 or 4; without
@@ -98,6 +109,9 @@ struct LasConvertOptions {
   bool dropWaveforms = false;
   uint32_t chunkSize = 50000;
   bool progress = false;
+  const PointFilter* filter = nullptr; // null or inactive: every record
+  std::function<bool(const uint8_t* record, const FilterPoint& point)> keep;
+  ClipNodeStats* nodeStats = nullptr;
 };
 uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::path& out,
                         const LasConvertOptions& options = {});
@@ -106,8 +120,12 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
 // source's integers, scale/offset and 16-bit colors): nodes in forEachNode order, decoded on all cores a
 // batch at a time, so memory stays a few batches of nodes whatever the octree's size. Returns the points
 // written.
+// With a filter (the source must hold what it reads: requireFilterAttributes), only the points that pass
+// it are written; nodes whose cube the clip rejects as a whole are not read (counted in nodeStats), and
+// the points of nodes it accepts as a whole are tested by the attribute filters alone.
 uint64_t writeLasFromOctree(const std::filesystem::path& path, lod::NodeSource& source, LasFlavor flavor,
-                            bool progress);
+                            bool progress, const PointFilter* filter = nullptr,
+                            ClipNodeStats* nodeStats = nullptr);
 
 // Writes RGBA8 pixels (row 0 = top) as an 8-bit RGB PNG (alpha dropped).
 void writePng(const std::filesystem::path& path, uint32_t width, uint32_t height, const uint32_t* rgba);

@@ -8,9 +8,13 @@
 #include <cstring>
 #include <ctime>
 #include <optional>
+#include <unordered_map>
 
 #include "base/parallel.h"
 #include "base/progress.h"
+#include "io/copc_ept/copc.h"
+#include "io/copc_ept/copc_chunks.h"
+#include "io/las/las_filter.h"
 #include "io/las/las_format.h"
 #include "io/las/laz_encoder.h"
 #include "io/las/laz_reader.h"
@@ -478,12 +482,64 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
   }
   if (setup.header[las::kVersionMinor] >= 4) setup.evlrs = readEvlrs(file, hd);
 
-  LasFileWriter writer(outPath, std::move(setup));
+  const PointFilter* filter = options.filter && options.filter->active() ? options.filter : nullptr;
+  if (filter) requireFilterAttributes(*filter, lasFilterFields(hd.pointFormat), in.filename().string());
+  PointFilter attributesOnly; // for the points of chunks the clip keeps as a whole
+  if (filter) {
+    attributesOnly = *filter;
+    attributesOnly.boxes.clear();
+    attributesOnly.orientedBoxes.clear();
+    attributesOnly.polygons.clear();
+  }
+  // A COPC file's chunks are octree nodes: with a clip, the chunks whose cube it rejects are not decoded.
+  std::vector<BoxVerdict> verdicts;
+  uint64_t skippedPoints = 0;
+  if (filter && filter->hasClip() && compressed && hasCopcInfoVlr(file)) {
+    const std::vector<CopcChunkCube> cubes = copcChunkCubes(in);
+    std::unordered_map<uint64_t, Bounds> cubeAt;
+    for (const CopcChunkCube& c : cubes)
+      cubeAt[c.offset] = c.cube;
+    std::vector<laz::Chunk> kept;
+    for (const laz::Chunk& chunk : lazFile->chunks) {
+      const auto it = cubeAt.find(chunk.offset);
+      const BoxVerdict v = it == cubeAt.end() ? BoxVerdict::Some : clipVerdict(*filter, it->second);
+      if (options.nodeStats) {
+        ++options.nodeStats->nodes;
+        options.nodeStats->skipped += v == BoxVerdict::None;
+      }
+      if (v == BoxVerdict::None) {
+        skippedPoints += chunk.pointCount;
+        continue;
+      }
+      kept.push_back(chunk);
+      verdicts.push_back(v);
+    }
+    lazFile->chunks = std::move(kept);
+  }
+
+  std::optional<LasFileWriter> writer;
+  if (!outPath.empty()) writer.emplace(outPath, std::move(setup));
   std::optional<Progress> line;
   if (options.progress) line.emplace("converting " + in.filename().string(), hd.pointCount);
-  std::vector<uint8_t> converted;
-  uint64_t done = 0;
-  auto deliver = [&](const uint8_t* records, uint64_t n) {
+  if (line) line->advance(skippedPoints);
+  std::vector<uint8_t> converted, selected;
+  uint64_t done = 0, written = 0;
+  auto deliver = [&](const uint8_t* records, uint64_t n, BoxVerdict verdict) {
+    const uint64_t read = n;
+    if (filter || options.keep) {
+      const PointFilter& test = verdict == BoxVerdict::All ? attributesOnly : *filter;
+      selected.resize(size_t(n) * hd.recordLength);
+      uint64_t k = 0;
+      for (uint64_t i = 0; i < n; ++i) {
+        const uint8_t* r = records + i * hd.recordLength;
+        const FilterPoint p = lasFilterPoint(r, hd.pointFormat, hd.scale, hd.offset);
+        if (filter && !passes(test, p)) continue;
+        if (options.keep && !options.keep(r, p)) continue;
+        std::memcpy(selected.data() + k++ * hd.recordLength, r, hd.recordLength);
+      }
+      records = selected.data();
+      n = k;
+    }
     if (transcode) {
       const size_t outLength = size_t(baseBytes) + extraBytes;
       converted.resize(size_t(n) * outLength);
@@ -494,22 +550,24 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
       records = converted.data();
     }
     done += n;
-    writer.write(records, n);
-    if (line) line->advance(n);
+    written += n;
+    if (writer) writer->write(records, n);
+    if (line) line->advance(read);
   };
   if (compressed) {
     detail::decodeLazInWindows(file, *lazFile, detail::lazThreads(),
-                               [&](size_t, std::vector<std::vector<uint8_t>>& records) {
-                                 for (const std::vector<uint8_t>& r : records)
-                                   deliver(r.data(), r.size() / hd.recordLength);
+                               [&](size_t first, std::vector<std::vector<uint8_t>>& records) {
+                                 for (size_t k = 0; k < records.size(); ++k)
+                                   deliver(records[k].data(), records[k].size() / hd.recordLength,
+                                           verdicts.empty() ? BoxVerdict::Some : verdicts[first + k]);
                                });
   } else {
-    forEachRecordChunk(file, hd.pointOffset, hd.pointCount, hd.recordLength, lasChunkBytes(),
-                       [&](const uint8_t* records, uint64_t, uint64_t n) { deliver(records, n); });
+    forEachRecordChunk(
+        file, hd.pointOffset, hd.pointCount, hd.recordLength, lasChunkBytes(),
+        [&](const uint8_t* records, uint64_t, uint64_t n) { deliver(records, n, BoxVerdict::Some); });
   }
   if (line) line->finish();
-  const uint64_t written = writer.pointsWritten();
-  writer.commit();
+  if (writer) writer->commit();
   return written;
 }
 
