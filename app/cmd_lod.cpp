@@ -22,6 +22,8 @@
 #include "commands.h"
 #include "io/format_table.h"
 #include "io/potree/lod_potree.h"
+#include "io/writer.h"
+#include "io/copc_ept/copc_writer.h"
 
 namespace pointrast::app {
 
@@ -31,6 +33,7 @@ struct LodArgs {
   std::vector<std::string> inputs;
   std::string output, memory, leafPoints = "20k", encoding = "default", colorFilter = "average";
   double spacing = 0;
+  std::string format; // potree or copc; empty: by the output's name (".laz": copc)
   unsigned threads = 0;
   bool json = false, quiet = false;
 };
@@ -101,6 +104,7 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
   j["bytes"] = r.bytes;
   j["input_bytes"] = b.inputBytes;
   j["seconds"] = b.seconds;
+  j["format"] = a.format;
   j["points_per_second"] = perSecond(double(b.octree.points), b.seconds);
   j["threads"] = b.threads;
   j["memory_bytes"] = b.memoryBytes;
@@ -156,6 +160,11 @@ int runLod(LodArgs a) {
   options.averageColors = a.colorFilter == "average";
   io::PotreeWriteOptions write;
   if (a.encoding == "brotli")
+  if (a.format.empty()) a.format = io::isLazPath(a.output) ? "copc" : "potree";
+  if (a.format != "potree" && a.format != "copc")
+    throw InputError("--format expects potree or copc, got '" + a.format + "'");
+  if (a.format == "copc" && a.encoding != "default")
+    throw InputError("--encoding applies to Potree output; COPC nodes are LAZ");
     write.encoding = io::PotreeEncoding::Brotli;
   else if (a.encoding != "default")
     throw InputError("--encoding expects default or brotli, got '" + a.encoding + "'");
@@ -169,7 +178,13 @@ int runLod(LodArgs a) {
   InterruptGuard guard;
   io::PotreeBuildReport report;
   try {
-    report = io::buildPotree(inputs, a.output, options, write);
+    if (a.format == "copc") {
+      io::CopcBuildReport copc = io::buildCopc(inputs, a.output, options);
+      report.build = std::move(copc.build);
+      report.bytes = copc.bytes;
+    } else {
+      report = io::buildPotree(inputs, a.output, options, write);
+    }
   } catch (const Interrupted&) {
     std::fprintf(stderr, "pointrast: interrupted; %s was not written\n", a.output.c_str());
     return 130;
@@ -186,7 +201,8 @@ int runLod(LodArgs a) {
 Command addLod(CLI::App& app) {
   auto a = std::make_shared<LodArgs>();
   CLI::App* cmd =
-      app.add_subcommand("lod", "Build a level-of-detail octree (Potree 2.0 folder) from point files");
+      app.add_subcommand("lod", "Build a level-of-detail octree (Potree 2.0 folder or COPC file) from point "
+                                "files");
   cmd->footer(
       "\nThe octree is additive, as PotreeConverter's: every input point is stored once, exactly (its\n"
       "integer coordinates and attributes); the root holds a subsample with one point per cell of a\n"
@@ -203,16 +219,24 @@ Command addLod(CLI::App& app) {
       "--memory and --threads are. The folder appears only when complete: an error or Ctrl-C leaves\n"
       "nothing behind (a second Ctrl-C stops at once).\n"
       "\n"
+      "An output named *.laz (or --format copc) is one COPC 1.0 file instead of a folder: the same nodes\n"
+      "and points, each node a LAZ chunk (point format 6, 7 with color), the inputs' WKT coordinate\n"
+      "system kept; `info` says whether its inner nodes hold averaged colors.\n"
+      "\n"
       "Examples:\n"
       "  pointrast lod scan.las -o scan_octree                 # all cores, in memory if it fits\n"
       "  pointrast lod tiles/*.las -o city --memory 8G         # many tiles, one octree, at most ~8 GiB\n"
       "  pointrast lod big.las -o big --encoding brotli --json # compressed nodes, one JSON summary\n"
       "  pointrast lod scan.las -o coarse --spacing 2 --leaf-points 50k\n"
+      "  pointrast lod scan.las -o scan.copc.laz               # one COPC file\n"
       "  pointrast info scan_octree                            # what was built\n"
       "  pointrast render scan_octree -o view.png              # draw all its points");
   cmd->add_option("IN", a->inputs, "Point files: LAS, PLY, XYZ/CSV (several merge into one octree)")
       ->required();
-  cmd->add_option("-o,--output", a->output, "Folder to create (must not exist)")->required();
+  cmd->add_option("-o,--output", a->output,
+                  "Folder (Potree 2.0) or .laz file (COPC 1.0) to create (must not exist)")
+      ->required();
+  cmd->add_option("--format", a->format, "potree or copc (default: copc for a .laz output, else potree)");
   cmd->add_option("--spacing", a->spacing,
                   "Root spacing in input units, rounded to the cube edge / 2^k (default: edge / 128)");
   cmd->add_option("--leaf-points", a->leafPoints, "A node whose cube holds more points is split (e.g. 20k)")

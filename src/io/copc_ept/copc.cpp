@@ -155,6 +155,7 @@ public:
   uint64_t nodeBytes(const NodeInfo& node) override { return uint64_t(dataEntry(node.key).byteSize); }
 
   const CopcInfo& copcInfo() const { return info_; }
+  const std::string& software() const { return laz_.header.software; }
   size_t pagesLoaded() {
     std::lock_guard lock(mutex_);
     return pages_.size();
@@ -272,6 +273,11 @@ std::optional<CopcSummary> summarizeCopc(const std::filesystem::path& path) {
   s.spacing = info.spacing;
   s.rootPageOffset = info.rootOffset;
   s.rootPageSize = info.rootSize;
+  const std::string& software = source.software();
+  if (software == kCopcSoftwareAveraged)
+    s.colors = "inner nodes hold averaged colors (each point the mean of the points it stands for)";
+  else if (software == kCopcSoftwareExact)
+    s.colors = "every point keeps its own color";
   lod::forEachNode(source, [&](const NodeInfo& node) {
     ++s.nodes;
     s.points += node.pointCount;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "cloud/octree.h"
 
@@ -29,6 +30,11 @@ class InputFile;
 bool looksLikeCopc(const std::filesystem::path& path);
 bool hasCopcInfoVlr(const detail::InputFile& file);
 
+// The generating software of the COPC files `pointrast lod` writes (copc_writer.h), which says how the
+// inner nodes' colors were made: averages of the points each stands for, or the points' own colors.
+inline constexpr const char* kCopcSoftwareAveraged = "pointrast lod, averaged colors";
+inline constexpr const char* kCopcSoftwareExact = "pointrast lod";
+
 // What `info` shows of a COPC file: the info VLR's cube and spacing, and the hierarchy walked in full
 // (node count, depth, points in nodes).
 struct CopcSummary {
@@ -37,6 +43,7 @@ struct CopcSummary {
   uint64_t rootPageOffset = 0, rootPageSize = 0;
   uint64_t nodes = 0, pages = 0, points = 0;
   int depth = 0;
+  std::string colors; // how inner nodes' colors were made, for files pointrast wrote (else empty)
 };
 std::optional<CopcSummary> summarizeCopc(const std::filesystem::path& path);
 

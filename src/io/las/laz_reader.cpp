@@ -287,6 +287,7 @@ FileInfo probeLaz(const std::filesystem::path& path) {
                                       (unsigned long long)copc->nodes, copc->depth,
                                       (unsigned long long)copc->points, (unsigned long long)copc->pages,
                                       copc->pages == 1 ? "" : "s"));
+    if (!copc->colors.empty()) info.extra.emplace_back("COPC colors", copc->colors);
   }
   return info;
 }
