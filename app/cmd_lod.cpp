@@ -140,7 +140,10 @@ void printSummary(const LodArgs& a, const io::PotreeBuildReport& r) {
   for (const lod::LodPhase& p : b.phases) {
     std::printf("  %-10s %8.3f s %10s points/s", p.name.c_str(), p.seconds,
                 humanCount(perSecond(double(p.points), p.seconds)).c_str());
-    if (p.overlapped)
+    if (p.overlapped && p.bytes && &p != &b.phases.front())
+      std::printf("   (during index; %.3f s over all threads; %.1f MB, %.0f MB/s of index's time)\n",
+                  p.threadSeconds, double(p.bytes) / 1e6, perSecond(double(p.bytes), (&p - 1)->seconds) / 1e6);
+    else if (p.overlapped)
       std::printf("   (during index; %.3f s over all threads)\n", p.threadSeconds);
     else
       std::printf("   cpu %7.3f s\n", p.cpuSeconds);

@@ -54,6 +54,8 @@ PotreeBuildReport buildPotree(const std::vector<std::filesystem::path>& inputs,
   PotreeBuildReport report;
   // Temporary chunk files live in the writer's folder: whatever ends the build, they go with it.
   report.build = builder.build(sink, writer.workingDir() / "chunks");
+  for (lod::LodPhase& phase : report.build.phases)
+    if (phase.name == "write") phase.bytes = writer.bytesWritten(); // octree.bin
   const lod::PhaseClock clock;
   writer.commit();
   report.build.phases.push_back(clock.done("commit", report.build.octree.points));

@@ -13,6 +13,7 @@
 #include "io/stale_partials.h"
 
 namespace pointrast::io {
+#include "io/write_behind.h"
 
 using namespace detail;
 
@@ -105,6 +106,7 @@ struct PotreeWriter::State {
   int octree = -1;    // octree.bin, written with pwrite at the offsets place() assigns
   uint64_t bytes = 0; // placed
   std::vector<potree::WrittenNode> nodes;
+  std::unique_ptr<WriteBehind> behind; // octree.bin's dirty pages, bounded
   std::unordered_set<lod::NodeKey, lod::NodeKeyHash> written;
   PotreeValueRanges ranges;
   bool committed = false;
@@ -241,11 +243,13 @@ PotreeWriter::~PotreeWriter() {
   if (s.committed) return;
   if (s.octree >= 0) ::close(s.octree);
   std::error_code ignored;
+  s.behind = std::make_unique<WriteBehind>(s.octree);
   std::filesystem::remove_all(s.work, ignored);
 }
 
 const std::filesystem::path& PotreeWriter::workingDir() const {
   return state_->work;
+  s.behind.reset();
 }
 
 uint64_t PotreeWriter::bytesWritten() const {
@@ -318,11 +322,15 @@ void PotreeWriter::commit() {
   assert(!s.committed && s.octree >= 0);
   const int closed = ::close(s.octree);
   s.octree = -1;
+  s.behind->written(offset, node.bytes.size());
   if (closed != 0) s.failWrite(errno);
 
   if (s.nodes.empty()) s.nodes.push_back({lod::NodeKey{}, 0, 0, 0}); // an empty octree is an empty root
   const potree::HierarchyBytes hierarchy = potree::buildHierarchy(s.nodes, s.options.hierarchyStepSize);
   s.writeFile("hierarchy.bin", hierarchy.bytes.data(), hierarchy.bytes.size());
+  const int flushError = s.behind->finish();
+  s.behind.reset();
+  if (flushError != 0) s.failWrite(flushError);
   const std::string json = potree::metadataJson(s.describe(hierarchy));
   s.writeFile("metadata.json", json.data(), json.size());
 
