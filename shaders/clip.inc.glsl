@@ -46,12 +46,20 @@ bool clipInside(ClipRef clip, vec3 p) {
   return false;
 }
 
+// Whether the clip volumes of a RasterPush scene record (kSceneClipped in bit 0) keep the point p: without the
+// bit, one test of a push constant.
+bool sceneKeeps(uint64_t scene, vec3 p);
+
 // Whether the clip volumes at `address` keep the point p.
 bool clipKeeps(uint64_t address, vec3 p) {
   ClipRef clip = ClipRef(address);
   uint mode = clip.c.mode;
   if (mode == kClipNone) return true;
   return clipInside(clip, p) == (mode == kClipInside);
+}
+
+bool sceneKeeps(uint64_t scene, vec3 p) {
+  return (scene & kSceneClipped) == 0ul || clipKeeps(scene & ~kSceneClipped, p);
 }
 
 // Relative slack of the box tests: a point's float position (decoded from its words, or rounded relative to

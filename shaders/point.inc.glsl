@@ -5,6 +5,11 @@
 #include "clip.inc.glsl"
 #include "project.inc.glsl"
 
+// CLIP (specialization constant 15): the pipeline tests each point against the scene's clip volumes. The
+// renderer takes the CLIP = 1 variant only for frames that clip, so that no other frame compiles the test in
+// (on lavapipe a test under a false uniform branch still costs its masked instructions).
+layout(constant_id = 15) const uint CLIP = 0;
+
 #if DEPTH_INT40
 #extension GL_ARB_gpu_shader_fp64 : require
 layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer DMat4Ref { dmat4 m; };
@@ -27,9 +32,9 @@ vec3 loadPosition(uint i) {
 bool depthWordOf(vec3 p, out uint pixel, out uint64_t word) {
   pixel = 0xFFFFFFFFu; // written on every path (see projectPoint)
   word = 0xFFFFFFFFFFFFFFFFul;
-  if (!clipKeeps(pc.scene, p)) return false;
+  if (CLIP != 0u && !sceneKeeps(pc.scene, p)) return false;
 #if DEPTH_INT40
-  dvec4 c = DMat4Ref(pc.scene + kSceneMatrixOffset).m * dvec4(dvec3(p), 1.0lf);
+  dvec4 c = DMat4Ref((pc.scene & ~kSceneClipped) + kSceneMatrixOffset).m * dvec4(dvec3(p), 1.0lf);
   if (!(c.w > double(pc.nearW))) return false;
   double fx = (c.x / c.w + 1.0lf) * 0.5lf * double(pc.width);
   double fy = (1.0lf - c.y / c.w) * 0.5lf * double(pc.height);

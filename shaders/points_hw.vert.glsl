@@ -28,6 +28,6 @@ void main() {
   color = UintArray(pc.colors).v[i];
   gl_PointSize = 1.0;
   // !(>) also drops NaN depths; a point the clip volumes drop goes outside the clip volume like one behind.
-  bool kept = c.w > pc.nearW && clipKeeps(pc.scene, p);
+  bool kept = c.w > pc.nearW && sceneKeeps(pc.scene, p);
   gl_Position = kept ? vec4(c.x, -c.y, pc.nearW, c.w) : vec4(2.0, 2.0, 2.0, 1.0);
 }

@@ -76,6 +76,9 @@ struct ClipVolumes {
 PR_CONST kSceneMatrixOffset = 3840;  // sizeof(ClipVolumes) = 3728, rounded up to a multiple of 128
 PR_CONST kSceneRecordBytes = 3968;   // + 128 B of dmat4
 PR_CONST kSceneTableHeader = 512;    // uint64_t[kMaxVisibilityParts]
+// Bit 0 of RasterPush::scene: the scene's clip volumes drop points (mode kClipInside or kClipOutside). Without
+// it a point method tests nothing and reads nothing more than without clip volumes.
+PR_CONST64 kSceneClipped = 1ul;
 
 // Push constants of the point rasterizers: one dispatch draws one part of a scene (a range of points
 // living in one buffer pair), addressed by buffer device address so parts may be anywhere in memory and
@@ -88,7 +91,9 @@ struct RasterPush {
   uint64_t framebuffer;  // address of the method's framebuffer (uint64_t per pixel for most methods)
   uint64_t aux;          // method-specific buffer (HQS accumulators), 0 if none
   uint64_t scene;        // address of the scene's record: ClipVolumes, then at kSceneMatrixOffset the same
-                         // matrix in double precision (a dmat4, int40 depth)
+                         // matrix in double precision (a dmat4, int40 depth); records are 128-byte aligned,
+                         // and bit 0 (kSceneClipped) is set when the clip volumes drop points
+
   uint pointCount;
   uint width;
   uint height;

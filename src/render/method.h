@@ -77,6 +77,9 @@ void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize,
     const GpuScene& scene = *frame.scenes[s];
     base.viewProj = glm::mat4(viewProjection(frame.camera, scene.origin(), aspect));
     base.scene = targets.scenes.address() + sceneRecordOffset(s);
+    const auto* clip = reinterpret_cast<const shared::ClipVolumes*>(
+        static_cast<const char*>(targets.scenes.mapped()) + sceneRecordOffset(s));
+    if (clip->mode != shared::kClipNone) base.scene |= shared::kSceneClipped;
     base.nearW = float(frame.camera.nearW > 0 ? frame.camera.nearW : defaultNear(scene.bounds()));
     for (const ScenePart& part : scene.parts()) {
       gpu::Grid grid = gpu::gridFor(part.count, groupSize);
@@ -88,6 +91,13 @@ void forEachPart(const Frame& frame, const Targets& targets, uint32_t groupSize,
     }
   }
 }
+
+// Whether the frame's clip volumes drop points (RenderSettings::filter): the methods then draw with their
+// CLIP = 1 pipelines (specialization constant kClipConstant of point.inc.glsl).
+inline bool clipsPoints(const RenderSettings& settings) {
+  return settings.filter.hasClip() && settings.filter.clipMode != ClipMode::Highlight;
+}
+constexpr uint32_t kClipConstant = 15;
 
 // int40 steps per unit of depth so that 2^40 - 1 steps span [0, farthest bounds corner from the eye].
 double int40Scale(std::span<const GpuScene* const> scenes, const Camera& camera);

@@ -1,5 +1,7 @@
 // High-quality splatting: a depth pass (the early-z closest-point shader), an accumulation pass that
 // blends every point within 1 % of the closest depth, and a resolve that divides.
+#include <optional>
+
 #include "base/error.h"
 #include "gpu/context.h"
 #include "render/method.h"
@@ -21,7 +23,7 @@ constexpr uint32_t kAccumulatePointsPerThread = 4;
 class HqsMethod : public PointMethod {
 public:
   HqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
-      : oneRound_(oneRound(method)) {
+      : context_(context), method_(method), oneRound_(oneRound(method)) {
     uint64_t pixels = uint64_t(width) * height;
     // hqs: 2 uint64 sums per pixel. hqs1r: 1 packed uint64 + 2 uint64 fallback sums per pixel.
     accumulators_ =
@@ -29,14 +31,9 @@ public:
                     oneRound_ ? "hqs1r accumulators" : "hqs accumulators");
     // The depth pass is the fastest closest-point shader on the H200 (reduce-earlyz, 4 points per thread;
     // docs/performance.md), reading positions only.
-    depth_ = gpu::ComputeProgram(context, "raster_closest.comp",
-                                 {{/* EARLY_Z= */ 0, 1},
-                                  {/* REDUCE= */ 1, 1},
-                                  {/* DEPTH_ONLY= */ 3, 1},
-                                  {/* POINTS_PER_THREAD= */ 4, kPointsPerThread}});
     // The accumulation pass draws 4 consecutive points per thread (its loads: three vec4s of positions),
     // its workgroups' chunks interleaved (raster_hqs.comp, hqs_accumulate.inc.glsl).
-    accumulate_ = gpu::ComputeProgram(context, method.shader, method.spec.span());
+    passes_[0] = makePasses(false);
     // The resolve reads the accumulators in the layout ONE_ROUND chose (the same constant id).
     resolve_ = gpu::ComputeProgram(context, "resolve_hqs.comp", method.spec.span());
   }
@@ -50,17 +47,22 @@ public:
     shared::RasterPush base{};
     base.framebuffer = targets.framebuffer.address();
     base.aux = accumulators_.address();
+    // The CLIP = 1 pair, made on the first frame that clips.
+    const bool clip = clipsPoints(frame.settings);
+    if (clip && !passes_[1]) passes_[1] = makePasses(true);
+    const gpu::ComputeProgram& depth = passes_[clip]->depth;
+    const gpu::ComputeProgram& accumulate = passes_[clip]->accumulate;
     forEachPart(
-        frame, targets, depth_.groupSize() * kPointsPerThread, base,
-        [&](const shared::RasterPush& push, gpu::Grid grid) { depth_.dispatch(cmd, grid.x, grid.y, push); });
+        frame, targets, depth.groupSize() * kPointsPerThread, base,
+        [&](const shared::RasterPush& push, gpu::Grid grid) { depth.dispatch(cmd, grid.x, grid.y, push); });
     gpu::fullBarrier(cmd);
-    forEachPart(frame, targets, accumulate_.groupSize() * kAccumulatePointsPerThread, base,
+    forEachPart(frame, targets, accumulate.groupSize() * kAccumulatePointsPerThread, base,
                 [&](const shared::RasterPush& push, gpu::Grid grid) {
                   // Each part's buffers are allocations of their own, aligned beyond 16 B on every driver;
                   // the shader's vec4 loads rely on it.
                   if ((push.positions | push.colors) % 16 != 0)
                     throw InternalError("internal error: HQS point buffers not 16-byte aligned");
-                  accumulate_.dispatch(cmd, grid.x, grid.y, push);
+                  accumulate.dispatch(cmd, grid.x, grid.y, push);
                 });
     gpu::fullBarrier(cmd);
     shared::ResolvePush resolve =
@@ -71,10 +73,29 @@ public:
   }
 
 private:
+  struct Passes {
+    gpu::ComputeProgram depth;
+    gpu::ComputeProgram accumulate;
+  };
+  Passes makePasses(bool clip) {
+    const uint32_t clipValue = clip ? 1u : 0u;
+    Passes p;
+    p.depth = gpu::ComputeProgram(context_, "raster_closest.comp",
+                                  {{/* EARLY_Z= */ 0, 1},
+                                   {/* REDUCE= */ 1, 1},
+                                   {/* DEPTH_ONLY= */ 3, 1},
+                                   {/* POINTS_PER_THREAD= */ 4, kPointsPerThread},
+                                   {kClipConstant, clipValue}});
+    p.accumulate =
+        gpu::ComputeProgram(context_, method_.shader, method_.spec.with({{kClipConstant, clipValue}}));
+    return p;
+  }
+
+  gpu::Context& context_;
+  MethodInfo method_;
   bool oneRound_;
   gpu::Buffer accumulators_;
-  gpu::ComputeProgram depth_;
-  gpu::ComputeProgram accumulate_;
+  std::optional<Passes> passes_[2]; // without and with the clip test (CLIP)
   gpu::ComputeProgram resolve_;
 };
 

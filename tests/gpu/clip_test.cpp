@@ -1,8 +1,7 @@
 // Clip volumes in the renderer (RenderSettings::filter, shaders/clip.inc.glsl):
 // - a clip box, an oriented box and a polygon, kept inside or outside, give the framebuffer of rendering the
-//   subset of points the rules keep (computed here on the CPU): the same framebuffer words for atomicmin and
-//   earlyz, the same image bit for bit for those, hqs, batch and batch-prefetch at full precision and
-//   hw-points;
+//   subset of points the rules keep (computed here on the CPU): the same framebuffer words for atomicmin, the
+//   same image bit for bit for it, hqs, batch and batch-prefetch at full precision and hw-points;
 // - batches and octree nodes whose boxes the clip keeps nothing of are culled and counted;
 // - lod draws only kept points and agrees with atomicmin of the subset.
 // Coordinates are multiples of 2^-12 and the subset keeps the whole cloud's bounds (its origin), so the float
@@ -132,7 +131,7 @@ void expectSameAsSubset(gpu::Context& context, const PointCloud& cloud, const Po
   const PointCloud subset = keptSubset(cloud, filter);
   ASSERT_GT(subset.size(), cloud.size() / 20) << what;
   ASSERT_LT(subset.size(), cloud.size() - cloud.size() / 20) << what;
-  for (const char* method : {"atomicmin", "earlyz", "hqs", "batch", "batch-prefetch", "hw-points"}) {
+  for (const char* method : {"atomicmin", "hqs", "batch", "batch-prefetch", "hw-points"}) {
     const Drawn clipped = draw(context, cloud, method, filter);
     const Drawn reference = draw(context, subset, method, PointFilter{});
     EXPECT_GT(lit(reference.image), size_t(kWidth * kHeight / 20)) << what << ", " << method;
