@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -20,6 +21,14 @@ std::string generateToken();
 bool tokenMatches(std::string_view given, std::string_view expected);
 // A Host header (or an Origin's host) naming the loopback: localhost, 127.x.x.x or [::1], any port.
 bool isLoopbackHost(std::string_view host);
+// Whether `text` holds a byte below 0x20 or 0x7F (NUL included): refused in paths and tokens, where a C
+// string would end early or a log line break.
+bool hasControlCharacter(std::string_view text);
+// The percent-decoded path of a request; nothing when an escape is malformed or decodes to a control
+// character ("%00", "%0a").
+std::optional<std::string> decodePath(std::string_view raw);
+// Whether `text` is well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing past U+10FFFF).
+bool isUtf8(std::string_view text);
 
 struct AccessPolicy {
   std::string token; // required when not empty

@@ -39,7 +39,10 @@ double now() {
 }
 
 // WebSocket close codes (RFC 6455, 7.4.1).
+constexpr uint16_t kCloseNormal = 1000;
 constexpr uint16_t kCloseGoingAway = 1001;
+constexpr uint16_t kCloseProtocol = 1002;
+constexpr uint16_t kCloseNotUtf8 = 1007;
 constexpr uint16_t kCloseUnsupported = 1003;
 constexpr uint16_t kClosePolicy = 1008;
 constexpr uint16_t kCloseTooBig = 1009;
@@ -275,13 +278,18 @@ int Server::gate(mg_connection* conn) {
     const char* v = cw::mg_get_header(conn, name);
     return std::string(v ? v : "");
   };
-  char queryToken[128] = "", cookieToken[128] = "";
+  // A token is compared by its decoded length: "%00" in it must not end the comparison early.
+  char queryBuffer[128] = "", cookieBuffer[128] = "";
+  int queryLength = -1, cookieLength = -1;
   if (info->query_string)
-    cw::mg_get_var(info->query_string, std::strlen(info->query_string), "token", queryToken,
-                   sizeof queryToken);
+    queryLength = cw::mg_get_var(info->query_string, std::strlen(info->query_string), "token", queryBuffer,
+                                 sizeof queryBuffer);
   std::string cookies = header("Cookie");
   if (!cookies.empty())
-    cw::mg_get_cookie(cookies.c_str(), access_.cookieName().c_str(), cookieToken, sizeof cookieToken);
+    cookieLength =
+        cw::mg_get_cookie(cookies.c_str(), access_.cookieName().c_str(), cookieBuffer, sizeof cookieBuffer);
+  std::string_view queryToken(queryBuffer, size_t(std::max(queryLength, 0)));
+  std::string_view cookieToken(cookieBuffer, size_t(std::max(cookieLength, 0)));
   std::string authorization = header("Authorization"), bearer;
   if (authorization.rfind("Bearer ", 0) == 0) bearer = authorization.substr(7);
   std::string upgrade = header("Upgrade"), host = header("Host"), origin = header("Origin");
@@ -292,6 +300,10 @@ int Server::gate(mg_connection* conn) {
   if (stopping_) {
     status = 503;
     body = "the server is shutting down";
+  } else if (!decodePath(info->local_uri ? info->local_uri : "") || hasControlCharacter(queryToken) ||
+             hasControlCharacter(cookieToken) || hasControlCharacter(bearer)) {
+    status = 400;
+    body = "a control character (such as %00) or a malformed escape in the path or the token";
   } else if (verdict != Verdict::Allow) {
     status = 403;
     body = verdictReason(verdict);
@@ -304,7 +316,8 @@ int Server::gate(mg_connection* conn) {
   }
   if (status == 0) return 0; // on to the page or the WebSocket
   body += "\n";
-  const char* text = status == 403   ? "Forbidden"
+  const char* text = status == 400   ? "Bad Request"
+                     : status == 403 ? "Forbidden"
                      : status == 405 ? "Method Not Allowed"
                                      : "Service Unavailable";
   std::string head = "HTTP/1.1 " + std::to_string(status) + " " + text +
@@ -321,7 +334,8 @@ int Server::handleHttp(mg_connection* conn, void* self) {
 
 int Server::serveHttp(mg_connection* conn) {
   const mg_request_info* info = cw::mg_get_request_info(conn);
-  std::string path = info->local_uri ? info->local_uri : "";
+  // civetweb leaves the path as sent ("decode_url" off): decoded here, where a "%00" is seen, not cut at.
+  std::string path = decodePath(info->local_uri ? info->local_uri : "").value_or("");
   std::string_view type = "text/plain; charset=utf-8", body;
   int status = 200;
   std::string extra;
@@ -333,10 +347,10 @@ int Server::serveHttp(mg_connection* conn) {
     // The page's later requests (script, style, WebSocket) carry the token in a cookie: the address bar
     // can drop it. Strict: no other site's page sends it along.
     char token[128] = "";
-    if (!access_.token.empty() && info->query_string &&
-        cw::mg_get_var(info->query_string, std::strlen(info->query_string), "token", token, sizeof token) >
-            0 &&
-        tokenMatches(token, access_.token))
+    int length = info->query_string ? cw::mg_get_var(info->query_string, std::strlen(info->query_string),
+                                                     "token", token, sizeof token)
+                                    : -1;
+    if (!access_.token.empty() && length > 0 && tokenMatches({token, size_t(length)}, access_.token))
       extra = "Set-Cookie: " + access_.cookieName() + "=" + access_.token + "; HttpOnly; SameSite=Strict\r\n";
   } else {
     status = 404;
@@ -369,10 +383,11 @@ void Server::wsReady(mg_connection* conn, void* selfPointer) {
   auto& c = *static_cast<Connection*>(cw::mg_get_user_connection_data(conn));
   c.conn = conn;
   if (c.refused) {
-    std::string why = "the server already has " + std::to_string(self.options_.maxClients) +
+    // One close frame whose reason the page shows: a browser reads the reason of a close after the
+    // handshake, never the body of a refused upgrade.
+    std::string why = "server full: " + std::to_string(self.options_.maxClients) +
                       " clients (--max-clients); try again later";
-    c.sendText(Json{{"t", "error"}, {"message", why}}.dump());
-    sendClose(conn, kCloseTryAgain, "server full");
+    sendClose(conn, kCloseTryAgain, why);
     self.emit({{"event", "refused"}, {"why", why}, {"websocket", true}});
     return;
   }
@@ -435,11 +450,34 @@ int Server::wsData(mg_connection* conn, int bits, char* data, size_t length, voi
   return static_cast<Server*>(self)->receive(c, bits, data, length);
 }
 
+// RFC 6455 (5.2, 5.5, 8.1) asks a server to fail the connection on frames civetweb passes on: reserved bits
+// without an extension, unknown opcodes, control frames fragmented or over 125 bytes, text that is not
+// UTF-8. civetweb answers pings and drops pongs itself, and does not tell this handler whether a frame was
+// masked.
 int Server::receive(Connection& c, int bits, const char* data, size_t length) {
   int opcode = bits & 0x0F;
   bool final = (bits & 0x80) != 0;
-  if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
+  if (bits & 0x70) return refuseMessage(c, kCloseProtocol, "reserved bits set (no extension was agreed)");
+  if ((opcode > MG_WEBSOCKET_OPCODE_BINARY && opcode < MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) ||
+      opcode > MG_WEBSOCKET_OPCODE_PONG)
+    return refuseMessage(c, kCloseProtocol, "unknown opcode " + std::to_string(opcode));
+  bool control = opcode >= MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE;
+  if (control && (!final || length > 125))
+    return refuseMessage(c, kCloseProtocol, "a control frame fragmented or longer than 125 bytes");
+  if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) {
+    if (length == 1 || (length > 2 && !isUtf8({data + 2, length - 2})))
+      return refuseMessage(c, length == 1 ? kCloseProtocol : kCloseNotUtf8, "a malformed close frame");
+    // The closing handshake's answer, after the last frame the sender was writing; none when this server
+    // closed first (the client's frame is then the answer).
+    if (!c.refused && !stopping_) {
+      if (c.stream) c.stream->stop();
+      sendClose(c.conn, kCloseNormal, "");
+    }
+    return 0;
+  }
   if (opcode == MG_WEBSOCKET_OPCODE_PING || opcode == MG_WEBSOCKET_OPCODE_PONG) return 1;
+  if (opcode == MG_WEBSOCKET_OPCODE_CONTINUATION)
+    return refuseMessage(c, kCloseProtocol, "a continuation frame without a message to continue");
   if (c.refused || !c.ready) return 0;
   if (!c.budget.take(now()))
     return refuseMessage(c, kClosePolicy, "more than the allowed messages per second");
@@ -447,6 +485,7 @@ int Server::receive(Connection& c, int bits, const char* data, size_t length) {
     return refuseMessage(c, kCloseTooBig, "message longer than the allowed bytes");
   if (opcode != MG_WEBSOCKET_OPCODE_TEXT || !final)
     return refuseMessage(c, kCloseUnsupported, "only whole text messages are accepted");
+  if (!isUtf8({data, length})) return refuseMessage(c, kCloseNotUtf8, "a text message that is not UTF-8");
   auto parsed = parseClientMessage({data, length}, methods_);
   if (auto* why = std::get_if<std::string>(&parsed))
     return refuseMessage(c, kClosePolicy, "invalid message: " + *why);
@@ -593,6 +632,8 @@ void Server::start() {
                                 "yes",
                                 "enable_keep_alive",
                                 "yes",
+                                "decode_url",
+                                "no",
                                 nullptr};
   mg_callbacks callbacks{};
   callbacks.begin_request = &Server::beginRequest;
