@@ -26,6 +26,7 @@ using Command = std::function<int()>;
   POINTRAST_COMMAND(Info)                                                                                    \
   POINTRAST_COMMAND(Render)                                                                                  \
   POINTRAST_COMMAND(Convert)                                                                                 \
+  POINTRAST_COMMAND(Profile)                                                                                 \
   POINTRAST_COMMAND(Generate)                                                                                \
   POINTRAST_COMMAND(Bench)                                                                                   \
   POINTRAST_COMMAND(BenchIo)                                                                                 \
