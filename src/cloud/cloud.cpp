@@ -1,9 +1,11 @@
 #include "cloud/cloud.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 
 #include "base/error.h"
 #include "base/parallel.h"
@@ -11,6 +13,21 @@
 #include "cloud/detail.h"
 
 namespace pointrast {
+
+void checkCoordinateRange(const Bounds& bounds, const std::string& source) {
+  if (bounds.empty()) return;
+  double reach = 0;
+  for (const glm::dvec3& corner : {bounds.min, bounds.max})
+    for (int a = 0; a < 3; ++a)
+      reach = std::isfinite(corner[a]) ? std::max(reach, std::abs(corner[a])) : INFINITY;
+  if (reach <= kMaxCoordinate) return;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                ": coordinates reach %.3g, beyond the %.0e pointrast renders (doubles are coarser than 1/8 "
+                "there); a damaged header or file?",
+                reach, kMaxCoordinate);
+  throw InputError(source + text);
+}
 
 namespace detail {
 

@@ -66,6 +66,13 @@ struct PointCloud {
   glm::dvec3 origin() const { return bounds.center(); }
 };
 
+// The largest coordinate magnitude pointrast renders: beyond it doubles are coarser than 1/8 unit, and no
+// survey, scan or simulation has such values; they come from a damaged header or file.
+constexpr double kMaxCoordinate = 1e15;
+// Throws InputError naming `source` when bounds are not finite or reach beyond kMaxCoordinate. Empty
+// bounds pass.
+void checkCoordinateRange(const Bounds& bounds, const std::string& source);
+
 // Recomputes cloud.bounds from the points (all hardware threads).
 void computeBounds(PointCloud& cloud);
 

@@ -54,21 +54,6 @@ Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm
   return camera;
 }
 
-void checkCoordinateRange(const Bounds& bounds, const std::string& source) {
-  if (bounds.empty()) return;
-  double reach = 0;
-  for (const glm::dvec3& corner : {bounds.min, bounds.max})
-    for (int a = 0; a < 3; ++a)
-      reach = std::isfinite(corner[a]) ? std::max(reach, std::abs(corner[a])) : INFINITY;
-  if (reach <= kMaxCoordinate) return;
-  char text[200];
-  std::snprintf(text, sizeof text,
-                ": coordinates reach %.3g, beyond the %.0e pointrast renders (doubles are coarser than 1/8 "
-                "there); a damaged header or file?",
-                reach, kMaxCoordinate);
-  throw InputError(source + text);
-}
-
 std::optional<CameraProblem> findCameraProblem(const Camera& camera) {
   auto finite = [](const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);

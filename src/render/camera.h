@@ -30,12 +30,7 @@ struct Camera {
 // points) get the same view of the origin. fovY must be in (0, 180).
 Camera overviewCamera(const Bounds& bounds, double aspect, double fovY = 60.0);
 
-// The largest coordinate magnitude pointrast renders: beyond it doubles are coarser than 1/8 unit, and no
-// survey, scan or simulation has such values; they come from a damaged header or file.
-constexpr double kMaxCoordinate = 1e15;
-// Throws InputError naming `source` when bounds are not finite or reach beyond kMaxCoordinate. Empty
-// bounds pass.
-void checkCoordinateRange(const Bounds& bounds, const std::string& source);
+// kMaxCoordinate and checkCoordinateRange (cloud/cloud.h) bound what is rendered.
 
 // The same framing from any direction: looking at the center of the bounds along -back (unit vector from
 // the target towards the eye) with the given up (not parallel to back), at the smallest distance that

@@ -12,6 +12,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "base/progress.h"
+#include "cloud/cloud.h"
 #include "io/io_util.h"
 #include "io/potree/lod_inputs.h"
 #include "io/potree/lod_spill.h"
@@ -71,6 +72,24 @@ template <class Body> void runWorkers(unsigned threads, Body&& body) {
   for (auto& t : pool)
     t.join();
   if (error) std::rethrow_exception(error);
+}
+
+// An octree the renderer could not draw (coordinates past kMaxCoordinate) is refused once its points
+// were scanned, before a node is written; a scale that alone puts them there is named, since a damaged
+// header's scale is the usual cause.
+void checkOctreeFrame(const Bounds& bounds, const glm::dvec3& scale, const std::string& source) {
+  // 2^31: the largest magnitude of a record's int32 coordinate.
+  const double largestScale = std::max({scale.x, scale.y, scale.z});
+  if (!(largestScale * 2147483648.0 <= kMaxCoordinate)) {
+    try {
+      checkCoordinateRange(bounds, source);
+    } catch (const InputError&) {
+      throw InputError(strFormat("%s: a scale of %.3g puts coordinates beyond the %.0e pointrast renders; a "
+                                 "damaged header?",
+                                 source.c_str(), largestScale, kMaxCoordinate));
+    }
+  }
+  checkCoordinateRange(bounds, source);
 }
 
 } // namespace
@@ -188,6 +207,7 @@ const lod::OctreeMetadata& OctreeBuilder::scan() {
   m.source = s.inputs.names();
   m.cube = s.grid.cube;
   m.bounds = pointrast::detail::worldBounds(box, s.grid.scale, s.grid.offset);
+  checkOctreeFrame(m.bounds, s.grid.scale, s.inputs.names());
   m.spacing = s.grid.spacing();
   m.scale = s.grid.scale;
   m.offset = s.grid.offset;

@@ -2,6 +2,8 @@
 // temporary sibling folder renamed into place at the end.
 #include <cassert>
 #include <cerrno>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -145,10 +147,15 @@ void checkMetadata(const std::filesystem::path& dir, const lod::OctreeMetadata& 
   if (!std::isfinite(m.spacing) || m.spacing < 0) fail(dir, "the octree's spacing is not a finite number");
   // Readers (the Potree viewer among them) halve this box into children: it must be the cube
   // OctreeMetadata promises, or nodes would not be where the hierarchy says.
+  // Equal up to the rounding of its corners: far from the origin (offsets of 1e12) a double's step
+  // there is larger than a billionth of the edge.
   const glm::dvec3 edges = m.cube.max - m.cube.min;
   const double edge = std::max({edges.x, edges.y, edges.z});
-  assert(edge - std::min({edges.x, edges.y, edges.z}) <= 1e-9 * edge && "the octree's cube has equal edges");
-  if (edge - std::min({edges.x, edges.y, edges.z}) > 1e-9 * edge)
+  const glm::dvec3 reach = glm::max(glm::abs(m.cube.min), glm::abs(m.cube.max));
+  const double tolerance =
+      1e-9 * edge + 8 * std::numeric_limits<double>::epsilon() * std::max({reach.x, reach.y, reach.z});
+  assert(edge - std::min({edges.x, edges.y, edges.z}) <= tolerance && "the octree's cube has equal edges");
+  if (edge - std::min({edges.x, edges.y, edges.z}) > tolerance)
     fail(dir, "the octree's bounding box is not a cube");
 }
 
