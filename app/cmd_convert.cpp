@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "input.h"
 #include "io/format_table.h"
+#include "io/output_check.h"
 #include "io/potree/potree.h"
 #include "io/writer.h"
 #include "options.h"
@@ -149,6 +150,7 @@ Command addConvert(CLI::App& app) {
       throw InputError("--las expects auto, 1.2 or 1.4");
     lasFlavorFor(a->output, 0);
     if (!pathExists(a->input)) throw InputError(a->input + ": no such file or folder");
+    io::checkOutputTarget(a->output, "OUT");
     const io::FormatInfo* format = io::detectFormat(a->input);
     if (a->chunkSize == 0) throw InputError("--chunk-size must be at least 1 point");
     a->filter = pointFilter(a->filters);

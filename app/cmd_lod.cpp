@@ -21,6 +21,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "io/format_table.h"
+#include "io/output_check.h"
 #include "io/potree/lod_potree.h"
 #include "io/writer.h"
 #include "io/copc_ept/copc_writer.h"
@@ -77,15 +78,7 @@ void checkOutputFolder(std::string& output) {
   std::error_code ec;
   if (std::filesystem::exists(std::filesystem::symlink_status(output, ec)))
     throw InputError(output + ": already exists (an octree is written into a new folder)");
-  const std::filesystem::path parent = std::filesystem::absolute(output, ec).parent_path();
-  const auto status = std::filesystem::status(parent, ec);
-  if (status.type() == std::filesystem::file_type::not_found)
-    throw InputError(output + ": the folder " + parent.string() + " does not exist");
-  if (status.type() != std::filesystem::file_type::directory)
-    throw InputError(output + ": " + parent.string() + " is not a folder");
-  if (::access(parent.c_str(), W_OK | X_OK) != 0)
-    throw InputError(output + ": cannot write in the folder " + parent.string() + " (" +
-                     std::strerror(errno) + ")");
+  io::checkOutputTarget(output, "-o");
 }
 
 double perSecond(double count, double seconds) {

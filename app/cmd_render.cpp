@@ -25,6 +25,7 @@
 #include "input.h"
 #include "options.h"
 #include "io/format_table.h"
+#include "io/output_check.h"
 #include "io/writer.h"
 #include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
@@ -170,6 +171,7 @@ void checkCommonArgs(const RenderArgs& a) {
     throw InputError("--path renders the point methods, not " + a.method);
   if (!pathMode && std::filesystem::path(a.output).extension() != ".png")
     throw InputError("-o " + a.output + ": the output must be a .png file");
+  if (!pathMode) io::checkOutputTarget(a.output, "-o");
   if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (!(a.fov > 0 && a.fov < 180)) throw InputError("--fov must be between 0 and 180 degrees");

@@ -12,6 +12,7 @@
 #include "cli_util.h"
 #include "gpu/context.h"
 #include "io/media/video_writer.h"
+#include "io/output_check.h"
 #include "view/path_render.h"
 
 namespace pointrast::app {
@@ -37,6 +38,7 @@ view::CameraPath loadPathForRender(const PathOutput& out, uint32_t width, uint32
   if (out.crf > 51) throw InputError("--crf must be between 0 and 51");
   if (!out.video.empty()) {
     io::videoContainer(out.video); // throws for another extension, before the cloud is loaded
+    io::checkOutputTarget(out.video, "--video");
     if (width % 2 || height % 2)
       throw InputError("--video needs an even --width and --height (H.264 halves the color resolution)");
   }

@@ -131,7 +131,7 @@ TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
   // Each names what is wrong with the output's name.
   const auto file =
       runPointrast("lod " + kAutzen.string() + " -o " + (dir / "exists" / "file" / "sub").string());
-  EXPECT_NE(file.err.find("is not a folder"), std::string::npos) << file.err;
+  EXPECT_NE(file.err.find("is a file, not a folder"), std::string::npos) << file.err;
   const auto slash = runPointrast("lod " + kAutzen.string() + " -o " + (dir / "exists").string() + "/");
   EXPECT_NE(slash.err.find("exists: already exists"), std::string::npos) << slash.err;
 }
