@@ -12,6 +12,9 @@
 #   scripts/fuzz.sh [SECONDS] [NAME...]          SECONDS per target (default 25), NAME: las, ply...
 #   scripts/fuzz.sh --total SECONDS [NAME...]    the running of all targets takes about SECONDS of wall
 #                                                time: each gets SECONDS x JOBS / targets (at least 10)
+#   scripts/fuzz.sh --report ...                 also appends the run to docs/fuzzing.md ("Runs" at its
+#                                                end): per target its seconds, executions, executions per
+#                                                second, coverage (cov / ft) and findings
 #   POINTRAST_FUZZ_JOBS     targets run at once (default: the number of cores); 1 for long runs on a
 #                           shared machine
 #   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
@@ -20,6 +23,11 @@
 #   POINTRAST_FUZZ_FLAGS    more libFuzzer flags, e.g. "-use_value_profile=1" for long runs
 set -euo pipefail
 cd "$(dirname "$0")/.."
+report=""
+if [ "${1:-}" = "--report" ]; then
+  report="docs/fuzzing.md"
+  shift
+fi
 total=""
 if [ "${1:-}" = "--total" ]; then
   total="${2:?--total needs SECONDS}"
@@ -91,6 +99,7 @@ fuzzTarget() {
   local log="$build/logs/$name.log"
   mkdir -p "$corpus"
   echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
+  local started=$SECONDS
   if "${generator[@]}" "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 \
     -malloc_limit_mb=256 -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" \
     ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" >"$log" 2>&1; then
@@ -112,11 +121,37 @@ fuzzTarget() {
       done
     } >"$result"
   fi
+  reportRow "$name" "$log" $((SECONDS - started)) >"$build/logs/$name.row"
+}
+
+# One Markdown row of the report for target $1 from its log $2, run for $3 s of wall time: libFuzzer's
+# final stats (executions, executions per second), the cov and ft of its last status line, and what it
+# found (the sanitizer's or libFuzzer's first error line and the kept input).
+reportRow() {
+  local name="$1" log="$2" wall="$3"
+  local executions rate status cov ft finding="none"
+  executions="$(sed -n 's/^stat::number_of_executed_units:[[:space:]]*//p' "$log" | tail -n 1)"
+  rate="$(sed -n 's/^stat::average_exec_per_sec:[[:space:]]*//p' "$log" | tail -n 1)"
+  status="$(grep -E '^#[0-9]+[[:space:]].*cov: [0-9]+' "$log" | tail -n 1 || true)"
+  cov="$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")"
+  ft="$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$status")"
+  if [ -z "$executions" ]; then executions="$(sed -n 's/^#\([0-9]*\)[[:space:]].*/\1/p' <<<"$status")"; fi
+  local input
+  for input in "$findings/$name-"*; do
+    if [ -e "$input" ]; then
+      local what
+      what="$(grep -m 1 -E '^(==[0-9]+==ERROR|SUMMARY|.*runtime error)' "$log" | sed 's/^==[0-9]*==//; s/|/\\|/g' | cut -c 1-120)"
+      finding="${what:-a finding}: \`$input\`"
+      break
+    fi
+  done
+  printf '| `%s` | %s s | %s | %s | %s / %s | %s |\n' "$name" "$wall" "${executions:-?}" "${rate:-?}" \
+    "${cov:-?}" "${ft:-?}" "$finding"
 }
 
 for name in "${names[@]}"; do
   [ -x "$build/fuzz/${name}_fuzz" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
-  rm -f "$build/logs/$name.result"
+  rm -f "$build/logs/$name.result" "$build/logs/$name.row"
 done
 running=0
 for name in "${names[@]}"; do
@@ -139,6 +174,23 @@ for name in "${names[@]}"; do
     cat "$result"
   fi
 done
+if [ -n "$report" ]; then
+  if ! grep -q '^## Runs$' "$report"; then
+    printf '\n## Runs\n\nAppended by `scripts/fuzz.sh --report`, newest last.\n' >>"$report"
+  fi
+  {
+    echo
+    echo "$(date -u +'%Y-%m-%d %H:%M') UTC, commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)," \
+      "$seconds s per target, $jobs at once on $(nproc) cores (load average $(cut -d ' ' -f 1 /proc/loadavg)):"
+    echo
+    echo "| target | time | executions | per second | cov / ft | findings |"
+    echo "| --- | --- | --- | --- | --- | --- |"
+    for name in "${names[@]}"; do
+      cat "$build/logs/$name.row" 2>/dev/null || echo "| \`$name\` | | | | | no result |"
+    done
+  } >>"$report"
+  echo "fuzz: the run is appended to $report"
+fi
 if [ ${#failed[@]} -gt 0 ]; then
   echo "fuzz: findings in ${failed[*]} (logs in $build/logs)" >&2
   exit 1
