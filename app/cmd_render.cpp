@@ -24,12 +24,14 @@
 #include "gpu/shared_types.h"
 #include "input.h"
 #include "options.h"
+#include "io/annotations_file.h"
 #include "io/format_table.h"
 #include "io/output_check.h"
 #include "io/writer.h"
 #include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
 #include "render/pick.h"
+#include "render/overlay.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
 #include "render_filter.h"
@@ -68,6 +70,7 @@ struct RenderArgs {
   std::optional<uint32_t> device;
   bool json = false, quiet = false;
   PathOutput path; // --path: a camera path into a video or PNG frames instead of -o
+  std::string annotations; // --annotations: measurements drawn over the image
   LookArgs look; // point methods: coloring and the resolve stage
   FilterArgs filter; // point methods: clip volumes and attribute filters
   std::string pick;  // --pick X,Y: the point drawn at that pixel, in the JSON
@@ -174,6 +177,8 @@ void checkCommonArgs(const RenderArgs& a) {
   if (!pathMode) io::checkOutputTarget(a.output, "-o");
   if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
   if (a.frames == 0) throw InputError("--frames must be at least 1");
+  if (!a.annotations.empty() && isSphereMethodName(a.method))
+    throw InputError("--annotations draws over the point methods, not " + a.method);
   if (!(a.fov > 0 && a.fov < 180)) throw InputError("--fov must be between 0 and 180 degrees");
   if (!(a.nearW >= 0) || !std::isfinite(a.nearW)) throw InputError("--near must be a number >= 0");
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
@@ -667,11 +672,38 @@ nlohmann::json pickAt(Renderer& renderer, const PointCloud& cloud, const std::op
   return pickJson(cloud, pixel, word == shared::kEmptyPixel, pickPoint(request, pixel.x, pixel.y, word));
 }
 
+// --annotations: read before the device starts, for the methods that draw a loaded cloud into one mono
+// image with a depth per pixel; the frame then keeps its canonical words for the overlay's depth test.
+std::optional<Annotations> overlayAnnotations(const RenderArgs& a, RenderSettings& settings) {
+  if (a.annotations.empty()) return std::nullopt;
+  const MethodInfo& info = settings.method.info();
+  if (info.layout == SceneLayout::Octree)
+    throw InputError("--annotations draws over the methods that draw a loaded cloud, not " + a.method);
+  if (a.stereo) throw InputError("--annotations draws over a mono image, not --stereo");
+  const bool resolved = settings.post.enabled(); // the resolve stage leaves float-depth words for any method
+  if (!resolved && !hasCanonicalWords(info))
+    throw InputError("--annotations needs the depth of each pixel, which " + a.method +
+                     " does not keep; use a closest-point method (atomicmin) or add --point-size 1.5");
+  if (!resolved && settings.depth == DepthMode::Int40)
+    throw InputError("--annotations reads float depths: leave --depth at float");
+  settings.captureWords = true;
+  return io::loadAnnotations(a.annotations);
+}
+
+// Draws the annotations over the frame the renderer drew last with `camera`.
+void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds, const Annotations& annotations,
+                 std::vector<uint32_t>& pixels) {
+  const std::vector<uint64_t> words = renderer.framebufferWords();
+  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(bounds);
+  drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
+}
+
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   checkCommonArgs(a);
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
-  const RenderSettings settings = pointSettings(a);
+  RenderSettings settings = pointSettings(a);
+  const std::optional<Annotations> annotations = overlayAnnotations(a, settings);
   if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
@@ -694,14 +726,20 @@ int runRender(const RenderArgs& a) {
     drawn.push_back(scene.get());
   if (!a.path.path.empty()) {
     if (cameraPath.empty()) cameraPath = view::orbitPath(camera);
-    return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet);
+    view::FrameOverlay overlay;
+    if (annotations)
+      overlay = [&](const Camera& c, std::vector<uint32_t>& image) {
+        drawOverlay(renderer, c, cloud.bounds, *annotations, image);
+      };
+    return renderCameraPath(context, renderer, drawn, settings, cameraPath, a.path, a.json, a.quiet, overlay);
   }
   settleClocksWith(context, settings, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); });
   bool settled = true;
   const FrameStats stats = timeSettled(
       context, settings, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); }, settled);
   warnUnsettled(settled, stats.medianMs, stats.minMs);
-  const std::vector<uint32_t> pixels = renderer.image();
+  std::vector<uint32_t> pixels = renderer.image();
+  if (annotations) drawOverlay(renderer, camera, cloud.bounds, *annotations, pixels);
   finishImage(
       a, context, pixels,
       [&] {
@@ -882,6 +920,9 @@ Command addRender(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");
   addPathOptions(*cmd, a->path);
+  cmd->add_option("--annotations", a->annotations,
+                  "Measurements, labels and clip volumes (a JSON file, docs/tools.md) drawn over the image, "
+                  "hidden where points are closer");
   return [a] { return runRender(*a); };
 }
 

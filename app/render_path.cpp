@@ -49,7 +49,7 @@ view::CameraPath loadPathForRender(const PathOutput& out, uint32_t width, uint32
 
 int renderCameraPath(gpu::Context& context, Renderer& renderer, std::span<const GpuScene* const> scenes,
                      const RenderSettings& settings, const view::CameraPath& path, const PathOutput& out,
-                     bool json, bool quiet) {
+                     bool json, bool quiet, const view::FrameOverlay& overlay) {
   std::unique_ptr<view::FrameSink> sink;
   if (!out.video.empty()) {
     io::VideoOptions options;
@@ -62,7 +62,7 @@ int renderCameraPath(gpu::Context& context, Renderer& renderer, std::span<const 
     sink = std::make_unique<view::PngFrameSink>(out.framesDir, renderer.width(), renderer.height());
   }
   view::PathRenderResult result =
-      view::renderPath(renderer, scenes, path, out.fps, settings, *sink, !quiet && Progress::enabled());
+      view::renderPath(renderer, scenes, path, out.fps, settings, *sink, !quiet && Progress::enabled(), overlay);
   if (context.validationErrors() > 0)
     throw InputError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
                      " error(s)");

@@ -8,6 +8,7 @@
 
 #include "render/renderer.h"
 #include "view/camera_path.h"
+#include "view/path_render.h"
 
 namespace CLI {
 class App;
@@ -35,9 +36,9 @@ void addPathOptions(CLI::App& render, PathOutput& out);
 view::CameraPath loadPathForRender(const PathOutput& out, uint32_t width, uint32_t height);
 
 // Renders every frame of the path and writes the video or the frames; prints a summary line (or one JSON
-// object). Returns the exit code.
+// object); `overlay`, when set, draws over each frame. Returns the exit code.
 int renderCameraPath(gpu::Context& context, Renderer& renderer, std::span<const GpuScene* const> scenes,
                      const RenderSettings& settings, const view::CameraPath& path, const PathOutput& out,
-                     bool json, bool quiet);
+                     bool json, bool quiet, const view::FrameOverlay& overlay = {});
 
 } // namespace pointrast::app

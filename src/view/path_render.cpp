@@ -121,7 +121,7 @@ void VideoFrameSink::finish() {
 
 PathRenderResult renderPath(Renderer& renderer, std::span<const GpuScene* const> scenes,
                             const CameraPath& path, double fps, const RenderSettings& settings,
-                            FrameSink& sink, bool progress) {
+                            FrameSink& sink, bool progress, const FrameOverlay& overlay) {
   assert(!path.empty() && fps > 0);
   uint64_t frames = path.frameCount(fps);
   auto start = std::chrono::steady_clock::now();
@@ -144,9 +144,12 @@ PathRenderResult renderPath(Renderer& renderer, std::span<const GpuScene* const>
   std::vector<double> gpuMs;
   try {
     for (uint64_t i = 0; i < frames; ++i) {
-      FrameStats stats = renderer.render(scenes, path.sample(double(i) / fps), one);
+      const Camera camera = path.sample(double(i) / fps);
+      FrameStats stats = renderer.render(scenes, camera, one);
       gpuMs.push_back(stats.medianMs);
-      queue.push(renderer.image());
+      std::vector<uint32_t> image = renderer.image();
+      if (overlay) overlay(camera, image);
+      queue.push(std::move(image));
     }
   } catch (...) {
     queue.fail(std::current_exception());

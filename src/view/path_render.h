@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -58,6 +59,10 @@ private:
   std::unique_ptr<io::VideoWriter> writer_;
 };
 
+// Draws over a frame (RGBA8, the renderer's size) just rendered with the camera, before it is written; the
+// renderer still holds the frame (its words, for a depth test).
+using FrameOverlay = std::function<void(const Camera&, std::vector<uint32_t>&)>;
+
 struct PathRenderResult {
   uint64_t frames = 0;
   double seconds = 0;         // wall clock of the whole render, writing included
@@ -66,9 +71,10 @@ struct PathRenderResult {
 };
 
 // Renders path.frameCount(fps) frames at the renderer's size and hands them to the sink in order, then
-// finishes it. On any error the sink is not finished (and cleans up when destroyed).
+// finishes it, each frame drawn over by `overlay` when set. On any error the sink is not finished (and
+// cleans up when destroyed).
 PathRenderResult renderPath(Renderer& renderer, std::span<const GpuScene* const> scenes,
                             const CameraPath& path, double fps, const RenderSettings& settings,
-                            FrameSink& sink, bool progress);
+                            FrameSink& sink, bool progress, const FrameOverlay& overlay = {});
 
 } // namespace pointrast::view

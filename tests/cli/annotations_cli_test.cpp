@@ -1,0 +1,131 @@
+// `render --annotations`: markers and lines land on the pixels this test projects itself from the camera it
+// passes, a line behind a wall of points is hidden, and bad annotation files or combinations are refused.
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+
+#include "cli_harness.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using pointrast::test::runPointrast;
+
+constexpr int kW = 160, kH = 120;
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+  std::array<int, 3> at(int x, int y) const {
+    const size_t i = (size_t(y) * size_t(width) + size_t(x)) * 4;
+    return {rgba[i], rgba[i + 1], rgba[i + 2]};
+  }
+};
+
+Image readPng(const fs::path& file) {
+  Image image;
+  int channels = 0;
+  uint8_t* data = stbi_load(file.c_str(), &image.width, &image.height, &channels, 4);
+  if (!data) return image;
+  image.rgba.assign(data, data + size_t(image.width) * size_t(image.height) * 4);
+  stbi_image_free(data);
+  return image;
+}
+
+// The camera of every render here: from (0, -10, 0) along +y, z up, 60 degrees, kW x kH. The pixel of a
+// point by docs/design.md: view x is world x, view y is world z, depth is y + 10.
+const char* kCamera = "--eye 0,-10,0 --target 0,0,0 --up 0,0,1 --fov 60 --width 160 --height 120";
+std::array<int, 2> pixelOf(double x, double y, double z) {
+  const double depth = y + 10, f = 1 / std::tan(30.0 * M_PI / 180), aspect = double(kW) / kH;
+  return {int(std::floor((x * f / aspect / depth + 1) / 2 * kW)), int(std::floor((1 - z * f / depth) / 2 * kH))};
+}
+
+// A gray wall of points in the plane y = 0 covering x in [-2, 0], z in [-3, 3] (the left half of the view
+// at that depth), dense enough to leave no hole at this size.
+fs::path wallCloud() {
+  const fs::path file = pointrast::test::cliTempDir() / "wall.xyz";
+  std::ofstream out(file);
+  for (int i = 0; i <= 200; ++i)
+    for (int k = 0; k <= 300; ++k)
+      out << -2 + i * 0.01 << " 0 " << -3 + k * 0.02 << " 128 128 128\n";
+  return file;
+}
+
+fs::path writeText(const std::string& name, const std::string& text) {
+  const fs::path file = pointrast::test::cliTempDir() / name;
+  std::ofstream(file) << text;
+  return file;
+}
+
+TEST(AnnotationsCli, MarkersAndLinesLandOnTheProjectedPixelsAndHideBehindPoints) {
+  const fs::path cloud = wallCloud();
+  // A red point marker in the open right half at depth 12, and a green line at depth 15 (behind the wall)
+  // from x = -3 to x = 3, z = -1.
+  const fs::path annotations = writeText("scene.json", R"({"version": 1, "annotations": [
+    {"type": "point", "color": [255, 0, 0], "points": [[2.5, 2, 1.5]]},
+    {"type": "distance", "color": [0, 255, 0], "points": [[-3, 5, -1], [3, 5, -1]]}]})");
+  const fs::path png = pointrast::test::cliTempDir() / "annotated.png";
+  const auto r = runPointrast("render " + cloud.string() + " " + kCamera + " --frames 1 -q --annotations " +
+                              annotations.string() + " -o " + png.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Image image = readPng(png);
+  ASSERT_EQ(image.width, kW);
+  ASSERT_EQ(image.height, kH);
+  const auto marker = pixelOf(2.5, 2, 1.5);
+  EXPECT_EQ(image.at(marker[0], marker[1]), (std::array<int, 3>{255, 0, 0}));
+  // The line's row: green in the open right half, never green over the wall (where the gray points are).
+  const auto leftEnd = pixelOf(-3, 5, -1), rightEnd = pixelOf(3, 5, -1);
+  const int row = leftEnd[1], wallEdge = pixelOf(0, 0, 0)[0];
+  int green = 0, gray = 0;
+  for (int x = leftEnd[0] + 5; x < rightEnd[0] - 5; ++x) {
+    const auto c = image.at(x, row);
+    if (x < wallEdge - 1) {
+      EXPECT_NE(c, (std::array<int, 3>{0, 255, 0})) << "line drawn over the wall at x " << x;
+      gray += c == std::array<int, 3>{128, 128, 128};
+    } else if (x > wallEdge + 1) {
+      green += c == std::array<int, 3>{0, 255, 0};
+    }
+  }
+  EXPECT_GT(gray, 10);
+  EXPECT_EQ(green, rightEnd[0] - 5 - (wallEdge + 2)) << "the line is missing where nothing hides it";
+
+  // The same render without the file: no red at the marker, so the overlay made it.
+  const fs::path plain = pointrast::test::cliTempDir() / "plain.png";
+  ASSERT_EQ(runPointrast("render " + cloud.string() + " " + kCamera + " --frames 1 -q -o " + plain.string()).exitCode, 0);
+  EXPECT_NE(readPng(plain).at(marker[0], marker[1]), (std::array<int, 3>{255, 0, 0}));
+}
+
+TEST(AnnotationsCli, BadFilesAndCombinationsAreRefusedWithoutOutput) {
+  const fs::path png = pointrast::test::cliTempDir() / "refused.png";
+  const fs::path bad = writeText("bad.json", R"({"version": 1, "annotations": [{"type": "angle", "points": [[0,0,0]]}]})");
+  const fs::path good = writeText("good.json", R"({"version": 1, "annotations": []})");
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"--annotations " + bad.string(), "annotation 1 (angle): needs exactly 3 points"},
+      {"--annotations /nonexistent.json", "no such annotations file"},
+      {"--annotations " + good.string() + " --method hqs", "needs the depth of each pixel"},
+      {"--annotations " + good.string() + " --stereo --method batch", "not --stereo"},
+      {"--annotations " + good.string() + " --method sphere-compute", "point methods"},
+  };
+  for (const Case& c : cases) {
+    fs::remove(png);
+    const auto r = runPointrast("render terrain --points 10k --width 64 --height 48 --frames 1 -q " + c.args +
+                                " -o " + png.string());
+    EXPECT_EQ(r.exitCode, 1) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(png)) << c.args;
+  }
+}
+
+} // namespace
