@@ -141,8 +141,9 @@ void expectSameAsSubset(gpu::Context& context, const PointCloud& cloud, const Po
     EXPECT_EQ(clipped.words.size(), reference.words.size()) << what << ", " << method;
     // The batch methods decode a point from its batch's quantization, and the subset's batches are others:
     // the depth may differ by an ulp, the winner (its unique color) may not.
-    if (methodInfo(parseMethod(method)).layout == SceneLayout::Float)
+    if (methodInfo(parseMethod(method)).layout == SceneLayout::Float) {
       EXPECT_EQ(differ, 0u) << what << ", " << method << ": framebuffer words differ";
+    }
     differ = 0;
     for (size_t i = 0; i < clipped.image.size() && i < reference.image.size(); ++i)
       differ += clipped.image[i] != reference.image[i];
