@@ -129,7 +129,9 @@ void killAtRandomMoments(const std::string& name,
                          const std::function<std::vector<std::string>(const fs::path&)>& command,
                          const std::string& outputName) {
   const fs::path dir = fresh("crash_" + name);
-  const fs::path reference = dir / ("reference_" + outputName), output = dir / outputName;
+  // The reference under the same name (an octree's metadata.json holds its folder's name).
+  fs::create_directories(dir / "reference");
+  const fs::path reference = dir / "reference" / outputName, output = dir / outputName;
   const ChildRun whole = runPointrastChild(command(reference));
   ASSERT_TRUE(whole.exited && whole.exitCode == 0) << whole.err;
   ASSERT_TRUE(fs::exists(reference));
