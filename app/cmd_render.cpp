@@ -20,6 +20,7 @@
 #include "cloud/generate.h"
 #include "cloud/particles_generate.h"
 #include "commands.h"
+#include "distributed.h"
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
 #include "input.h"
@@ -28,6 +29,8 @@
 #include "io/format_table.h"
 #include "io/output_check.h"
 #include "io/writer.h"
+#include "mpi/mpi_job.h"
+#include "render/composite.h"
 #include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
 #include "render/pick.h"
@@ -247,6 +250,7 @@ gpu::ContextOptions contextOptions(const RenderArgs& a) {
   gpu::ContextOptions options;
   options.deviceIndex = a.device;
   options.announce = !a.quiet;
+  chooseRankDevice(options); // under mpirun: the device of this rank
   return options;
 }
 
@@ -482,6 +486,8 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   settings.stereo = stereoSettings(a);
   settings.foveation = foveation(a);
   const ColorChoice colors = colorChoice(a.look);
+  const bool distributed = distributedRun(); // under mpirun: this rank draws its share of the selection
+  if (distributed) checkDistributed(settings, false, false);
   if (a.input.empty() || isSceneName(a.input))
     throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
                      a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
@@ -490,20 +496,43 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   options.gpuBytes = lod.gpuBytes;
   options.colorSource = colors.source;
   options.colorRange = colors.range;
+  options.shareIndex = mpi::Job::get().rank();
+  options.shares = mpi::Job::get().size();
   std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
   const lod::OctreeMetadata& octree = source->metadata();
   const Camera camera = renderCamera(a, octree.bounds.empty() ? octree.cube : octree.bounds, octree.source);
 
   gpu::Context context(contextOptions(a));
+  CompositeStats composite;
+  if (distributed) composite.devices = announceRanks(context, a.quiet);
   std::string why;
   if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
   Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
   lod::LodScene scene(context, *source, options);
-  const FrameStats stats = renderer.render(scene, camera, settings);
-  const std::vector<uint32_t> pixels = renderer.image();
+  FrameStats stats = renderer.render(scene, camera, distributed ? rankSettings(settings) : settings);
+  std::vector<uint32_t> pixels;
+  if (distributed) {
+    if (context.validationErrors() > 0)
+      throw InternalError("the Vulkan validation layer reported " +
+                          std::to_string(context.validationErrors()) + " error(s), above");
+    pixels = compositeFrame(context, renderer, camera, settings, 0, stats, composite);
+    stats.medianMs = composite.renderMs; // the frame is done when the slowest rank is
+    stats.points = composite.points;
+    stats.post = composite.post;
+    if (!mpi::Job::get().root()) {
+      mpi::Job::get().close();
+      return 0;
+    }
+  } else {
+    pixels = renderer.image();
+  }
   finishImage(
       a, context, pixels,
-      [&] { return octreeJson(context, settings, octree, colors, stats, camera, a, pixels); },
+      [&] {
+        nlohmann::json j = octreeJson(context, settings, octree, colors, stats, camera, a, pixels);
+        if (distributed) j["mpi"] = compositeJson(composite); // batch and LOD counts are rank 0's
+        return j;
+      },
       [&] {
         std::printf("%s: %s of %s points, %ux%u, %s: %.3f ms median GPU time over %u frames (%.3f..%.3f), "
                     "%s points/s\n",
@@ -513,7 +542,9 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
                     humanCount(perSecond(stats.points, stats.medianMs)).c_str());
         printLodStats(*stats.lod, *stats.batch);
         if (stats.post) printPostStats(settings.post, *stats.post);
+        if (distributed) printCompositeSummary(composite);
       });
+  if (distributed) mpi::Job::get().close();
   return 0;
 }
 
@@ -698,13 +729,117 @@ void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds,
   drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
 }
 
+// A rank of `mpirun -np N pointrast render` (docs/mpi.md): its share of the points drawn on its device,
+// the frame composited on rank 0, which alone resolves, writes and reports it.
+int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
+  mpi::Job& job = mpi::Job::get();
+  checkDistributed(settings, !a.path.path.empty(), false);
+  const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
+  gpu::Context context(contextOptions(a));
+  CompositeStats composite;
+  composite.devices = announceRanks(context, a.quiet);
+  const PointCloud cloud = loadShare(spec);
+  const std::optional<DisplayColorMode> chosen = colorMode(a, cloud);
+  const DisplayColorMode colors = agreeColors(chosen ? *chosen : displayColorMode(cloud));
+  // Rank 0's camera for every rank: an overview is framed from a sample of its share.
+  Camera camera = renderCamera(a, cloud.bounds, cloud.source);
+  job.broadcast(&camera, sizeof camera);
+  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
+  const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
+  std::vector<const GpuScene*> drawn;
+  for (const auto& scene : scenes)
+    drawn.push_back(scene.get());
+  RenderSettings rank = rankSettings(settings);
+  if (rank.depth == DepthMode::Int40 && rank.depthScale <= 0) rank.depthScale = int40ScaleOf(drawn, camera);
+  settleClocksWith(context, rank, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); });
+  bool settled = true;
+  FrameStats stats = timeSettled(
+      context, rank, [&](const RenderSettings& s) { return renderer.render(drawn, camera, s); }, settled);
+  if (context.validationErrors() > 0)
+    throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
+                        " error(s), above");
+  const std::vector<uint32_t> pixels =
+      compositeFrame(context, renderer, camera, settings, rank.depthScale, stats, composite);
+  if (job.root()) {
+    stats.medianMs = composite.renderMs; // the frame is done when the slowest rank is
+    stats.points = composite.points;
+    stats.batch.reset(); // counted per rank; the JSON would show rank 0's alone
+    stats.post = composite.post;
+    const std::optional<DisplayColorMode> named = chosen ? std::optional(colors) : std::nullopt;
+    finishImage(
+        a, context, pixels,
+        [&] {
+          nlohmann::json j = pointJson(context, settings, cloud, spec.order, named, stats, camera, a, pixels);
+          j["clocks_settled"] = settled;
+          j["mpi"] = compositeJson(composite);
+          return j;
+        },
+        [&] {
+          printPointSummary(a, settings, stats);
+          printCompositeSummary(composite);
+        });
+  }
+  job.close();
+  return 0;
+}
+
+// --annotations: read before the device starts, for the methods that draw a loaded cloud into one mono
+// image with a depth per pixel; the frame then keeps its canonical words for the overlay's depth test.
+std::optional<Annotations> overlayAnnotations(const RenderArgs& a, RenderSettings& settings) {
+  if (a.annotations.empty()) return std::nullopt;
+  const MethodInfo& info = settings.method.info();
+  if (info.layout == SceneLayout::Octree)
+    throw InputError("--annotations draws over the methods that draw a loaded cloud, not " + a.method);
+  if (a.stereo) throw InputError("--annotations draws over a mono image, not --stereo");
+  const bool resolved = settings.post.enabled(); // the resolve stage leaves float-depth words for any method
+  if (!resolved && !hasCanonicalWords(info))
+    throw InputError("--annotations needs the depth of each pixel, which " + a.method +
+                     " does not keep; use a closest-point method (atomicmin) or add --point-size 1.5");
+  if (!resolved && settings.depth == DepthMode::Int40)
+    throw InputError("--annotations reads float depths: leave --depth at float");
+  settings.captureWords = true;
+  return io::loadAnnotations(a.annotations);
+}
+
+// --pick: the point the last frame drew at the pixel, from its canonical word (render/pick.h).
+nlohmann::json pickAt(Renderer& renderer, const PointCloud& cloud, const std::optional<DisplayColorMode>& colors,
+                      const RenderSettings& settings, const Camera& camera, const RenderArgs& a) {
+  const PixelPos pixel = parsePick(a.pick, a.width, a.height);
+  if (!hasCanonicalWords(methodInfo(settings.method)) && !settings.post.enabled()) {
+    nlohmann::json j;
+    j["pixel"] = {pixel.x, pixel.y};
+    j["point"] = std::string("unavailable: ") + a.method + " keeps no depth per pixel to pick from";
+    return j;
+  }
+  const uint64_t word = renderer.framebufferWords(pixel.x, pixel.y, 1, 1)[0];
+  PickRequest request;
+  request.cloud = &cloud;
+  request.colors = colors ? *colors : displayColorMode(cloud);
+  request.filter = settings.filter;
+  request.camera = camera;
+  request.width = a.width;
+  request.height = a.height;
+  request.depth = settings.post.enabled() ? DepthMode::Float : settings.depth;
+  return pickJson(cloud, pixel, word == shared::kEmptyPixel, pickPoint(request, pixel.x, pixel.y, word));
+}
+
+// Draws the annotations over the frame the renderer drew last with `camera`.
+void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds, const Annotations& annotations,
+                 std::vector<uint32_t>& pixels) {
+  const std::vector<uint64_t> words = renderer.framebufferWords();
+  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(bounds);
+  drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
+}
+
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   checkCommonArgs(a);
+  if (distributedRun() && isSphereMethodName(a.method)) checkDistributed({}, false, true);
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
   RenderSettings settings = pointSettings(a);
   const std::optional<Annotations> annotations = overlayAnnotations(a, settings);
   if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  if (distributedRun()) return runRenderDistributed(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
   const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);

@@ -18,11 +18,18 @@
 #include "base/text.h"
 #include "commands.h"
 #include "gpu/vulkan_api.h"
+#include "mpi/mpi_job.h"
 
 namespace {
 
-// The one error line: control characters escaped, so a file name holding a newline cannot split it.
+// The one error line: control characters escaped, so a file name holding a newline cannot split it. A rank
+// of a distributed job tells the others instead, and rank 0 prints the line once for the job.
 void printError(const std::string& message) {
+  pointrast::mpi::Job& job = pointrast::mpi::Job::get();
+  if (job.launched()) {
+    job.fail(message);
+    return;
+  }
   std::fprintf(stderr, "pointrast: %s\n", pointrast::printableLine(message).c_str());
 }
 
@@ -72,10 +79,19 @@ int runCommand(int argc, char** argv) {
   }
 
   try {
-    for (CLI::App* sub : app.get_subcommands())
+    for (CLI::App* sub : app.get_subcommands()) {
+      // Under mpirun with several ranks only render draws a share per rank; the others would each do the
+      // whole work (and write the same files).
+      if (mpi::Job::get().distributed() && sub->get_name() != "render")
+        throw InputError("`pointrast " + sub->get_name() +
+                         "` runs as one process; under mpirun only render divides its work among ranks "
+                         "(docs/mpi.md)");
       for (const app::RegisteredCommand& command : commands)
         if (command.subcommand == sub) return command.run();
+    }
     return 1;
+  } catch (const mpi::JobFailed&) {
+    return 1; // another rank failed; rank 0 printed its line
   } catch (const InputError& e) {
     printError(e.what());
   } catch (const UnsupportedError& e) {
@@ -119,5 +135,9 @@ std::vector<RegisteredCommand> addCommands(CLI::App& app) {
 } // namespace pointrast::app
 
 int main(int argc, char** argv) {
-  return checkStdout(runCommand(argc, argv));
+  // Under mpirun: MPI starts before anything else and ends after everything (src/mpi/mpi_job.h).
+  pointrast::mpi::Job::start(argc, argv);
+  const int status = checkStdout(runCommand(argc, argv));
+  pointrast::mpi::Job::finish();
+  return status;
 }

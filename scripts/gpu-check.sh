@@ -210,8 +210,14 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT \
       timeout 540 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
     ;;
+  mpi)
+    # Distributed rendering (docs/mpi.md): 1 rank against 2 ranks at 2560x1140, render and composite ms
+    # apart; brute force on MPI_POINTS (default 1G) generated points, lod on MPI_OCTREE when given. Writes
+    # mpi-scaling.{jsonl,md}.
+    timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" "${MPI_POINTS:-1G}" "${MPI_OCTREE:-}" || status=1
+    ;;
   *)
-    echo "unknown check '$what' (tests, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, mpi, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

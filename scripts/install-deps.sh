@@ -17,6 +17,7 @@ packages=(
   clang libclang-rt-dev llvm # libFuzzer targets (scripts/fuzz.sh): the fuzzer runtime and llvm-symbolizer
   # the Python module (python/, for Debian's python3) and its tests; pip installs it from the checkout
   python3-dev pybind11-dev python3-numpy python3-pytest python3-setuptools python3-wheel python3-venv python3-pip
+  libopenmpi-dev openmpi-bin # distributed rendering under mpirun (docs/mpi.md) and its tests
 )
 
 missing=()

@@ -13,9 +13,21 @@
 
 namespace pointrast {
 
+// Processes that share this machine's cores (the ranks of a distributed job on one host, src/mpi): each
+// counts hardwareThreads() as its part of them. 1 outside a job.
+inline std::atomic<unsigned>& threadShares() {
+  static std::atomic<unsigned> shares{1};
+  return shares;
+}
+inline void setThreadShares(unsigned processes) {
+  threadShares() = processes ? processes : 1;
+}
+
+// The threads this process uses: the hardware's, or its part of them when processes share the machine.
 inline unsigned hardwareThreads() {
   unsigned n = std::thread::hardware_concurrency();
-  return n ? n : 1;
+  n = n ? n : 1;
+  return std::max(1u, n / threadShares().load());
 }
 
 // Calls body(blockIndex, begin, end) for consecutive blocks [begin, end) of at most blockSize indices

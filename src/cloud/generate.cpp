@@ -1,5 +1,6 @@
 #include "cloud/generate.h"
 
+#include <algorithm>
 #include <new>
 #include <optional>
 #include <string>
@@ -41,10 +42,12 @@ std::unique_ptr<SceneGenerator> makeScene(Scene scene, uint64_t points, uint64_t
 } // namespace detail
 
 PointCloud generateScene(Scene scene, const GenerateOptions& options) {
-  const uint64_t n = options.points;
-  const std::string what = std::string(sceneName(scene)) + ", " + std::to_string(n) + " points, seed " +
+  const uint64_t all = options.points;
+  const uint64_t first = std::min(options.first, all);
+  const uint64_t n = std::min(options.count, all - first);
+  const std::string what = std::string(sceneName(scene)) + ", " + std::to_string(all) + " points, seed " +
                            std::to_string(options.seed);
-  if (n > kMaxPoints)
+  if (all > kMaxPoints)
     throw InputError("cannot generate " + what + ": at most 2^40 (" + std::to_string(kMaxPoints) +
                      ") points");
   // Refuse up front what cannot fit in physical memory, rather than being killed half way.
@@ -64,12 +67,13 @@ PointCloud generateScene(Scene scene, const GenerateOptions& options) {
   } catch (const std::bad_alloc&) {
     throw InputError("cannot generate " + what + ": out of memory");
   }
-  auto generator = detail::makeScene(scene, n, options.seed);
+  auto generator = detail::makeScene(scene, all, options.seed);
   cloud.offset = generator->offset;
   std::optional<Progress> progress;
   if (options.progress) progress.emplace("generating " + std::string(sceneName(scene)), n);
   parallelBlocks(n, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
-    generator->generate(begin, end - begin, cloud.positions.data() + 3 * begin, cloud.colors.data() + begin);
+    generator->generate(first + begin, end - begin, cloud.positions.data() + 3 * begin,
+                        cloud.colors.data() + begin);
     if (progress) progress->advance(end - begin);
   });
   if (progress) progress->finish();

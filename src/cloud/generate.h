@@ -23,6 +23,10 @@ struct GenerateOptions {
   uint64_t points = 1'000'000;
   uint64_t seed = 1;
   bool progress = true;
+  // Only points [first, first + count) of the scene of `points` points (a rank's share of a distributed
+  // render): the same points the whole scene holds at those indices; bounds are the share's.
+  uint64_t first = 0;
+  uint64_t count = UINT64_MAX; // clamped to the scene's size
 };
 
 // Throws InputError if the count cannot be held (more than 2^40 points or allocation would fail).

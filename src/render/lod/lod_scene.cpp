@@ -309,7 +309,8 @@ Selection LodScene::selectAll(std::span<const Camera> views, uint32_t width, uin
     stats_.nodesSelected = sel.nodes.size();
     stats_.pointsSelected = sel.points;
     stats_.budgetReached = sel.limited;
-    if (sel.unexpanded.empty()) return sel;
+    if (sel.unexpanded.empty())
+      return options_.shares > 1 ? shareOf(sel, *hierarchy_, options_.shareIndex, options_.shares) : sel;
     // Points read for earlier frames give their staging blocks back: a reader waiting for blocks must not
     // hold up the hierarchy reads this selection waits for.
     uploadArrived({}, 0);

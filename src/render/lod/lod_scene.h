@@ -57,6 +57,10 @@ struct LodOptions {
   // choice (node_encoding.h). Colors are computed as nodes are encoded, so every LOD method draws them.
   std::optional<DisplayColorMode::Source> colorSource;
   std::optional<ColorRange> colorRange; // intensity and elevation: the values at the ramp's ends
+  // A distributed render (docs/mpi.md): selectAll() returns share `shareIndex` of `shares` of the whole
+  // selection (selection.h, shareOf), so that each rank draws its part of every frame.
+  uint32_t shareIndex = 0;
+  uint32_t shares = 1;
 };
 
 // Half the device-local memory: the rest stays for framebuffers, the other methods and the driver.

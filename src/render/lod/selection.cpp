@@ -138,4 +138,31 @@ Selection selectNodes(const Hierarchy& hierarchy, std::span<const Camera> camera
   return s;
 }
 
+Selection shareOf(const Selection& selection, const Hierarchy& hierarchy, uint32_t index, uint32_t shares) {
+  assert(shares > 0 && index < shares && "a share of the selection");
+  std::vector<uint32_t> nodes;
+  for (uint32_t id : selection.nodes)
+    if (hierarchy.node(id).info.pointCount > 0) nodes.push_back(id);
+  std::sort(nodes.begin(), nodes.end(),
+            [&](uint32_t a, uint32_t b) { return hierarchy.node(a).info.key < hierarchy.node(b).info.key; });
+  uint64_t total = 0;
+  for (uint32_t id : nodes)
+    total += hierarchy.node(id).info.pointCount;
+  Selection share;
+  share.limited = selection.limited;
+  // Node i is in run floor(shares * before / total), in 128-bit arithmetic: billions of points times
+  // thousands of shares cannot overflow.
+  unsigned __int128 before = 0;
+  for (uint32_t id : nodes) {
+    const uint64_t points = hierarchy.node(id).info.pointCount;
+    const uint64_t run = uint64_t(std::min<unsigned __int128>(before * shares / total, shares - 1));
+    before += points;
+    if (run != index) continue;
+    share.nodes.push_back(id);
+    share.points += points;
+    share.pages += pagesOf(points);
+  }
+  return share;
+}
+
 } // namespace pointrast::lod

@@ -68,4 +68,10 @@ inline Selection selectNodes(const Hierarchy& hierarchy, const Camera& camera, u
   return selectNodes(hierarchy, std::span<const Camera>(&camera, 1), width, height, origin, nearW, limits);
 }
 
+// Share `index` of `shares` of a selection (a rank's part of a distributed frame, docs/mpi.md): its nodes
+// with points in key order, cut into `shares` contiguous runs balanced by points (run k starts at the first
+// node whose preceding points reach k / shares of the total). Every rank computes every run alike, and the
+// runs tile the selection. The result lists its nodes in key order; unexpanded is left empty.
+Selection shareOf(const Selection& selection, const Hierarchy& hierarchy, uint32_t index, uint32_t shares);
+
 } // namespace pointrast::lod

@@ -1,0 +1,204 @@
+#include "distributed.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "base/error.h"
+#include "cloud/generate.h"
+#include "gpu/shared_types.h"
+#include "io/reader.h"
+#include "mpi/mpi_job.h"
+#include "render/composite.h"
+
+namespace pointrast::app {
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Keeps points [first, first + count) of every attribute array the cloud has.
+void keepRange(PointCloud& cloud, uint64_t first, uint64_t count) {
+  auto keep = [&](auto& values, uint64_t perPoint) {
+    if (values.empty()) return;
+    values.erase(values.begin() + static_cast<ptrdiff_t>((first + count) * perPoint), values.end());
+    values.erase(values.begin(), values.begin() + static_cast<ptrdiff_t>(first * perPoint));
+    values.shrink_to_fit();
+  };
+  keep(cloud.positions, 3);
+  keep(cloud.colors, 1);
+  keep(cloud.intensity, 1);
+  keep(cloud.classification, 1);
+  keep(cloud.returnNumber, 1);
+  keep(cloud.pointSourceId, 1);
+}
+
+// The device types in the order a rank prefers them (gpu::Context's own choice prefers them alike).
+int typeRank(VkPhysicalDeviceType type) {
+  switch (type) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+    return 4;
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+    return 3;
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+    return 2;
+  case VK_PHYSICAL_DEVICE_TYPE_CPU:
+    return 1;
+  default:
+    return 0;
+  }
+}
+
+// Test hook (docs/mpi.md): rank 0 writes the composited words, 8 B a pixel little-endian, to this file.
+void dumpWords(const std::vector<uint64_t>& words) {
+  const char* path = std::getenv("POINTRAST_MPI_WORDS");
+  if (!path || !*path) return;
+  const std::filesystem::path target(path), partial = target.string() + ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(words.data()), std::streamsize(words.size() * 8));
+    if (!out) throw InputError(target.string() + ": cannot write the composited words");
+  }
+  std::filesystem::rename(partial, target);
+}
+
+} // namespace
+
+bool distributedRun() {
+  return mpi::Job::get().launched();
+}
+
+void chooseRankDevice(gpu::ContextOptions& options) {
+  const mpi::Job& job = mpi::Job::get();
+  if (!job.launched()) return;
+  options.announce = false;
+  if (options.deviceIndex) return;
+  if (const char* env = std::getenv("POINTRAST_DEVICE"); env && *env) return; // the Context reads it
+  const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
+  int best = 0;
+  for (const gpu::DeviceInfo& d : devices)
+    best = std::max(best, typeRank(d.type));
+  std::vector<uint32_t> candidates;
+  for (uint32_t i = 0; i < devices.size(); ++i)
+    if (typeRank(devices[i].type) == best) candidates.push_back(i);
+  if (!candidates.empty()) options.deviceIndex = candidates[job.localRank() % candidates.size()];
+}
+
+std::vector<std::string> announceRanks(const gpu::Context& context, bool quiet) {
+  mpi::Job& job = mpi::Job::get();
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0) std::snprintf(host, sizeof host, "unknown host");
+  const std::string mine = std::string(host) + ": " + context.info().name + " (" + context.info().typeName +
+                           ")" + (context.validationEnabled() ? ", validation on" : "");
+  std::vector<std::string> all = job.gatherText(mine);
+  if (job.root() && !quiet)
+    for (size_t r = 0; r < all.size(); ++r)
+      std::fprintf(stderr, "rank %zu of %zu: %s\n", r, all.size(), all[r].c_str());
+  return all;
+}
+
+void checkDistributed(const RenderSettings& settings, bool cameraPath, bool spheres) {
+  if (cameraPath) throw InputError("--path renders on one process; under mpirun render draws single frames");
+  if (spheres) throw InputError("the sphere methods render on one process, not under mpirun");
+  const MethodInfo& info = settings.method.info();
+  if (info.output == MethodOutput::ColorOnly)
+    throw InputError(std::string(info.name) +
+                     " keeps no depth per pixel, so ranks' frames cannot be composited; under mpirun use a "
+                     "closest-point method (atomicmin, the batch methods, lod)");
+  if (!hasCanonicalWords(info))
+    throw InputError(std::string(info.name) +
+                     " blends points (HQS), which is not composited across ranks yet; under mpirun use a "
+                     "closest-point method (atomicmin, the batch methods, lod)");
+}
+
+PointCloud loadShare(const InputSpec& spec) {
+  mpi::Job& job = mpi::Job::get();
+  InputSpec mine = spec;
+  mine.progress = spec.progress && job.root();
+  const std::string source = spec.source.empty() ? kDemoScene : spec.source;
+  // A generated scene in its own order: each rank generates its points only. Any other input is loaded
+  // (and ordered) whole, so the points of the ranges are exactly those one process would draw.
+  if (!pathExists(source) && isSceneName(source) && spec.order == Order::Original) {
+    const uint64_t total = spec.source.empty() ? kDemoPoints : spec.points;
+    const mpi::Range range = mpi::rangeOf(total, shared::kBatchPoints, job.rank(), job.size());
+    GenerateOptions options;
+    options.points = total;
+    options.seed = spec.seed;
+    options.progress = mine.progress;
+    options.first = range.first;
+    options.count = range.count;
+    PointCloud cloud = generateScene(parseScene(source), options);
+    cloud.bounds = job.unionOf(cloud.bounds);
+    return cloud;
+  }
+  PointCloud cloud = loadInput(mine);
+  const mpi::Range range = mpi::rangeOf(cloud.size(), shared::kBatchPoints, job.rank(), job.size());
+  keepRange(cloud, range.first, range.count);
+  job.check(); // every rank has its share (or the job hears which failed)
+  return cloud;
+}
+
+DisplayColorMode agreeColors(const DisplayColorMode& mine) {
+  DisplayColorMode agreed = mine;
+  mpi::Job::get().broadcast(&agreed, sizeof agreed);
+  return agreed;
+}
+
+RenderSettings rankSettings(const RenderSettings& settings) {
+  RenderSettings s = settings;
+  s.post = PostSettings{};
+  s.captureWords = true;
+  return s;
+}
+
+std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, const Camera& camera,
+                                     const RenderSettings& settings, double int40Scale,
+                                     const FrameStats& stats, CompositeStats& out) {
+  mpi::Job& job = mpi::Job::get();
+  auto start = std::chrono::steady_clock::now();
+  std::vector<uint64_t> words = renderer.framebufferWords();
+  out.readbackMs = msSince(start);
+  out.ranks = job.size();
+  out.rankMs = job.gatherOf(stats.medianMs);
+  out.renderMs = job.maxOf(stats.medianMs);
+  out.points = job.sumOf(stats.points);
+  job.check(); // all ranks are here: the composite's time is its own, not a wait for the slowest rank
+  start = std::chrono::steady_clock::now();
+  job.minToRoot(words);
+  out.compositeMs = msSince(start);
+  out.bytesMoved = uint64_t(job.size() - 1) * words.size() * 8;
+  if (!job.root()) return {};
+  dumpWords(words);
+  start = std::chrono::steady_clock::now();
+  CompositeResolver resolver(context, renderer.width() / renderer.eyes(), renderer.height(), renderer.eyes());
+  std::vector<uint32_t> image = resolver.resolve(words, camera, settings, int40Scale, &out.post);
+  out.resolveMs = msSince(start);
+  return image;
+}
+
+nlohmann::json compositeJson(const CompositeStats& s) {
+  nlohmann::json j;
+  j["ranks"] = s.ranks;
+  j["render_ms"] = s.renderMs;
+  j["rank_render_ms"] = s.rankMs;
+  j["readback_ms"] = s.readbackMs;
+  j["composite_ms"] = s.compositeMs;
+  j["resolve_ms"] = s.resolveMs;
+  j["bytes_moved"] = s.bytesMoved;
+  j["devices"] = s.devices;
+  return j;
+}
+
+void printCompositeSummary(const CompositeStats& s) {
+  std::printf("  %u ranks: slowest rank %.3f ms median GPU time; composite %.3f ms (MIN of %.1f MB of words), "
+              "readback %.3f ms, resolve %.3f ms on rank 0\n",
+              s.ranks, s.renderMs, s.compositeMs, double(s.bytesMoved) / 1e6, s.readbackMs, s.resolveMs);
+}
+
+} // namespace pointrast::app

@@ -1,0 +1,81 @@
+#include "render/composite.h"
+
+#include <bit>
+#include <cstring>
+#include <memory>
+
+#include <glm/glm.hpp>
+
+#include "base/error.h"
+#include "gpu/buffer.h"
+#include "gpu/context.h"
+#include "gpu/shared_types.h"
+#include "gpu/timer.h"
+#include "render/method.h"
+#include "render/post/post_stage.h"
+
+namespace pointrast {
+
+CompositeResolver::CompositeResolver(gpu::Context& context, uint32_t width, uint32_t height, uint32_t eyes)
+    : context_(context), width_(width), height_(height), eyes_(eyes) {}
+
+CompositeResolver::~CompositeResolver() = default;
+
+double int40ScaleOf(std::span<const GpuScene* const> scenes, const Camera& camera) {
+  return int40Scale(scenes, camera);
+}
+
+std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words, const Camera& camera,
+                                                 const RenderSettings& settings, double int40Scale,
+                                                 std::optional<PostStats>* post) {
+  const uint64_t pixels = uint64_t(width_) * eyes_ * height_;
+  if (words.size() != pixels) throw InputError("composited words do not match the image size");
+  const bool int40 = settings.depth == DepthMode::Int40;
+  // The colors of the words, as the methods' resolve writes them (shaders/resolve.comp.glsl): int40 words
+  // carry RGB24, alpha restored as opaque.
+  auto colorOf = [&](uint64_t word) {
+    return int40 ? (uint32_t(word) & 0xFFFFFFu) | 0xFF000000u : uint32_t(word);
+  };
+  std::vector<uint32_t> image(pixels);
+  if (!settings.post.enabled()) {
+    for (uint64_t i = 0; i < pixels; ++i)
+      image[i] = words[i] == shared::kEmptyPixel ? settings.background : colorOf(words[i]);
+    if (post) post->reset();
+    return image;
+  }
+  validatePostSettings(settings.post);
+  if (!post_) post_ = std::make_unique<PostStage>(context_);
+  // The stage reads float-depth words: int40 steps are converted as the methods' resolve converts them.
+  gpu::Buffer staging(context_, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Upload, "composited words");
+  uint64_t* mapped = static_cast<uint64_t*>(staging.mapped());
+  for (uint64_t i = 0; i < pixels; ++i) {
+    const uint64_t w = words[i];
+    if (!int40 || w == shared::kEmptyPixel) {
+      mapped[i] = w;
+      continue;
+    }
+    const float depth = float(double(w >> shared::kInt40ColorBits) / int40Scale);
+    mapped[i] = uint64_t(std::bit_cast<uint32_t>(depth)) << 32 | colorOf(w);
+  }
+  gpu::Buffer device(context_, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "composited words");
+  gpu::Buffer target(context_, pixels * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "composited image");
+  const uint32_t pitch = width_ * eyes_;
+  std::vector<PostView> views;
+  for (uint32_t e = 0; e < eyes_; ++e)
+    views.push_back({device.address() + uint64_t(e) * width_ * 8, target.address() + uint64_t(e) * width_ * 4,
+                     width_, height_, pitch, float(glm::length(camera.target - camera.eye)),
+                     settings.background, false});
+  gpu::TimestampPool timestamps(context_, kPostPasses);
+  context_.submitAndWait([&](VkCommandBuffer cmd) {
+    timestamps.reset(cmd);
+    VkBufferCopy region{0, 0, pixels * 8};
+    gpu::vkCmdCopyBuffer(cmd, staging.handle(), device.handle(), 1, &region);
+    gpu::fullBarrier(cmd);
+    post_->record(cmd, views, settings.post, &timestamps, 0);
+  });
+  if (post) *post = PostStage::stats(timestamps.milliseconds(), 1);
+  gpu::readBuffer(context_, target, 0, image.data(), pixels * 4);
+  return image;
+}
+
+} // namespace pointrast

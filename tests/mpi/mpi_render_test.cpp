@@ -1,0 +1,225 @@
+// Distributed rendering as a user starts it: `mpirun -np N pointrast render ...` on lavapipe, compared
+// with the same render on one rank. Closest-point frames must composite to the one-rank frame exactly;
+// where a batch or LOD method's words differ, both words must hold the same depth (a tie the one-rank
+// frame breaks by point index, the composite by color).
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include "cli/cli_harness.h"
+#include "mpi/mpi_job.h"
+
+namespace fs = std::filesystem;
+using pointrast::test::cliTempDir;
+using pointrast::test::pointrastBinary;
+using pointrast::test::runPointrast;
+using pointrast::test::slurp;
+
+namespace {
+
+constexpr uint64_t kEmpty = ~uint64_t(0);
+
+struct MpiRun {
+  int exitCode = -1;
+  bool signaled = false;
+  std::string out, err;
+  double seconds = 0;
+};
+
+// Skips the test in a build without MPI (there is nothing distributed to test).
+#define REQUIRE_MPI()                                                                                       \
+  do {                                                                                                      \
+    if (!pointrast::mpi::Job::built() || std::string(POINTRAST_MPIRUN).empty())                              \
+      GTEST_SKIP() << "this build has no MPI (CMake option POINTRAST_MPI off, or no mpirun found)";        \
+  } while (0)
+
+// Runs `mpirun --oversubscribe LAUNCH` (LAUNCH names the binary, e.g. "-np 2 " + bin() + " render ..."),
+// stopped after `timeout` seconds so that a hang fails the test.
+MpiRun runMpi(const std::string& launch, const std::string& env = "", int timeout = 120) {
+  const fs::path out = cliTempDir() / "mpi_stdout.txt", err = cliTempDir() / "mpi_stderr.txt";
+  fs::remove(out);
+  const std::string command = "timeout -k 5 " + std::to_string(timeout) +
+                              " env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+                              "OMPI_MCA_rmaps_base_oversubscribe=1 "
+                              "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
+                              env + " " + POINTRAST_MPIRUN + " --oversubscribe " + launch + " >" +
+                              out.string() + " 2>" + err.string();
+  const auto start = std::chrono::steady_clock::now();
+  const int status = std::system(command.c_str());
+  MpiRun r;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) > 128);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+std::vector<uint64_t> readWords(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<uint64_t> words(fs::file_size(path) / 8);
+  in.read(reinterpret_cast<char*>(words.data()), std::streamsize(words.size() * 8));
+  return words;
+}
+
+// One render of `args` on `ranks` ranks (extra mpirun options first); the composited words and the JSON.
+struct Frame {
+  std::vector<uint64_t> words;
+  nlohmann::json json;
+};
+Frame renderOn(uint32_t ranks, const std::string& args, const std::string& mpirunOptions = "") {
+  const fs::path words = cliTempDir() / ("words_" + std::to_string(ranks) + ".bin");
+  fs::remove(words);
+  const MpiRun r = runMpi(mpirunOptions + " -np " + std::to_string(ranks) + " " + pointrastBinary() +
+                              " render " + args + " --json -q",
+                          "POINTRAST_MPI_WORDS=" + words.string());
+  EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.err;
+  Frame f;
+  if (r.exitCode != 0) return f;
+  f.words = readWords(words);
+  f.json = nlohmann::json::parse(r.out);
+  return f;
+}
+
+struct Difference {
+  uint64_t pixels = 0, covered = 0, differ = 0, ties = 0;
+};
+// Pixels whose words differ, and how many of them are ties: both hold a point at the same depth.
+Difference compare(const std::vector<uint64_t>& a, const std::vector<uint64_t>& b) {
+  Difference d;
+  d.pixels = a.size();
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    if (a[i] != kEmpty) ++d.covered;
+    if (a[i] == b[i]) continue;
+    ++d.differ;
+    if (a[i] != kEmpty && b[i] != kEmpty && a[i] >> 32 == b[i] >> 32) ++d.ties;
+  }
+  return d;
+}
+
+// An explicit camera: the overview under mpirun is framed from rank 0's share (docs/mpi.md).
+const std::string kImage = " --width 240 --height 160 --frames 1";
+const std::string kTerrainView = " --eye 500022.37,3999984.26,217.29 --target 500022.37,4000018.99,192.97";
+
+// A generated terrain of 40,000 points: four batches of 10,240 points or fewer, so three ranks get
+// unequal shares.
+std::string terrain(const std::string& out) {
+  return "terrain --points 40000 -o " + (cliTempDir() / out).string() + kImage + kTerrainView;
+}
+
+TEST(MpiRender, AtomicMinComposesTheOneRankFrameExactly) {
+  REQUIRE_MPI();
+  const Frame one = renderOn(1, terrain("one.png"));
+  const Frame two = renderOn(2, terrain("two.png"));
+  const Frame three = renderOn(3, terrain("three.png"));
+  ASSERT_FALSE(one.words.empty());
+  ASSERT_EQ(one.words.size(), 240u * 160u);
+  const Difference d2 = compare(one.words, two.words), d3 = compare(one.words, three.words);
+  EXPECT_GT(d2.covered, d2.pixels / 4) << "the frame must show the scene";
+  // MIN over depth << 32 | color words is the same MIN whichever rank a point was drawn by: no exceptions.
+  EXPECT_EQ(d2.differ, 0u);
+  EXPECT_EQ(d3.differ, 0u);
+  EXPECT_EQ(two.json["image_hash"], one.json["image_hash"]);
+  EXPECT_EQ(three.json["image_hash"], one.json["image_hash"]);
+  EXPECT_EQ(three.json["points"], 40000);
+  EXPECT_EQ(three.json["mpi"]["ranks"], 3);
+  EXPECT_EQ(three.json["mpi"]["rank_render_ms"].size(), 3u);
+  EXPECT_EQ(three.json["mpi"]["bytes_moved"], 2u * 240 * 160 * 8);
+  EXPECT_GE(three.json["mpi"]["composite_ms"].get<double>(), 0.0);
+  // And one rank under mpirun is today's render.
+  const pointrast::test::CliResult plain =
+      runPointrast("render " + terrain("plain.png") + " --json -q");
+  ASSERT_EQ(plain.exitCode, 0) << plain.err;
+  EXPECT_EQ(nlohmann::json::parse(plain.out)["image_hash"], one.json["image_hash"]);
+}
+
+TEST(MpiRender, BatchMethodDiffersFromOneRankOnlyAtDepthTies) {
+  REQUIRE_MPI();
+  const std::string args = terrain("batch.png") + " --method batch-prefetch --edl --point-size 2";
+  const Frame one = renderOn(1, args);
+  const Frame three = renderOn(3, args);
+  ASSERT_FALSE(one.words.empty());
+  ASSERT_FALSE(three.words.empty());
+  const Difference d = compare(one.words, three.words);
+  EXPECT_GT(d.covered, d.pixels / 4);
+  EXPECT_EQ(d.differ, d.ties) << d.differ - d.ties << " pixels differ in depth";
+  RecordProperty("depth_ties", std::to_string(d.ties));
+  std::printf("batch-prefetch on 3 ranks: %llu of %llu covered pixels differ, all at depth ties\n",
+              (unsigned long long)d.differ, (unsigned long long)d.covered);
+  if (d.ties == 0) {
+    EXPECT_EQ(three.json["image_hash"], one.json["image_hash"]);
+  }
+  // The resolve stage ran once, on the composite.
+  EXPECT_TRUE(three.json.contains("post"));
+}
+
+TEST(MpiRender, TcpTransportGivesTheSameFrame) {
+  REQUIRE_MPI();
+  const Frame one = renderOn(1, terrain("tcp1.png"));
+  const Frame two = renderOn(2, terrain("tcp2.png"), "--mca btl tcp,self");
+  ASSERT_FALSE(two.words.empty());
+  EXPECT_EQ(compare(one.words, two.words).differ, 0u);
+  EXPECT_EQ(two.json["image_hash"], one.json["image_hash"]);
+}
+
+TEST(MpiRender, LodSharesWithASmallNodeCacheGiveTheOneRankFrame) {
+  REQUIRE_MPI();
+  const fs::path las = cliTempDir() / "lod_terrain.las", octree = cliTempDir() / "lod_terrain";
+  fs::remove_all(octree);
+  ASSERT_EQ(runPointrast("generate terrain --points 60000 -o " + las.string() + " -q").exitCode, 0);
+  const pointrast::test::CliResult built = runPointrast("lod " + las.string() + " -o " + octree.string() + " -q");
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  const std::string args = octree.string() + " --method lod --min-node-px 0 -o " +
+                           (cliTempDir() / "lod.png").string() + kImage;
+  const Frame one = renderOn(1, args);
+  // Each rank's node cache holds six pages: its share is drawn in several passes.
+  const Frame two = renderOn(2, args + " --gpu-memory 384k");
+  ASSERT_FALSE(one.words.empty());
+  ASSERT_FALSE(two.words.empty());
+  const Difference d = compare(one.words, two.words);
+  EXPECT_GT(d.covered, d.pixels / 4);
+  EXPECT_EQ(d.differ, d.ties) << d.differ - d.ties << " pixels differ in depth";
+  EXPECT_EQ(two.json["points"], 60000);
+  EXPECT_GT(two.json["lod_stats"]["passes"].get<int>(), 1);
+}
+
+TEST(MpiRender, ARankWithADamagedFileEndsTheJobWithOneLine) {
+  REQUIRE_MPI();
+  const fs::path good = cliTempDir() / "good.las", bad = cliTempDir() / "damaged.las";
+  const fs::path png = cliTempDir() / "damaged.png";
+  ASSERT_EQ(runPointrast("generate terrain --points 20000 -o " + good.string() + " -q").exitCode, 0);
+  fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+  fs::resize_file(bad, fs::file_size(good) / 2); // the header promises twice the records present
+  fs::remove(png);
+  const std::string tail = " -o " + png.string() + kImage + " -q";
+  const MpiRun r = runMpi("-np 1 " + pointrastBinary() + " render " + good.string() + tail + " : -np 1 " +
+                              pointrastBinary() + " render " + bad.string() + tail,
+                          "", 60);
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_LT(r.seconds, 60);
+  int lines = 0;
+  for (size_t at = r.err.find("pointrast:"); at != std::string::npos; at = r.err.find("pointrast:", at + 1))
+    ++lines;
+  EXPECT_EQ(lines, 1) << r.err;
+  EXPECT_NE(r.err.find("pointrast: rank 1: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("damaged.las: header claims"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
+}
+
+TEST(MpiRender, OtherCommandsRefuseSeveralRanks) {
+  REQUIRE_MPI();
+  const MpiRun r = runMpi("-np 2 " + pointrastBinary() + " info terrain", "", 60);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("pointrast: `pointrast info` runs as one process"), std::string::npos) << r.err;
+}
+
+} // namespace
