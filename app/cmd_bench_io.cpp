@@ -25,6 +25,8 @@ struct BenchIoArgs {
   std::vector<std::string> inputs;
   std::string points = "0";
   std::vector<std::string> threads;
+  std::vector<int> pointFormats;
+  std::string disk = "0", diskDir = ".";
   int repeats = 5;
   bool noReadCloud = false, json = false, quiet = false;
   std::string out, name = "io-laz";
@@ -59,6 +61,15 @@ int runBenchIo(const BenchIoArgs& a) {
   if (a.repeats < 1 || a.repeats > 1000) throw InputError("--repeats must be 1 to 1000");
   config.repeats = a.repeats;
   config.readCloud = !a.noReadCloud;
+  for (int format : a.pointFormats)
+    if (!(format >= 0 && format <= 3) && !(format >= 6 && format <= 8))
+      throw InputError("--point-formats: " + std::to_string(format) +
+                       " is not a point format LAZ is written in (0-3, 6-8)");
+  config.pointFormats = a.pointFormats;
+  config.diskBytes = parseBytes(a.disk, "--disk");
+  config.diskDir = a.diskDir;
+  if (config.diskBytes && !std::filesystem::is_directory(config.diskDir))
+    throw InputError("--disk-dir: " + a.diskDir + " is not a folder");
   config.workDir =
       std::filesystem::temp_directory_path() / ("pointrast-bench-io-" + std::to_string(::getpid()));
   struct Cleanup {
@@ -98,14 +109,22 @@ Command addBenchIo(CLI::App& app) {
       "wall time, points/s, points/s per thread and points per CPU-second (from each thread's CPU\n"
       "clock: what a core delivers on a shared machine; the load average is recorded), then times\n"
       "readCloud end to end. --points replicates a file's own chunks (chunks decode on their own)\n"
-      "into a temporary LAZ of at least that many points. Writes <name>.json and <name>.md to\n"
-      "bench/results/cpu-<model>-<threads>t/.\n"
+      "into a temporary LAZ of at least that many points. --point-formats first converts each file to\n"
+      "those point formats (pointrast's LAZ encoder) and times each. --disk SIZE also measures the\n"
+      "sequential write bandwidth of the folder --disk-dir (a file of SIZE, timed until fdatasync\n"
+      "returns, once plain and once with the octree writer's write-behind). Writes <name>.json and\n"
+      "<name>.md to bench/results/cpu-<model>-<threads>t/.\n"
       "Examples:\n  pointrast bench-io autzen_trim.laz --points 3M\n"
+      "  pointrast bench-io autzen_trim.laz --points 30M --point-formats 3,7 --disk 8G --disk-dir out/\n"
       "  pointrast bench-io a.laz b.laz --points 3M --threads 1,4,all --repeats 9");
   cmd->add_option("FILE", a->inputs, "LAZ or COPC files")->required();
   cmd->add_option("--points", a->points,
                   "Replicate each file's chunks to at least this many points (3M, 1.5G)");
   cmd->add_option("--threads", a->threads, "Thread counts to time (default: 1,all)")->delimiter(',');
+  cmd->add_option("--point-formats", a->pointFormats, "Convert each file to these point formats first (3,7)")
+      ->delimiter(',');
+  cmd->add_option("--disk", a->disk, "Also measure sequential write bandwidth with a file of this size (4G)");
+  cmd->add_option("--disk-dir", a->diskDir, "Folder for the disk measurement")->capture_default_str();
   cmd->add_option("--repeats", a->repeats, "Timed runs per thread count")->capture_default_str();
   cmd->add_flag("--no-read-cloud", a->noReadCloud, "Skip the readCloud timing");
   cmd->add_option("--out", a->out, "Folder for the reports (default: bench/results/cpu-<model>-<threads>t/)");

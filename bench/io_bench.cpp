@@ -4,10 +4,15 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "base/build_info.h"
 #include "base/parallel.h"
@@ -16,6 +21,8 @@
 #include "io/las/laz_chunk.h"
 #include "io/las/laz_compose.h"
 #include "io/las/laz_reader.h"
+#include "io/write_behind.h"
+#include "io/writer.h"
 
 namespace pointrast::bench {
 
@@ -111,11 +118,59 @@ std::string layoutText(const io::laz::LazFile& laz) {
                                laz.layout.describeCompressor().c_str());
 }
 
+[[noreturn]] void failDisk(const std::filesystem::path& path, int error, const char* what) {
+  io::detail::fail(path, io::detail::strFormat("%s: %s", what, std::strerror(error)));
+}
+
 double mega(double v) {
   return v / 1e6;
 }
 
 } // namespace
+
+DiskTiming measureDiskWrite(const std::filesystem::path& dir, uint64_t bytes, bool writeBehind) {
+  const std::filesystem::path path = dir / (".pointrast-disk-" + std::to_string(::getpid()));
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) failDisk(path, errno, "cannot create a file to measure the disk");
+  struct Remove {
+    int fd;
+    std::filesystem::path path;
+    ~Remove() {
+      ::close(fd);
+      std::error_code ec;
+      std::filesystem::remove(path, ec);
+    }
+  } remove{fd, path};
+  // Bytes that no file system compresses or deduplicates.
+  std::vector<uint8_t> block(size_t(8) << 20);
+  uint64_t x = 0x9E3779B97F4A7C15ull;
+  for (size_t i = 0; i + 8 <= block.size(); i += 8) {
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    std::memcpy(block.data() + i, &x, 8);
+  }
+  DiskTiming t;
+  t.mode = writeBehind ? "write-behind" : "plain";
+  const Clock::time_point start = Clock::now();
+  {
+    std::optional<io::detail::WriteBehind> behind;
+    if (writeBehind) behind.emplace(fd);
+    for (uint64_t done = 0; done < bytes;) {
+      const size_t n = size_t(std::min<uint64_t>(block.size(), bytes - done));
+      const ssize_t w = ::pwrite(fd, block.data(), n, off_t(done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) failDisk(path, w < 0 ? errno : EIO, "cannot write");
+      if (behind) behind->written(done, uint64_t(w));
+      done += uint64_t(w);
+    }
+    if (behind && behind->finish() != 0) failDisk(path, EIO, "cannot write");
+  }
+  if (::fdatasync(fd) != 0) failDisk(path, errno, "cannot sync");
+  t.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  t.bytes = bytes;
+  return t;
+}
 
 double IoTiming::pointsPerSecond() const {
   return medianSeconds > 0 ? double(points) / medianSeconds : 0;
@@ -138,9 +193,9 @@ IoBenchRun runIoBench(const IoBenchConfig& config, bool progress) {
   std::sort(threadCounts.begin(), threadCounts.end());
   threadCounts.erase(std::unique(threadCounts.begin(), threadCounts.end()), threadCounts.end());
 
-  for (const std::filesystem::path& input : config.inputs) {
+  auto benchFile = [&](const std::filesystem::path& input, const std::string& name) {
     IoResult result;
-    result.file = input.filename().string();
+    result.file = name;
     std::filesystem::path path = input;
     {
       io::detail::InputFile file(input);
@@ -195,6 +250,32 @@ IoBenchRun runIoBench(const IoBenchConfig& config, bool progress) {
     }
     if (path != input) std::filesystem::remove(path);
     run.results.push_back(std::move(result));
+  };
+  for (const std::filesystem::path& input : config.inputs) {
+    if (config.pointFormats.empty()) {
+      benchFile(input, input.filename().string());
+      continue;
+    }
+    for (int format : config.pointFormats) {
+      // The same points in another point format, coded by pointrast's LAZ encoder.
+      std::filesystem::create_directories(config.workDir);
+      const std::string name = input.stem().string() + "-pf" + std::to_string(format) + ".laz";
+      const std::filesystem::path converted = config.workDir / name;
+      io::LasConvertOptions options;
+      options.pointFormat = format;
+      io::convertLasFile(input, converted, options);
+      benchFile(converted, name);
+      std::filesystem::remove(converted);
+    }
+  }
+  if (config.diskBytes) {
+    run.diskDir = config.diskDir.string();
+    for (const bool writeBehind : {false, true}) {
+      run.disk.push_back(measureDiskWrite(config.diskDir, config.diskBytes, writeBehind));
+      if (progress)
+        std::fprintf(stderr, "disk %s: %s: %.0f MB/s\n", run.diskDir.c_str(), run.disk.back().mode.c_str(),
+                     run.disk.back().bytesPerSecond() / 1e6);
+    }
   }
   run.loadAfter = firstLine("/proc/loadavg", nullptr);
   run.seconds = std::chrono::duration<double>(Clock::now() - begin).count();
@@ -239,6 +320,14 @@ nlohmann::json ioRunJson(const IoBenchRun& run, const std::string& commandLine, 
     if (r.readCloud.threads) jr["read_cloud"] = timing(r.readCloud);
     j["results"].push_back(jr);
   }
+  if (!run.disk.empty()) {
+    j["disk_write"] = {{"dir", run.diskDir}, {"runs", nlohmann::json::array()}};
+    for (const DiskTiming& d : run.disk)
+      j["disk_write"]["runs"].push_back({{"mode", d.mode},
+                                         {"bytes", d.bytes},
+                                         {"seconds", d.seconds},
+                                         {"bytes_per_s", d.bytesPerSecond()}});
+  }
   return j;
 }
 
@@ -274,6 +363,16 @@ std::string ioMarkdownReport(const IoBenchRun& run, const std::string& commandLi
                     mega(r.readCloud.pointsPerSecond()));
       md << line;
     }
+  if (!run.disk.empty()) {
+    md << "\nSequential write of one new file in `" << run.diskDir
+       << "` (8 MiB writes, timed until fdatasync returns):\n\n";
+    md << "| mode | MB | s | MB/s |\n| --- | ---: | ---: | ---: |\n";
+    for (const DiskTiming& d : run.disk) {
+      std::snprintf(line, sizeof line, "| %s | %.0f | %.3f | %.0f |\n", d.mode.c_str(), double(d.bytes) / 1e6,
+                    d.seconds, d.bytesPerSecond() / 1e6);
+      md << line;
+    }
+  }
   md << "\nFiles:\n\n";
   for (const IoResult& r : run.results) {
     std::snprintf(line, sizeof line, "- %s x %llu: %s, %llu chunks, %.1f MB compressed (%.2f B per point)\n",

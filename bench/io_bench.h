@@ -22,6 +22,19 @@ struct IoBenchConfig {
   int repeats = 5;
   bool readCloud = true; // also time readCloud (records into a PointCloud) at the highest thread count
   std::filesystem::path workDir; // where replicated files go (removed after the run)
+  // Each input converted to these point formats (0-3, 6-8) and timed in each; empty: as it is.
+  std::vector<int> pointFormats;
+  uint64_t diskBytes = 0;        // sequential write bandwidth measured with a file this large (0: not)
+  std::filesystem::path diskDir; // where that file is written (and removed)
+};
+
+// Sequential write of one new file in 8 MiB pwrites, timed until fdatasync returns: once as plain
+// writes, once with the octree writer's write-behind (io/write_behind.h).
+struct DiskTiming {
+  std::string mode; // "plain" or "write-behind"
+  uint64_t bytes = 0;
+  double seconds = 0;
+  double bytesPerSecond() const { return seconds > 0 ? double(bytes) / seconds : 0; }
 };
 
 struct IoTiming {
@@ -47,13 +60,18 @@ struct IoResult {
 
 struct IoBenchRun {
   std::vector<IoResult> results;
-  std::string cpu; // model name
+  std::string diskDir;          // where the disk was measured
+  std::vector<DiskTiming> disk; // empty: not measured
+  std::string cpu;              // model name
   unsigned hardwareThreads = 0;
   std::string loadBefore, loadAfter; // /proc/loadavg
   double seconds = 0;
 };
 
 IoBenchRun runIoBench(const IoBenchConfig& config, bool progress);
+
+// Writes `bytes` to a new file in `dir` and removes it (InputError when it cannot be written).
+DiskTiming measureDiskWrite(const std::filesystem::path& dir, uint64_t bytes, bool writeBehind);
 
 // "cpu-amd-epyc-2t": the results folder name of this machine.
 std::string ioDeviceName(const IoBenchRun& run);
