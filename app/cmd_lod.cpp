@@ -22,9 +22,9 @@
 #include "commands.h"
 #include "io/format_table.h"
 #include "io/output_check.h"
+#include "io/copc_ept/copc_writer.h"
 #include "io/potree/lod_potree.h"
 #include "io/writer.h"
-#include "io/copc_ept/copc_writer.h"
 
 namespace pointrast::app {
 
@@ -33,8 +33,8 @@ namespace {
 struct LodArgs {
   std::vector<std::string> inputs;
   std::string output, memory, leafPoints = "20k", encoding = "default", colorFilter = "average";
-  double spacing = 0;
   std::string format; // potree or copc; empty: by the output's name (".laz": copc)
+  double spacing = 0;
   unsigned threads = 0;
   bool json = false, quiet = false;
 };
@@ -97,7 +97,6 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
   j["bytes"] = r.bytes;
   j["input_bytes"] = b.inputBytes;
   j["seconds"] = b.seconds;
-  j["format"] = a.format;
   j["points_per_second"] = perSecond(double(b.octree.points), b.seconds);
   j["threads"] = b.threads;
   j["memory_bytes"] = b.memoryBytes;
@@ -105,6 +104,7 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
   j["spill_bytes"] = b.spillBytes;
   j["chunks"] = b.chunks;
   j["spacing"] = b.metadata.spacing;
+  j["format"] = a.format;
   j["encoding"] = a.encoding;
   j["color_filter"] = a.colorFilter;
   nlohmann::json phases = nlohmann::json::array();
@@ -156,15 +156,15 @@ int runLod(LodArgs a) {
   options.averageColors = a.colorFilter == "average";
   io::PotreeWriteOptions write;
   if (a.encoding == "brotli")
+    write.encoding = io::PotreeEncoding::Brotli;
+  else if (a.encoding != "default")
+    throw InputError("--encoding expects default or brotli, got '" + a.encoding + "'");
+  if (!(a.spacing >= 0) || !std::isfinite(a.spacing)) throw InputError("--spacing expects a positive length");
   if (a.format.empty()) a.format = io::isLazPath(a.output) ? "copc" : "potree";
   if (a.format != "potree" && a.format != "copc")
     throw InputError("--format expects potree or copc, got '" + a.format + "'");
   if (a.format == "copc" && a.encoding != "default")
     throw InputError("--encoding applies to Potree output; COPC nodes are LAZ");
-    write.encoding = io::PotreeEncoding::Brotli;
-  else if (a.encoding != "default")
-    throw InputError("--encoding expects default or brotli, got '" + a.encoding + "'");
-  if (!(a.spacing >= 0) || !std::isfinite(a.spacing)) throw InputError("--spacing expects a positive length");
   // Refused before any point is read: a mistake in the output's name should not cost a read of the input.
   checkOutputFolder(a.output);
 

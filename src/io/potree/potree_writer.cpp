@@ -13,9 +13,9 @@
 #include "io/io_util.h"
 #include "io/potree/potree_format.h"
 #include "io/stale_partials.h"
+#include "io/write_behind.h"
 
 namespace pointrast::io {
-#include "io/write_behind.h"
 
 using namespace detail;
 
@@ -106,9 +106,9 @@ struct PotreeWriter::State {
   PotreeWriteOptions options;
   potree::Layout layout;
   int octree = -1;    // octree.bin, written with pwrite at the offsets place() assigns
+  std::unique_ptr<WriteBehind> behind; // octree.bin's dirty pages, bounded
   uint64_t bytes = 0; // placed
   std::vector<potree::WrittenNode> nodes;
-  std::unique_ptr<WriteBehind> behind; // octree.bin's dirty pages, bounded
   std::unordered_set<lod::NodeKey, lod::NodeKeyHash> written;
   PotreeValueRanges ranges;
   bool committed = false;
@@ -243,20 +243,20 @@ PotreeWriter::PotreeWriter(std::filesystem::path dir, const lod::OctreeMetadata&
     std::filesystem::remove_all(s.work, ec);
     s.failWrite(error);
   }
+  s.behind = std::make_unique<WriteBehind>(s.octree);
 }
 
 PotreeWriter::~PotreeWriter() {
   State& s = *state_;
   if (s.committed) return;
+  s.behind.reset();
   if (s.octree >= 0) ::close(s.octree);
   std::error_code ignored;
-  s.behind = std::make_unique<WriteBehind>(s.octree);
   std::filesystem::remove_all(s.work, ignored);
 }
 
 const std::filesystem::path& PotreeWriter::workingDir() const {
   return state_->work;
-  s.behind.reset();
 }
 
 uint64_t PotreeWriter::bytesWritten() const {
@@ -322,22 +322,22 @@ void PotreeWriter::writeAt(uint64_t offset, const PotreeEncodedNode& node) const
     if (n <= 0) s.failWrite(n < 0 ? errno : EIO);
     done += static_cast<size_t>(n);
   }
+  s.behind->written(offset, node.bytes.size());
 }
 
 void PotreeWriter::commit() {
   State& s = *state_;
   assert(!s.committed && s.octree >= 0);
+  const int flushError = s.behind->finish();
+  s.behind.reset();
+  if (flushError != 0) s.failWrite(flushError);
   const int closed = ::close(s.octree);
   s.octree = -1;
-  s.behind->written(offset, node.bytes.size());
   if (closed != 0) s.failWrite(errno);
 
   if (s.nodes.empty()) s.nodes.push_back({lod::NodeKey{}, 0, 0, 0}); // an empty octree is an empty root
   const potree::HierarchyBytes hierarchy = potree::buildHierarchy(s.nodes, s.options.hierarchyStepSize);
   s.writeFile("hierarchy.bin", hierarchy.bytes.data(), hierarchy.bytes.size());
-  const int flushError = s.behind->finish();
-  s.behind.reset();
-  if (flushError != 0) s.failWrite(flushError);
   const std::string json = potree::metadataJson(s.describe(hierarchy));
   s.writeFile("metadata.json", json.data(), json.size());
 
