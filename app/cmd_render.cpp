@@ -33,8 +33,8 @@
 #include "render/composite.h"
 #include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
-#include "render/pick.h"
 #include "render/overlay.h"
+#include "render/pick.h"
 #include "render/renderer.h"
 #include "render/spheres/sphere_renderer.h"
 #include "render_filter.h"
@@ -208,9 +208,10 @@ std::string cameraOptionText(CameraProblem problem) {
 
 // The camera of --eye/--target/--up, or the overview of `bounds`. The data is checked first (coordinates
 // pointrast can place a camera among), so what fails afterwards is an option the user gave.
-Camera renderCamera(const RenderArgs& a, const Bounds& bounds, const std::string& source) {
+Camera renderCamera(const RenderArgs& a, const Bounds& bounds, const std::string& source,
+                    std::span<const glm::dvec3> framing = {}) {
   checkCoordinateRange(bounds, source);
-  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov);
+  Camera camera = overviewCamera(bounds, double(a.width) / double(a.height), a.fov, framing);
   if (!a.eye.empty()) {
     camera.eye = parseVec3(a.eye, "--eye");
     camera.target = a.target.empty() ? bounds.center() : parseVec3(a.target, "--target");
@@ -500,7 +501,8 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   options.shares = mpi::Job::get().size();
   std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
   const lod::OctreeMetadata& octree = source->metadata();
-  const Camera camera = renderCamera(a, octree.bounds.empty() ? octree.cube : octree.bounds, octree.source);
+  const Camera camera = renderCamera(a, octree.bounds.empty() ? octree.cube : octree.bounds, octree.source,
+                                     framingSample(*source));
 
   gpu::Context context(contextOptions(a));
   CompositeStats composite;
@@ -681,54 +683,6 @@ void printPointSummary(const RenderArgs& a, const RenderSettings& settings, cons
         stats.post->composeMs);
 }
 
-// --pick: the point the last frame drew at the pixel, from its canonical word (render/pick.h).
-nlohmann::json pickAt(Renderer& renderer, const PointCloud& cloud, const std::optional<DisplayColorMode>& colors,
-                      const RenderSettings& settings, const Camera& camera, const RenderArgs& a) {
-  const PixelPos pixel = parsePick(a.pick, a.width, a.height);
-  if (!hasCanonicalWords(methodInfo(settings.method)) && !settings.post.enabled()) {
-    nlohmann::json j;
-    j["pixel"] = {pixel.x, pixel.y};
-    j["point"] = std::string("unavailable: ") + a.method + " keeps no depth per pixel to pick from";
-    return j;
-  }
-  const uint64_t word = renderer.framebufferWords(pixel.x, pixel.y, 1, 1)[0];
-  PickRequest request;
-  request.cloud = &cloud;
-  request.colors = colors ? *colors : displayColorMode(cloud);
-  request.filter = settings.filter;
-  request.camera = camera;
-  request.width = a.width;
-  request.height = a.height;
-  request.depth = settings.post.enabled() ? DepthMode::Float : settings.depth;
-  return pickJson(cloud, pixel, word == shared::kEmptyPixel, pickPoint(request, pixel.x, pixel.y, word));
-}
-
-// --annotations: read before the device starts, for the methods that draw a loaded cloud into one mono
-// image with a depth per pixel; the frame then keeps its canonical words for the overlay's depth test.
-std::optional<Annotations> overlayAnnotations(const RenderArgs& a, RenderSettings& settings) {
-  if (a.annotations.empty()) return std::nullopt;
-  const MethodInfo& info = settings.method.info();
-  if (info.layout == SceneLayout::Octree)
-    throw InputError("--annotations draws over the methods that draw a loaded cloud, not " + a.method);
-  if (a.stereo) throw InputError("--annotations draws over a mono image, not --stereo");
-  const bool resolved = settings.post.enabled(); // the resolve stage leaves float-depth words for any method
-  if (!resolved && !hasCanonicalWords(info))
-    throw InputError("--annotations needs the depth of each pixel, which " + a.method +
-                     " does not keep; use a closest-point method (atomicmin) or add --point-size 1.5");
-  if (!resolved && settings.depth == DepthMode::Int40)
-    throw InputError("--annotations reads float depths: leave --depth at float");
-  settings.captureWords = true;
-  return io::loadAnnotations(a.annotations);
-}
-
-// Draws the annotations over the frame the renderer drew last with `camera`.
-void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds, const Annotations& annotations,
-                 std::vector<uint32_t>& pixels) {
-  const std::vector<uint64_t> words = renderer.framebufferWords();
-  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(bounds);
-  drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
-}
-
 // A rank of `mpirun -np N pointrast render` (docs/mpi.md): its share of the points drawn on its device,
 // the frame composited on rank 0, which alone resolves, writes and reports it.
 int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
@@ -742,7 +696,7 @@ int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
   const std::optional<DisplayColorMode> chosen = colorMode(a, cloud);
   const DisplayColorMode colors = agreeColors(chosen ? *chosen : displayColorMode(cloud));
   // Rank 0's camera for every rank: an overview is framed from a sample of its share.
-  Camera camera = renderCamera(a, cloud.bounds, cloud.source);
+  Camera camera = renderCamera(a, cloud.bounds, cloud.source, framingSample(cloud));
   job.broadcast(&camera, sizeof camera);
   Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
   const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
@@ -853,7 +807,7 @@ int runRender(const RenderArgs& a) {
   PointCloud cloud = loadInput(spec);
   filterLoadedCloud(cloud, settings.filter);
   const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
-  const Camera camera = renderCamera(a, cloud.bounds, cloud.source);
+  const Camera camera = renderCamera(a, cloud.bounds, cloud.source, framingSample(cloud));
   Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
   const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
   std::vector<const GpuScene*> drawn;
@@ -913,8 +867,9 @@ std::string renderFooter() {
   const std::string text =
       "\nWithout FILE, renders the built-in demo scene (terrain, 1 M points). FILE may also be a scene name\n"
       "(terrain, tls) generated with --points and --seed.\n"
-      "Without --eye the camera is an overview: it looks at the center of the bounds from the south-west,\n"
-      "35 degrees above the horizon, z up, as close as keeps the whole bounding box in the image.\n"
+      "Without --eye the camera is an overview: it looks at the cloud face on to its longer horizontal side\n"
+      "(from the south, or the west), 35 degrees above the horizon, z up, as close as keeps a sample of its\n"
+      "points (an octree's root node) in the image, centered.\n"
       "Coordinates of --eye/--target are in the file's own units (after LAS scale/offset).\n"
       "The GPU time is the median over --frames frames of clear + draw + resolve, from timestamp queries.\n\n"
       "Point methods (--method):\n" +

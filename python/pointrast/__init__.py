@@ -9,7 +9,7 @@
     >>> image = pointrast.render(octree, min_node_px=50)
 
 The camera follows the CLI's contract: right-handed, z up, eye and target in the data's own coordinates,
-the vertical field of view in degrees; without a camera, the overview of the bounds from the south-west.
+the vertical field of view in degrees; without a camera, the CLI's overview (face on, 35° above the horizon).
 Coordinates far from the origin (UTM, ECEF) are made relative to the cloud's center in double precision
 before anything becomes float. Errors raise ValueError (bad input, with the CLI's sentence), TypeError (an
 array of the wrong dtype) or RuntimeError (a device that cannot run what was asked).
@@ -293,13 +293,10 @@ class Renderer:
         return self._scene.bounds
 
     def overview(self, fov=None):
-        """Set the camera to the overview of the bounds (the CLI's default camera) and return it."""
+        """Set the camera to the overview of the scene (the CLI's default camera) and return it."""
         fov = fov if fov is not None else (self.camera.fov if self.camera else 60.0)
-        bounds = self._scene.bounds
-        if isinstance(self._scene, Octree) and not all(_math.isfinite(v) for v in bounds[0] + bounds[1]):
-            bounds = self._scene.cube
         aspect = self._options["width"] / self._options["height"]
-        self.camera = Camera.from_dict(_core.overview_camera(bounds, aspect, fov))
+        self.camera = Camera.from_dict(_core.scene_overview_camera(self._scene, aspect, fov))
         return self.camera
 
     def look_at(self, eye, target, up=(0.0, 0.0, 1.0), fov=None):

@@ -120,13 +120,13 @@ Options parseOptions(const py::dict& d) {
 // The camera of a render: the overview of `bounds` unless `camera` (a dict with eye, target, up, fov,
 // near, each optional) says otherwise; target defaults to the center of the bounds, as `--target` does.
 Camera resolveCamera(const py::object& camera, const Bounds& bounds, const std::string& source,
-                     const Options& o) {
+                     const Options& o, std::span<const glm::dvec3> framing) {
   checkCoordinateRange(bounds, source);
   py::dict d = camera.is_none() ? py::dict() : camera.cast<py::dict>();
   auto given = [&](const char* key) { return d.contains(key) && !d[key].is_none(); };
   const double fov = given("fov") ? d["fov"].cast<double>() : 60.0;
   if (!(fov > 0 && fov < 180)) throw InputError("camera fov must be between 0 and 180 degrees");
-  Camera c = overviewCamera(bounds, double(o.width) / double(o.height), fov);
+  Camera c = overviewCamera(bounds, double(o.width) / double(o.height), fov, framing);
   if (given("target") && !given("eye")) throw InputError("a camera target needs an eye");
   if (given("eye")) {
     c.eye = vec3(d["eye"], "eye");
@@ -250,7 +250,7 @@ private:
       colors = displayColorMode(cloud, parseColorSource(o.color), o.colorRange);
     else if (o.colorRange)
       throw InputError("color_range applies to color='intensity' and 'elevation'");
-    const Camera c = resolveCamera(camera, cloud.bounds, cloud.source, o);
+    const Camera c = resolveCamera(camera, cloud.bounds, cloud.source, o, framingSample(cloud));
 
     std::vector<uint32_t> pixels;
     FrameStats stats;
@@ -366,7 +366,8 @@ private:
     else if (o.colorRange)
       throw InputError("color_range applies to color='intensity' and 'elevation'");
     options.colorRange = o.colorRange;
-    const Camera c = resolveCamera(camera, meta.bounds.empty() ? meta.cube : meta.bounds, meta.source, o);
+    const Camera c = resolveCamera(camera, meta.bounds.empty() ? meta.cube : meta.bounds, meta.source, o,
+                                   framingSample(*input.source));
     std::vector<uint32_t> pixels;
     FrameStats stats;
     {
@@ -526,6 +527,18 @@ PYBIND11_MODULE(_core, m) {
     b.max = vec3(bounds[1], "bounds max");
     if (!(fov > 0 && fov < 180)) throw InputError("camera fov must be between 0 and 180 degrees");
     return cameraDict(overviewCamera(b, aspect, fov));
+  });
+  // The overview render() uses for a scene: its points framed (a sample of a cloud, an octree's root node).
+  m.def("scene_overview_camera", [](const py::object& scene, double aspect, double fov) {
+    if (!(fov > 0 && fov < 180)) throw InputError("camera fov must be between 0 and 180 degrees");
+    if (py::isinstance<Octree>(scene)) {
+      const Octree& o = scene.cast<const Octree&>();
+      const lod::OctreeMetadata& meta = o.source->metadata();
+      return cameraDict(overviewCamera(meta.bounds.empty() ? meta.cube : meta.bounds, aspect, fov,
+                                       framingSample(*o.source)));
+    }
+    const Cloud& c = scene.cast<const Cloud&>();
+    return cameraDict(overviewCamera(c.cloud->bounds, aspect, fov, framingSample(*c.cloud)));
   });
   m.def("method_names", [] {
     std::vector<std::string> names;

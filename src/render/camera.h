@@ -4,11 +4,17 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
 #include "cloud/cloud.h"
+
+namespace pointrast::lod {
+class NodeSource;
+}
 
 namespace pointrast {
 
@@ -23,20 +29,30 @@ struct Camera {
   double shiftX = 0.0;
 };
 
-// The overview used when no camera is given: looking at the center of the bounds from the south-west
-// (direction (-1, -1, 1) from the center, i.e. 35.3 degrees above the horizon), z up, at the smallest
-// distance at which all eight corners of the bounding box are inside the image, plus 5 %; never closer
-// than the coordinates' magnitude lets doubles tell the eye from the target. Empty bounds (a cloud without
-// points) get the same view of the origin. fovY must be in (0, 180).
-Camera overviewCamera(const Bounds& bounds, double aspect, double fovY = 60.0);
+// The overview used when no camera is given: looking at the bounds face on to their longer horizontal
+// side (from the south when x is the longer, else from the west), 35 degrees above the horizon, z up,
+// framed as framingCamera does. Empty bounds (a cloud without points) get the same view of the origin.
+// fovY must be in (0, 180). With `points` (a sample of the cloud, framingSample()) the points are framed
+// rather than the box's corners: a cloud fills the window however little of its box it occupies.
+Camera overviewCamera(const Bounds& bounds, double aspect, double fovY = 60.0,
+                      std::span<const glm::dvec3> points = {});
+
+// Points that stand for a cloud's shape when framing it: every n-th point, at most maxPoints.
+std::vector<glm::dvec3> framingSample(const PointCloud& cloud, size_t maxPoints = size_t(1) << 16);
+// An octree's root node (its coarsest subsample of the whole cloud), at most maxPoints of it; empty when
+// the root holds no points or cannot be read (framing then falls back to the bounds).
+std::vector<glm::dvec3> framingSample(lod::NodeSource& source, size_t maxPoints = size_t(1) << 16);
 
 // kMaxCoordinate and checkCoordinateRange (cloud/cloud.h) bound what is rendered.
 
-// The same framing from any direction: looking at the center of the bounds along -back (unit vector from
-// the target towards the eye) with the given up (not parallel to back), at the smallest distance that
-// keeps all eight corners in the image, plus 5 %. Views from the axes and "frame all" in the viewer.
+// Framing from any direction: looking along -back (unit vector from the target towards the eye) with the
+// given up (not parallel to back), at the smallest distance that keeps all eight corners of the bounding
+// box (or every one of `points`, when given) in the image, plus 5 %, with the target moved in the image plane so that the box's projection is
+// centered in the image (the target is the center of the bounds only when the projection is symmetric);
+// never closer than the coordinates' magnitude lets doubles tell the eye from the target. The overview,
+// views from the axes and "frame all" in the viewer.
 Camera framingCamera(const Bounds& bounds, double aspect, double fovY, const glm::dvec3& back,
-                     const glm::dvec3& up);
+                     const glm::dvec3& up, std::span<const glm::dvec3> points = {});
 
 // 1e-5 of the bounds' diagonal (at least 1e-9): far below any visible point, so it only drops points
 // at or behind the eye.

@@ -57,7 +57,7 @@ Camera pan(const Camera& start, Viewport viewport, glm::dvec2 delta, double dept
 Camera zoomTowards(const Camera& start, const glm::dvec3& point, double factor);
 
 // Axis views: CloudCompare's keys 8 top, 2 bottom, 5 front (looking north, +y), 0 back, 4 left side
-// (looking east, +x), 6 right side. Iso is the overview's direction (from the south-west, above).
+// (looking east, +x), 6 right side. Iso looks from the south-west, 35 degrees above the horizon.
 enum class StandardView { Top, Bottom, Front, Back, Left, Right, Iso };
 const char* standardViewName(StandardView view);
 

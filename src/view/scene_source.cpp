@@ -19,6 +19,7 @@ SceneInput SceneInput::fromCloud(PointCloud cloud) {
   input.name = cloud.source;
   input.bounds = cloud.bounds;
   input.points = cloud.size();
+  input.framing = framingSample(cloud);
   input.cloud = std::make_unique<PointCloud>(std::move(cloud));
   return input;
 }
@@ -30,6 +31,7 @@ SceneInput SceneInput::fromOctree(std::unique_ptr<lod::NodeSource> source) {
   input.bounds = octree.bounds.empty() ? octree.cube : octree.bounds;
   input.points = octree.pointCount;
   if (input.bounds.empty()) throw InputError(octree.source + ": the octree states no extent");
+  input.framing = framingSample(*source);
   input.octree = std::move(source);
   return input;
 }

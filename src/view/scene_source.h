@@ -43,6 +43,7 @@ struct SceneInput {
   std::string name;     // the file or scene, for titles and messages
   Bounds bounds;        // the points' bounds (an octree's cube when it states none)
   uint64_t points = 0;  // points of the cloud, or of the whole octree
+  std::vector<glm::dvec3> framing; // points the overview frames (render/camera.h framingSample)
   SceneInput();
   SceneInput(SceneInput&&) noexcept;
   SceneInput& operator=(SceneInput&&) noexcept;

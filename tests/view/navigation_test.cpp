@@ -207,7 +207,8 @@ TEST(Navigation, FrameAllKeepsTheDirectionAndMatchesTheOverview) {
   Viewport vp{640, 480};
   Camera overview = overviewCamera(b, vp.aspect());
   Camera away = overview;
-  away.eye = overview.eye * 7.0 + glm::dvec3(3, 3, 3);
+  // The same direction, seven times as far, from elsewhere.
+  away.eye = overview.target + 7.0 * (overview.eye - overview.target) + glm::dvec3(3, 3, 3);
   away.target = overview.target + glm::dvec3(3, 3, 3);
   Navigation nav(b, away);
   nav.frameAll(vp);

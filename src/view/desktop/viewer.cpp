@@ -132,7 +132,7 @@ private:
 
 Camera startCamera(const SceneInput& input, const ViewerOptions& options, Viewport viewport) {
   if (options.camera) return *options.camera;
-  return overviewCamera(input.bounds, viewport.aspect(), options.fovY);
+  return overviewCamera(input.bounds, viewport.aspect(), options.fovY, input.framing);
 }
 
 // The settings the session starts with: the options', with the method the source and device call for

@@ -80,7 +80,8 @@ void WebClient::resize(uint32_t width, uint32_t height) {
   Viewport viewport = clampViewport(width, height, setup_.maxSize);
   if (!session_) {
     Camera camera = setup_.camera ? *setup_.camera
-                                  : overviewCamera(setup_.cloud->bounds(), viewport.aspect(), setup_.fovY);
+                                  : overviewCamera(setup_.cloud->bounds(), viewport.aspect(), setup_.fovY,
+                                                   setup_.framing);
     session_.emplace(setup_.cloud->bounds(), camera, viewport, setup_.settings);
     session_->setContentSource(&full_);
     return;

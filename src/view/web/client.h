@@ -32,6 +32,7 @@ struct ClientSetup {
   std::span<const Method> methods; // this device runs them
   std::optional<Camera> camera;    // starting camera; the overview when absent
   double fovY = 60;                // of the overview
+  std::span<const glm::dvec3> framing; // the points the overview frames (SceneInput::framing)
   ViewSettings settings;
   Viewport maxSize{3840, 2160}; // frames are at most this large (aspect kept)
   StreamSettings stream;

@@ -210,6 +210,7 @@ Server::Server(SceneInput& input, const ServerOptions& options)
   setup_.methods = methods_;
   setup_.camera = options.camera;
   setup_.fovY = options.fovY;
+  setup_.framing = input.framing;
   setup_.settings = settings;
   setup_.maxSize = options.maxSize;
   setup_.stream = options.stream;
