@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# Builds pointrast and runs every test: all tests on the default Vulkan device (lavapipe without a GPU)
-# with the Khronos validation layer on, then the parser and data-preparation tests again under
-# AddressSanitizer + UBSan (truncation sweeps must never read out of bounds), and last the sphere tests
-# on a newer lavapipe (Mesa 25, Debian 12 backports, unpacked privately) that has mesh shaders and ray
-# tracing, which the system's Mesa 22.3 lacks: there those pipelines are only skipped. Then a tree built
-# with the test-only point method of tests/methods (one table row, one shader) checks that the method
-# appears in every generated name list and renders like atomicmin. Then the libFuzzer
-# targets (tests/fuzz), built with clang in build-fuzz, run for $POINTRAST_FUZZ_SECONDS (180) seconds of
-# wall time in all, shared between them, as many at once as there are cores.
+# Checks that every file the docs name exists, then builds pointrast and runs every test: all tests on the
+# default Vulkan device (lavapipe without a GPU) with the Khronos validation layer on, then the parser and
+# data-preparation tests again under AddressSanitizer + UBSan (truncation sweeps must never read out of
+# bounds), and the sphere tests on a newer lavapipe (Mesa 25, Debian 12 backports, unpacked privately)
+# that has mesh shaders and ray tracing, which the system's Mesa 22.3 lacks: there those pipelines are
+# only skipped. Then a tree built with the test-only point method of tests/methods (one table row, one
+# shader) checks that the method appears in every generated name list and renders like atomicmin. Last
+# the libFuzzer targets (tests/fuzz), built with clang in build-fuzz, run for $POINTRAST_FUZZ_SECONDS
+# (120) seconds of wall time in all, shared between them, as many at once as there are cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -17,6 +17,9 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 # Tests that read ../shared/data skip, naming the missing file, where it is absent (a fresh clone); CI has the
 # data, so there such a skip fails the test instead.
 if [ "${CI:-}" = true ]; then export POINTRAST_REQUIRE_DATA=1; fi
+
+echo "== every file the README and docs/ name exists"
+scripts/check-doc-links.sh
 
 echo "== tests (warnings as errors, validation layer on)"
 # Optimized, but with asserts on (no -DNDEBUG): the push-constant size checks are asserts.
@@ -60,9 +63,9 @@ echo "   a test-only command (tests/commands: its cmd_*.cpp and one row) in help
 # build of the three targets would cost CI several minutes.
 cmake -S . -B build-method -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O0" \
   -DPOINTRAST_WERROR=ON -DPOINTRAST_TEST_METHODS=ON -DPOINTRAST_TEST_COMMANDS=ON
-cmake --build build-method -j"$jobs" --target pointrast gpu_tests cli_tests
-POINTRAST_VALIDATION=1 build-method/tests/gpu_tests --gtest_brief=1 --gtest_filter='MethodTable.*:Table/*closest_variant*'
-POINTRAST_VALIDATION=1 build-method/tests/cli_tests --gtest_brief=1 --gtest_filter='TestMethodCli.*:TestCommandCli.*'
+cmake --build build-method -j"$jobs" --target pointrast table_tests
+POINTRAST_VALIDATION=1 build-method/tests/table_tests --gtest_brief=1 \
+  --gtest_filter='MethodTable.*:Table/*closest_variant*:TestMethodCli.*:TestCommandCli.*'
 
-echo "== parsers under libFuzzer (clang, ASan, UBSan), ${POINTRAST_FUZZ_SECONDS:-180} s in all"
-scripts/fuzz.sh --total "${POINTRAST_FUZZ_SECONDS:-180}"
+echo "== parsers under libFuzzer (clang, ASan, UBSan), ${POINTRAST_FUZZ_SECONDS:-120} s in all"
+scripts/fuzz.sh --total "${POINTRAST_FUZZ_SECONDS:-120}"
