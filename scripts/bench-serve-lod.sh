@@ -5,7 +5,7 @@
 # client `serve_load --flight` as one browser tab: low over the cloud and across it, then jumps. Writes
 # $OUT/serve-lod.{json,md}, the server's events and log. The LAS is removed once the octree is built (the
 # two together are about 50 GB).
-#   POINTRAST_BIN=... SERVE_LOAD=... OUT=... WORK=/tmp/servelod scripts/bench-serve-lod.sh [POINTS]
+#   POINTRAST_BIN=... SERVE_LOAD=... OUT=... WORK=/tmp/servelod [SERVE_RATE=120] scripts/bench-serve-lod.sh [POINTS]
 set -euo pipefail
 points=${1:-1G}
 pr=${POINTRAST_BIN:?the pointrast binary}
@@ -47,7 +47,9 @@ if [ -z "$port" ]; then
   exit 1
 fi
 status=0
-"$load" --port "$port" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" --flight \
+# SERVE_RATE: pointer moves a second, the page's display refresh rate (one move per animation frame).
+"$load" --port "$port" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" \
+  --rate "${SERVE_RATE:-120}" --flight \
   -o "$out/serve-lod.json" --markdown "$out/serve-lod.md" || status=1
 trap - EXIT
 kill -TERM "$server"

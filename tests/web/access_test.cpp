@@ -104,8 +104,10 @@ TEST(Access, TheMessageBudgetRefillsAtItsRate) {
     ++taken;
   EXPECT_EQ(taken, int(kMessageBurst));
   EXPECT_FALSE(budget.take(10.0));
-  EXPECT_TRUE(budget.take(10.0 + 1.0 / kMessagesPerSecond));
-  EXPECT_FALSE(budget.take(10.0 + 1.0 / kMessagesPerSecond));
+  // One and a half messages' worth of time later: one more (the half is not a message; whole seconds
+  // would hide a rate off by rounding).
+  EXPECT_TRUE(budget.take(10.0 + 1.5 / kMessagesPerSecond));
+  EXPECT_FALSE(budget.take(10.0 + 1.5 / kMessagesPerSecond));
 }
 
 } // namespace

@@ -16,11 +16,16 @@ using wsclient::Client;
 
 // Opens a client of `port` at w x h and reads frames (acknowledging each) until a full frame whose state
 // says the level of detail converged; that frame's JPEG, or nothing after `seconds`.
+// The first full frame drawn once the view converged, after `settings` (a "settings" message, as the
+// page's panel sends) when given: then only a frame whose state shows `options` (the settings as render
+// options) counts.
 std::optional<std::vector<uint8_t>> convergedFrame(uint16_t port, uint32_t w, uint32_t h, Json& state,
-                                                   double seconds = 120) {
+                                                   double seconds = 120, const Json& settings = nullptr,
+                                                   const std::string& options = "") {
   Client ws;
   if (!ws.connect("127.0.0.1", port, "/ws")) return std::nullopt;
   ws.sendText(Json{{"t", "resize"}, {"w", w}, {"h", h}}.dump());
+  if (!settings.is_null()) ws.sendText(settings.dump());
   auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   bool converged = false;
   while (std::chrono::steady_clock::now() < deadline) {
@@ -31,7 +36,9 @@ std::optional<std::vector<uint8_t>> convergedFrame(uint16_t port, uint32_t w, ui
       if (j.is_object() && j.value("t", "") == "state") {
         state = j;
         converged = j.contains("stats") && j["stats"].contains("lod") &&
-                    j["stats"]["lod"].value("converged", false);
+                    j["stats"]["lod"].value("converged", false) &&
+                    (settings.is_null() || (j.contains("settings") && j["settings"].is_object() &&
+                                            j["settings"].value("options", "") == options));
       }
       continue;
     }
@@ -76,6 +83,45 @@ TEST(ServeLod, PotreeOctreeOpensWithLodAndItsConvergedFrameEqualsRender) {
 TEST(ServeLod, PotreeBrotliOctreeOpensWithLodAndItsConvergedFrameEqualsRender) {
   POINTRAST_REQUIRE_DATA("potree/autzen_trim_brotli");
   expectConvergedFrameEqualsRender((dataDir() / "potree" / "autzen_trim_brotli").string());
+}
+
+// The panel's level-of-detail controls: a point budget and a minimum node size sent as the page sends them
+// give the frame `render --method lod` draws with those options, and a different one than before.
+TEST(ServeLod, PointBudgetAndMinNodeSizeFromThePanelEqualRender) {
+  POINTRAST_REQUIRE_DATA("potree/autzen_trim_default");
+  const std::string input = (dataDir() / "potree" / "autzen_trim_default").string();
+  ServeProcess server("'" + input + "' " + kAutzenCamera);
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  const auto dir = scratchDir("lod_panel");
+  auto render = [&](const std::string& options, const std::string& name) {
+    const std::string png = (dir / name).string();
+    commandOutput("'" + pointrastBinary() + "' render '" + input + "' --method lod " + kAutzenCamera + " " +
+                  options + " --width 320 --height 240 -q -o '" + png + "'");
+    return png;
+  };
+  const std::string unchanged = render("", "default.png");
+  const struct {
+    Json settings;
+    std::string options;
+  } steps[] = {{{{"t", "settings"}, {"pointBudget", 20000}}, "--point-budget 20000"},
+               {{{"t", "settings"}, {"minNodePx", 400}}, "--min-node-px 400"}};
+  for (const auto& step : steps) {
+    SCOPED_TRACE(step.options);
+    Json state;
+    // The state names the method too: an octree opens with lod, which is not the settings' default.
+    auto jpeg = convergedFrame(server.port(), 320, 240, state, 60, step.settings, "--method lod " + step.options);
+    ASSERT_TRUE(jpeg) << server.stderrText() << "\nlast state: " << state.dump();
+    uint32_t w = 0, h = 0;
+    std::vector<uint32_t> shown;
+    ASSERT_TRUE(view::web::decodeJpeg(*jpeg, w, h, shown));
+    ASSERT_EQ(w, 320u);
+    const std::string ref = render(step.options, "ref.png");
+    ImageDifference own = compareWithPng(shown, w, h, ref), before = compareWithPng(shown, w, h, unchanged);
+    EXPECT_GE(own.psnr, kJpegPsnr) << "mean abs " << own.meanAbs;
+    EXPECT_LE(own.meanAbs, kJpegMeanAbs);
+    EXPECT_GT(before.meanAbs, own.meanAbs + 1.0) << "the frame did not change as render's does";
+  }
+  EXPECT_EQ(server.stop(), 0) << server.stderrText();
 }
 
 } // namespace

@@ -326,8 +326,9 @@ Json Load::flightPhase() {
       down = false;
     }
     // A pump that returned late does not make the next moves come in a burst: a page sends at most one
-    // move per animation frame (60 a second here, besides an acknowledgement per frame), and the server cuts off a client that sends faster than a page does.
-    next = std::max(next + 1.0 / std::min(args_.rate, 60.0), clockSeconds());
+    // move per animation frame (--rate stands for the display's refresh rate), besides an acknowledgement
+    // per frame, and the server cuts off a client that sends faster than a page does.
+    next = std::max(next + 1.0 / args_.rate, clockSeconds());
     pump(next);
   }
   if (down) send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});

@@ -51,8 +51,9 @@ Verdict checkRequest(const AccessPolicy& policy, const RequestFacts& request);
 const char* verdictReason(Verdict verdict);
 
 // Messages a client may send: a bucket of kMessageBurst refilled at kMessagesPerSecond. A page sends at
-// most one pointer move per displayed frame, far below this; a client over it is cut off.
-constexpr double kMessagesPerSecond = 200;
+// most one pointer move and one acknowledgement per displayed frame (330 a second on a 165 Hz display),
+// below this; a client over it is cut off.
+constexpr double kMessagesPerSecond = 400;
 constexpr double kMessageBurst = 400;
 
 class MessageBudget {
