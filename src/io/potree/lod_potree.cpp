@@ -13,8 +13,13 @@ struct EncodedNode final : lod::PreparedNode {
 uint64_t folderBytes(const std::filesystem::path& dir) {
   uint64_t bytes = 0;
   std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-    if (entry.is_regular_file(ec)) bytes += entry.file_size(ec);
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    // A size that cannot be read is left out rather than added as -1 (a size printed as "-101 bytes").
+    std::error_code sizeError;
+    if (!entry.is_regular_file(sizeError)) continue;
+    const uintmax_t size = entry.file_size(sizeError);
+    if (!sizeError) bytes += size;
+  }
   return bytes;
 }
 
