@@ -10,6 +10,7 @@
 
 #include "base/error.h"
 #include "cloud/generate.h"
+#include "gpu/device_rank.h"
 #include "gpu/shared_types.h"
 #include "io/reader.h"
 #include "mpi/mpi_job.h"
@@ -37,22 +38,6 @@ void keepRange(PointCloud& cloud, uint64_t first, uint64_t count) {
   keep(cloud.classification, 1);
   keep(cloud.returnNumber, 1);
   keep(cloud.pointSourceId, 1);
-}
-
-// The device types in the order a rank prefers them (gpu::Context's own choice prefers them alike).
-int typeRank(VkPhysicalDeviceType type) {
-  switch (type) {
-  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-    return 4;
-  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-    return 3;
-  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-    return 2;
-  case VK_PHYSICAL_DEVICE_TYPE_CPU:
-    return 1;
-  default:
-    return 0;
-  }
 }
 
 // Test hook (docs/mpi.md): rank 0 writes the composited words, 8 B a pixel little-endian, to this file.
@@ -83,10 +68,10 @@ void chooseRankDevice(gpu::ContextOptions& options) {
   const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
   int best = 0;
   for (const gpu::DeviceInfo& d : devices)
-    best = std::max(best, typeRank(d.type));
+    best = std::max(best, gpu::deviceTypeRank(d.type));
   std::vector<uint32_t> candidates;
   for (uint32_t i = 0; i < devices.size(); ++i)
-    if (typeRank(devices[i].type) == best) candidates.push_back(i);
+    if (gpu::deviceTypeRank(devices[i].type) == best) candidates.push_back(i);
   if (!candidates.empty()) options.deviceIndex = candidates[job.localRank() % candidates.size()];
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "gpu/device_rank.h"
 
 namespace pointrast::gpu {
 
@@ -62,21 +63,6 @@ const char* typeName(VkPhysicalDeviceType type) {
   }
 }
 
-// Preference when no device is named: discrete > integrated > virtual > CPU > other.
-int typeRank(VkPhysicalDeviceType type) {
-  switch (type) {
-  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-    return 4;
-  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-    return 3;
-  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-    return 2;
-  case VK_PHYSICAL_DEVICE_TYPE_CPU:
-    return 1;
-  default:
-    return 0;
-  }
-}
 
 DeviceInfo describe(VkPhysicalDevice physical) {
   VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
@@ -271,7 +257,7 @@ void Context::chooseDevice(const ContextOptions& options) {
     physical_ = devices[*index];
   } else {
     physical_ = *std::max_element(devices.begin(), devices.end(), [](VkPhysicalDevice a, VkPhysicalDevice b) {
-      return typeRank(describe(a).type) < typeRank(describe(b).type);
+      return deviceTypeRank(describe(a).type) < deviceTypeRank(describe(b).type);
     });
   }
   info_ = describe(physical_);
