@@ -793,6 +793,8 @@ int runRender(const RenderArgs& a) {
   RenderSettings settings = pointSettings(a);
   const std::optional<Annotations> annotations = overlayAnnotations(a, settings);
   if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
+  if (distributedRun() && annotations)
+    throw InputError("--annotations draws over the frame of one process; under mpirun render draws without it");
   if (distributedRun()) return runRenderDistributed(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);

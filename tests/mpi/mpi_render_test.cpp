@@ -222,4 +222,22 @@ TEST(MpiRender, OtherCommandsRefuseSeveralRanks) {
   EXPECT_NE(r.err.find("pointrast: `pointrast info` runs as one process"), std::string::npos) << r.err;
 }
 
+// Annotations are drawn over one process's frame; under mpirun they are refused, not silently dropped.
+TEST(MpiRender, AnnotationsAreRefusedUnderMpirun) {
+  REQUIRE_MPI();
+  const fs::path json = cliTempDir() / "label.json", png = cliTempDir() / "annotated.png";
+  {
+    std::ofstream out(json);
+    out << R"({"version": 1, "annotations": [{"type": "label", "text": "x", "points": [[0, 0, 0]]}]})";
+  }
+  fs::remove(png);
+  const MpiRun r = runMpi("-np 2 " + pointrastBinary() + " render terrain --points 20000 --annotations " +
+                              json.string() + " -o " + png.string() + kImage + " -q",
+                          "", 60);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("pointrast: --annotations draws over the frame of one process"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(png));
+}
+
 } // namespace
