@@ -29,22 +29,6 @@ constexpr size_t kEvlrHeaderSize = 60; // R15 section 2.7, Table 26
 constexpr uint16_t kWktRecord = 2112;  // "LASF_Projection": OGC coordinate system WKT
 constexpr uint16_t kGeoKeysRecord = 34735;
 
-void copyString(uint8_t* dst, size_t n, const char* s) {
-  std::memset(dst, 0, n);
-  std::memcpy(dst, s, std::min(n, std::strlen(s)));
-}
-
-std::vector<uint8_t> vlrBytes(const char* userId, uint16_t recordId, const char* description,
-                              const std::vector<uint8_t>& payload) {
-  std::vector<uint8_t> v(las::kVlrHeaderSize + payload.size(), 0);
-  copyString(v.data() + 2, 16, userId);
-  storeLE<uint16_t>(v.data() + 18, recordId);
-  storeLE<uint16_t>(v.data() + 20, static_cast<uint16_t>(payload.size()));
-  copyString(v.data() + 22, 32, description);
-  std::memcpy(v.data() + las::kVlrHeaderSize, payload.data(), payload.size());
-  return v;
-}
-
 struct Entry {
   uint64_t offset = 0;
   int32_t byteSize = 0;
@@ -119,9 +103,9 @@ void CopcWriter::State::header() {
   storeLE<uint16_t>(h + las::kGlobalEncoding, 0x10);
   h[las::kVersionMajor] = 1;
   h[las::kVersionMinor] = 4;
-  copyString(h + las::kSystemId, 32, "pointrast");
+  las::copyString(h + las::kSystemId, 32, "pointrast");
   // The creation day and year stay 0 (unknown): the file's bytes depend on its points only.
-  copyString(h + las::kSoftware, 32,
+  las::copyString(h + las::kSoftware, 32,
              metadata.fields.color && averagedColors ? kCopcSoftwareAveraged : kCopcSoftwareExact);
   storeLE<uint16_t>(h + las::kHeaderSizeField, static_cast<uint16_t>(las::kHeaderSize14));
   for (int a = 0; a < 3; ++a) {
@@ -228,8 +212,8 @@ CopcWriter::CopcWriter(std::filesystem::path path, const lod::OctreeMetadata& me
   s.header();
   std::vector<uint8_t> info(kInfoBytes, 0); // filled in at commit
   const std::vector<std::vector<uint8_t>> vlrs = {
-      vlrBytes("copc", 1, "COPC info", info),
-      vlrBytes("laszip encoded", 22204, "LAZ by pointrast", laz::laszipVlrPayload(s.layout))};
+      las::vlrBytes("copc", 1, "COPC info", info),
+      las::vlrBytes("laszip encoded", 22204, "LAZ by pointrast", laz::laszipVlrPayload(s.layout))};
   for (const auto& v : vlrs)
     s.prefix.insert(s.prefix.end(), v.begin(), v.end());
   uint32_t vlrCount = 2;
@@ -238,7 +222,7 @@ CopcWriter::CopcWriter(std::filesystem::path path, const lod::OctreeMetadata& me
       fail(s.path, "the coordinate system's WKT is too long for a VLR");
     std::vector<uint8_t> wkt(options.wkt.begin(), options.wkt.end());
     wkt.push_back(0); // null-terminated, as R15 2.5 asks of WKT
-    const std::vector<uint8_t> v = vlrBytes("LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt);
+    const std::vector<uint8_t> v = las::vlrBytes("LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt);
     s.prefix.insert(s.prefix.end(), v.begin(), v.end());
     ++vlrCount;
   }
@@ -363,10 +347,10 @@ void CopcWriter::commit() {
   uint64_t rootOffset = 0, rootSize = 0;
   const std::vector<uint8_t> pages = s.hierarchy(evlrStart + kEvlrHeaderSize, rootOffset, rootSize);
   std::vector<uint8_t> evlr(kEvlrHeaderSize, 0);
-  copyString(evlr.data() + 2, 16, "copc");
+  las::copyString(evlr.data() + 2, 16, "copc");
   storeLE<uint16_t>(evlr.data() + 18, 1000);
   storeLE<uint64_t>(evlr.data() + 20, pages.size());
-  copyString(evlr.data() + 28, 32, "EPT hierarchy");
+  las::copyString(evlr.data() + 28, 32, "EPT hierarchy");
   evlr.insert(evlr.end(), pages.begin(), pages.end());
   s.pwriteAll(evlrStart, evlr.data(), evlr.size());
   s.fileBytes = evlrStart + evlr.size();

@@ -2,8 +2,10 @@
 // Shared by the LAS reader, the LAS writer and format detection.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,24 @@ inline constexpr uint64_t kHeaderSize12 = 227;
 inline constexpr uint64_t kHeaderSize13 = 235;
 inline constexpr uint64_t kHeaderSize14 = 375;
 inline constexpr uint64_t kVlrHeaderSize = 54; // R15 section 2.5, Table 4
+
+// A fixed-size character field: `s` cut to `n` bytes, the rest zero (LAS strings need no terminator).
+inline void copyString(uint8_t* dst, size_t n, const char* s) {
+  std::memset(dst, 0, n);
+  std::memcpy(dst, s, std::min(n, std::strlen(s)));
+}
+
+// A variable length record: its 54-byte header (R15 Table 4) followed by `payload`.
+inline std::vector<uint8_t> vlrBytes(const char* userId, uint16_t recordId, const char* description,
+                                     const std::vector<uint8_t>& payload) {
+  std::vector<uint8_t> v(kVlrHeaderSize + payload.size(), 0);
+  copyString(v.data() + 2, 16, userId);
+  storeLE<uint16_t>(v.data() + 18, recordId);
+  storeLE<uint16_t>(v.data() + 20, static_cast<uint16_t>(payload.size()));
+  copyString(v.data() + 22, 32, description);
+  std::memcpy(v.data() + kVlrHeaderSize, payload.data(), payload.size());
+  return v;
+}
 
 inline constexpr int kFileSourceId = 4;
 inline constexpr int kGlobalEncoding = 6;

@@ -46,11 +46,6 @@ FlavorInfo flavorInfo(LasFlavor flavor) {
   return {2, 3, las::kHeaderSize12};
 }
 
-void copyString(uint8_t* dst, size_t n, const char* s) {
-  std::memset(dst, 0, n);
-  std::memcpy(dst, s, std::min(n, std::strlen(s)));
-}
-
 } // namespace
 
 bool isLazPath(const std::filesystem::path& path) {
@@ -66,17 +61,6 @@ namespace {
 // LAZ chunks encoded at once: a few per core, so every core has work while memory stays a few chunks
 // of records per core.
 constexpr uint64_t kChunksPerThread = 2;
-
-std::vector<uint8_t> vlrBytes(const char* userId, uint16_t recordId, const char* description,
-                              const std::vector<uint8_t>& payload) {
-  std::vector<uint8_t> v(las::kVlrHeaderSize + payload.size(), 0);
-  copyString(v.data() + 2, 16, userId);
-  storeLE<uint16_t>(v.data() + 18, recordId);
-  storeLE<uint16_t>(v.data() + 20, static_cast<uint16_t>(payload.size()));
-  copyString(v.data() + 22, 32, description);
-  std::memcpy(v.data() + las::kVlrHeaderSize, payload.data(), payload.size());
-  return v;
-}
 
 } // namespace
 
@@ -173,7 +157,7 @@ LasFileWriter::LasFileWriter(const std::filesystem::path& path, LasFileSetup set
     if (st.chunkSize == 0) fail(path, "a LAZ chunk size of 0 points");
     s.layout = laz::encoderLayout(st.pointFormat, st.recordLength, st.chunkSize);
     const std::vector<uint8_t> vlr =
-        vlrBytes("laszip encoded", 22204, "LAZ by pointrast", laz::laszipVlrPayload(*s.layout));
+        las::vlrBytes("laszip encoded", 22204, "LAZ by pointrast", laz::laszipVlrPayload(*s.layout));
     s.prefix.insert(s.prefix.end(), vlr.begin(), vlr.end());
     ++vlrCount;
   }
@@ -630,8 +614,8 @@ std::vector<uint8_t> LasRecordWriter::State::header(const glm::dvec3& scale, con
   storeLE<uint16_t>(h + las::kGlobalEncoding, extended ? 0x10 : 0);
   h[las::kVersionMajor] = 1;
   h[las::kVersionMinor] = f.minor;
-  copyString(h + las::kSystemId, 32, "pointrast");
-  copyString(h + las::kSoftware, 32, "pointrast");
+  las::copyString(h + las::kSystemId, 32, "pointrast");
+  las::copyString(h + las::kSoftware, 32, "pointrast");
   std::time_t now = std::time(nullptr);
   std::tm utc{};
   gmtime_r(&now, &utc);
