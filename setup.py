@@ -25,7 +25,7 @@ class CMakeBuild(build_ext):
         if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
             subprocess.check_call(configure)
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
-        subprocess.check_call(["cmake", "--build", build, "--target", "pointrast_python", "-j", jobs])
+        subprocess.check_call(["cmake", "--build", build, "--target", "pointrast_python", "pointrast", "-j", jobs])
         package = os.path.join(build, "python", "pointrast")
         built = [f for f in os.listdir(package) if f.startswith("_core") and f.endswith(".so")]
         if len(built) != 1:
@@ -33,6 +33,11 @@ class CMakeBuild(build_ext):
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(os.path.join(package, built[0]), target)
+        # The command-line program goes along: pointrast.show() runs its `serve`.
+        program = os.path.join(os.path.dirname(target), "_bin", "pointrast")
+        os.makedirs(os.path.dirname(program), exist_ok=True)
+        shutil.copyfile(os.path.join(build, "pointrast"), program)
+        os.chmod(program, 0o755)
 
 
 setup(

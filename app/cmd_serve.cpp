@@ -20,7 +20,7 @@ namespace {
 
 struct ServeArgs {
   std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
-  std::string method, points = "1M", bind = "127.0.0.1", token, maxSize = "3840x2160";
+  std::string method, points = "1M", bind = "127.0.0.1", token, maxSize = "3840x2160", frameAncestors;
   uint32_t port = 8080, maxClients = view::web::kDefaultMaxClients;
   double fov = 60, motionScale = 0.5;
   int quality = 90, motionQuality = 60;
@@ -46,6 +46,7 @@ int runServe(const ServeArgs& a) {
   if (a.port > 65535) throw InputError("--port takes 0 to 65535");
   o.port = uint16_t(a.port);
   o.token = a.token;
+  o.frameAncestors = a.frameAncestors;
   o.maxClients = a.maxClients;
   o.maxSize = parseSize(a.maxSize);
   o.fovY = a.fov;
@@ -106,6 +107,10 @@ Command addServe(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--token", a->token, "Access token clients must present (16-100 letters, digits, - or _)");
   cmd->add_option("--max-clients", a->maxClients, "Browser tabs served at once")->capture_default_str();
+  cmd->add_option("--frame-ancestors", a->frameAncestors,
+                  "Pages allowed to show the viewer in a frame, as origins separated by spaces (e.g. "
+                  "\"http://localhost:*\"; default: none). pointrast.show() uses it to embed the viewer in "
+                  "a Jupyter notebook");
   cmd->add_option("--max-size", a->maxSize, "Largest frame WxH (a larger canvas is drawn scaled up)")
       ->capture_default_str();
   cmd->add_option("--quality", a->quality, "JPEG quality of the full frame at rest")->capture_default_str();

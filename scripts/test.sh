@@ -47,7 +47,8 @@ rm -rf build-test/venv
 /usr/bin/python3 -m venv --system-site-packages build-test/venv
 POINTRAST_BUILD_DIR="$PWD/build-test" build-test/venv/bin/pip install -q --no-build-isolation .
 (cd /tmp && "$OLDPWD/build-test/venv/bin/python" -c 'import numpy, pointrast
-assert pointrast.render(numpy.random.default_rng(1).random((1000, 3)), width=64, height=48)[..., :3].any()')
+assert pointrast.render(numpy.random.default_rng(1).random((1000, 3)), width=64, height=48)[..., :3].any()
+assert pointrast.cli_path().endswith("pointrast/_bin/pointrast"), pointrast.cli_path()')
 
 echo "== sphere pipelines on Mesa 25 lavapipe (mesh shaders, ray tracing)"
 (

@@ -7,6 +7,7 @@
     >>> image = pointrast.render(cloud, color="classification", edl=True)
     >>> octree = pointrast.open("octree/")                         # Potree, COPC, EPT: level of detail
     >>> image = pointrast.render(octree, min_node_px=50)
+    >>> pointrast.show(octree)                                      # Jupyter: the interactive viewer
 
 The camera follows the CLI's contract: right-handed, z up, eye and target in the data's own coordinates,
 the vertical field of view in degrees; without a camera, the CLI's overview (face on, 35° above the horizon).
@@ -23,7 +24,7 @@ import numpy as _np
 
 from . import _core
 
-__all__ = ["Camera", "Cloud", "Frame", "Octree", "Renderer", "open", "render", "methods"]
+__all__ = ["Camera", "Cloud", "Frame", "Octree", "Renderer", "Viewer", "open", "render", "methods", "show"]
 
 Cloud = _core.Cloud
 Octree = _core.Octree
@@ -390,3 +391,6 @@ def save_png(path, image):
     """Write an (H, W, 4) uint8 image (render()'s result) to a PNG file."""
     with _io.open(_os.fspath(path), "wb") as f:
         f.write(png_bytes(image))
+
+
+from ._show import Viewer, cli_path, show  # noqa: E402  (show() uses the helpers above)

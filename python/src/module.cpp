@@ -24,6 +24,7 @@
 #include "gpu/context.h"
 #include "io/format_table.h"
 #include "io/reader.h"
+#include "io/writer.h"
 #include "render/camera.h"
 #include "render/lod/lod_scene.h"
 #include "render/renderer.h"
@@ -517,6 +518,13 @@ PYBIND11_MODULE(_core, m) {
   });
   m.def("set_attribute", [](Cloud& c, const std::string& name, const py::object& values) {
     setAttribute(*c.cloud, name, values);
+  });
+  // The cloud as a LAS file (its own scale and offset, colors, intensity, classification, returns, source
+  // ids): what pointrast.show() hands to `pointrast serve` for a cloud made in Python.
+  m.def("write_las", [](const Cloud& c, const std::string& path) {
+    py::gil_scoped_release unlocked;
+    io::writeLas(path, *c.cloud,
+                 c.cloud->size() > 0xFFFFFFFFull ? io::LasFlavor::Las14Pf7 : io::LasFlavor::Las12Pf3);
   });
   m.def("read_cloud", &readCloud);
   m.def("open_octree", &openOctree);

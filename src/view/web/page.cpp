@@ -39,4 +39,8 @@ const PageFile* findPageFile(std::string_view path) {
   return nullptr;
 }
 
+bool isPublicPageFile(std::string_view path) {
+  return path != "/" && (path.ends_with(".js") || path.ends_with(".css")) && findPageFile(path) != nullptr;
+}
+
 } // namespace pointrast::view::web

@@ -21,4 +21,8 @@ struct PageFile {
 // The file a URL path names ("/" is index.html, "/app.js", ...), or nothing: no other path is served.
 const PageFile* findPageFile(std::string_view path);
 
+// The page's script and style sheet (not the page itself): files that hold no data and may load without the
+// access token.
+bool isPublicPageFile(std::string_view path);
+
 } // namespace pointrast::view::web

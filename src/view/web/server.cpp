@@ -66,6 +66,17 @@ constexpr const char* kSecurityHeaders =
     "Content-Security-Policy: default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' "
     "blob: data:; connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'\r\n";
 
+// The viewer's own files carry the same headers, except that --frame-ancestors may name pages that embed it
+// in a frame (a notebook's output cell).
+std::string pageHeaders(const std::string& frameAncestors) {
+  std::string headers = kSecurityHeaders;
+  if (frameAncestors.empty()) return headers;
+  headers.erase(headers.find("X-Frame-Options"), std::strlen("X-Frame-Options: DENY\r\n"));
+  const std::string none = "frame-ancestors 'none'";
+  headers.replace(headers.find(none), none.size(), "frame-ancestors " + frameAncestors);
+  return headers;
+}
+
 void sendClose(mg_connection* conn, uint16_t code, std::string_view reason) {
   char payload[125]; // a control frame's payload is at most 125 bytes
   payload[0] = char(code >> 8);
@@ -161,6 +172,7 @@ private:
   SceneInput& input_;
   ServerOptions options_;
   AccessPolicy access_;
+  std::string pageHeaders_; // security headers of the viewer's own files
   gpu::Context context_;
   std::unique_ptr<SceneSource> source_;
   std::vector<Method> methods_;
@@ -196,6 +208,7 @@ Server::Server(SceneInput& input, const ServerOptions& options)
     : input_(input), options_(options), context_(makeContext(options)),
       source_(makeSceneSource(context_, input, options.settings, !options.quiet)) {
   access_.token = options.token;
+  pageHeaders_ = pageHeaders(options.frameAncestors);
   // A client's page offers the methods that draw what was opened (an uploaded cloud, or an octree).
   methods_ = methodsFor(*source_, context_);
   ViewSettings settings = options.settings;
@@ -296,6 +309,11 @@ int Server::gate(mg_connection* conn) {
   std::string upgrade = header("Upgrade"), host = header("Host"), origin = header("Origin");
   RequestFacts facts{host, origin, queryToken, cookieToken, bearer, !upgrade.empty()};
   Verdict verdict = checkRequest(access_, facts);
+  // The page's script and style hold no data. A page in another site's frame (a notebook) gets no cookie
+  // with its requests, so they load without the token; the WebSocket still needs it.
+  if (verdict == Verdict::NoToken && !facts.websocket &&
+      isPublicPageFile(info->local_uri ? info->local_uri : ""))
+    verdict = Verdict::Allow;
   int status = 0;
   std::string body;
   if (stopping_) {
@@ -358,7 +376,7 @@ int Server::serveHttp(mg_connection* conn) {
     body = "not found: this server serves its viewer page only\n";
   }
   std::string head = "HTTP/1.1 " + std::to_string(status) + (status == 200 ? " OK" : " Not Found") +
-                     "\r\nContent-Type: " + std::string(type) + "\r\n" + kSecurityHeaders + extra +
+                     "\r\nContent-Type: " + std::string(type) + "\r\n" + pageHeaders_ + extra +
                      "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n";
   cw::mg_write(conn, head.data(), head.size());
   if (std::strcmp(info->request_method, "HEAD") != 0) cw::mg_write(conn, body.data(), body.size());
@@ -715,6 +733,12 @@ void checkServerOptions(const ServerOptions& o) {
        o.token.find_first_not_of("0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ-_") !=
            std::string::npos))
     throw InputError("--token takes 16 to 100 letters, digits, '-' or '_'");
+  // Sources as a Content-Security-Policy writes them ("http://localhost:*", "'self'"): nothing that could end
+  // the header or the directive.
+  if (o.frameAncestors.size() > 512 ||
+      o.frameAncestors.find_first_not_of("0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                         "-_.:/*' ") != std::string::npos)
+    throw InputError("--frame-ancestors takes page origins such as http://localhost:* separated by spaces");
 }
 
 int runServer(SceneInput& input, ServerOptions options) {

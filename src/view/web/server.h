@@ -35,6 +35,7 @@ struct ServerOptions {
   Viewport maxSize = kDefaultMaxSize;
   StreamSettings stream;
   std::optional<uint32_t> device;
+  std::string frameAncestors; // pages that may show the viewer in a frame (CSP sources); empty: none
   bool events = false; // one JSON object a line on stdout: listening, clients, refusals, the exit
   bool quiet = false;
 };
