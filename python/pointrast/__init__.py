@@ -59,7 +59,9 @@ class Camera:
 class Frame:
     """A rendered frame: image (H, W, 4) uint8 RGBA, row 0 at the top; depth (H, W) float32 linear depth of
     the closest point (inf where none) and index (H, W) int64 index of that point (-1 where none) when
-    asked for; the camera it was drawn from. Shows itself as a PNG in Jupyter."""
+    asked for; the camera it was drawn from; gpu_ms, the GPU time of a frame (the median of `frames`);
+    upload_s, the seconds this render spent uploading the cloud (0 when a Renderer reused it). Shows itself
+    as a PNG in Jupyter."""
 
     def __init__(self, result):
         self.image = result["image"]
@@ -69,6 +71,7 @@ class Frame:
         self.method = result["method"]
         self.points = result["points"]
         self.gpu_ms = result["gpu_ms"]
+        self.upload_s = result.get("upload_s", 0.0)
 
     def _repr_png_(self):
         return png_bytes(self.image)
@@ -212,7 +215,7 @@ _DEFAULTS = dict(width=1920, height=1080, method="auto", depth="float", precisio
                  background=(0, 0, 0), color="auto", color_range=None, point_size=1.0, point_shape="square",
                  point_size_mode="fixed", point_size_max=16.0, dilate=0, edl=False, edl_strength=None,
                  edl_radius=None, min_node_px=None, point_budget=None, gpu_memory=None, foveated=False,
-                 fovea_radius=None, fovea_periphery=None)
+                 fovea_radius=None, fovea_periphery=None, frames=1)
 
 
 def _options(kwargs, base):
@@ -373,7 +376,8 @@ def render(xyz, colors=None, *, camera=None, return_depth=False, return_index=Fa
     lod for an octree; pointrast.methods() lists them), depth="float"|"int40", precision="adaptive"|1|2|3,
     background=(r, g, b), color="auto"|"rgb"|"intensity"|"classification"|"elevation"|"return"|"source",
     color_range=(lo, hi), point_size, point_shape="square"|"disc", point_size_mode="fixed"|"attenuated",
-    point_size_max, dilate, edl, edl_strength, edl_radius; octrees: min_node_px (100), point_budget,
+    point_size_max, dilate, edl, edl_strength, edl_radius, frames (timed frames after a warm-up: the Frame's
+    gpu_ms is their median); octrees: min_node_px (100), point_budget,
     gpu_memory ("8G" or bytes), foveated, fovea_radius, fovea_periphery. device: Vulkan device index.
     """
     scene = _as_cloud(xyz, colors, intensity, classification)

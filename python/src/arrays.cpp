@@ -1,11 +1,13 @@
 #include "arrays.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <type_traits>
 
+#include "base/parallel.h"
 #include "io/io_util.h"
 
 namespace pointrast::python {
@@ -52,26 +54,33 @@ template <typename T> std::vector<T> copyVector(const py::array& a) {
   return v;
 }
 
-template <typename Src>
-void quantizeRows(PointCloud& cloud, const Src* src, uint64_t n, const io::detail::Quantization& q) {
-  int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-  for (uint64_t i = 0; i < 3 * n; ++i) {
-    const int a = int(i % 3);
-    const int32_t v = io::detail::quantize(double(src[i]), q.scale[a], q.offset[a]);
-    cloud.positions[i] = v;
-    qmin[a] = std::min(qmin[a], v);
-    qmax[a] = std::max(qmax[a], v);
-  }
-  if (n > 0) cloud.bounds = io::detail::boundsFromQuantized(qmin, qmax, cloud.scale, cloud.offset);
-}
+constexpr uint64_t kBlock = 1 << 20; // points per block of the parallel passes
 
 template <typename Src> std::shared_ptr<PointCloud> quantizeXyz(const Src* src, uint64_t n) {
+  // Bounds per block on every core; the first row that is not finite is the error.
+  const uint64_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<Bounds> blockBounds(blocks);
+  std::vector<uint64_t> firstBad(blocks, UINT64_MAX);
+  parallelBlocks(n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
+    Bounds bounds;
+    for (uint64_t i = begin; i < end; ++i) {
+      const glm::dvec3 p(src[3 * i], src[3 * i + 1], src[3 * i + 2]);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        firstBad[b] = i;
+        return;
+      }
+      bounds.expand(p);
+    }
+    blockBounds[b] = bounds;
+  });
   Bounds raw;
-  for (uint64_t i = 0; i < n; ++i) {
-    const glm::dvec3 p(src[3 * i], src[3 * i + 1], src[3 * i + 2]);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw py::value_error("xyz row " + std::to_string(i) + " is not finite (NaN or infinity)");
-    raw.expand(p);
+  for (uint64_t b = 0; b < blocks; ++b) {
+    if (firstBad[b] != UINT64_MAX)
+      throw py::value_error("xyz row " + std::to_string(firstBad[b]) + " is not finite (NaN or infinity)");
+    if (!blockBounds[b].empty()) {
+      raw.expand(blockBounds[b].min);
+      raw.expand(blockBounds[b].max);
+    }
   }
   auto cloud = std::make_shared<PointCloud>();
   cloud->source = "array";
@@ -80,7 +89,28 @@ template <typename Src> std::shared_ptr<PointCloud> quantizeXyz(const Src* src, 
   cloud->scale = q.scale;
   cloud->offset = q.offset;
   cloud->positions.resize(3 * n);
-  quantizeRows(*cloud, src, n, q);
+  std::vector<std::array<int32_t, 6>> blockRange(blocks); // quantized min x y z, max x y z
+  int32_t* dst = cloud->positions.data();
+  parallelBlocks(n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
+    std::array<int32_t, 6> r = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, INT32_MIN};
+    for (uint64_t i = begin; i < end; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const int32_t v = io::detail::quantize(double(src[3 * i + a]), q.scale[a], q.offset[a]);
+        dst[3 * i + a] = v;
+        r[a] = std::min(r[a], v);
+        r[3 + a] = std::max(r[3 + a], v);
+      }
+    blockRange[b] = r;
+  });
+  if (n > 0) {
+    int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+    for (const auto& r : blockRange)
+      for (int a = 0; a < 3; ++a) {
+        qmin[a] = std::min(qmin[a], r[a]);
+        qmax[a] = std::max(qmax[a], r[3 + a]);
+      }
+    cloud->bounds = io::detail::boundsFromQuantized(qmin, qmax, cloud->scale, cloud->offset);
+  }
   return cloud;
 }
 
@@ -146,15 +176,29 @@ void setColors(PointCloud& cloud, const py::object& red, const py::object& green
         wide = at<uint16_t>(channels[c], i) > 255;
   }
   cloud.colors.resize(n);
-  for (uint64_t i = 0; i < n; ++i) {
-    uint32_t v[3];
-    for (int c = 0; c < 3; ++c) {
-      const uint32_t raw =
-          isUint8(channels[c].dtype()) ? at<uint8_t>(channels[c], i) : at<uint16_t>(channels[c], i);
-      v[c] = wide ? raw >> 8 : raw;
-    }
-    cloud.colors[i] = packRgba(v[0], v[1], v[2]);
+  // Read without the interpreter: each channel's bytes, stride and width taken first.
+  const char* data[3];
+  py::ssize_t stride[3];
+  bool byte[3];
+  for (int c = 0; c < 3; ++c) {
+    data[c] = static_cast<const char*>(channels[c].data());
+    stride[c] = n ? channels[c].strides(0) : 0;
+    byte[c] = isUint8(channels[c].dtype());
   }
+  uint32_t* dst = cloud.colors.data();
+  py::gil_scoped_release release; // the arrays stay referenced by the caller
+  parallelBlocks(n, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
+    for (uint64_t i = begin; i < end; ++i) {
+      uint32_t v[3];
+      for (int c = 0; c < 3; ++c) {
+        const char* p = data[c] + py::ssize_t(i) * stride[c];
+        const uint32_t raw = byte[c] ? uint32_t(*reinterpret_cast<const uint8_t*>(p))
+                                     : uint32_t(*reinterpret_cast<const uint16_t*>(p));
+        v[c] = wide ? raw >> 8 : raw;
+      }
+      dst[i] = packRgba(v[0], v[1], v[2]);
+    }
+  });
 }
 
 void setAttribute(PointCloud& cloud, const std::string& name, const py::object& values) {

@@ -4,6 +4,7 @@
 // The GIL is released while the GPU works; errors of the library become Python exceptions carrying the
 // same sentence as the CLI's one line (InputError: ValueError, a device that cannot: RuntimeError).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -63,6 +64,7 @@ struct Options {
   uint64_t pointBudget = 0, gpuMemory = 0;
   lod::Foveation foveation;
   bool lodOptionsGiven = false;
+  uint32_t frames = 1; // timed frames: gpu_ms is their median
 };
 
 Options parseOptions(const py::dict& d) {
@@ -82,6 +84,11 @@ Options parseOptions(const py::dict& d) {
       *std::max_element(bg.begin(), bg.end()) > 255)
     throw InputError("background must be three values 0..255 (r, g, b)");
   o.background = packRgba(bg[0], bg[1], bg[2]);
+  if (given("frames")) {
+    const int64_t frames = get("frames").cast<int64_t>();
+    if (frames < 1 || frames > 10000) throw InputError("frames must be 1 to 10000");
+    o.frames = uint32_t(frames);
+  }
   o.color = get("color").cast<std::string>();
   if (given("color_range")) {
     const auto r = get("color_range").cast<std::vector<double>>();
@@ -194,8 +201,8 @@ private:
     s.depth = parseDepthMode(o.depth);
     s.precision = parsePrecision(o.precision);
     s.background = o.background;
-    s.frames = 1;
-    s.warmup = 0; // one frame makes the image; timing is the benchmarks' business
+    s.frames = o.frames;
+    s.warmup = o.frames > 1 ? 1 : 0; // one frame makes the image; more are timed after a warm-up
     s.post = o.post;
     std::string why;
     if (!Renderer::supports(*context_, s.method, &why)) throw UnsupportedError(why);
@@ -228,6 +235,7 @@ private:
     r["method"] = method;
     r["points"] = st.points;
     r["gpu_ms"] = st.medianMs;
+    r["upload_s"] = lastUploadS_;
     return r;
   }
 
@@ -267,10 +275,14 @@ private:
         upload.layout = layout;
         upload.progress = false;
         upload.colors = colors;
+        const auto start = std::chrono::steady_clock::now();
         scene_ = std::make_unique<GpuScene>(*context_, cloud, upload);
+        lastUploadS_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         sceneCloud_ = input.cloud;
         sceneLayout_ = layout;
         sceneColors_ = colors;
+      } else {
+        lastUploadS_ = 0;
       }
       Renderer& r = renderer(o);
       stats = r.render(*scene_, c, s);
@@ -347,6 +359,7 @@ private:
   }
 
   py::dict renderOctree(const Octree& input, const py::object& camera, const Options& o) {
+    lastUploadS_ = 0;
     const lod::OctreeMetadata& meta = input.source->metadata();
     const std::string method = o.method == "auto" ? "lod" : o.method;
     RenderSettings s = settings(o, method);
@@ -404,6 +417,7 @@ private:
   std::weak_ptr<PointCloud> sceneCloud_;
   SceneLayout sceneLayout_ = SceneLayout::Float;
   std::optional<DisplayColorMode> sceneColors_;
+  double lastUploadS_ = 0; // seconds the last render spent uploading its cloud (0: the upload was reused)
   std::unique_ptr<GpuScene> indexScene_;
   std::weak_ptr<PointCloud> indexCloud_;
   std::unique_ptr<lod::LodScene> lod_;

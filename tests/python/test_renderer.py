@@ -54,3 +54,15 @@ def test_pick():
     assert r.pick(0, 0) is None
     with pytest.raises(ValueError, match="outside"):
         r.pick(W, 0)
+
+
+def test_a_renderer_uploads_once_and_times_frames():
+    xyz = np.random.default_rng(3).random((50_000, 3)) * [10, 10, 1]
+    r = pointrast.Renderer(xyz, width=160, height=120, method="batch-prefetch")
+    first = r.render()
+    assert first.upload_s > 0
+    again = r.render(frames=4)
+    assert again.upload_s == 0 and again.gpu_ms > 0
+    np.testing.assert_array_equal(first.image, again.image)
+    with pytest.raises(ValueError, match="frames must be 1 to 10000"):
+        r.render(frames=0)
