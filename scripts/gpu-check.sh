@@ -210,6 +210,14 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT \
       timeout 540 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
     ;;
+  python)
+    # The Python module against the CLI (scripts/bench-python.py): pointrast.render of NumPy arrays, upload
+    # GB/s and frame ms beside `pointrast render` of the same points. Needs .gpu/python/pointrast, the
+    # module built for this machine's python3 (docs/python.md says how). Writes python-render.{json,md}.
+    echo "== python: ${PY_POINTS:-100M 1G}"
+    PYTHONPATH=$PWD/.gpu/python POINTRAST_VALIDATION=0 BENCH_TMP=${BENCH_TMP:-/tmp} \
+      timeout 560 python3 scripts/bench-python.py "$OUT" "$pr" ${PY_POINTS:-100M 1G} || status=1
+    ;;
   mpi)
     # Distributed rendering (docs/mpi.md): 1 rank against 2 ranks at 2560x1140, render and composite ms
     # apart; brute force on MPI_POINTS (default 1G) generated points, lod on MPI_OCTREE when given. Writes
@@ -217,7 +225,7 @@ for what in "$@"; do
     timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" "${MPI_POINTS:-1G}" "${MPI_OCTREE:-}" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, mpi, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, mpi, python, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
