@@ -215,7 +215,9 @@ _DEFAULTS = dict(width=1920, height=1080, method="auto", depth="float", precisio
                  background=(0, 0, 0), color="auto", color_range=None, point_size=1.0, point_shape="square",
                  point_size_mode="fixed", point_size_max=16.0, dilate=0, edl=False, edl_strength=None,
                  edl_radius=None, min_node_px=None, point_budget=None, gpu_memory=None, foveated=False,
-                 fovea_radius=None, fovea_periphery=None, frames=1)
+                 fovea_radius=None, fovea_periphery=None, frames=1, clip_box=None, clip_polygon=None,
+                 clip_z=None, clip_mode=None, classes=None, returns=None, intensity_range=None, gps_time=None,
+                 source_ids=None)
 
 
 def _options(kwargs, base):
@@ -379,6 +381,11 @@ def render(xyz, colors=None, *, camera=None, return_depth=False, return_index=Fa
     point_size_max, dilate, edl, edl_strength, edl_radius, frames (timed frames after a warm-up: the Frame's
     gpu_ms is their median); octrees: min_node_px (100), point_budget,
     gpu_memory ("8G" or bytes), foveated, fovea_radius, fovea_periphery. device: Vulkan device index.
+    Filters, as the CLI's Filters options: clip_box=(xmin, ymin, zmin, xmax, ymax, zmax) or a list of boxes,
+    clip_polygon=[(x, y), ...] or a list of polygons (extruded in z; clip_z=(zmin, zmax) bounds them),
+    clip_mode="inside"|"outside"|"highlight" (clip volumes are drawn by the GPU, which skips whole batches
+    and nodes outside); clouds only: classes=[2, 6], returns="all"|"first"|"last"|"only",
+    intensity_range=(lo, hi) (the CLI's --intensity), gps_time=(lo, hi), source_ids=[1, 4].
     """
     scene = _as_cloud(xyz, colors, intensity, classification)
     if (colors is not None and _np.asarray(colors).ndim == 1 and options.get("color", "auto") == "auto"):

@@ -4,6 +4,7 @@
 // The GIL is released while the GPU works; errors of the library become Python exceptions carrying the
 // same sentence as the CLI's one line (InputError: ValueError, a device that cannot: RuntimeError).
 #include <algorithm>
+#include <bitset>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -22,11 +23,13 @@
 #include "base/error.h"
 #include "cloud/attribute_colors.h"
 #include "cloud/octree.h"
+#include "cloud/point_filter.h"
 #include "gpu/context.h"
 #include "io/format_table.h"
 #include "io/reader.h"
 #include "io/writer.h"
 #include "render/camera.h"
+#include "render/clip_volumes.h"
 #include "render/lod/lod_scene.h"
 #include "render/renderer.h"
 #include "render/scene.h"
@@ -65,7 +68,98 @@ struct Options {
   lod::Foveation foveation;
   bool lodOptionsGiven = false;
   uint32_t frames = 1; // timed frames: gpu_ms is their median
+  PointFilter filter;  // clip volumes and attribute filters, as the CLI's Filters options
 };
+
+// A number pair (lo, hi) with lo <= hi, for the range filters.
+std::pair<double, double> rangeOf(const py::handle& value, const char* name) {
+  const auto r = value.cast<std::vector<double>>();
+  if (r.size() != 2 || !std::isfinite(r[0]) || !std::isfinite(r[1]) || r[0] > r[1])
+    throw InputError(std::string(name) + " must be (lo, hi) with lo <= hi");
+  return {r[0], r[1]};
+}
+
+// clip_box, clip_polygon, clip_z, clip_mode, classes, returns, intensity_range, gps_time, source_ids: the
+// CLI's --clip-box ... --source-ids, as Python values.
+PointFilter parseFilter(const py::dict& d) {
+  auto given = [&](const char* key) { return d.contains(key) && !d[key].is_none(); };
+  PointFilter f;
+  if (given("clip_box")) {
+    py::object boxes = d["clip_box"];
+    const bool one = py::len(boxes) > 0 && !py::isinstance<py::sequence>(boxes[py::int_(0)]);
+    for (const py::handle box : one ? py::list(py::make_tuple(boxes)) : py::list(boxes)) {
+      const auto v = box.cast<std::vector<double>>();
+      if (v.size() != 6 || !std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); }) ||
+          v[0] > v[3] || v[1] > v[4] || v[2] > v[5])
+        throw InputError("clip_box must be (xmin, ymin, zmin, xmax, ymax, zmax) with each min <= max, or a "
+                         "list of such boxes");
+      f.boxes.push_back({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}});
+    }
+  }
+  if (given("clip_polygon")) {
+    py::object polygons = d["clip_polygon"];
+    // One polygon [(x, y), ...] or a list of them.
+    const bool one = py::len(polygons) > 0 && py::len(polygons[py::int_(0)]) == 2 &&
+                     !py::isinstance<py::sequence>(polygons[py::int_(0)][py::int_(0)]);
+    for (const py::handle polygon : one ? py::list(py::make_tuple(polygons)) : py::list(polygons)) {
+      ClipPolygon p;
+      for (const py::handle vertex : polygon) {
+        const auto v = vertex.cast<std::vector<double>>();
+        if (v.size() != 2 || !std::isfinite(v[0]) || !std::isfinite(v[1]))
+          throw InputError("clip_polygon vertices must be (x, y) pairs of finite numbers");
+        p.vertices.push_back({v[0], v[1]});
+      }
+      if (p.vertices.size() < 3) throw InputError("clip_polygon needs at least three vertices");
+      f.polygons.push_back(std::move(p));
+    }
+  }
+  if (given("clip_z")) {
+    if (f.polygons.empty()) throw InputError("clip_z applies to clip_polygon");
+    const auto [lo, hi] = rangeOf(d["clip_z"], "clip_z");
+    for (ClipPolygon& p : f.polygons) {
+      p.zMin = lo;
+      p.zMax = hi;
+    }
+  }
+  const std::string mode = given("clip_mode") ? d["clip_mode"].cast<std::string>() : "inside";
+  if (mode == "inside") f.clipMode = ClipMode::Inside;
+  else if (mode == "outside") f.clipMode = ClipMode::Outside;
+  else if (mode == "highlight") f.clipMode = ClipMode::Highlight;
+  else throw InputError("clip_mode must be 'inside', 'outside' or 'highlight', not '" + mode + "'");
+  if (given("clip_mode") && !f.hasClip()) throw InputError("clip_mode needs clip_box or clip_polygon");
+  if (given("classes")) {
+    std::bitset<256> keep;
+    for (const py::handle c : d["classes"]) {
+      const int64_t v = c.cast<int64_t>();
+      if (v < 0 || v > 255) throw InputError("classes are classification values 0 to 255");
+      keep.set(size_t(v));
+    }
+    f.classes = keep;
+  }
+  if (given("returns")) {
+    const std::string r = d["returns"].cast<std::string>();
+    if (r == "all") f.returns = ReturnFilter::All;
+    else if (r == "first") f.returns = ReturnFilter::First;
+    else if (r == "last") f.returns = ReturnFilter::Last;
+    else if (r == "only") f.returns = ReturnFilter::Only;
+    else throw InputError("returns must be 'all', 'first', 'last' or 'only', not '" + r + "'");
+  }
+  if (given("intensity_range")) f.intensity = rangeOf(d["intensity_range"], "intensity_range");
+  if (given("gps_time")) f.gpsTime = rangeOf(d["gps_time"], "gps_time");
+  if (given("source_ids")) {
+    std::vector<uint16_t> ids;
+    for (const py::handle c : d["source_ids"]) {
+      const int64_t v = c.cast<int64_t>();
+      if (v < 0 || v > 65535) throw InputError("source_ids are point source ids 0 to 65535");
+      ids.push_back(uint16_t(v));
+    }
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    f.sourceIds = ids;
+  }
+  checkGpuClip(f);
+  return f;
+}
 
 Options parseOptions(const py::dict& d) {
   Options o;
@@ -122,6 +216,7 @@ Options parseOptions(const py::dict& d) {
     throw InputError("fovea_radius must be between 0 and 1");
   if (!(o.foveation.periphery >= 1) || !std::isfinite(o.foveation.periphery))
     throw InputError("fovea_periphery must be a factor >= 1");
+  o.filter = parseFilter(d);
   return o;
 }
 
@@ -204,6 +299,7 @@ private:
     s.frames = o.frames;
     s.warmup = o.frames > 1 ? 1 : 0; // one frame makes the image; more are timed after a warm-up
     s.post = o.post;
+    s.filter = o.filter; // the renderer draws the clip volumes; attribute filters are applied to the cloud
     std::string why;
     if (!Renderer::supports(*context_, s.method, &why)) throw UnsupportedError(why);
     return s;
@@ -241,7 +337,8 @@ private:
 
   py::dict renderCloud(const Cloud& input, const py::object& camera, const Options& o, bool wantDepth,
                        bool wantIndex) {
-    const PointCloud& cloud = *input.cloud;
+    const std::shared_ptr<PointCloud> drawn = filtered(input.cloud, o.filter);
+    const PointCloud& cloud = *drawn;
     const std::string method = o.method == "auto" ? "atomicmin" : o.method;
     RenderSettings s = settings(o, method);
     const SceneLayout layout = s.method.info().layout;
@@ -267,20 +364,24 @@ private:
     {
       py::gil_scoped_release release;
       // One uploaded scene per layout and color mode of the cloud last drawn.
-      const bool same = scene_ && sceneCloud_.lock() == input.cloud && sceneLayout_ == layout &&
-                        sameColors(sceneColors_, colors);
+      const std::optional<PointFilter> highlight =
+          o.filter.hasClip() && o.filter.clipMode == ClipMode::Highlight ? std::optional(o.filter) : std::nullopt;
+      const bool same = scene_ && sceneCloud_.lock() == drawn && sceneLayout_ == layout &&
+                        sameColors(sceneColors_, colors) && sceneHighlight_ == highlight;
       if (!same) {
         scene_.reset();
         UploadOptions upload;
         upload.layout = layout;
         upload.progress = false;
         upload.colors = colors;
+        upload.filter = highlight;
         const auto start = std::chrono::steady_clock::now();
         scene_ = std::make_unique<GpuScene>(*context_, cloud, upload);
         lastUploadS_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        sceneCloud_ = input.cloud;
+        sceneCloud_ = drawn;
         sceneLayout_ = layout;
         sceneColors_ = colors;
+        sceneHighlight_ = highlight;
       } else {
         lastUploadS_ = 0;
       }
@@ -293,6 +394,28 @@ private:
     py::dict out = result(pixels, o, c, stats, method);
     if (wantDepth || wantIndex) addDepthIndex(out, words, o, wantDepth, wantIndex);
     return out;
+  }
+
+  // The cloud as drawn: the points that pass the attribute filters (a copy kept while the same cloud and
+  // filters are drawn), or the cloud itself. The bounds stay the whole cloud's, as the CLI's.
+  std::shared_ptr<PointCloud> filtered(const std::shared_ptr<PointCloud>& cloud, const PointFilter& filter) {
+    if (!filter.hasAttributeFilter()) return cloud;
+    PointFilter attributes = filter;
+    attributes.boxes.clear();
+    attributes.orientedBoxes.clear();
+    attributes.polygons.clear();
+    if (filtered_ && filteredFrom_.lock() == cloud && filteredBy_ == attributes) return filtered_;
+    requireFilterAttributes(attributes, filterFields(*cloud), cloud->source);
+    auto copy = std::make_shared<PointCloud>(*cloud);
+    {
+      py::gil_scoped_release release;
+      applyFilter(*copy, attributes);
+    }
+    copy->bounds = cloud->bounds;
+    filtered_ = copy;
+    filteredFrom_ = cloud;
+    filteredBy_ = attributes;
+    return copy;
   }
 
   static bool sameColors(const std::optional<DisplayColorMode>& a, const std::optional<DisplayColorMode>& b) {
@@ -370,6 +493,12 @@ private:
     if (o.depth != "float")
       throw InputError("depth does not apply to " + method +
                        ", which draws an octree's nodes in their stored order");
+    if (o.filter.hasAttributeFilter())
+      throw InputError("classes, returns, intensity_range, gps_time and source_ids apply to clouds drawn "
+                       "from memory; " + method + " draws an octree, which takes clip volumes only");
+    if (o.filter.hasClip() && o.filter.clipMode == ClipMode::Highlight)
+      throw InputError("clip_mode='highlight' tints the colors of a cloud drawn from memory; " + method +
+                       " draws an octree: use 'inside' or 'outside'");
     s.minNodePx = o.minNodePx;
     s.pointBudget = o.pointBudget;
     s.foveation = o.foveation;
@@ -417,6 +546,10 @@ private:
   std::weak_ptr<PointCloud> sceneCloud_;
   SceneLayout sceneLayout_ = SceneLayout::Float;
   std::optional<DisplayColorMode> sceneColors_;
+  std::optional<PointFilter> sceneHighlight_;
+  std::shared_ptr<PointCloud> filtered_; // the last cloud's points that pass its attribute filters
+  std::weak_ptr<PointCloud> filteredFrom_;
+  PointFilter filteredBy_;
   double lastUploadS_ = 0; // seconds the last render spent uploading its cloud (0: the upload was reused)
   std::unique_ptr<GpuScene> indexScene_;
   std::weak_ptr<PointCloud> indexCloud_;
