@@ -683,12 +683,20 @@ void printPointSummary(const RenderArgs& a, const RenderSettings& settings, cons
         stats.post->composeMs);
 }
 
+// The input of a render: a generated scene carries its classes when a class filter or the classification
+// colors need them.
+InputSpec renderInputSpec(const RenderArgs& a, const RenderSettings& settings) {
+  InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
+  spec.classification = settings.filter.classes.has_value() || a.look.color == "classification";
+  return spec;
+}
+
 // A rank of `mpirun -np N pointrast render` (docs/mpi.md): its share of the points drawn on its device,
 // the frame composited on rank 0, which alone resolves, writes and reports it.
 int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
   mpi::Job& job = mpi::Job::get();
   checkDistributed(settings, !a.path.path.empty(), false);
-  const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
+  const InputSpec spec = renderInputSpec(a, settings);
   gpu::Context context(contextOptions(a));
   CompositeStats composite;
   composite.devices = announceRanks(context, a.quiet);
@@ -798,7 +806,7 @@ int runRender(const RenderArgs& a) {
   if (distributedRun()) return runRenderDistributed(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
-  const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
+  const InputSpec spec = renderInputSpec(a, settings);
 
   // The header's count before the device starts, the device's memory before the read.
   const std::optional<uint64_t> stated = statedPoints(spec);

@@ -118,6 +118,7 @@ PointCloud loadShare(const InputSpec& spec) {
     options.progress = mine.progress;
     options.first = range.first;
     options.count = range.count;
+    options.classification = spec.classification;
     PointCloud cloud = generateScene(parseScene(source), options);
     cloud.bounds = job.unionOf(cloud.bounds);
     return cloud;

@@ -36,6 +36,7 @@ PointCloud loadInput(const InputSpec& spec) {
     options.points = spec.source.empty() ? kDemoPoints : spec.points;
     options.seed = spec.seed;
     options.progress = spec.progress;
+    options.classification = spec.classification;
     cloud = generateScene(parseScene(source), options);
   } else {
     throw InputError(source + ": no such file, and not a scene name (terrain, tls)");

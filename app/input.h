@@ -22,6 +22,7 @@ struct InputSpec {
   uint64_t seed = 1;           // for scenes and shuffled orders
   Order order = Order::Original;
   bool progress = true;
+  bool classification = false; // a generated scene's ASPRS classes too (files have what they have)
 };
 
 // The input of the commands that take a point cloud (render, view, serve) from their shared options: FILE or

@@ -64,6 +64,7 @@ PointCloud generateScene(Scene scene, const GenerateOptions& options) {
     // Exactly 16 B per point, allocated once; generation writes in place.
     cloud.positions.resize(3 * n);
     cloud.colors.resize(n);
+    if (options.classification) cloud.classification.resize(n);
   } catch (const std::bad_alloc&) {
     throw InputError("cannot generate " + what + ": out of memory");
   }
@@ -73,7 +74,8 @@ PointCloud generateScene(Scene scene, const GenerateOptions& options) {
   if (options.progress) progress.emplace("generating " + std::string(sceneName(scene)), n);
   parallelBlocks(n, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
     generator->generate(first + begin, end - begin, cloud.positions.data() + 3 * begin,
-                        cloud.colors.data() + begin);
+                        cloud.colors.data() + begin,
+                        options.classification ? cloud.classification.data() + begin : nullptr);
     if (progress) progress->advance(end - begin);
   });
   if (progress) progress->finish();

@@ -27,6 +27,9 @@ struct GenerateOptions {
   // render): the same points the whole scene holds at those indices; bounds are the share's.
   uint64_t first = 0;
   uint64_t count = UINT64_MAX; // clamped to the scene's size
+  // ASPRS classes as well (terrain: 2 ground, 5 high vegetation, 6 building; tls: 1), 1 byte a point more:
+  // for class filters and the classification colors.
+  bool classification = false;
 };
 
 // Throws InputError if the count cannot be held (more than 2^40 points or allocation would fail).

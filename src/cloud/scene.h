@@ -21,8 +21,9 @@ class SceneGenerator {
 public:
   virtual ~SceneGenerator() = default;
   // Writes points [first, first + count): positions[3k..3k+2] (quantized, see scale/offset) and
-  // colors[k] for point first + k.
-  virtual void generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors) const = 0;
+  // colors[k] for point first + k, and their ASPRS classes[k] when `classes` is not null.
+  virtual void generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors,
+                        uint8_t* classes) const = 0;
 
   // Quantization of the scene: world = q * scale + offset. 1 mm, with a UTM-like offset so the
   // double-precision origin path is exercised as with real survey data.

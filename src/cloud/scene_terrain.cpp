@@ -109,7 +109,8 @@ inline double shade(const glm::dvec3& n) {
 class TerrainScene final : public SceneGenerator {
 public:
   TerrainScene(uint64_t points, uint64_t seed);
-  void generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors) const override;
+  void generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors,
+                uint8_t* classes) const override;
 
 private:
   struct Line; // per scan line constants
@@ -493,7 +494,8 @@ void TerrainScene::hitCrowns(CellCache<Tree, 6>& cache, const Pulse& p, double z
   }
 }
 
-void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors) const {
+void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors,
+                            uint8_t* classes) const {
   CellCache<Building, 4> buildings;
   CellCache<Tree, 6> trees;
   NoiseCells cells;
@@ -539,6 +541,8 @@ void TerrainScene::generate(uint64_t first, uint64_t count, int32_t* positions, 
       break;
     }
     colors[n] = toRgba(c);
+    // ASPRS: 2 ground, 6 building (roofs and walls), 5 high vegetation.
+    if (classes) classes[n] = hit.kind == PulseHit::kGround ? 2 : hit.kind == PulseHit::kCrown ? 5 : 6;
   }
 }
 

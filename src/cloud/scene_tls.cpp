@@ -86,7 +86,8 @@ private:
 class TlsScene final : public SceneGenerator {
 public:
   TlsScene(uint64_t points, uint64_t seed);
-  void generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors) const override;
+  void generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors,
+                uint8_t* classes) const override;
 
 private:
   double groundZ(double x, double y) const { return kBaseElevation + gradX_ * x + gradY_ * y; }
@@ -415,7 +416,10 @@ Rgb TlsScene::shadeHit(const Candidate* c, bool top, const glm::dvec3& p, const 
   return color * factor;
 }
 
-void TlsScene::generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors) const {
+void TlsScene::generate(uint64_t first, uint64_t count, int32_t* positions, uint32_t* colors,
+                        uint8_t* classes) const {
+  // A terrestrial scan is not classified here: every point is ASPRS 1, unclassified.
+  if (classes) std::fill(classes, classes + count, uint8_t(1));
   const uint64_t total = offsets_.back();
   Profile p;
   uint64_t current = ~0ull;

@@ -121,6 +121,24 @@ TEST(RenderFilterCli, ClassFilterDrawsTheSubset) {
   }
 }
 
+// A generated scene carries its classes when a class filter or the classification colors ask for them:
+// keeping every class the terrain has (ground, high vegetation, building) draws the whole scene; ground
+// alone draws less; the classification colors are not the scene's own.
+TEST(RenderFilterCli, GeneratedTerrainHasClassesToFilter) {
+  const std::string out = (cliTempDir() / "terrain_classes.png").string();
+  const std::string base = "terrain --points 50k --width 160 --height 120 -o " + out;
+  const nlohmann::json whole = renderJson(base);
+  const nlohmann::json every = renderJson(base + " --classes 2,5,6");
+  const nlohmann::json ground = renderJson(base + " --classes 2");
+  const nlohmann::json colored = renderJson(base + " --color classification");
+  EXPECT_EQ(every["image_hash"], whole["image_hash"]);
+  EXPECT_EQ(every["points"], whole["points"]);
+  EXPECT_LT(ground["points"].get<uint64_t>(), whole["points"].get<uint64_t>());
+  EXPECT_GT(ground["points"].get<uint64_t>(), whole["points"].get<uint64_t>() / 2);
+  EXPECT_NE(ground["image_hash"], whole["image_hash"]);
+  EXPECT_NE(colored["image_hash"], whole["image_hash"]);
+}
+
 TEST(RenderFilterCli, ClipBoxCullsBatchesInJson) {
   const TestCloud t = makeCloud();
   const std::string all = writeCloud(t.cloud, "filter_clip.las");

@@ -102,7 +102,7 @@ TEST_P(EachScene, EveryPointIsAFunctionOfItsIndexAlone) {
   for (auto [first, count] : ranges) {
     std::vector<int32_t> positions(3 * count);
     std::vector<uint32_t> colors(count);
-    scene->generate(first, count, positions.data(), colors.data());
+    scene->generate(first, count, positions.data(), colors.data(), nullptr);
     for (uint64_t k = 0; k < count; ++k) {
       ASSERT_EQ(colors[k], cloud.colors[first + k]) << "point " << first + k;
       for (int a = 0; a < 3; ++a)
@@ -112,7 +112,7 @@ TEST_P(EachScene, EveryPointIsAFunctionOfItsIndexAlone) {
   // And the whole cloud in a single serial call.
   std::vector<int32_t> positions(3 * n);
   std::vector<uint32_t> colors(n);
-  scene->generate(0, n, positions.data(), colors.data());
+  scene->generate(0, n, positions.data(), colors.data(), nullptr);
   EXPECT_EQ(positions, cloud.positions);
   EXPECT_EQ(colors, cloud.colors);
 }
@@ -199,6 +199,39 @@ TEST(TlsScene, DensityFallsWithDistance) {
     return double(count) / (M_PI * (r1 * r1 - r0 * r0));
   };
   EXPECT_GT(ringDensity(2, 4), 4 * ringDensity(40, 60));
+}
+
+TEST(GenerateClassification, TerrainClassesFollowWhatEachPulseHit) {
+  const uint64_t n = 300'000;
+  GenerateOptions options;
+  options.points = n;
+  options.progress = false;
+  const PointCloud plain = generateScene(Scene::Terrain, options);
+  options.classification = true;
+  const PointCloud classified = generateScene(Scene::Terrain, options);
+  // The same points and colors; the classes besides.
+  EXPECT_TRUE(plain.classification.empty());
+  EXPECT_EQ(classified.positions, plain.positions);
+  EXPECT_EQ(classified.colors, plain.colors);
+  ASSERT_EQ(classified.classification.size(), n);
+  uint64_t count[256] = {};
+  for (uint8_t c : classified.classification)
+    ++count[c];
+  EXPECT_EQ(count[2] + count[5] + count[6], n) << "only ground, high vegetation and building";
+  EXPECT_GT(count[2], n / 2) << "mostly ground";
+  EXPECT_GT(count[5], n / 100);
+  EXPECT_GT(count[6], n / 100);
+  // Buildings stand above the ground around them: their mean height is above the ground's.
+  double z[256] = {};
+  for (uint64_t i = 0; i < n; ++i)
+    z[classified.classification[i]] += classified.world(i).z;
+  EXPECT_GT(z[6] / double(count[6]), z[2] / double(count[2]));
+  // A share of the scene (a rank's) has the classes of the same points of the whole.
+  options.first = 123'456;
+  options.count = 5'000;
+  const PointCloud share = generateScene(Scene::Terrain, options);
+  for (uint64_t k = 0; k < options.count; ++k)
+    ASSERT_EQ(share.classification[k], classified.classification[options.first + k]);
 }
 
 } // namespace
