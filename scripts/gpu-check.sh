@@ -210,6 +210,12 @@ for what in "$@"; do
     POINTRAST_VALIDATION=0 SERVE_LOAD=$PWD/.gpu/bin/serve_load OUT=$OUT \
       timeout 540 scripts/bench-serve.sh "${SERVE_POINTS:-1G}" "${SERVE_METHOD:-batch-prefetch}" || status=1
     ;;
+  filtercost)
+    # Clip volumes and a class filter on the 1 G overview against no filter (scripts/bench-filter-cost.sh);
+    # writes filter-cost.{jsonl,md}.
+    echo "== filter cost: ${FILTER_POINTS:-1G} points"
+    POINTRAST_VALIDATION=0 timeout 560 scripts/bench-filter-cost.sh "$pr" "$OUT" "${FILTER_POINTS:-1G}" || status=1
+    ;;
   python)
     # The Python module against the CLI (scripts/bench-python.py): pointrast.render of NumPy arrays, upload
     # GB/s and frame ms beside `pointrast render` of the same points. Needs .gpu/python/pointrast, the
@@ -225,7 +231,7 @@ for what in "$@"; do
     timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" "${MPI_POINTS:-1G}" "${MPI_OCTREE:-}" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, mpi, python, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, mpi, python, filtercost, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"
