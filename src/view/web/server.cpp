@@ -26,6 +26,7 @@
 #include "view/web/access.h"
 #include "view/web/civetweb_api.h"
 #include "view/web/page.h"
+#include "view/web/request_rules.h"
 
 namespace pointrast::view::web {
 
@@ -41,11 +42,8 @@ double now() {
 // WebSocket close codes (RFC 6455, 7.4.1).
 constexpr uint16_t kCloseNormal = 1000;
 constexpr uint16_t kCloseGoingAway = 1001;
-constexpr uint16_t kCloseProtocol = 1002;
-constexpr uint16_t kCloseNotUtf8 = 1007;
-constexpr uint16_t kCloseUnsupported = 1003;
 constexpr uint16_t kClosePolicy = 1008;
-constexpr uint16_t kCloseTooBig = 1009;
+constexpr uint16_t kCloseInternal = 1011;
 constexpr uint16_t kCloseTryAgain = 1013;
 // How long a shutdown waits for the clients' close frames to be written.
 constexpr double kCloseGraceSeconds = 2.0;
@@ -194,6 +192,7 @@ private:
   std::thread renderThread_;
   std::map<uint64_t, std::unique_ptr<WebClient>> clients_; // render thread only
   std::exception_ptr renderError_;
+  std::atomic<bool> renderFailed_{false};
   uint64_t framesServed_ = 0;
 };
 
@@ -307,33 +306,17 @@ int Server::gate(mg_connection* conn) {
   std::string authorization = header("Authorization"), bearer;
   if (authorization.rfind("Bearer ", 0) == 0) bearer = authorization.substr(7);
   std::string upgrade = header("Upgrade"), host = header("Host"), origin = header("Origin");
-  RequestFacts facts{host, origin, queryToken, cookieToken, bearer, !upgrade.empty()};
-  Verdict verdict = checkRequest(access_, facts);
-  // The page's script and style hold no data. A page in another site's frame (a notebook) gets no cookie
-  // with its requests, so they load without the token; the WebSocket still needs it.
-  if (verdict == Verdict::NoToken && !facts.websocket &&
-      isPublicPageFile(info->local_uri ? info->local_uri : ""))
-    verdict = Verdict::Allow;
-  int status = 0;
-  std::string body;
-  if (stopping_) {
-    status = 503;
-    body = "the server is shutting down";
-  } else if (!decodePath(info->local_uri ? info->local_uri : "") || hasControlCharacter(queryToken) ||
-             hasControlCharacter(cookieToken) || hasControlCharacter(bearer)) {
-    status = 400;
-    body = "a control character (such as %00) or a malformed escape in the path or the token";
-  } else if (verdict != Verdict::Allow) {
-    status = 403;
-    body = verdictReason(verdict);
+  HttpRequest request{info->request_method, info->local_uri ? info->local_uri : "",
+                      RequestFacts{host, origin, queryToken, cookieToken, bearer, !upgrade.empty()}, false};
+  request.publicPageFile = isPublicPageFile(request.path);
+  std::optional<HttpRefusal> refusal = gateRequest(access_, request, stopping_);
+  if (!refusal) return 0; // on to the page or the WebSocket
+  int status = refusal->status;
+  std::string body = refusal->why;
+  if (status == 403) {
     log_.line(std::string("refused ") + info->remote_addr + ": " + body);
-    emit({{"event", "refused"}, {"why", body}, {"websocket", facts.websocket}});
-  } else if (std::strcmp(info->request_method, "GET") != 0 &&
-             std::strcmp(info->request_method, "HEAD") != 0) {
-    status = 405;
-    body = "only GET and HEAD";
+    emit({{"event", "refused"}, {"why", body}, {"websocket", request.facts.websocket}});
   }
-  if (status == 0) return 0; // on to the page or the WebSocket
   body += "\n";
   const char* text = status == 400   ? "Bad Request"
                      : status == 403 ? "Forbidden"
@@ -469,23 +452,14 @@ int Server::wsData(mg_connection* conn, int bits, char* data, size_t length, voi
   return static_cast<Server*>(self)->receive(c, bits, data, length);
 }
 
-// RFC 6455 (5.2, 5.5, 8.1) asks a server to fail the connection on frames civetweb passes on: reserved bits
-// without an extension, unknown opcodes, control frames fragmented or over 125 bytes, text that is not
-// UTF-8. civetweb answers pings and drops pongs itself, and does not tell this handler whether a frame was
-// masked.
+// The frame rules of RFC 6455 (request_rules.h) on what civetweb passes on; civetweb answers pings and
+// drops pongs itself, and does not tell this handler whether a frame was masked.
 int Server::receive(Connection& c, int bits, const char* data, size_t length) {
-  int opcode = bits & 0x0F;
-  bool final = (bits & 0x80) != 0;
-  if (bits & 0x70) return refuseMessage(c, kCloseProtocol, "reserved bits set (no extension was agreed)");
-  if ((opcode > MG_WEBSOCKET_OPCODE_BINARY && opcode < MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) ||
-      opcode > MG_WEBSOCKET_OPCODE_PONG)
-    return refuseMessage(c, kCloseProtocol, "unknown opcode " + std::to_string(opcode));
-  bool control = opcode >= MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE;
-  if (control && (!final || length > 125))
-    return refuseMessage(c, kCloseProtocol, "a control frame fragmented or longer than 125 bytes");
-  if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) {
-    if (length == 1 || (length > 2 && !isUtf8({data + 2, length - 2})))
-      return refuseMessage(c, length == 1 ? kCloseProtocol : kCloseNotUtf8, "a malformed close frame");
+  std::string_view payload(data, length);
+  FrameVerdict frame = checkFrame(bits, payload);
+  if (frame.action == FrameAction::Refuse) return refuseMessage(c, frame.code, frame.why);
+  if (frame.action == FrameAction::Ignore) return 1;
+  if (frame.action == FrameAction::Close) {
     // The closing handshake's answer, after the last frame the sender was writing; none when this server
     // closed first (the client's frame is then the answer).
     if (!c.refused && !stopping_) {
@@ -494,17 +468,11 @@ int Server::receive(Connection& c, int bits, const char* data, size_t length) {
     }
     return 0;
   }
-  if (opcode == MG_WEBSOCKET_OPCODE_PING || opcode == MG_WEBSOCKET_OPCODE_PONG) return 1;
-  if (opcode == MG_WEBSOCKET_OPCODE_CONTINUATION)
-    return refuseMessage(c, kCloseProtocol, "a continuation frame without a message to continue");
   if (c.refused || !c.ready) return 0;
   if (!c.budget.take(now()))
     return refuseMessage(c, kClosePolicy, "more than the allowed messages per second");
-  if (length > kMaxMessageBytes)
-    return refuseMessage(c, kCloseTooBig, "message longer than the allowed bytes");
-  if (opcode != MG_WEBSOCKET_OPCODE_TEXT || !final)
-    return refuseMessage(c, kCloseUnsupported, "only whole text messages are accepted");
-  if (!isUtf8({data, length})) return refuseMessage(c, kCloseNotUtf8, "a text message that is not UTF-8");
+  if (auto refused = checkMessage(bits, payload, kMaxMessageBytes))
+    return refuseMessage(c, refused->code, refused->why);
   auto parsed = parseClientMessage({data, length}, methods_);
   if (auto* why = std::get_if<std::string>(&parsed))
     return refuseMessage(c, kClosePolicy, "invalid message: " + *why);
@@ -596,7 +564,22 @@ void Server::renderLoop() {
       work_ = false;
     }
   } catch (...) {
+    // A lost device (or any other failure of the render thread) ends the server: every page is told why
+    // before run() closes the connections and the error becomes the process's one line on stderr.
     renderError_ = std::current_exception();
+    std::string why = "the server stopped rendering";
+    try {
+      throw;
+    } catch (const std::exception& e) {
+      why = std::string("the server stopped: ") + e.what();
+    } catch (...) {
+    }
+    {
+      std::lock_guard lock(connectionsMutex_);
+      for (auto& [id, c] : connections_)
+        if (c->stream) c->stream->submitText(Json{{"t", "error"}, {"message", why}}.dump());
+    }
+    renderFailed_ = true;
     kill(getpid(), SIGTERM); // wakes run()'s sigwait
   }
   // The GPU objects of every client go on this thread, before the context.
@@ -696,7 +679,9 @@ int Server::run() {
   {
     std::lock_guard lock(connectionsMutex_);
     for (auto& [id, c] : connections_)
-      if (c->stream) c->stream->submitClose(kCloseGoingAway, "server shutting down");
+      if (c->stream)
+        c->stream->submitClose(renderFailed_ ? kCloseInternal : kCloseGoingAway,
+                               renderFailed_ ? "server error" : "server shutting down");
   }
   wakeRenderer();
   renderThread_.join();
@@ -704,7 +689,10 @@ int Server::run() {
   cw::mg_stop(civet_); // waits for civetweb's threads; the close handlers stop the remaining senders
   civet_ = nullptr;
   connections_.clear();
-  if (renderError_) std::rethrow_exception(renderError_);
+  if (renderError_) {
+    emit({{"event", "exit"}, {"signal", signal}, {"error", true}});
+    std::rethrow_exception(renderError_);
+  }
   uint32_t errors = context_.validationErrors();
   emit({{"event", "exit"}, {"signal", signal}, {"validation_errors", errors}});
   if (errors > 0) {
