@@ -77,52 +77,13 @@ struct RenderArgs {
   LookArgs look; // point methods: coloring and the resolve stage
   FilterArgs filter; // point methods: clip volumes and attribute filters
   std::string pick;  // --pick X,Y: the point drawn at that pixel, in the JSON
-  // Stereo (batch and LOD methods) and foveated LOD.
-  bool stereo = false;
-  std::optional<double> ipd;
-  std::string convergence, stereoLayout = "side-by-side";
-  bool foveated = false;
-  std::optional<double> foveaRadius, foveaPeriphery;
+  StereoArgs eyes; // stereo (batch and LOD methods) and foveated LOD
 };
-
-// --stereo and its options; throws InputError for stereo options without --stereo and bad values.
-StereoSettings stereoSettings(const RenderArgs& a) {
-  if (!a.stereo && (a.ipd || !a.convergence.empty() || a.stereoLayout != "side-by-side"))
-    throw InputError("--ipd, --convergence and --stereo-layout need --stereo");
-  StereoSettings s;
-  if (!a.stereo) return s;
-  if (a.stereoLayout != "side-by-side" && a.stereoLayout != "cross-eyed" && a.stereoLayout != "separate")
-    throw InputError("unknown --stereo-layout '" + a.stereoLayout +
-                     "'; choose side-by-side, cross-eyed or separate");
-  if (a.ipd) {
-    if (!(*a.ipd > 0) || !std::isfinite(*a.ipd))
-      throw InputError("--ipd must be a distance > 0 in scene units");
-    s.separation = *a.ipd;
-  }
-  if (!a.convergence.empty()) s.convergence = parseConvergence(a.convergence);
-  s.crossed = a.stereoLayout == "cross-eyed";
-  validateStereo(s);
-  return s;
-}
-
-// --foveated and its options (LOD methods).
-lod::Foveation foveation(const RenderArgs& a) {
-  if (!a.foveated && (a.foveaRadius || a.foveaPeriphery))
-    throw InputError("--fovea-radius and --fovea-periphery need --foveated");
-  lod::Foveation f;
-  f.enabled = a.foveated;
-  if (a.foveaRadius) f.radius = *a.foveaRadius;
-  if (a.foveaPeriphery) f.periphery = *a.foveaPeriphery;
-  if (!(f.radius >= 0 && f.radius <= 1)) throw InputError("--fovea-radius must be between 0 and 1");
-  if (!(f.periphery >= 1) || !std::isfinite(f.periphery))
-    throw InputError("--fovea-periphery must be a factor >= 1");
-  return f;
-}
 
 // The PNG file(s) of a frame: -o, or with --stereo-layout separate the two eyes as OUT-left.png and
 // OUT-right.png.
 std::vector<std::string> outputFiles(const RenderArgs& a) {
-  if (!a.stereo || a.stereoLayout != "separate") return {a.output};
+  if (!a.eyes.stereo || a.eyes.stereoLayout != "separate") return {a.output};
   const std::filesystem::path out(a.output);
   std::vector<std::string> files;
   for (const char* eye : {"-left", "-right"}) {
@@ -136,7 +97,7 @@ std::vector<std::string> outputFiles(const RenderArgs& a) {
 // Writes the frame to outputFiles(a): one image (both eyes side by side in stereo) or one per eye.
 void writeOutput(const RenderArgs& a, const std::vector<uint32_t>& pixels) {
   const std::vector<std::string> files = outputFiles(a);
-  const uint32_t eyes = a.stereo ? 2 : 1;
+  const uint32_t eyes = a.eyes.stereo ? 2 : 1;
   if (files.size() == 1) {
     io::writePng(files[0], a.width * eyes, a.height, pixels.data());
     return;
@@ -160,7 +121,7 @@ nlohmann::json stereoJson(const RenderArgs& a, const StereoSettings& s, const Ca
   j["ipd"] = eyeSeparation(camera, s);
   const double convergence = convergenceDistance(camera, s);
   j["convergence"] = std::isinf(convergence) ? nlohmann::json("inf") : nlohmann::json(convergence);
-  j["layout"] = a.stereoLayout;
+  j["layout"] = a.eyes.stereoLayout;
   return j;
 }
 
@@ -463,7 +424,7 @@ nlohmann::json octreeJson(const gpu::Context& context, const RenderSettings& set
   j["lod_stats"] = report::lodStatsJson(*stats.lod);
   if (settings.foveation.enabled)
     j["foveation"] = {{"radius", settings.foveation.radius}, {"periphery", settings.foveation.periphery}};
-  if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
+  if (a.eyes.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
   if (colors.source) j["color"] = colorSourceName(*colors.source);
   if (stats.post) j["post"] = postJson(settings.post, *stats.post);
   j["camera"] = describeCamera(camera);
@@ -484,8 +445,8 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   settings.minNodePx = lod.minNodePx;
   settings.pointBudget = lod.pointBudget;
   settings.post = postSettings(a.look);
-  settings.stereo = stereoSettings(a);
-  settings.foveation = foveation(a);
+  settings.stereo = stereoSettings(a.eyes);
+  settings.foveation = foveation(a.eyes);
   const ColorChoice colors = colorChoice(a.look);
   const bool distributed = distributedRun(); // under mpirun: this rank draws its share of the selection
   if (distributed) checkDistributed(settings, false, false);
@@ -509,7 +470,7 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   if (distributed) composite.devices = announceRanks(context, a.quiet);
   std::string why;
   if (!Renderer::supports(context, settings.method, &why)) throw UnsupportedError(why);
-  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
+  Renderer renderer(context, a.width, a.height, a.eyes.stereo ? 2 : 1);
   lod::LodScene scene(context, *source, options);
   FrameStats stats = renderer.render(scene, camera, distributed ? rankSettings(settings) : settings);
   std::vector<uint32_t> pixels;
@@ -569,29 +530,29 @@ RenderSettings pointSettings(const RenderArgs& a) {
     throw InputError("--precision applies to the batch and LOD methods (" +
                      methodNamesReading(SceneLayout::Batched) + ", " +
                      methodNamesReading(SceneLayout::Octree) + ")");
-  if (a.stereo && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
+  if (a.eyes.stereo && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
     throw InputError("--stereo draws both eyes in one pass with the batch and LOD methods (" +
                      methodNamesReading(SceneLayout::Batched) + ", " +
                      methodNamesReading(SceneLayout::Octree) + "), not " + a.method);
-  if (a.stereo && !a.path.path.empty())
+  if (a.eyes.stereo && !a.path.path.empty())
     throw InputError("--stereo renders one frame with -o, not a camera path");
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   settings.filter = renderFilter(a.filter);
-  if (!a.pick.empty() && (a.stereo || !a.path.path.empty() || layout == SceneLayout::Octree || !a.json))
+  if (!a.pick.empty() && (a.eyes.stereo || !a.path.path.empty() || layout == SceneLayout::Octree || !a.json))
     throw InputError("--pick reports the point at a pixel of a mono image of a cloud drawn from memory, in "
                      "--json output (not with --stereo, --path or a LOD method)");
   if (!a.pick.empty()) parsePick(a.pick, a.width, a.height);
   settings.captureWords = settings.captureWords || !a.pick.empty(); // the word at the pixel
   if (layout == SceneLayout::Octree) return settings; // runRenderOctree checks the octree's own options
-  if (a.foveated || a.foveaRadius || a.foveaPeriphery)
+  if (a.eyes.foveated || a.eyes.foveaRadius || a.eyes.foveaPeriphery)
     throw InputError("--foveated applies to the LOD methods (" + methodNamesReading(SceneLayout::Octree) +
                      "), which choose octree nodes by their size on screen");
   if (a.lod.given)
     throw InputError("--min-node-px, --point-budget and --gpu-memory apply to the LOD methods (" +
                      methodNamesReading(SceneLayout::Octree) + ")");
   settings.post = postSettings(a.look);
-  settings.stereo = stereoSettings(a);
+  settings.stereo = stereoSettings(a.eyes);
   if (settings.post.enabled() && settings.method.info().output == MethodOutput::ColorOnly)
     throw InputError("--point-size, --dilate and --edl need a compute method; " + a.method +
                      " keeps no depth per pixel to work on");
@@ -649,7 +610,7 @@ nlohmann::json pointJson(const gpu::Context& context, const RenderSettings& sett
     j["batch_stats"] = report::batchStatsJson(*stats.batch);
   }
   if (colors) j["color"] = colorSourceName(colors->source);
-  if (a.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
+  if (a.eyes.stereo) j["stereo"] = stereoJson(a, settings.stereo, camera);
   if (stats.post) j["post"] = postJson(settings.post, *stats.post);
   j["camera"] = describeCamera(camera);
   j["image_hash"] = hashText(pixels);
@@ -706,7 +667,7 @@ int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
   // Rank 0's camera for every rank: an overview is framed from a sample of its share.
   Camera camera = renderCamera(a, cloud.bounds, cloud.source, framingSample(cloud));
   job.broadcast(&camera, sizeof camera);
-  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
+  Renderer renderer(context, a.width, a.height, a.eyes.stereo ? 2 : 1);
   const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
   std::vector<const GpuScene*> drawn;
   for (const auto& scene : scenes)
@@ -752,7 +713,7 @@ std::optional<Annotations> overlayAnnotations(const RenderArgs& a, RenderSetting
   const MethodInfo& info = settings.method.info();
   if (info.layout == SceneLayout::Octree)
     throw InputError("--annotations draws over the methods that draw a loaded cloud, not " + a.method);
-  if (a.stereo) throw InputError("--annotations draws over a mono image, not --stereo");
+  if (a.eyes.stereo) throw InputError("--annotations draws over a mono image, not --stereo");
   const bool resolved = settings.post.enabled(); // the resolve stage leaves float-depth words for any method
   if (!resolved && !hasCanonicalWords(info))
     throw InputError("--annotations needs the depth of each pixel, which " + a.method +
@@ -818,7 +779,7 @@ int runRender(const RenderArgs& a) {
   filterLoadedCloud(cloud, settings.filter);
   const std::optional<DisplayColorMode> colors = colorMode(a, cloud);
   const Camera camera = renderCamera(a, cloud.bounds, cloud.source, framingSample(cloud));
-  Renderer renderer(context, a.width, a.height, a.stereo ? 2 : 1);
+  Renderer renderer(context, a.width, a.height, a.eyes.stereo ? 2 : 1);
   const auto scenes = uploadParts(context, cloud, settings.method.info().layout, colors, a);
   std::vector<const GpuScene*> drawn;
   for (const auto& scene : scenes)
@@ -976,32 +937,6 @@ void addSphereOptions(CLI::App& cmd, RenderArgs& a) {
 }
 
 
-// Stereo and foveated level of detail.
-void addStereoOptions(CLI::App& cmd, RenderArgs& a) {
-  cmd.add_flag("--stereo", a.stereo,
-               "Batch and LOD methods: render both eyes in one pass, each --width x --height, into one "
-               "side-by-side image (left eye on the left); each point is read once and drawn into both eyes");
-  cmd.add_option("--ipd", a.ipd,
-                 "Stereo: distance between the eyes in scene units (default: the convergence distance / 30, "
-                 "comfortable whatever the units; 0.064 is life-size for a cloud in metres)");
-  cmd.add_option("--convergence", a.convergence,
-                 "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
-                 "the target's distance), or inf for parallel eyes as a VR headset renders");
-  cmd.add_option("--stereo-layout", a.stereoLayout,
-                 "Stereo output: side-by-side (one PNG, left eye left), cross-eyed (right eye left, for "
-                 "cross-eyed viewing) or separate (OUT-left.png and OUT-right.png)")
-      ->capture_default_str();
-  cmd.add_flag("--foveated", a.foveated,
-               "LOD methods: foveated level of detail, nodes must look larger away from the image's centre "
-               "(each eye's centre in stereo) to be drawn");
-  cmd.add_option("--fovea-radius", a.foveaRadius,
-                 "Foveated LOD: radius of the fovea in half-diagonals of the image (0..1, default 0.3); "
-                 "inside it --min-node-px holds");
-  cmd.add_option("--fovea-periphery", a.foveaPeriphery,
-                 "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
-                 "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
-}
-
 } // namespace
 
 Command addRender(CLI::App& app) {
@@ -1015,7 +950,7 @@ Command addRender(CLI::App& app) {
   addFilterOptions(*cmd, a->filter);
   cmd->add_option("--pick", a->pick,
                   "With --json: report the point drawn at pixel X,Y (0,0 at the top left) with its attributes");
-  addStereoOptions(*cmd, *a);
+  addStereoOptions(*cmd, a->eyes);
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("--json", a->json, "Print one JSON object with the result");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress or device lines");

@@ -102,6 +102,64 @@ LodValues lodValues(const LodArgs& a) {
   return v;
 }
 
+void addStereoOptions(CLI::App& cmd, StereoArgs& a) {
+  cmd.add_flag("--stereo", a.stereo,
+               "Batch and LOD methods: render both eyes in one pass into one side-by-side image (left eye on "
+               "the left); each point is read once and drawn into both eyes. render: each eye --width x "
+               "--height; the viewers: each eye half the window or page");
+  cmd.add_option("--ipd", a.ipd,
+                 "Stereo: distance between the eyes in scene units (default: the convergence distance / 30, "
+                 "comfortable whatever the units; 0.064 is life-size for a cloud in metres)");
+  cmd.add_option("--convergence", a.convergence,
+                 "Stereo: distance from the eye of the plane seen at zero parallax, in scene units (default: "
+                 "the target's distance), or inf for parallel eyes as a VR headset renders");
+  cmd.add_option("--stereo-layout", a.stereoLayout,
+                 "Stereo output: side-by-side (left eye left), cross-eyed (right eye left, for cross-eyed "
+                 "viewing) or, for render, separate (OUT-left.png and OUT-right.png)")
+      ->capture_default_str();
+  cmd.add_flag("--foveated", a.foveated,
+               "LOD methods: foveated level of detail, nodes must look larger away from the image's centre "
+               "(each eye's centre in stereo) to be drawn");
+  cmd.add_option("--fovea-radius", a.foveaRadius,
+                 "Foveated LOD: radius of the fovea in half-diagonals of the image (0..1, default 0.3); "
+                 "inside it --min-node-px holds");
+  cmd.add_option("--fovea-periphery", a.foveaPeriphery,
+                 "Foveated LOD: --min-node-px is multiplied by this at the image's corners, growing linearly "
+                 "from the fovea's edge (default 3: 100 px in the centre, 300 px at the corners)");
+}
+
+StereoSettings stereoSettings(const StereoArgs& a) {
+  if (!a.stereo && (a.ipd || !a.convergence.empty() || a.stereoLayout != "side-by-side"))
+    throw InputError("--ipd, --convergence and --stereo-layout need --stereo");
+  StereoSettings s;
+  if (!a.stereo) return s;
+  if (a.stereoLayout != "side-by-side" && a.stereoLayout != "cross-eyed" && a.stereoLayout != "separate")
+    throw InputError("unknown --stereo-layout '" + a.stereoLayout +
+                     "'; choose side-by-side, cross-eyed or separate");
+  if (a.ipd) {
+    if (!(*a.ipd > 0) || !std::isfinite(*a.ipd))
+      throw InputError("--ipd must be a distance > 0 in scene units");
+    s.separation = *a.ipd;
+  }
+  if (!a.convergence.empty()) s.convergence = parseConvergence(a.convergence);
+  s.crossed = a.stereoLayout == "cross-eyed";
+  validateStereo(s);
+  return s;
+}
+
+lod::Foveation foveation(const StereoArgs& a) {
+  if (!a.foveated && (a.foveaRadius || a.foveaPeriphery))
+    throw InputError("--fovea-radius and --fovea-periphery need --foveated");
+  lod::Foveation f;
+  f.enabled = a.foveated;
+  if (a.foveaRadius) f.radius = *a.foveaRadius;
+  if (a.foveaPeriphery) f.periphery = *a.foveaPeriphery;
+  if (!(f.radius >= 0 && f.radius <= 1)) throw InputError("--fovea-radius must be between 0 and 1");
+  if (!(f.periphery >= 1) || !std::isfinite(f.periphery))
+    throw InputError("--fovea-periphery must be a factor >= 1");
+  return f;
+}
+
 void addDrawOptions(CLI::App& cmd, DrawArgs& a) {
   cmd.add_option("--depth", a.depth,
                  "Depth encoding of the atomic methods: float (32-bit linear depth) or int40 (40-bit integer "
@@ -110,6 +168,7 @@ void addDrawOptions(CLI::App& cmd, DrawArgs& a) {
   addLookOptions(cmd, a.look);
   addLodOptions(cmd, a.lod);
   addFilterOptions(cmd, a.filter);
+  addStereoOptions(cmd, a.eyes);
 }
 
 void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings) {
@@ -122,6 +181,12 @@ void applyDrawOptions(const DrawArgs& a, view::ViewSettings& settings) {
   settings.minNodePx = lod.minNodePx;
   settings.pointBudget = lod.pointBudget;
   settings.gpuMemory = lod.gpuBytes;
+  if (a.eyes.stereoLayout == "separate")
+    throw InputError("the viewers show both eyes side by side: --stereo-layout takes side-by-side or "
+                     "cross-eyed there");
+  settings.stereo = a.eyes.stereo;
+  settings.eyes = stereoSettings(a.eyes);
+  settings.foveation = foveation(a.eyes);
   // The viewers draw clip volumes per frame; attribute filters and a highlight are folded in when a cloud
   // is loaded or uploaded, which render does and the viewers do not.
   settings.filter = pointFilter(a.filter);

@@ -10,7 +10,9 @@
 
 #include "cloud/attribute_colors.h"
 #include "cloud/point_filter.h"
+#include "render/lod/foveation.h"
 #include "render/post/post_settings.h"
+#include "render/stereo.h"
 #include "view/session.h"
 
 namespace pointrast::app {
@@ -53,6 +55,21 @@ struct LodValues {
 };
 LodValues lodValues(const LodArgs& a);
 
+// Stereo (batch and LOD methods) and foveated level of detail (LOD methods): render draws them into its
+// PNG(s), the viewers into the window or page (both eyes side by side, each half as wide).
+struct StereoArgs {
+  bool stereo = false;
+  std::optional<double> ipd;
+  std::string convergence, stereoLayout = "side-by-side";
+  bool foveated = false;
+  std::optional<double> foveaRadius, foveaPeriphery;
+};
+void addStereoOptions(CLI::App& cmd, StereoArgs& a);
+// --stereo and its options; throws InputError for stereo options without --stereo and bad values.
+StereoSettings stereoSettings(const StereoArgs& a);
+// --foveated and its options; throws InputError for fovea options without --foveated and bad values.
+lod::Foveation foveation(const StereoArgs& a);
+
 // Which points to keep (convert, profile) or show (the renderers): clip volumes and attribute filters,
 // one "Filters" group of options. Oriented boxes have no option: they come from annotation files, added
 // to the PointFilter that pointFilter() returns.
@@ -73,6 +90,7 @@ struct DrawArgs {
   LodArgs lod;
   std::string depth = "float";
   FilterArgs filter; // the Filters group: the viewers draw its clip volumes
+  StereoArgs eyes;   // stereo and foveated LOD
 };
 void addDrawOptions(CLI::App& cmd, DrawArgs& a);
 // The options as a viewer's starting settings (the method aside). Throws InputError naming the option.

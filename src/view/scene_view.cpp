@@ -43,6 +43,8 @@ RenderSettings renderSettings(const ViewSettings& requested) {
   settings.minNodePx = view.minNodePx;
   settings.pointBudget = view.pointBudget;
   settings.filter = view.filter;
+  settings.stereo = view.eyes;
+  settings.foveation = view.foveation;
   settings.frames = 1;
   settings.warmup = 0;
   return settings;
@@ -147,15 +149,19 @@ uint64_t SceneView::gpuBytes() const {
   return bytes;
 }
 
-void SceneView::ensureRenderer(Viewport viewport) {
-  if (renderer_ && renderer_->width() == viewport.width && renderer_->height() == viewport.height) return;
+void SceneView::ensureRenderer(Viewport viewport, uint32_t eyes) {
+  if (renderer_ && renderer_->width() == viewport.width * eyes && renderer_->height() == viewport.height &&
+      renderer_->eyes() == eyes)
+    return;
   renderer_.reset(); // its targets go before the new ones are allocated
-  renderer_ = std::make_unique<Renderer>(context_, viewport.width, viewport.height);
+  renderer_ = std::make_unique<Renderer>(context_, viewport.width, viewport.height, eyes);
 }
 
 FrameReport SceneView::render(const Camera& camera, const ViewSettings& settings, Viewport viewport) {
   auto start = std::chrono::steady_clock::now();
-  ensureRenderer(viewport);
+  // Stereo: two eyes of half the viewport each, side by side (one column short for an odd width).
+  const bool stereo = applicable(settings).stereo;
+  ensureRenderer(eyeViewport(settings, viewport), stereo ? 2 : 1);
   RenderSettings rs = renderSettings(settings);
   FrameReport report;
   FrameStats stats = source_.draw(*renderer_, camera, rs, settings, report.status);
@@ -173,7 +179,9 @@ std::optional<SceneView::Picked> SceneView::pickPoint(const Camera& camera, cons
                                                       Viewport viewport, glm::dvec2 position) {
   if (!(position.x >= 0 && position.y >= 0 && position.x < viewport.width && position.y < viewport.height))
     return std::nullopt;
-  ensureRenderer(viewport);
+  // A stereo frame shows two cameras side by side: the pivot and zoom keep to the camera's own plane.
+  if (applicable(settings).stereo) return std::nullopt;
+  ensureRenderer(viewport, 1);
   RenderSettings rs = pickSettings(settings);
   std::string status;
   // A frame the source could not draw (a damaged node) has no words to read: nothing is picked.
@@ -217,15 +225,26 @@ std::optional<double> SceneView::depthAt(const Camera& camera, const ViewSetting
 
 std::vector<uint32_t> SceneView::screenshot(const Camera& camera, const ViewSettings& settings,
                                             Viewport viewport, uint32_t supersample) {
+  // An odd-width stereo frame is a column short of the viewport: the background fills it.
+  auto fitted = [&](std::vector<uint32_t> pixels, uint32_t width) {
+    if (width == viewport.width) return pixels;
+    std::vector<uint32_t> out(uint64_t(viewport.width) * viewport.height, applicable(settings).background);
+    for (uint32_t y = 0; y < viewport.height; ++y)
+      std::copy_n(pixels.begin() + int64_t(y) * width, std::min(width, viewport.width),
+                  out.begin() + int64_t(y) * viewport.width);
+    return out;
+  };
   if (supersample <= 1) {
     render(camera, settings, viewport);
-    return renderer_->image();
+    return fitted(renderer_->image(), renderer_->width());
   }
-  Renderer big(context_, viewport.width * supersample, viewport.height * supersample);
+  const bool stereo = applicable(settings).stereo;
+  const Viewport eye = eyeViewport(settings, viewport);
+  Renderer big(context_, eye.width * supersample, eye.height * supersample, stereo ? 2 : 1);
   std::string status;
   source_.draw(big, camera, renderSettings(settings), settings, status);
   std::vector<uint32_t> pixels = big.image();
-  return boxDownsample(pixels, big.width(), big.height(), supersample);
+  return fitted(boxDownsample(pixels, big.width(), big.height(), supersample), big.width() / supersample);
 }
 
 void zoomAtCursor(Session& session, SceneView& view, glm::dvec2 position, double steps) {

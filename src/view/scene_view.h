@@ -109,7 +109,7 @@ private:
     glm::dvec3 point;
     double depth;
   };
-  void ensureRenderer(Viewport viewport);
+  void ensureRenderer(Viewport viewport, uint32_t eyes); // viewport: one eye's
   std::optional<Picked> pickPoint(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                   glm::dvec2 position);
   gpu::Context& context_;

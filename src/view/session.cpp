@@ -44,7 +44,10 @@ bool ViewSettings::operator==(const ViewSettings& o) const {
   };
   return method == o.method && background == o.background && depth == o.depth && samePost(post, o.post) &&
          colorSource == o.colorSource && sameRange(colorRange, o.colorRange) && minNodePx == o.minNodePx &&
-         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory && filter == o.filter;
+         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory && filter == o.filter && stereo == o.stereo &&
+         eyes.separation == o.eyes.separation && eyes.convergence == o.eyes.convergence &&
+         eyes.crossed == o.eyes.crossed && foveation.enabled == o.foveation.enabled &&
+         foveation.radius == o.foveation.radius && foveation.periphery == o.foveation.periphery;
 }
 
 namespace {
@@ -82,10 +85,28 @@ bool takesInt40(Method method) {
   return methodInfo(method).int40Shader != nullptr;
 }
 
+bool takesStereo(Method method) {
+  const SceneLayout layout = methodInfo(method).layout;
+  return layout == SceneLayout::Batched || layout == SceneLayout::Octree;
+}
+
+bool takesFoveation(Method method) {
+  return methodInfo(method).layout == SceneLayout::Octree;
+}
+
+Viewport eyeViewport(const ViewSettings& settings, Viewport viewport) {
+  if (!settings.stereo || !takesStereo(settings.method)) return viewport;
+  return {std::max(1u, viewport.width / 2), viewport.height};
+}
+
 ViewSettings applicable(const ViewSettings& settings) {
   ViewSettings s = settings;
   if (!takesPost(s.method)) s.post = PostSettings{};
   if (!takesInt40(s.method)) s.depth = DepthMode::Float;
+  if (!takesStereo(s.method)) s.stereo = false;
+  if (!s.stereo) s.eyes = StereoSettings{};
+  if (!takesFoveation(s.method)) s.foveation.enabled = false;
+  if (!s.foveation.enabled) s.foveation = lod::Foveation{};
   return s;
 }
 
@@ -122,6 +143,21 @@ std::string describeSettings(const ViewSettings& settings) {
   if (s.minNodePx != defaults.minNodePx) add("--min-node-px", number(s.minNodePx));
   if (s.pointBudget != defaults.pointBudget) add("--point-budget", std::to_string(s.pointBudget));
   if (s.gpuMemory != defaults.gpuMemory) add("--gpu-memory", std::to_string(s.gpuMemory));
+  if (s.stereo) {
+    add("--stereo");
+    if (s.eyes.separation > 0) add("--ipd", number(s.eyes.separation));
+    if (std::isinf(s.eyes.convergence))
+      add("--convergence", "inf");
+    else if (s.eyes.convergence > 0)
+      add("--convergence", number(s.eyes.convergence));
+    if (s.eyes.crossed) add("--stereo-layout", "cross-eyed");
+  }
+  if (s.foveation.enabled) {
+    const lod::Foveation f;
+    add("--foveated");
+    if (s.foveation.radius != f.radius) add("--fovea-radius", number(s.foveation.radius));
+    if (s.foveation.periphery != f.periphery) add("--fovea-periphery", number(s.foveation.periphery));
+  }
   return out;
 }
 
@@ -145,6 +181,11 @@ void validateSettings(const ViewSettings& s) {
     throw InputError("the minimum node size must be 0.." + number(kMaxMinNodePx) + " pixels");
   if (s.pointBudget > kMaxPointBudget) throw InputError("the point budget is out of range");
   if (s.gpuMemory > kMaxGpuMemory) throw InputError("the GPU memory budget is out of range");
+  validateStereo(s.eyes);
+  if (!(s.foveation.radius >= 0 && s.foveation.radius <= 1))
+    throw InputError("the fovea's radius must be between 0 and 1");
+  if (!(s.foveation.periphery >= 1 && s.foveation.periphery <= kMaxFoveaPeriphery))
+    throw InputError("the periphery factor must be 1.." + number(kMaxFoveaPeriphery));
 }
 
 Session::Session(const Bounds& bounds, const Camera& camera, Viewport viewport, const ViewSettings& settings)

@@ -16,9 +16,11 @@
 
 #include "cloud/cloud.h"
 #include "cloud/point_filter.h"
+#include "render/lod/foveation.h"
 #include "render/lod/lod_stats.h"
 #include "render/post/post_settings.h"
 #include "render/renderer.h"
+#include "render/stereo.h"
 #include "view/camera_path.h"
 #include "view/navigation.h"
 
@@ -43,6 +45,12 @@ struct ViewSettings {
   // Clip volumes drawn per frame (RenderSettings::filter): --clip-box, --clip-polygon, --clip-mode inside or
   // outside.
   PointFilter filter;
+  // Stereo (render --stereo, --ipd, --convergence; batch and LOD methods): both eyes side by side, each
+  // half the viewport wide, the left eye on the left unless eyes.crossed.
+  bool stereo = false;
+  StereoSettings eyes;
+  // Foveated level of detail (render --foveated, --fovea-radius, --fovea-periphery; LOD methods).
+  lod::Foveation foveation;
   bool operator==(const ViewSettings& other) const;
 };
 
@@ -51,6 +59,7 @@ constexpr double kMaxMinNodePx = 10000;
 constexpr uint64_t kMaxPointBudget = 1ull << 40;
 constexpr uint64_t kMaxGpuMemory = 1ull << 44; // 16 TiB: any device's memory
 constexpr float kMaxEdlStrength = 10.0f;       // the panels' bound; render takes any finite strength
+constexpr double kMaxFoveaPeriphery = 100.0;   // the panels' bound; render takes any finite factor
 
 // What of the settings the method takes: the resolve stage (point size, dilation, eye-dome lighting) is
 // dropped for methods that keep no depth per pixel (MethodOutput::ColorOnly) and int40 depth for methods
@@ -59,6 +68,10 @@ constexpr float kMaxEdlStrength = 10.0f;       // the panels' bound; render take
 ViewSettings applicable(const ViewSettings& settings);
 bool takesPost(Method method);
 bool takesInt40(Method method);
+bool takesStereo(Method method);    // the batch and LOD methods draw both eyes in one pass
+bool takesFoveation(Method method); // the LOD methods
+// The size of one eye's image for a viewport: half its width (at least 1) in stereo, all of it otherwise.
+Viewport eyeViewport(const ViewSettings& settings, Viewport viewport);
 
 // The applicable settings as `pointrast render` options, only those that differ from render's defaults, e.g.
 // "--method batch --color intensity --point-size 3 --edl": with the camera's options (describeCamera)

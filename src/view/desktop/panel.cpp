@@ -215,6 +215,39 @@ void lodControls(ViewSettings& settings, PanelItems& items) {
   remember(items, "GPU memory");
 }
 
+// Stereo (batch and LOD methods) and foveated LOD (LOD methods), as render --stereo and --foveated.
+void stereoControls(ViewSettings& settings, PanelItems& items) {
+  ImGui::BeginDisabled(!takesStereo(settings.method));
+  ImGui::Checkbox("Stereo", &settings.stereo);
+  remember(items, "Stereo");
+  ImGui::SameLine();
+  ImGui::Checkbox("Cross-eyed", &settings.eyes.crossed);
+  remember(items, "Cross-eyed");
+  // Scene units; 0: the convergence distance / 30, whatever the units.
+  double separation = settings.eyes.separation, step = 0.01;
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::InputScalar("Eye separation (0: auto)", ImGuiDataType_Double, &separation, &step, nullptr, "%.4g",
+                         ImGuiInputTextFlags_EnterReturnsTrue))
+    settings.eyes.separation = std::max(0.0, separation);
+  remember(items, "Eye separation");
+  ImGui::EndDisabled();
+  ImGui::BeginDisabled(!takesFoveation(settings.method));
+  lod::Foveation& f = settings.foveation;
+  ImGui::Checkbox("Foveated", &f.enabled);
+  remember(items, "Foveated");
+  ImGui::BeginDisabled(!f.enabled);
+  float radius = float(f.radius), periphery = float(f.periphery);
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::SliderFloat("Fovea radius", &radius, 0.0f, 1.0f, "%.2f")) f.radius = std::clamp(double(radius), 0.0, 1.0);
+  remember(items, "Fovea radius");
+  ImGui::SetNextItemWidth(160);
+  if (ImGui::SliderFloat("Periphery factor", &periphery, 1.0f, 10.0f, "%.1f"))
+    f.periphery = std::clamp(double(periphery), 1.0, kMaxFoveaPeriphery);
+  remember(items, "Periphery factor");
+  ImGui::EndDisabled();
+  ImGui::EndDisabled();
+}
+
 std::string mib(uint64_t bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / (1 << 20));
@@ -321,6 +354,7 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
     lodControls(settings, items);
     ImGui::EndDisabled();
   }
+  if (ImGui::CollapsingHeader("Stereo and foveation", ImGuiTreeNodeFlags_DefaultOpen)) stereoControls(settings, items);
   // A value render would refuse (a slider typed past its end with Ctrl+click) keeps the last good settings.
   try {
     validateSettings(settings);

@@ -46,6 +46,14 @@ Json settingsJson(const ViewSettings& s) {
             {"minNodePx", s.minNodePx},
             {"pointBudget", s.pointBudget},
             {"gpuMemory", s.gpuMemory},
+            {"stereo", s.stereo},
+            {"crossed", s.eyes.crossed},
+            {"ipd", s.eyes.separation},
+            {"foveated", s.foveation.enabled},
+            {"foveaRadius", s.foveation.radius},
+            {"foveaPeriphery", s.foveation.periphery},
+            {"takesStereo", takesStereo(s.method)},
+            {"takesFoveation", takesFoveation(s.method)},
             {"takesPost", takesPost(s.method)},
             {"takesInt40", takesInt40(s.method)},
             {"octree", methodInfo(s.method).layout == SceneLayout::Octree},
@@ -245,8 +253,8 @@ void WebClient::renderFrame(double now, FrameQuality quality) {
   FrameHeader& h = frame.header;
   h.frame = nextFrame_++;
   h.seq = seq_;
-  h.width = uint16_t(size.width);
-  h.height = uint16_t(size.height);
+  h.width = uint16_t(view.renderer().width()); // a stereo frame of odd width is a column short
+  h.height = uint16_t(view.renderer().height());
   h.viewWidth = uint16_t(viewport.width);
   h.viewHeight = uint16_t(viewport.height);
   h.flags = quality == FrameQuality::Full ? kFrameFull : 0;

@@ -57,7 +57,8 @@ const TypeName kTypes[] = {
     {MessageType::Settings,
      "settings",
      {"method", "background", "depth", "color", "colorRange", "pointSize", "pointSizeMax", "pointShape",
-      "pointSizeMode", "dilate", "edlStrength", "edlRadius", "minNodePx", "pointBudget", "gpuMemory"}},
+      "pointSizeMode", "dilate", "edlStrength", "edlRadius", "minNodePx", "pointBudget", "gpuMemory", "stereo", "crossed", "ipd",
+      "foveated", "foveaRadius", "foveaPeriphery"}},
     {MessageType::Options, "options", {"supersample", "keyframeSeconds"}},
     {MessageType::Stream, "stream", {"motionScale", "quality", "motionQuality"}},
     {MessageType::Action, "action", {"name"}},
@@ -196,6 +197,12 @@ void settings(const Json& j, std::span<const Method> methods, ClientMessage& m) 
   if (j.contains("minNodePx")) c.minNodePx = number(j, "minNodePx", 0, kMaxMinNodePx);
   if (j.contains("pointBudget")) c.pointBudget = integer(j, "pointBudget", 0, kMaxPointBudget);
   if (j.contains("gpuMemory")) c.gpuMemory = integer(j, "gpuMemory", 0, kMaxGpuMemory);
+  if (j.contains("stereo")) c.stereo = boolean(j, "stereo");
+  if (j.contains("crossed")) c.crossed = boolean(j, "crossed");
+  if (j.contains("ipd")) c.ipd = number(j, "ipd", 0, 1e12);
+  if (j.contains("foveated")) c.foveated = boolean(j, "foveated");
+  if (j.contains("foveaRadius")) c.foveaRadius = number(j, "foveaRadius", 0, 1);
+  if (j.contains("foveaPeriphery")) c.foveaPeriphery = number(j, "foveaPeriphery", 1, kMaxFoveaPeriphery);
   // Only "t" and "seq" besides: a message that names no setting changes nothing.
   if (j.size() <= (j.contains("seq") ? 2u : 1u)) refuse("\"settings\" changes nothing");
 }
@@ -319,6 +326,12 @@ ViewSettings applySettings(const ViewSettings& settings, const SettingsChange& c
   if (c.minNodePx) s.minNodePx = *c.minNodePx;
   if (c.pointBudget) s.pointBudget = *c.pointBudget;
   if (c.gpuMemory) s.gpuMemory = *c.gpuMemory;
+  if (c.stereo) s.stereo = *c.stereo;
+  if (c.crossed) s.eyes.crossed = *c.crossed;
+  if (c.ipd) s.eyes.separation = *c.ipd;
+  if (c.foveated) s.foveation.enabled = *c.foveated;
+  if (c.foveaRadius) s.foveation.radius = *c.foveaRadius;
+  if (c.foveaPeriphery) s.foveation.periphery = *c.foveaPeriphery;
   validateSettings(s);
   return s;
 }

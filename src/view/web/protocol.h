@@ -60,6 +60,8 @@ enum class ClientAction { ClearKeyframes, DownloadPath };
 //   dilate          0..kMaxDilateRadius (integer)
 //   edlStrength     0..kMaxEdlStrength (0: off);  edlRadius (0, 16]
 //   minNodePx       0..kMaxMinNodePx;  pointBudget 0..kMaxPointBudget;  gpuMemory 0..kMaxGpuMemory (bytes)
+//   stereo, crossed true/false;  ipd 0..1e12 (scene units, 0: auto)
+//   foveated        true/false;  foveaRadius 0..1;  foveaPeriphery 1..kMaxFoveaPeriphery
 struct SettingsChange {
   std::optional<Method> method;
   std::optional<uint32_t> background; // RGBA8, alpha 255
@@ -74,6 +76,8 @@ struct SettingsChange {
   std::optional<uint32_t> dilate;
   std::optional<double> minNodePx;
   std::optional<uint64_t> pointBudget, gpuMemory;
+  std::optional<bool> stereo, crossed, foveated;
+  std::optional<double> ipd, foveaRadius, foveaPeriphery;
 };
 
 // The settings with the change applied; a new color source without a range drops the old range. Throws

@@ -261,6 +261,15 @@ function showSettings(v) {
   show('minNodePx', v.minNodePx);
   show('pointBudget', v.pointBudget);
   show('gpuMemory', Math.round(v.gpuMemory / 1048576));
+  $('stereoControls').disabled = !v.takesStereo;
+  show('stereo', v.stereo, 'checked');
+  show('crossed', v.crossed, 'checked');
+  show('ipd', v.ipd);
+  $('foveaControls').disabled = !v.takesFoveation;
+  show('foveated', v.foveated, 'checked');
+  $('foveaRadius').disabled = $('foveaPeriphery').disabled = !v.foveated;
+  show('foveaRadius', v.foveaRadius);
+  show('foveaPeriphery', v.foveaPeriphery);
 }
 
 // --- panel controls -------------------------------------------------------------------------------------
@@ -302,6 +311,11 @@ numberControl('edlRadius', 0.5, 16, (v) => ({ edlRadius: v }));
 numberControl('minNodePx', 0, 10000, (v) => ({ minNodePx: v }));
 numberControl('pointBudget', 0, 2 ** 40, (v) => ({ pointBudget: Math.round(v) }));
 numberControl('gpuMemory', 0, 2 ** 24, (v) => ({ gpuMemory: Math.round(v) * 1048576 }));
+for (const id of ['stereo', 'crossed', 'foveated'])
+  $(id).addEventListener('change', (e) => send({ t: 'settings', [id]: e.target.checked }));
+numberControl('ipd', 0, 1e12, (v) => ({ ipd: v }));
+numberControl('foveaRadius', 0, 1, (v) => ({ foveaRadius: v }));
+numberControl('foveaPeriphery', 1, 100, (v) => ({ foveaPeriphery: v }));
 
 $('method').addEventListener('change', (e) => send({ t: 'settings', method: e.target.value }));
 for (const r of document.querySelectorAll('input[name=background]'))
