@@ -682,7 +682,9 @@ int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
     throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
                         " error(s), above");
   const std::vector<uint32_t> pixels =
-      compositeFrame(context, renderer, camera, settings, rank.depthScale, stats, composite);
+      settings.method.info().family == MethodFamily::Hqs
+          ? compositeHqsFrame(renderer, drawn, camera, settings, stats, composite)
+          : compositeFrame(context, renderer, camera, settings, rank.depthScale, stats, composite);
   if (job.root()) {
     stats.medianMs = composite.renderMs; // the frame is done when the slowest rank is
     stats.points = composite.points;

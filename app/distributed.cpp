@@ -96,10 +96,11 @@ void checkDistributed(const RenderSettings& settings, bool cameraPath, bool sphe
     throw InputError(std::string(info.name) +
                      " keeps no depth per pixel, so ranks' frames cannot be composited; under mpirun use a "
                      "closest-point method (atomicmin, the batch methods, lod)");
-  if (!hasCanonicalWords(info))
+  if (!hasCanonicalWords(info) && info.family != MethodFamily::Hqs)
     throw InputError(std::string(info.name) +
-                     " blends points (HQS), which is not composited across ranks yet; under mpirun use a "
-                     "closest-point method (atomicmin, the batch methods, lod)");
+                     " blends points in batches or octree nodes, which is not composited across ranks yet; "
+                     "under mpirun use hqs, hqs1r or a closest-point method (atomicmin, the batch methods, "
+                     "lod)");
 }
 
 PointCloud loadShare(const InputSpec& spec) {
@@ -164,6 +165,53 @@ std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, 
   start = std::chrono::steady_clock::now();
   CompositeResolver resolver(context, renderer.width() / renderer.eyes(), renderer.height(), renderer.eyes());
   std::vector<uint32_t> image = resolver.resolve(words, camera, settings, int40Scale, &out.post);
+  out.resolveMs = msSince(start);
+  return image;
+}
+
+std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuScene* const> scenes,
+                                        const Camera& camera, const RenderSettings& settings,
+                                        const FrameStats& stats, CompositeStats& out) {
+  mpi::Job& job = mpi::Job::get();
+  out.ranks = job.size();
+  out.rankMs = job.gatherOf(stats.medianMs);
+  out.renderMs = job.maxOf(stats.medianMs);
+  out.points = job.sumOf(stats.points);
+  RenderSettings step = rankSettings(settings);
+  step.captureWords = false;
+  step.frames = 1;
+  step.warmup = 0;
+  step.hqsPass = HqsPass::Depth;
+  renderer.render(scenes, camera, step);
+  auto start = std::chrono::steady_clock::now();
+  std::vector<uint64_t> depths = renderer.hqsDepths();
+  out.readbackMs = msSince(start);
+  job.check(); // all ranks are here: the composite's time is its own
+  start = std::chrono::steady_clock::now();
+  job.minToAll(depths); // every rank blends against the closest depth of all
+  out.compositeMs = msSince(start);
+  renderer.setHqsDepths(depths);
+  step.hqsPass = HqsPass::Blend;
+  renderer.render(scenes, camera, step);
+  start = std::chrono::steady_clock::now();
+  std::vector<uint64_t> sums = renderer.hqsSums();
+  out.readbackMs += msSince(start);
+  job.check();
+  start = std::chrono::steady_clock::now();
+  job.sumToRoot(sums);
+  out.compositeMs += msSince(start);
+  // The depths go to every rank and back (8 B a pixel each way), the sums to rank 0 (16 B a pixel).
+  out.bytesMoved = uint64_t(job.size() - 1) * depths.size() * 32;
+  if (!job.root()) return {};
+  start = std::chrono::steady_clock::now();
+  renderer.setHqsSums(sums);
+  step = settings;
+  step.frames = 1;
+  step.warmup = 0;
+  step.hqsPass = HqsPass::Resolve;
+  const FrameStats resolved = renderer.render(scenes, camera, step);
+  out.post = resolved.post;
+  std::vector<uint32_t> image = renderer.image();
   out.resolveMs = msSince(start);
   return image;
 }

@@ -53,7 +53,7 @@ struct CompositeStats {
   double readbackMs = 0;           // rank 0: its words read back from the device
   double compositeMs = 0;          // rank 0: the MIN over all ranks' words (wall clock)
   double resolveMs = 0;            // rank 0: the composited words to the image (wall clock)
-  uint64_t bytesMoved = 0;         // words sent to the composite: 8 B a pixel from every rank but 0
+  uint64_t bytesMoved = 0;         // sent to the composite: 8 B a pixel from every rank but 0 (HQS: 32)
   std::optional<PostStats> post;   // the resolve stage on rank 0
   std::vector<std::string> devices; // "host: device" per rank
 };
@@ -64,6 +64,14 @@ struct CompositeStats {
 std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, const Camera& camera,
                                      const RenderSettings& settings, double int40Scale,
                                      const FrameStats& stats, CompositeStats& out);
+
+// The same for the HQS methods (hqs, hqs1r), after this rank's timed frames: the depth pass again, the
+// closest depths of all ranks to every rank (MIN), the blend pass against them, the blend sums of all ranks
+// to rank 0 (SUM), where the method's resolve and the resolve stage run once: the frame of one process.
+// Returns the image on rank 0, nothing elsewhere. A collective.
+std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuScene* const> scenes,
+                                        const Camera& camera, const RenderSettings& settings,
+                                        const FrameStats& stats, CompositeStats& out);
 
 // The "mpi" object of render --json.
 nlohmann::json compositeJson(const CompositeStats& stats);

@@ -152,4 +152,16 @@ void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* d
   std::memcpy(destination, staging.mapped(), size);
 }
 
+void writeBuffer(Context& context, const Buffer& target, uint64_t offset, const void* source, uint64_t size) {
+  if (size == 0) return;
+  Buffer staging(context, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::Upload, "upload staging");
+  std::memcpy(staging.mapped(), source, size);
+  context.submitAndWait([&](VkCommandBuffer cmd) {
+    fullBarrier(cmd);
+    VkBufferCopy region{0, offset, size};
+    vkCmdCopyBuffer(cmd, staging.handle(), target.handle(), 1, &region);
+    fullBarrier(cmd);
+  });
+}
+
 } // namespace pointrast::gpu

@@ -64,5 +64,7 @@ void fullBarrier(VkCommandBuffer cmd);
 
 // Copies size bytes of a Device buffer into host memory through a temporary readback buffer.
 void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* destination, uint64_t size);
+// Copies size bytes of host memory into a Device buffer through a temporary upload buffer.
+void writeBuffer(Context& context, const Buffer& target, uint64_t offset, const void* source, uint64_t size);
 
 } // namespace pointrast::gpu

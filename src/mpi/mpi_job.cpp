@@ -217,15 +217,15 @@ void Job::minToAll(std::span<uint64_t> words) {
   }
 }
 
-void Job::sumToRoot(std::span<uint32_t> values) {
+void Job::sumToRoot(std::span<uint64_t> values) {
   check();
   if (!started_) return;
   for (uint64_t at = 0; at < values.size(); at += kSlice) {
     const int n = int(std::min<uint64_t>(kSlice, values.size() - at));
     if (rank_ == 0)
-      MPI_Reduce(MPI_IN_PLACE, values.data() + at, n, MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
+      MPI_Reduce(MPI_IN_PLACE, values.data() + at, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
     else
-      MPI_Reduce(values.data() + at, nullptr, n, MPI_UINT32_T, MPI_SUM, 0, MPI_COMM_WORLD);
+      MPI_Reduce(values.data() + at, nullptr, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
   }
 }
 
@@ -260,7 +260,7 @@ Bounds Job::unionOf(const Bounds& bounds) {
 void Job::broadcast(void*, uint64_t) {}
 void Job::minToRoot(std::span<uint64_t>) {}
 void Job::minToAll(std::span<uint64_t>) {}
-void Job::sumToRoot(std::span<uint32_t>) {}
+void Job::sumToRoot(std::span<uint64_t>) {}
 
 #endif
 

@@ -80,7 +80,7 @@ public:
   // Element-wise MIN of every rank's words into every rank's.
   void minToAll(std::span<uint64_t> words);
   // Element-wise SUM of every rank's values into rank 0's.
-  void sumToRoot(std::span<uint32_t> values);
+  void sumToRoot(std::span<uint64_t> values);
 
 private:
   Job() = default;

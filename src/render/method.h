@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -58,6 +59,11 @@ public:
   // Counts of the last frame, for methods that keep them (the batch methods); read after the frame's
   // submission finished.
   virtual std::optional<BatchStats> readStats() { return std::nullopt; }
+  // HQS methods (blends() true): the blend sums of Renderer::hqsSums(), two words a pixel, read from or
+  // written into the accumulators.
+  virtual bool blends() const { return false; }
+  virtual std::vector<uint64_t> readSums() { return {}; }
+  virtual void writeSums(std::span<const uint64_t>) {}
 };
 
 // Points per thread of the raster_closest and raster_hqs shaders (POINTS_PER_THREAD): a thread loads 4

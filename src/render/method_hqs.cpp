@@ -1,6 +1,8 @@
 // High-quality splatting: a depth pass (the early-z closest-point shader), an accumulation pass that
 // blends every point within 1 % of the closest depth, and a resolve that divides.
+#include <algorithm>
 #include <optional>
+#include <vector>
 
 #include "base/error.h"
 #include "gpu/context.h"
@@ -23,8 +25,8 @@ constexpr uint32_t kAccumulatePointsPerThread = 4;
 class HqsMethod : public PointMethod {
 public:
   HqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height)
-      : context_(context), method_(method), oneRound_(oneRound(method)) {
-    uint64_t pixels = uint64_t(width) * height;
+      : context_(context), method_(method), oneRound_(oneRound(method)), pixels_(uint64_t(width) * height) {
+    const uint64_t pixels = pixels_;
     // hqs: 2 uint64 sums per pixel. hqs1r: 1 packed uint64 + 2 uint64 fallback sums per pixel.
     accumulators_ =
         gpu::Buffer(context, pixels * 8 * (oneRound_ ? 3 : 2), gpu::kBufferUsage, gpu::MemoryKind::Device,
@@ -41,8 +43,12 @@ public:
   void recordFrame(const Frame& frame, Targets& targets) override {
     VkCommandBuffer cmd = frame.cmd;
     uint64_t pixels = targets.pixels();
-    gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 8, 0xFFFFFFFFu);
-    gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
+    const HqsPass pass = frame.settings.hqsPass;
+    const bool whole = pass == HqsPass::Whole;
+    if (whole || pass == HqsPass::Depth)
+      gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 8, 0xFFFFFFFFu);
+    if (whole || pass == HqsPass::Blend)
+      gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
     gpu::fullBarrier(cmd);
     shared::RasterPush base{};
     base.framebuffer = targets.framebuffer.address();
@@ -52,24 +58,62 @@ public:
     if (clip && !passes_[1]) passes_[1] = makePasses(true);
     const gpu::ComputeProgram& depth = passes_[clip]->depth;
     const gpu::ComputeProgram& accumulate = passes_[clip]->accumulate;
-    forEachPart(
-        frame, targets, depth.groupSize() * kPointsPerThread, base,
-        [&](const shared::RasterPush& push, gpu::Grid grid) { depth.dispatch(cmd, grid.x, grid.y, push); });
-    gpu::fullBarrier(cmd);
-    forEachPart(frame, targets, accumulate.groupSize() * kAccumulatePointsPerThread, base,
-                [&](const shared::RasterPush& push, gpu::Grid grid) {
-                  // Each part's buffers are allocations of their own, aligned beyond 16 B on every driver;
-                  // the shader's vec4 loads rely on it.
-                  if ((push.positions | push.colors) % 16 != 0)
-                    throw InternalError("internal error: HQS point buffers not 16-byte aligned");
-                  accumulate.dispatch(cmd, grid.x, grid.y, push);
-                });
-    gpu::fullBarrier(cmd);
-    shared::ResolvePush resolve =
-        resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
-    resolve.aux = accumulators_.address();
-    resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
-    gpu::fullBarrier(cmd);
+    if (whole || pass == HqsPass::Depth) {
+      forEachPart(
+          frame, targets, depth.groupSize() * kPointsPerThread, base,
+          [&](const shared::RasterPush& push, gpu::Grid grid) { depth.dispatch(cmd, grid.x, grid.y, push); });
+      gpu::fullBarrier(cmd);
+    }
+    if (whole || pass == HqsPass::Blend) {
+      forEachPart(frame, targets, accumulate.groupSize() * kAccumulatePointsPerThread, base,
+                  [&](const shared::RasterPush& push, gpu::Grid grid) {
+                    // Each part's buffers are allocations of their own, aligned beyond 16 B on every driver;
+                    // the shader's vec4 loads rely on it.
+                    if ((push.positions | push.colors) % 16 != 0)
+                      throw InternalError("internal error: HQS point buffers not 16-byte aligned");
+                    accumulate.dispatch(cmd, grid.x, grid.y, push);
+                  });
+      gpu::fullBarrier(cmd);
+    }
+    if (whole || pass == HqsPass::Resolve) {
+      shared::ResolvePush resolve =
+          resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
+      resolve.aux = accumulators_.address();
+      resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
+      gpu::fullBarrier(cmd);
+    }
+  }
+
+  bool blends() const override { return true; }
+
+  // hqs keeps the two words a pixel as they are; hqs1r's packed 16-bit fields are added into its fallback
+  // sums, as its resolve adds them.
+  std::vector<uint64_t> readSums() override {
+    std::vector<uint64_t> sums(2 * pixels_);
+    if (!oneRound_) {
+      gpu::readBuffer(context_, accumulators_, 0, sums.data(), sums.size() * 8);
+      return sums;
+    }
+    std::vector<uint64_t> packed(pixels_);
+    gpu::readBuffer(context_, accumulators_, 0, packed.data(), pixels_ * 8);
+    gpu::readBuffer(context_, accumulators_, pixels_ * 8, sums.data(), sums.size() * 8);
+    for (uint64_t i = 0; i < pixels_; ++i) {
+      const uint64_t p = packed[i];
+      sums[2 * i] += ((p & 0xFFFFu) << 32) + ((p >> 16) & 0xFFFFu);
+      sums[2 * i + 1] += (((p >> 32) & 0xFFFFu) << 32) + (p >> 48);
+    }
+    return sums;
+  }
+
+  void writeSums(std::span<const uint64_t> sums) override {
+    if (sums.size() != 2 * pixels_) throw InternalError("internal error: HQS sums of another image size");
+    if (!oneRound_) {
+      gpu::writeBuffer(context_, accumulators_, 0, sums.data(), sums.size() * 8);
+      return;
+    }
+    std::vector<uint64_t> all(3 * pixels_, 0); // packed words empty, everything in the fallback sums
+    std::copy(sums.begin(), sums.end(), all.begin() + static_cast<ptrdiff_t>(pixels_));
+    gpu::writeBuffer(context_, accumulators_, 0, all.data(), all.size() * 8);
   }
 
 private:
@@ -94,6 +138,7 @@ private:
   gpu::Context& context_;
   MethodInfo method_;
   bool oneRound_;
+  uint64_t pixels_;
   gpu::Buffer accumulators_;
   std::optional<Passes> passes_[2]; // without and with the clip test (CLIP)
   gpu::ComputeProgram resolve_;

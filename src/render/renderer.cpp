@@ -193,6 +193,9 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   if (settings.precision > 3) throw InputError("precision must be 0 (adaptive) or 1..3 words");
   const bool post = preparePost(settings);
   PointMethod& m = method(settings);
+  if (settings.hqsPass != HqsPass::Whole && !m.blends())
+    throw InputError(std::string(info.name) + " records whole frames; HQS steps are for hqs and hqs1r");
+  last_ = &m;
   Targets& t = *targets_;
   if (settings.captureWords) allocateWords();
   // Each scene's record: its clip volumes and the double-precision copy of its matrix (the int40 path).
@@ -388,6 +391,35 @@ std::vector<uint64_t> Renderer::framebufferWords(uint32_t x, uint32_t y, uint32_
     gpu::readBuffer(context_, targets_->words, ((uint64_t(y) + row) * targets_->width + x) * 8,
                     words.data() + uint64_t(row) * w, uint64_t(w) * 8);
   return words;
+}
+
+namespace {
+PointMethod& blending(PointMethod* last) {
+  if (!last || !last->blends())
+    throw InputError("no HQS buffers: the last frame was not rendered with hqs or hqs1r");
+  return *last;
+}
+} // namespace
+
+std::vector<uint64_t> Renderer::hqsDepths() {
+  blending(last_);
+  std::vector<uint64_t> words(targets_->pixels());
+  gpu::readBuffer(context_, targets_->framebuffer, 0, words.data(), words.size() * 8);
+  return words;
+}
+
+void Renderer::setHqsDepths(std::span<const uint64_t> words) {
+  blending(last_);
+  if (words.size() != targets_->pixels()) throw InternalError("internal error: depths of another image size");
+  gpu::writeBuffer(context_, targets_->framebuffer, 0, words.data(), words.size() * 8);
+}
+
+std::vector<uint64_t> Renderer::hqsSums() {
+  return blending(last_).readSums();
+}
+
+void Renderer::setHqsSums(std::span<const uint64_t> sums) {
+  blending(last_).writeSums(sums);
 }
 
 uint64_t Renderer::imageAddress() const {

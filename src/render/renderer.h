@@ -35,6 +35,12 @@ enum class DepthMode {
 DepthMode parseDepthMode(std::string_view name);
 const char* depthModeName(DepthMode mode);
 
+// The steps of an HQS frame (hqs, hqs1r) a frame records: all of them, or one, for frames composited across
+// processes (docs/mpi.md): each draws its depths (Depth), the closest of all is set (Renderer::setHqsDepths),
+// each blends its points against it (Blend), the sums of all are set (setHqsSums) and one resolves them
+// (Resolve, with the resolve stage of the settings). Other methods record whole frames only.
+enum class HqsPass { Whole, Depth, Blend, Resolve };
+
 struct RenderSettings {
   Method method; // the first row of the method table: atomicmin
   DepthMode depth = DepthMode::Float;
@@ -63,6 +69,7 @@ struct RenderSettings {
   // were decided (shared.h, ClipVolumes). The renderer ignores the attribute filters (applied where a cloud
   // is loaded) and ClipMode::Highlight (a tint of the uploaded colors: UploadOptions::filter).
   PointFilter filter;
+  HqsPass hqsPass = HqsPass::Whole; // HQS methods: the step(s) each frame records
 };
 // "adaptive", "1", "2", "3" -> 0..3; throws InputError naming the choices.
 uint32_t parsePrecision(std::string_view text);
@@ -150,6 +157,15 @@ public:
   // front ends that show it without a copy to the host. Valid until the Renderer is destroyed.
   uint64_t imageAddress() const;
 
+  // The buffers between the steps of an HQS frame (HqsPass), after a frame of an HQS method: the depth
+  // words of the depth pass (depth << 32, all ones where empty), and the blend sums, two words a pixel
+  // (r << 32 | g, b << 32 | count) in every method's accumulator layout. Sums of several frames' blends add
+  // word by word. Throws InputError when the last frame was not an HQS method's.
+  std::vector<uint64_t> hqsDepths();
+  void setHqsDepths(std::span<const uint64_t> words);
+  std::vector<uint64_t> hqsSums();
+  void setHqsSums(std::span<const uint64_t> sums);
+
   uint32_t width() const; // of the image: eyes() x an eye's width
   uint32_t height() const;
   uint32_t eyes() const;
@@ -176,6 +192,7 @@ private:
   std::unique_ptr<PostStage> post_; // made on the first frame that uses it
   std::map<Method, std::unique_ptr<lod::LodPasses>> lodPasses_;
   bool wordsCaptured_ = false; // the last frame wrote canonical words
+  PointMethod* last_ = nullptr; // the method of the last render() frame
 };
 
 } // namespace pointrast

@@ -161,6 +161,67 @@ TEST(MpiRender, BatchMethodDiffersFromOneRankOnlyAtDepthTies) {
   EXPECT_TRUE(three.json.contains("post"));
 }
 
+// One render of `args` on `ranks` ranks for a method without composited words (HQS): its JSON and PNG.
+struct Image {
+  nlohmann::json json;
+  std::string png;
+};
+Image imageOn(uint32_t ranks, const std::string& args, const fs::path& png) {
+  fs::remove(png);
+  const MpiRun r = runMpi("-np " + std::to_string(ranks) + " " + pointrastBinary() + " render " + args +
+                          " -o " + png.string() + " --json -q");
+  EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.err;
+  Image image;
+  if (r.exitCode != 0) return image;
+  image.json = nlohmann::json::parse(r.out);
+  image.png = slurp(png);
+  return image;
+}
+
+// HQS: the closest depth of all ranks to every rank, each rank's blend sums added on rank 0, resolved once:
+// integer sums, so the frame is the one-rank frame bit for bit.
+TEST(MpiRender, HqsComposesTheOneRankFrameExactly) {
+  REQUIRE_MPI();
+  const std::string scene = "terrain --points 40000" + kImage + kTerrainView;
+  for (const std::string method : {"hqs", "hqs1r"}) {
+    const std::string args = scene + " --method " + method;
+    const Image one = imageOn(1, args, cliTempDir() / "hqs1.png");
+    const Image two = imageOn(2, args, cliTempDir() / "hqs2.png");
+    const Image three = imageOn(3, args, cliTempDir() / "hqs3.png");
+    ASSERT_FALSE(one.png.empty());
+    EXPECT_EQ(two.json["image_hash"], one.json["image_hash"]) << method;
+    EXPECT_EQ(three.json["image_hash"], one.json["image_hash"]) << method;
+    EXPECT_TRUE(two.png == one.png) << method;
+    EXPECT_TRUE(three.png == one.png) << method;
+    EXPECT_EQ(three.json["points"], 40000);
+    EXPECT_EQ(three.json["mpi"]["ranks"], 3);
+    EXPECT_EQ(three.json["mpi"]["bytes_moved"], 2u * 240 * 160 * 32);
+  }
+  // The frame blends: it is not the closest-point frame of the same view.
+  const Image closest = imageOn(1, scene, cliTempDir() / "closest.png");
+  const Image blended = imageOn(1, scene + " --method hqs", cliTempDir() / "hqs1.png");
+  EXPECT_NE(closest.json["image_hash"], blended.json["image_hash"]);
+  // One rank under mpirun is the plain render, and the resolve stage runs once on the composite.
+  const fs::path plainPng = cliTempDir() / "hqs_plain.png";
+  const pointrast::test::CliResult plain =
+      runPointrast("render " + scene + " --method hqs --edl -o " + plainPng.string() + " --json -q");
+  ASSERT_EQ(plain.exitCode, 0) << plain.err;
+  const Image edl = imageOn(3, scene + " --method hqs --edl", cliTempDir() / "hqs_edl.png");
+  EXPECT_EQ(edl.json["image_hash"], nlohmann::json::parse(plain.out)["image_hash"]);
+  EXPECT_TRUE(edl.json.contains("post"));
+}
+
+TEST(MpiRender, BlendingInBatchesIsRefusedWithOneLine) {
+  REQUIRE_MPI();
+  const MpiRun r =
+      runMpi("-np 2 " + pointrastBinary() + " render terrain --points 20000 --method batch-hqs -o " +
+                 (cliTempDir() / "refused.png").string() + kImage + " -q",
+             "", 60);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("pointrast: batch-hqs blends points in batches or octree nodes"), std::string::npos)
+      << r.err;
+}
+
 TEST(MpiRender, TcpTransportGivesTheSameFrame) {
   REQUIRE_MPI();
   const Frame one = renderOn(1, terrain("tcp1.png"));
