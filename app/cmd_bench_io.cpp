@@ -1,4 +1,4 @@
-// pointrast bench-io FILE... : LAZ decoding throughput with 1 and N threads (bench/io_bench.h).
+// pointrast bench-io FILE...: LAZ decoding and encoding throughput, 1 and N threads (bench/io_bench.h).
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -28,7 +28,7 @@ struct BenchIoArgs {
   std::vector<int> pointFormats;
   std::string disk = "0", diskDir = ".";
   int repeats = 5;
-  bool noReadCloud = false, json = false, quiet = false;
+  bool noReadCloud = false, noEncode = false, json = false, quiet = false;
   std::string out, name = "io-laz";
 };
 
@@ -61,6 +61,7 @@ int runBenchIo(const BenchIoArgs& a) {
   if (a.repeats < 1 || a.repeats > 1000) throw InputError("--repeats must be 1 to 1000");
   config.repeats = a.repeats;
   config.readCloud = !a.noReadCloud;
+  config.encode = !a.noEncode;
   for (int format : a.pointFormats)
     if (!(format >= 0 && format <= 3) && !(format >= 6 && format <= 8))
       throw InputError("--point-formats: " + std::to_string(format) +
@@ -102,13 +103,16 @@ int runBenchIo(const BenchIoArgs& a) {
 
 Command addBenchIo(CLI::App& app) {
   auto a = std::make_shared<BenchIoArgs>();
-  CLI::App* cmd = app.add_subcommand("bench-io", "Measure LAZ decoding throughput on 1 and on all cores");
+  CLI::App* cmd =
+      app.add_subcommand("bench-io", "Measure LAZ decoding and encoding throughput on 1 and on all cores");
   cmd->footer(
       "\nDecodes every chunk of each LAZ (or COPC) file to raw LAS records, from compressed chunks read\n"
       "into memory first, once per thread count and --repeats times; reports the median and best\n"
       "wall time, points/s, points/s per thread and points per CPU-second (from each thread's CPU\n"
-      "clock: what a core delivers on a shared machine; the load average is recorded), then times\n"
-      "readCloud end to end. --points replicates a file's own chunks (chunks decode on their own)\n"
+      "clock: what a core delivers on a shared machine; the load average is recorded). Then encodes\n"
+      "the same records, decoded once into memory, back to LAZ chunks of the file's point format\n"
+      "(0-3, 6-8) with pointrast's encoder at the same thread counts, and times readCloud end to end.\n"
+      "--points replicates a file's own chunks (chunks decode on their own)\n"
       "into a temporary LAZ of at least that many points. --point-formats first converts each file to\n"
       "those point formats (pointrast's LAZ encoder) and times each. --disk SIZE also measures the\n"
       "sequential write bandwidth of the folder --disk-dir (a file of SIZE, timed until fdatasync\n"
@@ -127,6 +131,7 @@ Command addBenchIo(CLI::App& app) {
   cmd->add_option("--disk-dir", a->diskDir, "Folder for the disk measurement")->capture_default_str();
   cmd->add_option("--repeats", a->repeats, "Timed runs per thread count")->capture_default_str();
   cmd->add_flag("--no-read-cloud", a->noReadCloud, "Skip the readCloud timing");
+  cmd->add_flag("--no-encode", a->noEncode, "Skip the encoding timing");
   cmd->add_option("--out", a->out, "Folder for the reports (default: bench/results/cpu-<model>-<threads>t/)");
   cmd->add_option("--name", a->name, "Report file stem")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print the report's JSON on stdout");

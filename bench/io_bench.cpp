@@ -20,6 +20,7 @@
 #include "io/io_util.h"
 #include "io/las/laz_chunk.h"
 #include "io/las/laz_compose.h"
+#include "io/las/laz_encoder.h"
 #include "io/las/laz_reader.h"
 #include "io/write_behind.h"
 #include "io/writer.h"
@@ -74,29 +75,92 @@ struct OneRun {
   double wall = 0, cpu = 0;
 };
 
-// Every chunk decoded once on `threads` threads, chunks handed out in file order.
-OneRun decodeOnce(const LoadedLaz& l, std::vector<std::unique_ptr<io::laz::ChunkDecoder>>& decoders,
-                  unsigned threads) {
-  std::atomic<size_t> next{0};
-  std::vector<double> cpu(threads, 0.0);
+// What one thread keeps from run to run, made on that thread during the warm-up: its coder's models and
+// its output buffer come from its own malloc arena (and its own NUMA node), no timed run allocates or
+// faults in pages, and slots are cache-line aligned so that threads share no line they write.
+struct alignas(64) DecodeSlot {
+  std::unique_ptr<io::laz::ChunkDecoder> decoder;
+  std::vector<uint8_t> records;
+  double cpu = 0;
+};
+
+struct alignas(64) EncodeSlot {
+  std::unique_ptr<io::laz::ChunkEncoder> encoder;
+  uint64_t bytes = 0;
+  double cpu = 0;
+};
+
+// Runs task(slot, i) for i in [0, tasks) on slots.size() threads (thread 0 the calling one), each task
+// to whichever thread asks next, and times the whole.
+template <class Slot, class Task>
+OneRun runOnThreads(std::vector<Slot>& slots, size_t tasks, const Task& task) {
+  struct alignas(64) Counter {
+    std::atomic<size_t> next{0};
+  } counter;
   auto work = [&](unsigned t) {
+    Slot& slot = slots[t];
     const double c0 = threadCpuSeconds();
-    std::vector<uint8_t> records;
-    for (size_t i = next++; i < l.chunks.size(); i = next++)
-      decoders[t]->decode(l.chunks[i].data(), l.chunks[i].size(), l.laz.chunks[i].pointCount, records);
-    cpu[t] = threadCpuSeconds() - c0;
+    for (size_t i = counter.next.fetch_add(1, std::memory_order_relaxed); i < tasks;
+         i = counter.next.fetch_add(1, std::memory_order_relaxed))
+      task(slot, i);
+    slot.cpu = threadCpuSeconds() - c0;
   };
   const Clock::time_point start = Clock::now();
   std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t)
+  for (unsigned t = 1; t < slots.size(); ++t)
     pool.emplace_back(work, t);
   work(0);
   for (std::thread& t : pool)
     t.join();
   OneRun r;
   r.wall = std::chrono::duration<double>(Clock::now() - start).count();
-  for (double c : cpu)
-    r.cpu += c;
+  for (const Slot& slot : slots)
+    r.cpu += slot.cpu;
+  return r;
+}
+
+// Every chunk decoded once, chunks handed out in file order.
+OneRun decodeOnce(const LoadedLaz& l, std::vector<DecodeSlot>& slots) {
+  return runOnThreads(slots, l.chunks.size(), [&](DecodeSlot& slot, size_t i) {
+    if (!slot.decoder) slot.decoder = std::make_unique<io::laz::ChunkDecoder>(l.laz.layout);
+    slot.decoder->decode(l.chunks[i].data(), l.chunks[i].size(), l.laz.chunks[i].pointCount, slot.records);
+  });
+}
+
+// The raw records of a file's distinct chunks (a replicated file repeats them), decoded once: what the
+// encoder is timed on.
+struct DecodedChunks {
+  std::vector<std::vector<uint8_t>> records;
+  std::vector<uint64_t> counts;
+};
+
+DecodedChunks decodeDistinct(const LoadedLaz& l, uint64_t copies) {
+  DecodedChunks d;
+  const size_t distinct = std::max<size_t>(1, l.chunks.size() / std::max<uint64_t>(1, copies));
+  io::laz::ChunkDecoder decoder(l.laz.layout);
+  for (size_t i = 0; i < distinct && i < l.chunks.size(); ++i) {
+    d.records.emplace_back();
+    decoder.decode(l.chunks[i].data(), l.chunks[i].size(), l.laz.chunks[i].pointCount, d.records.back());
+    d.counts.push_back(l.laz.chunks[i].pointCount);
+  }
+  return d;
+}
+
+// Every chunk of the file (`chunks` of them, cycling through the distinct ones) encoded once; `bytes`
+// receives the compressed size of the run.
+OneRun encodeOnce(const DecodedChunks& d, size_t chunks, const io::laz::Layout& layout,
+                  std::vector<EncodeSlot>& slots, uint64_t& bytes) {
+  for (EncodeSlot& slot : slots)
+    slot.bytes = 0;
+  const OneRun r = runOnThreads(slots, chunks, [&](EncodeSlot& slot, size_t i) {
+    const size_t c = i % d.records.size();
+    if (d.counts[c] == 0) return;
+    if (!slot.encoder) slot.encoder = std::make_unique<io::laz::ChunkEncoder>(layout);
+    slot.bytes += slot.encoder->encode(d.records[c].data(), d.counts[c]).size();
+  });
+  bytes = 0;
+  for (const EncodeSlot& slot : slots)
+    bytes += slot.bytes;
   return r;
 }
 
@@ -219,13 +283,11 @@ IoBenchRun runIoBench(const IoBenchConfig& config, bool progress) {
     result.chunks = loaded.chunks.size();
     result.compressedBytes = loaded.bytes;
     for (unsigned threads : threadCounts) {
-      std::vector<std::unique_ptr<io::laz::ChunkDecoder>> decoders;
-      for (unsigned t = 0; t < threads; ++t)
-        decoders.push_back(std::make_unique<io::laz::ChunkDecoder>(loaded.laz.layout));
-      decodeOnce(loaded, decoders, threads); // warm-up: caches, page faults of the decoders' models
+      std::vector<DecodeSlot> slots(threads);
+      decodeOnce(loaded, slots); // warm-up: each thread makes its decoder and buffer, caches fill
       std::vector<OneRun> runs;
       for (int r = 0; r < std::max(1, config.repeats); ++r)
-        runs.push_back(decodeOnce(loaded, decoders, threads));
+        runs.push_back(decodeOnce(loaded, slots));
       result.decode.push_back(summarize(runs, threads, loaded.points));
       const IoTiming& t = result.decode.back();
       if (progress)
@@ -233,6 +295,28 @@ IoBenchRun runIoBench(const IoBenchConfig& config, bool progress) {
             stderr, "%s: %u thread%s: %.1f M points/s (%.2f M/s per thread, %.2f M per CPU-second)\n",
             path.filename().string().c_str(), threads, threads == 1 ? "" : "s", mega(t.pointsPerSecond()),
             mega(t.pointsPerSecondPerThread()), mega(t.pointsPerCpuSecond()));
+    }
+    const int format = loaded.laz.header.pointFormat;
+    if (config.encode && io::laz::canEncodePointFormat(format) && !loaded.chunks.empty()) {
+      const DecodedChunks records = decodeDistinct(loaded, result.copies);
+      const io::laz::Layout layout =
+          io::laz::encoderLayout(format, loaded.laz.layout.recordLength, loaded.laz.layout.chunkSize);
+      for (unsigned threads : threadCounts) {
+        std::vector<EncodeSlot> slots(threads);
+        encodeOnce(records, loaded.chunks.size(), layout, slots, result.encodedBytes); // warm-up
+        std::vector<OneRun> runs;
+        for (int r = 0; r < std::max(1, config.repeats); ++r)
+          runs.push_back(encodeOnce(records, loaded.chunks.size(), layout, slots, result.encodedBytes));
+        result.encode.push_back(summarize(runs, threads, loaded.points));
+        const IoTiming& t = result.encode.back();
+        if (progress)
+          std::fprintf(stderr,
+                       "%s: encoding, %u thread%s: %.1f M points/s (%.2f M/s per thread, %.2f M per "
+                       "CPU-second)\n",
+                       path.filename().string().c_str(), threads, threads == 1 ? "" : "s",
+                       mega(t.pointsPerSecond()), mega(t.pointsPerSecondPerThread()),
+                       mega(t.pointsPerCpuSecond()));
+      }
     }
     if (config.readCloud) {
       const unsigned threads = threadCounts.back();
@@ -317,6 +401,12 @@ nlohmann::json ioRunJson(const IoBenchRun& run, const std::string& commandLine, 
     };
     for (const IoTiming& t : r.decode)
       jr["decode"].push_back(timing(t));
+    if (!r.encode.empty()) {
+      jr["encode"] = nlohmann::json::array();
+      for (const IoTiming& t : r.encode)
+        jr["encode"].push_back(timing(t));
+      jr["encoded_bytes"] = r.encodedBytes;
+    }
     if (r.readCloud.threads) jr["read_cloud"] = timing(r.readCloud);
     j["results"].push_back(jr);
   }
@@ -333,7 +423,7 @@ nlohmann::json ioRunJson(const IoBenchRun& run, const std::string& commandLine, 
 
 std::string ioMarkdownReport(const IoBenchRun& run, const std::string& commandLine, const std::string& date) {
   std::ostringstream md;
-  md << "# LAZ decoding throughput\n\n";
+  md << "# LAZ decoding and encoding throughput\n\n";
   md << "CPU: " << run.cpu << ", " << run.hardwareThreads
      << " hardware threads. Load average before: " << run.loadBefore << "; after: " << run.loadAfter
      << ".\n\n";
@@ -353,6 +443,25 @@ std::string ioMarkdownReport(const IoBenchRun& run, const std::string& commandLi
                     mega(t.pointsPerCpuSecond()));
       md << line;
     }
+  }
+  bool encoded = false;
+  for (const IoResult& r : run.results)
+    encoded = encoded || !r.encode.empty();
+  if (encoded) {
+    md << "\nEncoding the same raw LAS records (decoded once, in memory) to LAZ chunks of the file's point "
+          "format and chunk size with pointrast's encoder:\n\n";
+    md << "| file | points | threads | median s (best) | M points/s | M points/s per thread | M points per "
+          "CPU-s | B per point |\n";
+    md << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    for (const IoResult& r : run.results)
+      for (const IoTiming& t : r.encode) {
+        std::snprintf(line, sizeof line, "| %s | %llu | %u | %.3f (%.3f) | %.2f | %.2f | %.2f | %.2f |\n",
+                      r.file.c_str(), static_cast<unsigned long long>(r.points), t.threads, t.medianSeconds,
+                      t.bestSeconds, mega(t.pointsPerSecond()), mega(t.pointsPerSecondPerThread()),
+                      mega(t.pointsPerCpuSecond()),
+                      r.points ? double(r.encodedBytes) / double(r.points) : 0.0);
+        md << line;
+      }
   }
   md << "\nreadCloud (records into the renderer's cloud, all stages) at the highest thread count:\n\n";
   md << "| file | threads | median s (best) | M points/s |\n| --- | ---: | ---: | ---: |\n";

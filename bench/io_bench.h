@@ -1,6 +1,7 @@
-// LAZ decoding throughput (`pointrast bench-io`): a LAZ file, replicated from its own chunks to a
-// target point count when asked, decoded to raw LAS records with one thread and with N threads, its
-// compressed chunks read into memory first so the figures are the decoder's, not the disk's. Each
+// LAZ decoding and encoding throughput (`pointrast bench-io`): a LAZ file, replicated from its own chunks
+// to a target point count when asked, decoded to raw LAS records with one thread and with N threads, its
+// compressed chunks read into memory first so the figures are the decoder's, not the disk's; then the
+// same records (decoded once, in memory) encoded back to LAZ chunks of the file's point format. Each
 // configuration is timed `repeats` times; the report gives the median and the best, wall-clock points/s
 // and, from each thread's CPU clock, points per CPU-second (what a core delivers when the machine is
 // shared, as the load average written beside the figures tells).
@@ -21,6 +22,7 @@ struct IoBenchConfig {
   std::vector<unsigned> threads;             // thread counts to time (1 and all hardware threads by default)
   int repeats = 5;
   bool readCloud = true; // also time readCloud (records into a PointCloud) at the highest thread count
+  bool encode = true;    // also time the encoder (point formats 0-3 and 6-8) at every thread count
   std::filesystem::path workDir; // where replicated files go (removed after the run)
   // Each input converted to these point formats (0-3, 6-8) and timed in each; empty: as it is.
   std::vector<int> pointFormats;
@@ -55,6 +57,8 @@ struct IoResult {
   uint64_t chunks = 0;
   uint64_t compressedBytes = 0;
   std::vector<IoTiming> decode; // per thread count
+  std::vector<IoTiming> encode; // per thread count; empty: not timed
+  uint64_t encodedBytes = 0;    // the chunks the encoder wrote in one run
   IoTiming readCloud;           // threads == 0: not timed
 };
 
