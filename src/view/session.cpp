@@ -44,10 +44,11 @@ bool ViewSettings::operator==(const ViewSettings& o) const {
   };
   return method == o.method && background == o.background && depth == o.depth && samePost(post, o.post) &&
          colorSource == o.colorSource && sameRange(colorRange, o.colorRange) && minNodePx == o.minNodePx &&
-         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory && filter == o.filter && stereo == o.stereo &&
-         eyes.separation == o.eyes.separation && eyes.convergence == o.eyes.convergence &&
-         eyes.crossed == o.eyes.crossed && foveation.enabled == o.foveation.enabled &&
-         foveation.radius == o.foveation.radius && foveation.periphery == o.foveation.periphery;
+         pointBudget == o.pointBudget && gpuMemory == o.gpuMemory && filter == o.filter &&
+         stereo == o.stereo && eyes.separation == o.eyes.separation &&
+         eyes.convergence == o.eyes.convergence && eyes.crossed == o.eyes.crossed &&
+         foveation.enabled == o.foveation.enabled && foveation.radius == o.foveation.radius &&
+         foveation.periphery == o.foveation.periphery;
 }
 
 namespace {

@@ -1,5 +1,6 @@
 // The page's Stereo controls in Debian's chromium (headless, tests/web/browser.mjs through playwright-core)
-// against `pointrast serve` on lavapipe: ticking Stereo, typing an eye separation and ticking Cross-eyed change the canvas as render's
+// against `pointrast serve` on lavapipe: ticking Stereo, typing an eye separation and ticking Cross-eyed
+// change the canvas as render's
 // --stereo and --stereo-layout cross-eyed do, both eyes side by side at half the canvas's width.
 #include <string>
 
@@ -30,14 +31,17 @@ TEST(BrowserStereo, StereoControlsChangeTheCanvasAsRenderOptionsDo) {
   const std::string dir = std::string(POINTRAST_SOURCE_DIR) + "/tests/web";
   ASSERT_TRUE(std::filesystem::exists(dir + "/node_modules/playwright-core"))
       << "playwright-core is not installed: run scripts/web-test-setup.sh (npm ci in tests/web)";
-  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium")) << "chromium is missing: run scripts/install-deps.sh";
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "chromium is missing: run scripts/install-deps.sh";
   ServeProcess server(autzen() + " " + kAutzenCamera + " --method batch");
   ASSERT_TRUE(server.listening()) << server.stderrText();
   const auto out = scratchDir("browser_stereo");
   const Json steps = Json::array({
       {{"id", "stereo"}, {"check", true}, {"expect", "--method batch --stereo"}},
       {{"id", "ipd"}, {"value", 60}, {"expect", "--method batch --stereo --ipd 60"}},
-      {{"id", "crossed"}, {"check", true}, {"expect", "--method batch --stereo --ipd 60 --stereo-layout cross-eyed"}},
+      {{"id", "crossed"},
+       {"check", true},
+       {"expect", "--method batch --stereo --ipd 60 --stereo-layout cross-eyed"}},
   });
   Json r = runBrowser("settings", server.url(), out, {{"steps", steps}});
   ASSERT_TRUE(r.contains("shown"));

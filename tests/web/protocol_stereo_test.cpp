@@ -39,9 +39,10 @@ TEST(ProtocolStereo, StereoAndFoveationFieldsBecomeRenderOptions) {
 }
 
 TEST(ProtocolStereo, OutOfRangeValuesAreRefused) {
-  for (const char* text : {R"({"t":"settings","stereo":1})", R"({"t":"settings","ipd":-1})",
-                           R"({"t":"settings","foveaRadius":1.5})", R"({"t":"settings","foveaPeriphery":0.5})",
-                           R"({"t":"settings","foveated":"yes"})"}) {
+  for (const char* text :
+       {R"({"t":"settings","stereo":1})", R"({"t":"settings","ipd":-1})",
+        R"({"t":"settings","foveaRadius":1.5})", R"({"t":"settings","foveaPeriphery":0.5})",
+        R"({"t":"settings","foveated":"yes"})"}) {
     auto parsed = parse(text);
     EXPECT_TRUE(std::holds_alternative<std::string>(parsed)) << text << " was accepted";
   }

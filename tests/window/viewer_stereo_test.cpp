@@ -33,8 +33,8 @@ std::filesystem::path stereoTempDir() {
 std::vector<uint32_t> renderStereo(const std::string& args, uint32_t eyeWidth, uint32_t height) {
   const std::filesystem::path out = stereoTempDir() / "reference.png";
   std::filesystem::remove(out);
-  const std::string command = "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() + "' render " +
-                              args + " --width " + std::to_string(eyeWidth) + " --height " +
+  const std::string command = "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() +
+                              "' render " + args + " --width " + std::to_string(eyeWidth) + " --height " +
                               std::to_string(height) + " -o '" + out.string() + "' -q --frames 1";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   int w = 0, h = 0, comp = 0;
@@ -92,12 +92,13 @@ protected:
   }
   void SetUp() override {
     ASSERT_FALSE(xvfb_->display().empty()) << "Xvfb did not start (scripts/install-deps.sh installs xvfb)";
-    ASSERT_EQ(std::system("command -v xdotool >/dev/null"), 0) << "xdotool is missing (scripts/install-deps.sh)";
+    ASSERT_EQ(std::system("command -v xdotool >/dev/null"), 0)
+        << "xdotool is missing (scripts/install-deps.sh)";
   }
   std::unique_ptr<Viewer> open(const std::string& args, uint32_t width, uint32_t height) {
-    return std::make_unique<Viewer>(xvfb_->display(), args + " --width " + std::to_string(width) + " --height " +
-                                                          std::to_string(height) + " --path '" +
-                                                          (stereoTempDir() / "path.json").string() + "'");
+    return std::make_unique<Viewer>(
+        xvfb_->display(), args + " --width " + std::to_string(width) + " --height " + std::to_string(height) +
+                              " --path '" + (stereoTempDir() / "path.json").string() + "'");
   }
   // The window's pixels once they equal `expected` where `keep` says (the X server shows a presented image
   // a moment after the viewer reports it), or the last capture after 20 s.
@@ -197,7 +198,8 @@ TEST_F(ViewerStereo, PanelCheckboxesChangeTheImageAsTheOptionsDo) {
                  e["lod"].value("converged", false);
         },
         from, 90);
-    ASSERT_TRUE(frame) << step.item << ": no converged frame with " << step.expect << "\n" << viewer->errors();
+    ASSERT_TRUE(frame) << step.item << ": no converged frame with " << step.expect << "\n"
+                       << viewer->errors();
     const std::string args = input + cameraOptions((*frame)["camera"]) + " " + step.expect;
     std::vector<uint32_t> expected =
         step.stereo ? renderStereo(args, kWidth / 2, kHeight) : std::vector<uint32_t>{};

@@ -226,8 +226,8 @@ void stereoControls(ViewSettings& settings, PanelItems& items) {
   // Scene units; 0: the convergence distance / 30, whatever the units.
   double separation = settings.eyes.separation, step = 0.01;
   ImGui::SetNextItemWidth(160);
-  if (ImGui::InputScalar("Eye separation (0: auto)", ImGuiDataType_Double, &separation, &step, nullptr, "%.4g",
-                         ImGuiInputTextFlags_EnterReturnsTrue))
+  if (ImGui::InputScalar("Eye separation (0: auto)", ImGuiDataType_Double, &separation, &step, nullptr,
+                         "%.4g", ImGuiInputTextFlags_EnterReturnsTrue))
     settings.eyes.separation = std::max(0.0, separation);
   remember(items, "Eye separation");
   ImGui::EndDisabled();
@@ -238,7 +238,8 @@ void stereoControls(ViewSettings& settings, PanelItems& items) {
   ImGui::BeginDisabled(!f.enabled);
   float radius = float(f.radius), periphery = float(f.periphery);
   ImGui::SetNextItemWidth(160);
-  if (ImGui::SliderFloat("Fovea radius", &radius, 0.0f, 1.0f, "%.2f")) f.radius = std::clamp(double(radius), 0.0, 1.0);
+  if (ImGui::SliderFloat("Fovea radius", &radius, 0.0f, 1.0f, "%.2f"))
+    f.radius = std::clamp(double(radius), 0.0, 1.0);
   remember(items, "Fovea radius");
   ImGui::SetNextItemWidth(160);
   if (ImGui::SliderFloat("Periphery factor", &periphery, 1.0f, 10.0f, "%.1f"))
@@ -354,7 +355,8 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
     lodControls(settings, items);
     ImGui::EndDisabled();
   }
-  if (ImGui::CollapsingHeader("Stereo and foveation", ImGuiTreeNodeFlags_DefaultOpen)) stereoControls(settings, items);
+  if (ImGui::CollapsingHeader("Stereo and foveation", ImGuiTreeNodeFlags_DefaultOpen))
+    stereoControls(settings, items);
   // A value render would refuse (a slider typed past its end with Ctrl+click) keeps the last good settings.
   try {
     validateSettings(settings);
