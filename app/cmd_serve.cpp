@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "input.h"
 #include "options.h"
+#include "io/annotations_file.h"
 #include "io/format_table.h"
 #include "view/web/server.h"
 
@@ -20,6 +21,7 @@ namespace {
 
 struct ServeArgs {
   std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
+  std::string annotations; // --annotations: the measurement list each page starts with
   std::string method, points = "1M", bind = "127.0.0.1", token, maxSize = "3840x2160", frameAncestors;
   uint32_t port = 8080, maxClients = view::web::kDefaultMaxClients;
   double fov = 60, motionScale = 0.5;
@@ -61,9 +63,11 @@ int runServe(const ServeArgs& a) {
   o.events = a.events;
   o.quiet = a.quiet;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
+  if (!a.annotations.empty()) o.annotations = io::loadAnnotations(a.annotations);
   view::web::checkServerOptions(o);
   const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
   checkSceneMethod(spec, o.method);
+  o.inputFile = spec.source;
 
   SceneOptions scene;
   scene.method = o.method;
@@ -119,6 +123,8 @@ Command addServe(CLI::App& app) {
   cmd->add_option("--motion-scale", a->motionScale,
                   "Frame side while the camera moves, relative to the canvas")
       ->capture_default_str();
+  cmd->add_option("--annotations", a->annotations,
+                 "Annotations file (JSON) whose measurements every page starts with, drawn over the frames");
   cmd->add_option("--eye", a->eye, "Starting camera position x,y,z (default: overview)");
   cmd->add_option("--target", a->target, "Point looked at x,y,z (default: center of the bounds)");
   cmd->add_option("--up", a->up, "Up direction x,y,z")->capture_default_str();

@@ -15,6 +15,7 @@
 #include "commands.h"
 #include "input.h"
 #include "options.h"
+#include "io/annotations_file.h"
 #include "io/format_table.h"
 #include "view/desktop/viewer.h"
 
@@ -25,6 +26,7 @@ namespace {
 struct ViewArgs {
   std::string input, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method, points = "1M", path = "path.json", screenshots = ".", stats;
+  std::string annotations; // --annotations: measurements loaded and saved
   uint32_t width = 1280, height = 720;
   double fov = 60;
   uint64_t seed = 1;
@@ -79,6 +81,10 @@ int runView(const ViewArgs& a) {
   options.settings.background = parseRgb(a.background, "--background");
   applyDrawOptions(a.draw, options.settings);
   options.pathFile = a.path;
+  options.annotationsFile = a.annotations;
+  // A file given but damaged is said now, not after the window opened.
+  std::error_code exists;
+  if (!a.annotations.empty() && std::filesystem::exists(a.annotations, exists)) io::loadAnnotations(a.annotations);
   options.screenshotDir = a.screenshots;
   options.device = a.device;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
@@ -109,7 +115,9 @@ Command addView(CLI::App& app) {
       app.add_subcommand("view", "View a point cloud in a window (GLFW + Vulkan), with a settings panel");
   cmd->footer(
       "\nMouse: left drag orbits around the pivot, right or middle drag pans, the wheel zooms towards the\n"
-      "point under the cursor, a double-click makes the clicked point the pivot.\n"
+      "point under the cursor, a double-click makes the clicked point the pivot; Ctrl+click picks the point\n"
+      "under the cursor (its attributes in the panel), Ctrl+Shift+click adds it to a measurement (the\n"
+      "panel's kind: distance, height or area); Ctrl+S saves the measurements to --annotations.\n"
       "Keys: W A S D Q E fly (Shift: faster); 8 2 5 0 4 6 top, bottom, front, back, left, right views,\n"
       "1 the overview's direction; F frames the whole cloud; K records a keyframe (saved to --path at "
       "once);\n"
@@ -147,6 +155,8 @@ Command addView(CLI::App& app) {
   cmd->add_option("--points", a->points, "Points of a generated scene (e.g. 1M, 100M)")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
+  cmd->add_option("--annotations", a->annotations,
+                 "Measurements file (JSON): loaded when it exists, drawn in the panel, written by Ctrl+S");
   cmd->add_option("--path", a->path, "Keyframes file: loaded when it exists, written on every K")
       ->capture_default_str();
   cmd->add_option("--screenshot-dir", a->screenshots, "Folder of F12 screenshots (pointrast-0001.png, ...)")

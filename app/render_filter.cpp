@@ -5,6 +5,7 @@
 
 #include "base/error.h"
 #include "render/clip_volumes.h"
+#include "report/pick_json.h"
 
 namespace pointrast::app {
 
@@ -55,33 +56,7 @@ PixelPos parsePick(const std::string& text, uint32_t width, uint32_t height) {
 }
 
 nlohmann::json pickJson(const PointCloud& cloud, PixelPos pixel, bool empty, std::optional<uint64_t> index) {
-  nlohmann::json j;
-  j["pixel"] = {pixel.x, pixel.y};
-  if (empty) {
-    j["point"] = "none";
-    return j;
-  }
-  if (!index) {
-    j["point"] = "unknown"; // a point was drawn there, but none of the cloud matches its word
-    return j;
-  }
-  const uint64_t i = *index;
-  nlohmann::json p;
-  p["index"] = i;
-  const glm::dvec3 w = cloud.world(i);
-  p["x"] = w.x;
-  p["y"] = w.y;
-  p["z"] = w.z;
-  if (!cloud.intensity.empty()) p["intensity"] = cloud.intensity[i];
-  if (!cloud.classification.empty()) p["classification"] = cloud.classification[i];
-  if (!cloud.returnNumber.empty()) p["return_number"] = cloud.returnNumber[i];
-  if (!cloud.pointSourceId.empty()) p["point_source_id"] = cloud.pointSourceId[i];
-  if (cloud.hasColor()) {
-    const uint32_t c = cloud.colors[i];
-    p["color"] = {c & 0xFF, (c >> 8) & 0xFF, (c >> 16) & 0xFF};
-  }
-  j["point"] = p;
-  return j;
+  return pointrast::pickJson(cloud, pixel.x, pixel.y, empty, index);
 }
 
 } // namespace pointrast::app

@@ -9,7 +9,10 @@
 #include "base/error.h"
 #include "cloud/cloud.h"
 #include "gpu/context.h"
+#include "render/overlay.h"
+#include "render/pick.h"
 #include "render/scene.h"
+#include "report/pick_json.h"
 
 namespace pointrast::view {
 
@@ -123,6 +126,10 @@ FrameStats GpuCloud::draw(Renderer& renderer, const Camera& camera, const Render
   return renderer.render(scene(methodInfo(rs.method).layout), camera, rs);
 }
 
+DisplayColorMode GpuCloud::colors() const {
+  return colors_ ? *colors_ : displayColorMode(cloud_);
+}
+
 const Bounds& GpuCloud::bounds() const {
   return cloud_.bounds;
 }
@@ -216,6 +223,74 @@ std::optional<glm::dvec3> SceneView::pick(const Camera& camera, const ViewSettin
   return picked->point;
 }
 
+nlohmann::json SceneView::pickAttributes(const Camera& camera, const ViewSettings& settings,
+                                         Viewport viewport, glm::dvec2 position) {
+  const int px = int(std::floor(position.x)), py = int(std::floor(position.y));
+  if (!(position.x >= 0 && position.y >= 0 && position.x < viewport.width && position.y < viewport.height))
+    return {{"pixel", {px, py}}, {"point", "none"}};
+  auto unavailable = [&](const std::string& why) {
+    return nlohmann::json{{"pixel", {px, py}}, {"point", "unavailable: " + why}};
+  };
+  if (applicable(settings).stereo) return unavailable("a stereo frame shows two cameras; turn stereo off to pick");
+  auto* cloud = dynamic_cast<GpuCloud*>(&source_);
+  if (!cloud) return unavailable("picking reads a cloud in memory; an octree's points are streamed");
+  ensureRenderer(viewport, 1);
+  RenderSettings rs = pickSettings(settings);
+  std::string status;
+  if (source_.draw(*renderer_, camera, rs, settings, status).frames == 0) return unavailable(status);
+  const int r = int(kPickRadius);
+  const int x0 = std::max(0, px - r), y0 = std::max(0, py - r);
+  const int x1 = std::min(int(viewport.width) - 1, px + r), y1 = std::min(int(viewport.height) - 1, py + r);
+  const std::vector<uint64_t> words =
+      renderer_->framebufferWords(uint32_t(x0), uint32_t(y0), uint32_t(x1 - x0 + 1), uint32_t(y1 - y0 + 1));
+  // The nearest pixel that shows a point, the closest point where pixels tie.
+  std::optional<std::pair<int, int>> best;
+  uint64_t bestWord = kEmptyWord;
+  int bestDistance = 0;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const uint64_t word = words[size_t(y - y0) * size_t(x1 - x0 + 1) + size_t(x - x0)];
+      if (word == kEmptyWord) continue;
+      const int distance = (x - px) * (x - px) + (y - py) * (y - py);
+      if (best && (distance > bestDistance || (distance == bestDistance && word >= bestWord))) continue;
+      best = {x, y};
+      bestWord = word;
+      bestDistance = distance;
+    }
+  if (rs.method != settings.method) render(camera, settings, viewport);
+  if (!best) return {{"pixel", {px, py}}, {"point", "none"}};
+  PickRequest request;
+  request.cloud = &cloud->cloud();
+  request.colors = cloud->colors();
+  request.filter = rs.filter;
+  request.camera = camera;
+  request.width = viewport.width;
+  request.height = viewport.height;
+  request.depth = DepthMode::Float;
+  const auto [bx, by] = *best;
+  std::optional<uint64_t> index = pointrast::pickPoint(request, uint32_t(bx), uint32_t(by), bestWord);
+  nlohmann::json j = pickJson(cloud->cloud(), uint32_t(bx), uint32_t(by), false, index);
+  if (index) {
+    const glm::dvec3 w = cloud->cloud().world(*index);
+    j["world"] = {w.x, w.y, w.z};
+  }
+  return j;
+}
+
+void SceneView::drawOverlay(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                            const Annotations& annotations, std::vector<uint32_t>& rgba) {
+  if (annotations.items.empty() || applicable(settings).stereo) return;
+  if (rgba.size() != uint64_t(viewport.width) * viewport.height) return;
+  ensureRenderer(viewport, 1);
+  const RenderSettings rs = pickSettings(settings);
+  std::string status;
+  std::vector<uint64_t> words;
+  if (source_.draw(*renderer_, camera, rs, settings, status).frames > 0) words = renderer_->framebufferWords();
+  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(source_.bounds());
+  drawAnnotations({rgba, viewport.width, viewport.height, words}, camera, nearW, annotations);
+  if (rs.method != settings.method || rs.depth != settings.depth) render(camera, settings, viewport);
+}
+
 std::optional<double> SceneView::depthAt(const Camera& camera, const ViewSettings& settings,
                                          Viewport viewport, glm::dvec2 position) {
   auto picked = pickPoint(camera, settings, viewport, position);
@@ -251,6 +326,17 @@ void zoomAtCursor(Session& session, SceneView& view, glm::dvec2 position, double
   std::optional<double> depth =
       view.depthAt(session.camera(), session.settings(), session.viewport(), position);
   session.wheel(position, steps, depth);
+}
+
+nlohmann::json pickTool(Session& session, SceneView& view, glm::dvec2 position,
+                        std::optional<AnnotationKind> measure) {
+  nlohmann::json picked = view.pickAttributes(session.camera(), session.settings(), session.viewport(), position);
+  if (measure && picked.contains("world")) {
+    const nlohmann::json& w = picked["world"];
+    session.measurements().add(*measure, {w[0].get<double>(), w[1].get<double>(), w[2].get<double>()});
+    session.invalidate(); // the overlay changed
+  }
+  return picked;
 }
 
 std::optional<glm::dvec3> pickPivot(Session& session, SceneView& view, glm::dvec2 position) {

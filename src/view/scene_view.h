@@ -14,7 +14,9 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
+#include "cloud/annotations.h"
 #include "render/renderer.h"
 #include "view/navigation.h"
 #include "view/scene_source.h"
@@ -59,6 +61,9 @@ public:
   bool streamed() const override { return false; }
   // Bytes of GPU memory of the layouts uploaded so far.
   uint64_t bytes() const override;
+  const PointCloud& cloud() const { return cloud_; }
+  // The color mode of the uploads (what a pick compares the drawn colors with).
+  DisplayColorMode colors() const;
   FrameStats draw(Renderer& renderer, const Camera& camera, const RenderSettings& rs,
                   const ViewSettings& settings, std::string& status) override;
 
@@ -88,6 +93,17 @@ public:
   // The renderer's image is the current settings' again afterwards.
   std::optional<glm::dvec3> pick(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                  glm::dvec2 position);
+  // The pick tool: the point of the cloud drawn closest within kPickRadius pixels of a viewport position
+  // (the nearest pixel first), with every attribute the cloud holds, as render --pick reports it
+  // (report/pick_json.h) plus "world": its position as a point of the measurements, when one was found.
+  // A "point" of "unavailable: ..." says why a frame cannot be picked from (stereo, an octree source).
+  nlohmann::json pickAttributes(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                                glm::dvec2 position);
+  // Draws the annotations over a mono frame `rgba` this view just rendered at `viewport` with `camera`,
+  // depth-tested against the canonical words of a closest-point frame drawn for it (every method,
+  // the LOD methods included). Nothing for a stereo frame or an empty list.
+  void drawOverlay(const Camera& camera, const ViewSettings& settings, Viewport viewport,
+                   const Annotations& annotations, std::vector<uint32_t>& rgba);
   // Linear depth of the point pick() would return, for zooming towards the cursor.
   std::optional<double> depthAt(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                 glm::dvec2 position);
@@ -121,6 +137,11 @@ private:
 // the depth under the cursor (read from the framebuffer, the pivot's plane over an empty pixel), and the
 // pivot picked under a double-click (Requests::pick). pickPivot returns the picked point, if any.
 void zoomAtCursor(Session& session, SceneView& view, glm::dvec2 position, double steps);
+// The pick tool of every front end: the point under a position with its attributes
+// (SceneView::pickAttributes); with a measuring kind (Distance, Height, Area) a picked point also becomes
+// the next vertex of the session's open measurement.
+nlohmann::json pickTool(Session& session, SceneView& view, glm::dvec2 position,
+                        std::optional<AnnotationKind> measure);
 std::optional<glm::dvec3> pickPivot(Session& session, SceneView& view, glm::dvec2 position);
 
 } // namespace pointrast::view

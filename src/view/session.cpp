@@ -212,6 +212,12 @@ void Session::doubleClick(glm::dvec2 position) {
   requests_.pick = position;
 }
 
+void Session::toolClick(glm::dvec2 position, bool measure) {
+  navigation_.endDrag();
+  requests_.toolPick = position;
+  requests_.toolMeasure = measure;
+}
+
 void Session::wheel(glm::dvec2 position, double steps, std::optional<double> depth) {
   if (steps == 0) return;
   navigation_.zoom(position, steps, viewport_, depth);

@@ -22,6 +22,7 @@
 #include "render/renderer.h"
 #include "render/stereo.h"
 #include "view/camera_path.h"
+#include "view/measure_tool.h"
 #include "view/navigation.h"
 
 namespace pointrast::view {
@@ -146,6 +147,8 @@ constexpr size_t kStatsWindow = 60;
 // What a front end must do on the session's behalf, taken (and cleared) by the front end.
 struct Requests {
   std::optional<glm::dvec2> pick; // read the depth under this viewport position, then call pivotPicked
+  std::optional<glm::dvec2> toolPick; // the pick tool at this position (scene_view.h pickTool)
+  bool toolMeasure = false;           // ... adding the point to a measurement
   bool screenshot = false;
   bool printCamera = false;
   bool quit = false;
@@ -168,6 +171,7 @@ public:
   void mouseMove(glm::dvec2 position);
   void mouseUp(MouseButton button, glm::dvec2 position);
   void doubleClick(glm::dvec2 position); // asks for a pick; pivotPicked sets the pivot
+  void toolClick(glm::dvec2 position, bool measure); // Ctrl+click: asks for the pick tool (Requests::toolPick)
   // Wheel steps (positive: zoom in); `depth` is the linear depth under the cursor when the front end has
   // it (see Navigation::zoom).
   void wheel(glm::dvec2 position, double steps, std::optional<double> depth = std::nullopt);
@@ -195,6 +199,9 @@ public:
 
   CameraPath& path() { return path_; }
   const CameraPath& path() const { return path_; }
+  // The measurements drawn with the pick tool and those loaded from --annotations.
+  MeasureTool& measurements() { return measurements_; }
+  const MeasureTool& measurements() const { return measurements_; }
   void recordKeyframe() { path_.append(camera(), options_.keyframeSeconds); }
 
   // Whether the image is stale (camera, viewport, settings or content changed since the last frame), or
@@ -215,6 +222,7 @@ private:
   ViewSettings settings_;
   ViewOptions options_;
   CameraPath path_;
+  MeasureTool measurements_;
   Requests requests_;
   FlyInput fly_;
   int flyKeys_[6] = {0, 0, 0, 0, 0, 0}; // held state of Forward..Up

@@ -67,6 +67,38 @@ TEST_F(SceneViewTest, PicksTheClosestPointUnderTheCursor) {
   }
 }
 
+TEST_F(SceneViewTest, ThePickToolReturnsTheClosestPointWithItsAttributes) {
+  cloud.intensity = {100, 200, 300};
+  cloud.classification = {2, 6, 9};
+  GpuCloud gpuCloud(*context, cloud, false);
+  SceneView view(*context, gpuCloud);
+  ViewSettings settings;
+  for (const char* name : {"atomicmin", "batch", "hqs"}) {
+    SCOPED_TRACE(name);
+    settings.method = parseMethod(name);
+    const glm::dvec3 center = project(camera(), viewport, {0.05, 10, 0.07});
+    // On the point's pixel and one pixel beside it: the front point (index 0), not the one behind it.
+    for (double dx : {0.0, 1.0}) {
+      nlohmann::json j = view.pickAttributes(camera(), settings, viewport, {center.x + dx, center.y});
+      ASSERT_TRUE(j["point"].is_object()) << j.dump();
+      EXPECT_EQ(j["point"]["index"], 0);
+      EXPECT_EQ(j["point"]["intensity"], 100);
+      EXPECT_EQ(j["point"]["classification"], 2);
+      EXPECT_EQ(j["point"]["color"], nlohmann::json::array({255, 0, 0}));
+      EXPECT_NEAR(j["point"]["x"].get<double>(), 0.05, 1e-6);
+      EXPECT_NEAR(j["world"][1].get<double>(), 10, 1e-6);
+      EXPECT_EQ(j["pixel"], nlohmann::json::array({int(center.x), int(center.y)}));
+    }
+    EXPECT_EQ(view.pickAttributes(camera(), settings, viewport, {2, 45})["point"], "none");
+    EXPECT_EQ(view.pickAttributes(camera(), settings, viewport, {-1, 5})["point"], "none");
+  }
+  settings.method = parseMethod("batch"); // a method that draws stereo
+  settings.stereo = true;
+  const nlohmann::json stereo = view.pickAttributes(camera(), settings, viewport, {32, 24})["point"];
+  ASSERT_TRUE(stereo.is_string()) << stereo.dump();
+  EXPECT_EQ(stereo.get<std::string>().rfind("unavailable: ", 0), 0u) << stereo;
+}
+
 TEST_F(SceneViewTest, FramesAndScreenshots) {
   GpuCloud gpuCloud(*context, cloud, false);
   SceneView view(*context, gpuCloud);

@@ -159,6 +159,61 @@ const scenarios = {
     const refusals = await page.evaluate(() => window.pointrast.refusals);
     return { errors, shown, refusals };
   },
+  // The pick and measure tools: args.steps, each {tool, pixel: [x, y]} (a pixel of the frame) clicked with that
+  // tool chosen in the panel; after each click, the pick the page received, the text it shows and the
+  // measurement list. args.ctrl: Ctrl+click with the tool left at "navigates".
+  async tools(context) {
+    const { page, errors } = await open(context, url);
+    const shown = await waitFull(page);
+    const results = [];
+    for (const step of args.steps) {
+      const tool = args.ctrl ? 'navigate' : step.tool;
+      if (await page.inputValue('#tool') !== tool) await page.selectOption('#tool', tool); // a change finishes a measurement
+      const [before, lists] = await page.evaluate(() => [window.pointrast.picks, window.pointrast.measurementUpdates || 0]);
+      const at = await page.evaluate(([x, y, w, h]) => {
+        const r = document.getElementById('view').getBoundingClientRect();
+        return [r.left + (x + 0.5) * r.width / w, r.top + (y + 0.5) * r.height / h];
+      }, [...step.pixel, shown.frame.viewWidth, shown.frame.viewHeight]);
+      if (args.ctrl) await page.keyboard.down('Control');
+      await page.mouse.click(at[0], at[1]);
+      if (args.ctrl) await page.keyboard.up('Control');
+      await page.waitForFunction((n) => window.pointrast.picks > n, before, { timeout: TIMEOUT, polling: 50 });
+      // A measuring click: the list that follows the pick.
+      if (!args.ctrl && step.tool !== 'pick')
+        await page.waitForFunction((n) => (window.pointrast.measurementUpdates || 0) > n, lists, { timeout: TIMEOUT, polling: 50 });
+      results.push(await page.evaluate(() => ({ pick: window.pointrast.picked, text: document.getElementById('picked').textContent,
+        measurements: window.pointrast.measurements, listText: document.getElementById('measurements').textContent })));
+    }
+    let annotations = null;
+    if (args.download) {
+      const [download] = await Promise.all([page.waitForEvent('download'), page.click('#downloadMeasures')]);
+      const file = join(outdir, 'annotations.json');
+      await download.saveAs(file);
+      annotations = file;
+    }
+    const after = await page.evaluate(() => ({ state: window.pointrast.state }));
+    return { errors, shown, results, annotations, after };
+  },
+  // The Export button with args.box ("x0,y0,z0,x1,y1,z1" or ""), args.mode and args.classes in the panel:
+  // the downloaded file as export.las, and what the page reported (points, or the error it showed).
+  async export(context) {
+    const { page, errors } = await open(context, url);
+    await waitFull(page);
+    await page.fill('#clipBox', args.box || '');
+    if (args.mode) await page.selectOption('#clipMode', args.mode);
+    await page.fill('#exportClasses', args.classes || '');
+    let file = null;
+    const downloaded = page.waitForEvent('download', { timeout: TIMEOUT }).then(async (download) => {
+      file = join(outdir, 'export.las');
+      await download.saveAs(file);
+    }).catch(() => {});
+    await page.click('#exportLas');
+    await page.waitForFunction(() => window.pointrast.exported, null, { timeout: TIMEOUT, polling: 50 });
+    const exported = await page.evaluate(() => window.pointrast.exported);
+    if (!exported.error) await downloaded;
+    const shown = await page.evaluate(() => document.getElementById('exportStatus').textContent);
+    return { errors, exported, shown, file };
+  },
   // A picture of the page (panel and frame) for the README.
   async pageshot(context) {
     const { page, errors } = await open(context, url);

@@ -1,5 +1,12 @@
 // The page in Debian's chromium (headless, driven by tests/web/browser.mjs through playwright-core) against
 // `pointrast serve` on lavapipe: what a user sees and does.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
 #include <gtest/gtest.h>
 
 #include "image_compare.h"
@@ -175,6 +182,195 @@ TEST_F(Browser, PanelControlsChangeTheImageAsRenderOptionsDo) {
                 own.psnr, own.meanAbs, before.meanAbs);
     previous = ref;
   }
+  expectCleanExit(server);
+}
+
+// The camera of a page's state as render options, every digit kept.
+std::string cameraOptions(const Camera& c) {
+  char text[512];
+  std::snprintf(text, sizeof text, "--eye %.17g,%.17g,%.17g --target %.17g,%.17g,%.17g --up %.17g,%.17g,%.17g --fov %.17g",
+                c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z, c.fovY);
+  return text;
+}
+
+// render --pick at a pixel of a 640x480 image with the page's camera: the "pick" object of its JSON.
+Json renderPick(const Camera& camera, const Json& pixel, const std::filesystem::path& dir) {
+  std::string out = commandOutput("'" + pointrastBinary() + "' render '" + autzen() + "' " + cameraOptions(camera) +
+                                  " --width 640 --height 480 -q --json --pick " + std::to_string(pixel[0].get<int>()) +
+                                  "," + std::to_string(pixel[1].get<int>()) + " -o '" + (dir / "pick.png").string() +
+                                  "' 2>&1");
+  Json j = Json::parse(out.substr(out.find('{')), nullptr, false);
+  if (!j.is_object() || !j.contains("pick")) {
+    ADD_FAILURE() << "render --pick printed:\n" << out;
+    return Json::object();
+  }
+  return j["pick"];
+}
+
+glm::dvec3 pointOf(const Json& point) {
+  return {point["x"].get<double>(), point["y"].get<double>(), point["z"].get<double>()};
+}
+
+TEST_F(Browser, APickShowsThePointRenderPicksAtThatPixel) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  ServeProcess server(autzen() + " " + kAutzenCamera);
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  auto dir = scratchDir("browser_pick");
+  const Json pixels = {{450, 300}, {430, 260}}; // right of the panel (the left 390 pixels), on points
+  Json steps = Json::array();
+  for (const Json& p : pixels)
+    steps.push_back({{"tool", "pick"}, {"pixel", p}});
+  Json r = browser("tools", server.url(), dir, {{"steps", steps}});
+  ASSERT_EQ(r["results"].size(), 2u);
+  EXPECT_EQ(r["errors"], Json::array());
+  const Camera camera = cameraOf(r["shown"]["state"]);
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    const Json& shown = r["results"][i];
+    // The nearest pixel within the pick radius (2) that shows a point: render --pick there.
+    const Json& at = shown["pick"]["pixel"];
+    ASSERT_TRUE(at.is_array()) << shown.dump();
+    EXPECT_LE(std::abs(at[0].get<int>() - pixels[i][0].get<int>()), 2);
+    EXPECT_LE(std::abs(at[1].get<int>() - pixels[i][1].get<int>()), 2);
+    const Json expected = renderPick(camera, at, dir);
+    ASSERT_TRUE(expected["point"].is_object()) << "the test's pixel shows no point: " << expected.dump();
+    Json page = shown["pick"];
+    page.erase("world");
+    EXPECT_EQ(page, expected) << "page " << shown["pick"].dump() << "\nrender " << expected.dump();
+    // The panel shows the attributes.
+    const std::string text = shown["text"];
+    EXPECT_NE(text.find("intensity " + std::to_string(expected["point"]["intensity"].get<int>())), std::string::npos)
+        << text;
+    EXPECT_NE(text.find("class " + std::to_string(expected["point"]["classification"].get<int>())), std::string::npos)
+        << text;
+  }
+  // Ctrl+click picks with the tool left at navigating, and does not move the camera.
+  Json c = browser("tools", server.url(), dir, {{"steps", Json::array({steps[0]})}, {"ctrl", true}});
+  ASSERT_EQ(c["results"].size(), 1u);
+  Json page = c["results"][0]["pick"];
+  page.erase("world");
+  EXPECT_EQ(page, renderPick(cameraOf(c["after"]["state"]), page["pixel"], dir));
+  expectNear(cameraOf(c["after"]["state"]).eye, camera.eye, 1e-9, "eye after a Ctrl+click");
+  expectCleanExit(server);
+}
+
+TEST_F(Browser, ADistanceBetweenTwoClicksIsTheDistanceOfThePickedPoints) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  ServeProcess server(autzen() + " " + kAutzenCamera);
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  auto dir = scratchDir("browser_distance");
+  const Json pixels = {{410, 250}, {460, 280}};
+  Json steps = Json::array();
+  for (const Json& p : pixels)
+    steps.push_back({{"tool", "distance"}, {"pixel", p}});
+  Json r = browser("tools", server.url(), dir, {{"steps", steps}, {"download", true}});
+  ASSERT_EQ(r["results"].size(), 2u);
+  EXPECT_EQ(r["errors"], Json::array());
+  const Camera camera = cameraOf(r["shown"]["state"]);
+  const Json a = renderPick(camera, r["results"][0]["pick"]["pixel"], dir),
+             b = renderPick(camera, r["results"][1]["pick"]["pixel"], dir);
+  ASSERT_TRUE(a["point"].is_object() && b["point"].is_object());
+  const double expected = glm::length(pointOf(a["point"]) - pointOf(b["point"]));
+  ASSERT_GT(expected, 1.0);
+  const Json& list = r["results"][1]["measurements"];
+  ASSERT_EQ(list.size(), 1u) << list.dump();
+  ASSERT_TRUE(list[0].contains("value")) << list.dump();
+  EXPECT_EQ(list[0]["type"], "distance");
+  EXPECT_NEAR(list[0]["value"].get<double>(), expected, 1e-9 * expected);
+  char shownText[64];
+  std::snprintf(shownText, sizeof shownText, "distance %.2f", expected);
+  EXPECT_NE(r["results"][1]["listText"].get<std::string>().find(shownText), std::string::npos)
+      << r["results"][1]["listText"];
+  // The downloaded annotations file holds the two picked points.
+  ASSERT_TRUE(r["annotations"].is_string());
+  std::ifstream in(r["annotations"].get<std::string>());
+  Json file = Json::parse(in, nullptr, false);
+  ASSERT_TRUE(file.is_object() && file.contains("annotations")) << file.dump();
+  ASSERT_EQ(file["annotations"].size(), 1u);
+  EXPECT_EQ(file["annotations"][0]["type"], "distance");
+  expectNear(pointOf({{"x", file["annotations"][0]["points"][0][0]}, {"y", file["annotations"][0]["points"][0][1]},
+                      {"z", file["annotations"][0]["points"][0][2]}}),
+             pointOf(a["point"]), 1e-9, "first vertex");
+  expectCleanExit(server);
+}
+
+// The point records of a LAS file (formats 0-10, legacy or 1.4 counts), each as its bytes, and the
+// scale/offset to read their positions: the test's own reading, not the library's.
+struct LasRecords {
+  std::vector<std::string> records;
+  glm::dvec3 scale{1}, offset{0};
+};
+LasRecords readLasRecords(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  LasRecords r;
+  if (bytes.size() < 227 || bytes.compare(0, 4, "LASF") != 0) {
+    ADD_FAILURE() << path << " is not a LAS file";
+    return r;
+  }
+  auto u32 = [&](size_t at) { uint32_t v; std::memcpy(&v, bytes.data() + at, 4); return v; };
+  auto u16 = [&](size_t at) { uint16_t v; std::memcpy(&v, bytes.data() + at, 2); return v; };
+  auto f64 = [&](size_t at) { double v; std::memcpy(&v, bytes.data() + at, 8); return v; };
+  const uint32_t start = u32(96), length = u16(105);
+  uint64_t count = u32(107);
+  if (count == 0 && bytes.size() >= 255) std::memcpy(&count, bytes.data() + 247, 8);
+  r.scale = {f64(131), f64(139), f64(147)};
+  r.offset = {f64(155), f64(163), f64(171)};
+  if (start + count * length > bytes.size()) {
+    ADD_FAILURE() << path << " is shorter than its header says";
+    return r;
+  }
+  for (uint64_t i = 0; i < count; ++i)
+    r.records.push_back(bytes.substr(start + i * length, length));
+  return r;
+}
+
+glm::dvec3 recordPosition(const LasRecords& las, const std::string& record) {
+  int32_t v[3];
+  std::memcpy(v, record.data(), 12);
+  return glm::dvec3(v[0], v[1], v[2]) * las.scale + las.offset;
+}
+
+TEST_F(Browser, ExportDownloadsThePointsInsideTheClipBoxAsLas) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  ServeProcess server(autzen() + " " + kAutzenCamera);
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  auto dir = scratchDir("browser_export");
+  const glm::dvec3 lo(636400, 849000, 300), hi(636800, 849400, 600);
+  char box[200];
+  std::snprintf(box, sizeof box, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+  Json r = browser("export", server.url(), dir, {{"box", box}, {"mode", "inside"}});
+  EXPECT_EQ(r["errors"], Json::array());
+  ASSERT_TRUE(r["file"].is_string()) << r.dump();
+  // The test's own selection from the input: the records whose position lies in the closed box.
+  const LasRecords input = readLasRecords(autzen());
+  std::vector<std::string> expected;
+  for (const std::string& record : input.records) {
+    const glm::dvec3 p = recordPosition(input, record);
+    if (glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi))) expected.push_back(record);
+  }
+  ASSERT_GT(expected.size(), 100u);
+  ASSERT_LT(expected.size(), input.records.size());
+  const LasRecords exported = readLasRecords(r["file"].get<std::string>());
+  EXPECT_EQ(r["exported"]["points"], expected.size());
+  ASSERT_EQ(exported.records.size(), expected.size());
+  std::vector<std::string> got = exported.records;
+  std::sort(got.begin(), got.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_TRUE(got == expected) << "the exported records are not the input's records inside the box";
+  // No temporary file is left behind.
+  EXPECT_EQ(commandOutput("ls -d \"${TMPDIR:-/tmp}\"/pointrast-export-* 2>/dev/null"), "");
+  expectCleanExit(server);
+}
+
+TEST_F(Browser, ExportSaysWhyAGeneratedSceneCannotBeExported) {
+  ServeProcess server("terrain --points 20000");
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  Json r = browser("export", server.url(), scratchDir("browser_export_refused"), Json::object());
+  ASSERT_TRUE(r["exported"]["error"].is_string()) << r.dump();
+  const std::string why = r["exported"]["error"];
+  EXPECT_NE(why.find("generated scene"), std::string::npos) << why;
+  EXPECT_EQ(r["shown"], why);
+  EXPECT_TRUE(r["file"].is_null());
   expectCleanExit(server);
 }
 

@@ -13,6 +13,7 @@
 #include <stb_image.h>
 
 #include "cloud/cloud.h"
+#include "io/annotations_file.h"
 #include "io/reader.h"
 #include "io/writer.h"
 #include "viewer_harness.h"
@@ -221,6 +222,80 @@ TEST_F(ViewerWindow, DoubleClickSetsThePivotOnTheClickedPoint) {
   ASSERT_TRUE(turned);
   EXPECT_LT(glm::length(vec3((*turned)["pivot"]) - pivot), 1e-9);
   finish(*viewer);
+}
+
+// render --pick at a pixel of a kWidth x kHeight image with a frame event's camera: its "pick" object.
+nlohmann::json renderPick(const nlohmann::json& camera, int x, int y) {
+  const std::string command = "POINTRAST_VALIDATION=1 '" + pointrastBinary() + "' render '" + autzen() + "' " +
+                              cameraArgs(camera) + " --width " + std::to_string(kWidth) + " --height " +
+                              std::to_string(kHeight) + " -q --json --pick " + std::to_string(x) + "," +
+                              std::to_string(y) + " -o '" + (tempDir() / "pick.png").string() + "'";
+  std::string out;
+  if (FILE* pipe = popen(command.c_str(), "r")) {
+    char buffer[4096];
+    size_t n = 0;
+    while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0)
+      out.append(buffer, n);
+    pclose(pipe);
+  }
+  nlohmann::json j = nlohmann::json::parse(out, nullptr, false);
+  if (!j.is_object() || !j.contains("pick")) {
+    ADD_FAILURE() << command << " printed " << out;
+    return nlohmann::json::object();
+  }
+  return j["pick"];
+}
+
+TEST_F(ViewerWindow, CtrlClickPicksThePointRenderPicksAndMeasurementsSaveAndLoad) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const std::filesystem::path file = tempDir() / "measured.json";
+  std::filesystem::remove(file);
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel --annotations '" + file.string() + "'");
+  ASSERT_TRUE(first_);
+  const nlohmann::json camera = (*first_)["camera"];
+  viewer->xdotool("mousemove --window $W 240 200 keydown ctrl click 1 keyup ctrl");
+  auto picked = viewer->waitEvent("picked", 0, 30);
+  ASSERT_TRUE(picked) << viewer->errors();
+  nlohmann::json shown = (*picked)["pick"];
+  shown.erase("world");
+  const nlohmann::json expected = renderPick(camera, 240, 200);
+  ASSERT_TRUE(expected["point"].is_object()) << expected.dump();
+  EXPECT_EQ(shown, expected);
+  EXPECT_EQ((*picked)["measurements"], nlohmann::json::array()) << "a plain Ctrl+click measures nothing";
+  // Ctrl+Shift+click twice: a distance between the two picked points, saved by Ctrl+S.
+  size_t from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 120 250 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
+  auto a = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(a);
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 380 150 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
+  auto b = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(b);
+  const glm::dvec3 pa = vec3((*a)["pick"]["world"]), pb = vec3((*b)["pick"]["world"]);
+  const nlohmann::json list = (*b)["measurements"];
+  ASSERT_EQ(list.size(), 1u) << list.dump();
+  EXPECT_NEAR(list[0]["value"].get<double>(), glm::length(pa - pb), 1e-9 * glm::length(pa - pb));
+  from = viewer->eventCount();
+  viewer->xdotool("key ctrl+s");
+  auto saved = viewer->waitEvent("annotations", from, 30);
+  ASSERT_TRUE(saved) << viewer->errors();
+  EXPECT_EQ((*saved)["count"], 1);
+  finish(*viewer);
+  // The file holds the two points; a viewer started with it lists the same measurement.
+  Annotations loaded = io::loadAnnotations(file);
+  ASSERT_EQ(loaded.items.size(), 1u);
+  EXPECT_EQ(loaded.items[0].kind, AnnotationKind::Distance);
+  ASSERT_EQ(loaded.items[0].points.size(), 2u);
+  EXPECT_EQ(loaded.items[0].points[0], pa);
+  EXPECT_EQ(loaded.items[0].points[1], pb);
+  auto again = start("'" + autzen() + "' " + kCamera + " --no-panel --annotations '" + file.string() + "'");
+  ASSERT_TRUE(first_);
+  again->xdotool("mousemove --window $W 240 200 keydown ctrl click 1 keyup ctrl");
+  auto listed = again->waitEvent("picked", 0, 30);
+  ASSERT_TRUE(listed);
+  ASSERT_EQ((*listed)["measurements"].size(), 1u);
+  EXPECT_EQ((*listed)["measurements"][0]["value"], list[0]["value"]);
+  finish(*again);
 }
 
 TEST_F(ViewerWindow, PanelControlChangesTheImage) {

@@ -97,7 +97,7 @@ DesktopInput::DesktopInput(GLFWwindow* window, Session& session) : window_(windo
   glfw::glfwSetWindowUserPointer(window, this);
   glfw::glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) { of(w).cursor(x, y); });
   glfw::glfwSetMouseButtonCallback(
-      window, [](GLFWwindow* w, int button, int action, int) { of(w).button(button, action); });
+      window, [](GLFWwindow* w, int button, int action, int mods) { of(w).button(button, action, mods); });
   glfw::glfwSetScrollCallback(window, [](GLFWwindow* w, double, double y) { of(w).scroll(y); });
   glfw::glfwSetKeyCallback(
       window, [](GLFWwindow* w, int key, int, int action, int mods) { of(w).key(key, action, mods); });
@@ -153,7 +153,7 @@ void DesktopInput::cursor(double x, double y) {
   if (dragging_ || !panelWantsMouse()) session_.mouseMove(cursor_);
 }
 
-void DesktopInput::button(int button, int action) {
+void DesktopInput::button(int button, int action, int mods) {
   arrived_ = true;
   if (button >= 0 && button < 3) {
     bool pressed = action == GLFW_PRESS;
@@ -172,6 +172,11 @@ void DesktopInput::button(int button, int action) {
     return;
   }
   if (panelWantsMouse() || overPanel()) return;
+  // Ctrl+click: the pick tool, not a drag; with Shift the picked point is the next vertex of a measurement.
+  if (which == MouseButton::Left && (mods & GLFW_MOD_CONTROL)) {
+    session_.toolClick(cursor_, (mods & GLFW_MOD_SHIFT) != 0);
+    return;
+  }
   double now = glfw::glfwGetTime();
   if (which == MouseButton::Left && now - lastClickTime_ < kDoubleClickSeconds &&
       glm::length(cursor_ - lastClick_) <= kDoubleClickPixels) {
@@ -206,6 +211,11 @@ void DesktopInput::key(int key, int action, int mods) {
   io.KeyShift = mods & GLFW_MOD_SHIFT;
   io.KeyAlt = mods & GLFW_MOD_ALT;
   io.KeySuper = mods & GLFW_MOD_SUPER;
+  // Ctrl+S saves the measurements (not the S of flying).
+  if (key == GLFW_KEY_S && (mods & GLFW_MOD_CONTROL)) {
+    if (action == GLFW_PRESS && !panelWantsKeyboard()) saveMeasurements_ = true;
+    return;
+  }
   std::optional<Key> k = sessionKey(key);
   if (!k) return;
   if (action == GLFW_RELEASE) {

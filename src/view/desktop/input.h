@@ -44,6 +44,8 @@ public:
   // Wheel steps gathered since the last call, at the cursor's last position: the viewer reads the depth
   // under the cursor once for all of them.
   std::optional<WheelInput> takeWheel();
+  // Whether Ctrl+S asked to save the measurements since the last call.
+  bool takeSaveMeasurements() { return std::exchange(saveMeasurements_, false); }
 
 private:
   static DesktopInput& of(GLFWwindow* window);
@@ -52,7 +54,7 @@ private:
   bool overPanel() const;
   bool panelWantsKeyboard() const;
   void cursor(double x, double y);
-  void button(int button, int action);
+  void button(int button, int action, int mods);
   void scroll(double y);
   void key(int key, int action, int mods);
 
@@ -68,6 +70,7 @@ private:
   double lastClickTime_ = -1;
   glm::dvec2 lastClick_{0};
   double wheel_ = 0;
+  bool saveMeasurements_ = false;
 };
 
 } // namespace pointrast::view

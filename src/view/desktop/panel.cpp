@@ -330,6 +330,46 @@ void screenshotControls(Session& session, PanelActions& actions) {
   if (ImGui::Button("Screenshot (F12)")) actions.screenshot = true;
 }
 
+// Pick and measure: the last pick's attributes, the kind Ctrl+Shift+click measures, the measurements with
+// their values, Delete and Save.
+void toolControls(Session& session, const PanelInfo& info, PanelActions& actions) {
+  ImGui::TextUnformatted("Ctrl+click: pick  Ctrl+Shift+click: measure");
+  if (!info.picked.empty()) ImGui::TextUnformatted(info.picked.c_str());
+  MeasureTool& tool = session.measurements();
+  const std::pair<AnnotationKind, const char*> kinds[] = {
+      {AnnotationKind::Distance, "distance"}, {AnnotationKind::Height, "height"}, {AnnotationKind::Area, "area"}};
+  for (const auto& [kind, name] : kinds) {
+    ImGui::SameLine();
+    if (ImGui::RadioButton(name, tool.measureKind == kind)) {
+      tool.measureKind = kind;
+      tool.finish();
+    }
+  }
+  const Annotations& all = tool.all();
+  for (size_t i = 0; i < all.items.size(); ++i) {
+    const Annotation& a = all.items[i];
+    ImGui::PushID(int(i));
+    if (annotationProblem(a).empty()) {
+      const Measurement m = measure(a);
+      const double value = a.kind == AnnotationKind::Height ? m.dz
+                           : a.kind == AnnotationKind::Area ? m.area
+                                                            : m.length;
+      ImGui::Text("%s %s", annotationKindName(a.kind), formatLength(value, all.unit).c_str());
+    } else {
+      ImGui::Text("%s: %zu point(s)", annotationKindName(a.kind), a.points.size());
+    }
+    ImGui::SameLine();
+    if (ImGui::SmallButton("delete")) actions.deleteMeasurement = i;
+    ImGui::PopID();
+  }
+  if (ImGui::Button("Finish")) tool.finish();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(info.annotationsFile.empty());
+  if (ImGui::Button("Save (Ctrl+S)")) actions.saveMeasurements = true;
+  ImGui::EndDisabled();
+  if (info.annotationsFile.empty()) ImGui::TextDisabled("--annotations FILE to save");
+}
+
 } // namespace
 
 PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& settings, PanelItems& items) {
@@ -368,6 +408,7 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
     cameraControls(session, actions, items);
   if (ImGui::CollapsingHeader("Keyframes")) keyframeControls(session, info, actions);
   if (ImGui::CollapsingHeader("Screenshot")) screenshotControls(session, actions);
+  if (ImGui::CollapsingHeader("Pick and measure")) toolControls(session, info, actions);
   ImGui::TextDisabled("drag: orbit  right/middle drag: pan  wheel: zoom\n"
                       "double-click: pivot  WASD QE: fly (Shift: fast)\n"
                       "8 2 5 0 4 6: views  F: frame all  K: keyframe\n"

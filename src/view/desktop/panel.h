@@ -20,6 +20,8 @@ struct PanelInfo {
   uint64_t points = 0;
   std::vector<Method> methods; // the methods this device runs
   std::string pathFile;
+  std::string annotationsFile; // where Save writes the measurements; empty: no Save
+  std::string picked;          // the last pick, as lines of attributes
 };
 
 struct PanelActions {
@@ -28,6 +30,8 @@ struct PanelActions {
   bool addKeyframe = false;
   bool clearKeyframes = false;
   std::optional<StandardView> view;
+  bool saveMeasurements = false;
+  std::optional<size_t> deleteMeasurement;
 };
 
 // Screen rectangles (x, y, width, height in pixels) of the panel's controls by label, for --events.

@@ -14,6 +14,7 @@
 #include "cloud/cloud.h"
 #include "gpu/context.h"
 #include "gpu/swapchain.h"
+#include "io/annotations_file.h"
 #include "io/writer.h"
 #include "view/desktop/glfw_api.h"
 #include "view/desktop/input.h"
@@ -110,6 +111,7 @@ private:
   void handlePanel(const PanelActions& actions);
   void takeScreenshot();
   void saveKeyframes();
+  void saveMeasurements();
   ImDrawData* buildPanelFrame(double seconds);
 
   const ViewerOptions& options_;
@@ -170,6 +172,9 @@ Viewer::Viewer(SceneInput& input, const ViewerOptions& options, gpu::Context& co
   info_.input = input.name;
   info_.points = input.points;
   info_.pathFile = options.pathFile.string();
+  info_.annotationsFile = options.annotationsFile.string();
+  if (!options.annotationsFile.empty() && std::filesystem::exists(options.annotationsFile, error))
+    session_.measurements().load(io::loadAnnotations(options.annotationsFile));
   info_.methods = methodsFor(*source_, context);
 }
 
@@ -203,6 +208,33 @@ void Viewer::handlePanel(const PanelActions& actions) {
     saveKeyframes();
   }
   if (actions.screenshot) takeScreenshot();
+  if (actions.deleteMeasurement && session_.measurements().remove(*actions.deleteMeasurement)) session_.invalidate();
+  if (actions.saveMeasurements) saveMeasurements();
+}
+
+// The measurements that can be measured, to --annotations (written under a temporary name, then renamed).
+void Viewer::saveMeasurements() {
+  if (options_.annotationsFile.empty()) {
+    std::fprintf(stderr, "measurements: start the viewer with --annotations FILE to save them\n");
+    return;
+  }
+  const Annotations annotations = session_.measurements().complete();
+  io::saveAnnotations(options_.annotationsFile, annotations);
+  if (options_.events)
+    emit({{"event", "annotations"}, {"count", annotations.items.size()}, {"file", options_.annotationsFile.string()}});
+  else
+    std::printf("measurements: %s (%zu)\n", options_.annotationsFile.string().c_str(), annotations.items.size());
+  std::fflush(stdout);
+}
+
+// Lines of a pick's attributes for the panel.
+std::string pickedText(const nlohmann::json& pick) {
+  const nlohmann::json& p = pick["point"];
+  if (!p.is_object()) return p.is_string() ? p.get<std::string>() : std::string();
+  std::string text;
+  for (const auto& [name, value] : p.items())
+    if (name != "index") text += name + " " + value.dump() + "\n";
+  return text;
 }
 
 void Viewer::saveKeyframes() {
@@ -247,6 +279,19 @@ void Viewer::handleRequests() {
             {"hit", point.has_value()},
             {"pivot", vec(session_.pivot())}});
   }
+  if (r.toolPick) {
+    std::optional<AnnotationKind> measure;
+    if (r.toolMeasure) measure = session_.measurements().measureKind;
+    nlohmann::json picked = pickTool(session_, scene_, *r.toolPick, measure);
+    info_.picked = pickedText(picked);
+    if (options_.events)
+      emit({{"event", "picked"},
+            {"x", r.toolPick->x},
+            {"y", r.toolPick->y},
+            {"pick", picked},
+            {"measurements", nlohmann::json::parse(session_.measurements().json())}});
+  }
+  if (input_.takeSaveMeasurements()) saveMeasurements();
   if (r.printCamera) {
     if (options_.events)
       emit({{"event", "camera"},

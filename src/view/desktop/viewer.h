@@ -28,6 +28,9 @@ struct ViewerOptions {
   std::optional<Method> method;    // absent: defaultMethod() for the input and the device
   std::filesystem::path pathFile = "path.json"; // keyframes: loaded when it exists, saved on every K
   std::filesystem::path screenshotDir = ".";    // F12 writes pointrast-NNNN.png here
+  // --annotations: measurements loaded at the start when the file exists, written by Ctrl+S and the
+  // panel's Save; empty: measurements are not saved.
+  std::filesystem::path annotationsFile;
   std::optional<uint32_t> device;
   std::string title = "pointrast";
   // When set, receives every frame rendered and the device, for the statistics written at the close.

@@ -8,6 +8,7 @@
 
 #include "base/error.h"
 #include "cloud/attribute_colors.h"
+#include "io/annotations_file.h"
 #include "io/writer.h"
 
 namespace pointrast::view::web {
@@ -52,6 +53,11 @@ Json settingsJson(const ViewSettings& s) {
             {"foveated", s.foveation.enabled},
             {"foveaRadius", s.foveation.radius},
             {"foveaPeriphery", s.foveation.periphery},
+            {"clipBox", s.filter.boxes.empty() ? Json(nullptr)
+                                               : Json{s.filter.boxes[0].min.x, s.filter.boxes[0].min.y,
+                                                      s.filter.boxes[0].min.z, s.filter.boxes[0].max.x,
+                                                      s.filter.boxes[0].max.y, s.filter.boxes[0].max.z}},
+            {"clipMode", s.filter.clipMode == ClipMode::Outside ? "outside" : "inside"},
             {"takesStereo", takesStereo(s.method)},
             {"takesFoveation", takesFoveation(s.method)},
             {"takesPost", takesPost(s.method)},
@@ -92,6 +98,8 @@ void WebClient::resize(uint32_t width, uint32_t height) {
                                                    setup_.framing);
     session_.emplace(setup_.cloud->bounds(), camera, viewport, setup_.settings);
     session_->setContentSource(&full_);
+    session_->measurements().load(setup_.annotations);
+    sendMeasurements();
     return;
   }
   session_->resize(viewport);
@@ -175,12 +183,39 @@ void WebClient::receive(const ClientMessage& m) {
       stream_.submitText(Json{{"t", "path"}, {"path", Json::parse(session_->path().toJson())}}.dump());
     stateChanged_ = true;
     break;
+  case MessageType::PickPoint:
+    toolPick_ = {pixels(m.position), m.measure};
+    break;
+  case MessageType::Measure: {
+    MeasureTool& tool = session_->measurements();
+    if (m.measureOp == MeasureOp::Finish) tool.finish();
+    if (m.measureOp == MeasureOp::Delete && !tool.remove(m.index))
+      stream_.submitText(Json{{"t", "refused"}, {"text", "no measurement " + std::to_string(m.index)}}.dump());
+    if (m.measureOp == MeasureOp::Clear) tool.clear();
+    if (m.measureOp == MeasureOp::Download)
+      stream_.submitText(Json{{"t", "annotations"}, {"text", io::annotationsJson(tool.complete())}}.dump());
+    else
+      sendMeasurements();
+    session_->invalidate(); // the overlay changed
+    break;
+  }
   default:
     break;
   }
 }
 
+void WebClient::sendMeasurements() {
+  stream_.submitText(
+      Json{{"t", "measurements"}, {"list", Json::parse(session_->measurements().json())}}.dump());
+}
+
 void WebClient::serveRequests() {
+  if (toolPick_) {
+    const auto [at, kind] = *std::exchange(toolPick_, std::nullopt);
+    Json picked = pickTool(*session_, full_, at, kind);
+    stream_.submitText(Json{{"t", "picked"}, {"pick", picked}}.dump());
+    if (kind) sendMeasurements();
+  }
   if (wheel_ != 0) {
     zoomAtCursor(*session_, full_, wheelAt_, std::exchange(wheel_, 0.0));
   }
@@ -246,6 +281,8 @@ void WebClient::renderFrame(double now, FrameQuality quality) {
   FrameReport report = view.render(session_->camera(), session_->settings(), size);
   RawFrame frame;
   frame.rgba = view.renderer().image();
+  if (!session_->measurements().all().items.empty())
+    view.drawOverlay(session_->camera(), session_->settings(), size, session_->measurements().complete(), frame.rgba);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   session_->frameRendered(report);
   quality_.rendered(session_->camera(), quality, now);

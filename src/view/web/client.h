@@ -36,6 +36,7 @@ struct ClientSetup {
   ViewSettings settings;
   Viewport maxSize{3840, 2160}; // frames are at most this large (aspect kept)
   StreamSettings stream;
+  Annotations annotations; // --annotations: every client's measurement list starts with them
 };
 
 // The canvas size clamped into `maxSize`, aspect kept, at least 1x1.
@@ -63,6 +64,7 @@ private:
   void serveRequests();
   void renderFrame(double now, FrameQuality quality);
   void sendScreenshot();
+  void sendMeasurements();
   std::string stateJson(const FrameHeader* frame) const;
   glm::dvec2 pixels(glm::dvec2 normalized) const;
 
@@ -78,6 +80,8 @@ private:
   glm::dvec2 wheelAt_{0};
   double lastStep_ = -1;
   bool stateChanged_ = true; // something the panel shows changed without a frame
+  // The pick tool's click, served with the other requests: the position and the measurement it extends.
+  std::optional<std::pair<glm::dvec2, std::optional<AnnotationKind>>> toolPick_;
 };
 
 } // namespace pointrast::view::web

@@ -56,14 +56,15 @@ const TypeName kTypes[] = {
     {MessageType::Key, "key", {"key", "down", "shift"}},
     {MessageType::Settings,
      "settings",
-     {"method",       "background",  "depth",         "color",  "colorRange",  "pointSize",
-      "pointSizeMax", "pointShape",  "pointSizeMode", "dilate", "edlStrength", "edlRadius",
-      "minNodePx",    "pointBudget", "gpuMemory",     "stereo", "crossed",     "ipd",
-      "foveated",     "foveaRadius", "foveaPeriphery"}},
+     {"method", "background", "depth", "color", "colorRange", "pointSize", "pointSizeMax", "pointShape",
+      "pointSizeMode", "dilate", "edlStrength", "edlRadius", "minNodePx", "pointBudget", "gpuMemory", "stereo", "crossed", "ipd", "foveated", "foveaRadius",
+      "foveaPeriphery", "clipBox", "clipMode"}},
     {MessageType::Options, "options", {"supersample", "keyframeSeconds"}},
     {MessageType::Stream, "stream", {"motionScale", "quality", "motionQuality"}},
     {MessageType::Action, "action", {"name"}},
     {MessageType::Ack, "ack", {"frame"}},
+    {MessageType::PickPoint, "pickpoint", {"x", "y", "measure"}},
+    {MessageType::Measure, "measure", {"op", "index"}},
 };
 
 // Thrown inside the parser only; parseClientMessage turns it into the refusal's sentence.
@@ -143,6 +144,31 @@ constexpr std::pair<const char*, PointSizeMode> kSizeModes[] = {{"fixed", PointS
 
 void settings(const Json& j, std::span<const Method> methods, ClientMessage& m) {
   SettingsChange& c = m.settings;
+  if (j.contains("clipBox")) {
+    const Json& v = j["clipBox"];
+    c.clip = true;
+    if (!v.is_null()) {
+      if (!v.is_array() || v.size() != 6) refuse("\"clipBox\" must be [x0, y0, z0, x1, y1, z1] or null");
+      ClipBox b;
+      for (int i = 0; i < 6; ++i) {
+        if (!v[size_t(i)].is_number() || !std::isfinite(v[size_t(i)].get<double>()))
+          refuse("\"clipBox\" takes finite numbers");
+        (i < 3 ? b.min : b.max)[i % 3] = v[size_t(i)].get<double>();
+      }
+      if (!(b.min.x <= b.max.x && b.min.y <= b.max.y && b.min.z <= b.max.z))
+        refuse("\"clipBox\" is [min corner, max corner]");
+      c.clipBox = b;
+    }
+  }
+  if (j.contains("clipMode")) {
+    const std::string& mode = string(j, "clipMode");
+    if (mode == "inside")
+      c.clipMode = ClipMode::Inside;
+    else if (mode == "outside")
+      c.clipMode = ClipMode::Outside;
+    else
+      refuse("\"clipMode\" takes inside or outside");
+  }
   if (j.contains("method")) {
     const std::string& name = string(j, "method");
     for (Method method : methods)
@@ -289,6 +315,35 @@ ClientMessage parse(const Json& j, std::span<const Method> methods) {
   case MessageType::Ack:
     m.frame = uint32_t(integer(j, "frame", 0, UINT32_MAX));
     break;
+  case MessageType::PickPoint:
+    m.position = position(j);
+    if (j.contains("measure")) {
+      const std::string& kind = string(j, "measure");
+      if (kind == "distance")
+        m.measure = AnnotationKind::Distance;
+      else if (kind == "height")
+        m.measure = AnnotationKind::Height;
+      else if (kind == "area")
+        m.measure = AnnotationKind::Area;
+      else
+        refuse("unknown measurement");
+    }
+    break;
+  case MessageType::Measure: {
+    const std::string& op = string(j, "op");
+    if (op == "finish")
+      m.measureOp = MeasureOp::Finish;
+    else if (op == "delete")
+      m.measureOp = MeasureOp::Delete;
+    else if (op == "clear")
+      m.measureOp = MeasureOp::Clear;
+    else if (op == "download")
+      m.measureOp = MeasureOp::Download;
+    else
+      refuse("unknown measure operation");
+    if (m.measureOp == MeasureOp::Delete) m.index = uint32_t(integer(j, "index", 0, UINT32_MAX));
+    break;
+  }
   }
   return m;
 }
@@ -333,6 +388,11 @@ ViewSettings applySettings(const ViewSettings& settings, const SettingsChange& c
   if (c.foveated) s.foveation.enabled = *c.foveated;
   if (c.foveaRadius) s.foveation.radius = *c.foveaRadius;
   if (c.foveaPeriphery) s.foveation.periphery = *c.foveaPeriphery;
+  if (c.clip) {
+    s.filter.boxes.clear();
+    if (c.clipBox) s.filter.boxes.push_back(*c.clipBox);
+  }
+  if (c.clipMode) s.filter.clipMode = *c.clipMode;
   validateSettings(s);
   return s;
 }

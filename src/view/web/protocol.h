@@ -18,6 +18,7 @@
 
 #include <glm/glm.hpp>
 
+#include "cloud/annotations.h"
 #include "render/method_table.h"
 #include "view/session.h"
 
@@ -45,7 +46,11 @@ enum class MessageType {
   Stream,      // motionScale (0.25..1), quality and/or motionQuality (10..100)
   Action,      // name: clearKeyframes, downloadPath
   Ack,         // frame: the id of a frame the page has drawn
+  PickPoint,   // x, y, and measure ("distance", "height", "area"): the pick tool, adding a vertex if measuring
+  Measure,     // op ("finish", "delete" with index, "clear", "download"): the measurements' list
 };
+
+enum class MeasureOp { Finish, Delete, Clear, Download };
 
 enum class ClientAction { ClearKeyframes, DownloadPath };
 
@@ -62,6 +67,7 @@ enum class ClientAction { ClearKeyframes, DownloadPath };
 //   minNodePx       0..kMaxMinNodePx;  pointBudget 0..kMaxPointBudget;  gpuMemory 0..kMaxGpuMemory (bytes)
 //   stereo, crossed true/false;  ipd 0..1e12 (scene units, 0: auto)
 //   foveated        true/false;  foveaRadius 0..1;  foveaPeriphery 1..kMaxFoveaPeriphery
+//   clipBox         [x0, y0, z0, x1, y1, z1], finite, min <= max, or null;  clipMode "inside"/"outside"
 struct SettingsChange {
   std::optional<Method> method;
   std::optional<uint32_t> background; // RGBA8, alpha 255
@@ -78,6 +84,9 @@ struct SettingsChange {
   std::optional<uint64_t> pointBudget, gpuMemory;
   std::optional<bool> stereo, crossed, foveated;
   std::optional<double> ipd, foveaRadius, foveaPeriphery;
+  bool clip = false;                 // clipBox given: the view's axis-aligned clip boxes become this one
+  std::optional<ClipBox> clipBox;    // null: none
+  std::optional<ClipMode> clipMode;  // inside or outside
 };
 
 // The settings with the change applied; a new color source without a range drops the old range. Throws
@@ -100,6 +109,9 @@ struct ClientMessage {
   std::optional<int> quality, motionQuality;
   ClientAction action = ClientAction::ClearKeyframes;
   uint32_t frame = 0;
+  std::optional<AnnotationKind> measure; // PickPoint: the kind of measurement the point extends
+  MeasureOp measureOp = MeasureOp::Finish;
+  uint32_t index = 0;
   double received = 0; // seconds on the steady clock: when the server read it (not from the wire)
 };
 

@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -25,6 +27,7 @@
 #include "gpu/context.h"
 #include "view/web/access.h"
 #include "view/web/civetweb_api.h"
+#include "view/web/export.h"
 #include "view/web/page.h"
 #include "view/web/request_rules.h"
 
@@ -145,6 +148,7 @@ private:
   // civetweb's callbacks, each on one of its worker threads.
   static Server& of(const mg_connection* conn);
   static int beginRequest(mg_connection* conn);
+  int serveExport(mg_connection* conn, const std::string& query);
   static int logMessage(const mg_connection* conn, const char* message);
   static int httpError(mg_connection* conn, int status, const char* message);
   static int handleHttp(mg_connection* conn, void* self);
@@ -226,6 +230,7 @@ Server::Server(SceneInput& input, const ServerOptions& options)
   setup_.settings = settings;
   setup_.maxSize = options.maxSize;
   setup_.stream = options.stream;
+  setup_.annotations = options.annotations;
   Json methods = Json::array();
   for (Method m : methods_)
     methods.push_back({{"name", methodName(m)}, {"help", methodInfo(m).help}});
@@ -330,6 +335,43 @@ int Server::gate(mg_connection* conn) {
   return status;
 }
 
+// The points inside the page's clip box as LAS (export.h), or 400 with the one sentence why not.
+int Server::serveExport(mg_connection* conn, const std::string& query) {
+  auto fail = [&](const std::string& why) {
+    const std::string body = why + "\n";
+    const std::string head = "HTTP/1.1 400 Bad Request\r\nContent-Type: text/plain; charset=utf-8\r\n" +
+                             pageHeaders_ + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n";
+    cw::mg_write(conn, head.data(), head.size());
+    cw::mg_write(conn, body.data(), body.size());
+    return 400;
+  };
+  const ExportSource source = exportSource(options_.inputFile);
+  if (!source.file) return fail("export: " + source.whyNot);
+  try {
+    const PointFilter filter = parseExportQuery(query);
+    uint64_t points = 0;
+    exportLas(*source.file, filter, [&](const std::filesystem::path& file, uint64_t count) {
+      points = count;
+      std::ifstream in(file, std::ios::binary);
+      const uint64_t size = std::filesystem::file_size(file);
+      const std::string head = "HTTP/1.1 200 OK\r\nContent-Type: application/octet-stream\r\n"
+                               "Content-Disposition: attachment; filename=\"export.las\"\r\n" +
+                               pageHeaders_ + "X-Points: " + std::to_string(count) +
+                               "\r\nContent-Length: " + std::to_string(size) + "\r\n\r\n";
+      cw::mg_write(conn, head.data(), head.size());
+      std::vector<char> buffer(1 << 20);
+      while (in) {
+        in.read(buffer.data(), std::streamsize(buffer.size()));
+        if (in.gcount() > 0 && cw::mg_write(conn, buffer.data(), size_t(in.gcount())) <= 0) break;
+      }
+    });
+    emit({{"event", "export"}, {"points", points}});
+    return 200;
+  } catch (const InputError& e) {
+    return fail(e.what());
+  }
+}
+
 int Server::handleHttp(mg_connection* conn, void* self) {
   return static_cast<Server*>(self)->serveHttp(conn);
 }
@@ -343,6 +385,8 @@ int Server::serveHttp(mg_connection* conn) {
   std::string extra;
   if (path == "/healthz") {
     body = "ok\n";
+  } else if (path == "/export.las") {
+    return serveExport(conn, info->query_string ? info->query_string : "");
   } else if (const PageFile* file = findPageFile(path)) {
     type = file->contentType;
     body = file->body;

@@ -34,6 +34,8 @@ struct ServerOptions {
   std::optional<Method> method; // absent: defaultMethod() for the input and the device
   Viewport maxSize = kDefaultMaxSize;
   StreamSettings stream;
+  Annotations annotations; // --annotations: every page's measurement list starts with them
+  std::string inputFile;   // the file the input was read from (empty: a generated scene), for /export.las
   std::optional<uint32_t> device;
   std::string frameAncestors; // pages that may show the viewer in a frame (CSP sources); empty: none
   bool events = false; // one JSON object a line on stdout: listening, clients, refusals, the exit

@@ -27,7 +27,7 @@ const $ = (id) => document.getElementById(id);
 // What tests and scripts read: the server's last info and state, and the frames drawn.
 const pointrast = window.pointrast = {
   info: null, state: null, frames: 0, fullFrames: 0, lastFrame: null, lastPick: null, cameraText: null,
-  errors: [], refusals: [], closed: null, sentSeq: 0,
+  errors: [], refusals: [], closed: null, sentSeq: 0, picked: null, picks: 0, measurements: [], exported: null,
 };
 
 let socket = null;
@@ -133,6 +133,9 @@ function receiveText(message) {
     case 'info': pointrast.info = message; buildPanel(message); break;
     case 'state': pointrast.state = message; showState(message); break;
     case 'pick': pointrast.lastPick = message; break;
+    case 'picked': pointrast.picked = message.pick; pointrast.picks++; showPicked(message.pick); break;
+    case 'measurements': pointrast.measurements = message.list; pointrast.measurementUpdates = (pointrast.measurementUpdates || 0) + 1; showMeasurements(message.list); break;
+    case 'annotations': download(new Blob([message.text], { type: 'application/json' }), 'annotations.json'); break;
     case 'camera': pointrast.cameraText = message.text; $('cameraText').textContent = 'pointrast render FILE ' + message.text; break;
     case 'refused': pointrast.refusals.push(message.text); status(message.text, true); break;
     case 'path': download(new Blob([JSON.stringify(message.path, null, 1)], { type: 'application/json' }), 'path.json'); break;
@@ -187,6 +190,11 @@ function showState(s) {
   const info = pointrast.info || { device: '', input: '', points: 0 };
   const st = s.stats;
   $('panel').hidden = !s.options.panel;
+  if (s.settings.clipBox && !pointrast.clipShown) {
+    $('clipBox').value = s.settings.clipBox.join(',');
+    $('clipMode').value = s.settings.clipMode;
+    pointrast.clipShown = true;
+  }
   if (document.activeElement !== $('method')) $('method').value = s.settings.method;
   const bg = s.settings.background.join(',');
   let preset = false;
@@ -452,12 +460,106 @@ function touchUp(e) {
   if (touchMode === 'orbit' && touches.size === 0) { send({ t: 'up', b: 0, ...p }); touchMode = null; }
 }
 
+// --- tools: pick and measure -----------------------------------------------------------------------------
+
+// A left click with a tool chosen (or Ctrl+click in any) picks the point under it; measuring tools add it
+// as the next vertex of the open measurement.
+function toolClick(e) {
+  const tool = $('tool').value;
+  if (e.button !== 0 || (tool === 'navigate' && !e.ctrlKey)) return false;
+  flush();
+  const message = { t: 'pickpoint', ...clampPosition(position(e)) };
+  if (tool === 'distance' || tool === 'height' || tool === 'area') message.measure = tool;
+  send(message);
+  return true;
+}
+
+function showPicked(pick) {
+  const p = pick.point;
+  if (typeof p !== 'object') { $('picked').textContent = 'pixel ' + pick.pixel.join(',') + ': ' + p; return; }
+  const lines = [`x ${p.x}`, `y ${p.y}`, `z ${p.z}`];
+  for (const [name, label] of [['intensity', 'intensity'], ['classification', 'class'], ['return_number', 'return'],
+                               ['number_of_returns', 'returns'], ['gps_time', 'GPS time'], ['point_source_id', 'source id']])
+    if (name in p) lines.push(`${label} ${p[name]}`);
+  if (p.color) lines.push('color ' + p.color.join(', '));
+  $('picked').textContent = lines.join('\n');
+}
+
+function showMeasurements(list) {
+  const box = $('measurements');
+  box.replaceChildren();
+  for (const m of list) {
+    const row = document.createElement('div');
+    row.className = 'measurement';
+    const text = m.value !== undefined
+      ? `${m.type} ${m.text}` + (m.segments.length > 1 ? ' (' + m.segments.map((d) => d.toFixed(2)).join(' + ') + ')' : '')
+      : `${m.type}: ${m.points.length} point(s)` + (m.open ? ', click to add' : '');
+    row.append(text + ' ');
+    const remove = document.createElement('button');
+    remove.className = 'small';
+    remove.textContent = 'delete';
+    remove.addEventListener('click', () => send({ t: 'measure', op: 'delete', index: m.index }));
+    row.append(remove);
+    box.append(row);
+  }
+}
+
+$('finishMeasure').addEventListener('click', () => send({ t: 'measure', op: 'finish' }));
+$('clearMeasures').addEventListener('click', () => send({ t: 'measure', op: 'clear' }));
+$('downloadMeasures').addEventListener('click', () => send({ t: 'measure', op: 'download' }));
+$('tool').addEventListener('change', () => send({ t: 'measure', op: 'finish' }));
+
+// --- clip box and export ----------------------------------------------------------------------------------
+
+function clipBoxValue() {
+  const text = $('clipBox').value.trim();
+  if (!text) return null;
+  const v = text.split(',').map(Number);
+  return v.length === 6 && v.every(Number.isFinite) ? v : undefined;
+}
+
+$('applyClip').addEventListener('click', () => {
+  const box = clipBoxValue();
+  if (box === undefined) { status('the clip box takes six numbers: x0,y0,z0,x1,y1,z1', true); return; }
+  send({ t: 'settings', clipBox: box, clipMode: $('clipMode').value });
+});
+
+// The export is an HTTP request of its own (the access cookie goes along): the points inside the box in the
+// fields (or outside it), of the classes listed, as the LAS file convert would write.
+$('exportLas').addEventListener('click', async () => {
+  const box = clipBoxValue();
+  if (box === undefined) { status('the clip box takes six numbers: x0,y0,z0,x1,y1,z1', true); return; }
+  const query = new URLSearchParams();
+  if (box) { query.set('box', box.join(',')); query.set('mode', $('clipMode').value); }
+  const classes = $('exportClasses').value.replace(/\s/g, '');
+  if (classes) query.set('classes', classes);
+  $('exportStatus').textContent = 'exporting...';
+  try {
+    const response = await fetch('export.las?' + query.toString());
+    if (!response.ok) {
+      const why = (await response.text()).trim();
+      pointrast.exported = { error: why };
+      $('exportStatus').textContent = why;
+      status(why, true);
+      return;
+    }
+    const points = Number(response.headers.get('X-Points'));
+    download(await response.blob(), 'export.las');
+    pointrast.exported = { points };
+    $('exportStatus').textContent = `${points} points exported`;
+  } catch (error) {
+    pointrast.exported = { error: String(error) };
+    $('exportStatus').textContent = String(error);
+  }
+});
+
 let buttonsDown = 0;
 canvas.addEventListener('pointerdown', (e) => {
   canvas.focus();
   canvas.setPointerCapture(e.pointerId);
   if (e.pointerType === 'touch') return touchDown(e);
   if (e.button > 2) return;
+  if (toolClick(e)) return;
   flush();
   buttonsDown++;
   send({ t: 'down', b: e.button, ...clampPosition(position(e)) });
