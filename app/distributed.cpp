@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <string_view>
 
 #include <unistd.h>
 
@@ -12,6 +13,8 @@
 #include "cloud/generate.h"
 #include "gpu/device_rank.h"
 #include "gpu/shared_types.h"
+#include "io/format_table.h"
+#include "io/las/las_range.h"
 #include "io/reader.h"
 #include "mpi/mpi_job.h"
 #include "render/composite.h"
@@ -124,6 +127,22 @@ PointCloud loadShare(const InputSpec& spec) {
     cloud.bounds = job.unionOf(cloud.bounds);
     return cloud;
   }
+  // A LAS file in its own order: each rank reads only the bytes of its records, the same ranges the
+  // whole file would be cut into. The ranks agree on the file's color depth (any value above 255 anywhere
+  // makes it 16-bit) and its bounds.
+  const io::FormatInfo* format = pathExists(source) ? io::detectFormat(source) : nullptr;
+  if (format && std::string_view(format->name) == "LAS" && spec.order == Order::Original) {
+    const uint64_t total = io::statedPointCount(source).value_or(0);
+    const mpi::Range range = mpi::rangeOf(total, shared::kBatchPoints, job.rank(), job.size());
+    io::ReadOptions options;
+    options.progress = mine.progress;
+    uint16_t colorMax = 0;
+    PointCloud cloud = io::readLasRecords(source, options, range.first, range.count, &colorMax);
+    if (job.maxOf(double(colorMax)) > 255 && colorMax <= 255)
+      std::fill(cloud.colors.begin(), cloud.colors.end(), packRgba(0, 0, 0));
+    cloud.bounds = job.unionOf(cloud.bounds);
+    return cloud;
+  }
   PointCloud cloud = loadInput(mine);
   const mpi::Range range = mpi::rangeOf(cloud.size(), shared::kBatchPoints, job.rank(), job.size());
   keepRange(cloud, range.first, range.count);
@@ -155,6 +174,8 @@ std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, 
   out.rankMs = job.gatherOf(stats.medianMs);
   out.renderMs = job.maxOf(stats.medianMs);
   out.points = job.sumOf(stats.points);
+  for (double points : job.gatherOf(double(stats.points)))
+    out.rankPoints.push_back(uint64_t(points));
   job.check(); // all ranks are here: the composite's time is its own, not a wait for the slowest rank
   start = std::chrono::steady_clock::now();
   job.minToRoot(words);
@@ -177,6 +198,8 @@ std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuS
   out.rankMs = job.gatherOf(stats.medianMs);
   out.renderMs = job.maxOf(stats.medianMs);
   out.points = job.sumOf(stats.points);
+  for (double points : job.gatherOf(double(stats.points)))
+    out.rankPoints.push_back(uint64_t(points));
   RenderSettings step = rankSettings(settings);
   step.captureWords = false;
   step.frames = 1;
@@ -221,6 +244,7 @@ nlohmann::json compositeJson(const CompositeStats& s) {
   j["ranks"] = s.ranks;
   j["render_ms"] = s.renderMs;
   j["rank_render_ms"] = s.rankMs;
+  j["rank_points"] = s.rankPoints;
   j["readback_ms"] = s.readbackMs;
   j["composite_ms"] = s.compositeMs;
   j["resolve_ms"] = s.resolveMs;

@@ -47,14 +47,15 @@ RenderSettings rankSettings(const RenderSettings& settings);
 
 struct CompositeStats {
   uint32_t ranks = 1;
-  double renderMs = 0;             // the slowest rank's median GPU time of a frame
-  std::vector<double> rankMs;      // each rank's median, rank 0 first
-  uint64_t points = 0;             // points drawn by all ranks
-  double readbackMs = 0;           // rank 0: its words read back from the device
-  double compositeMs = 0;          // rank 0: the MIN over all ranks' words (wall clock)
-  double resolveMs = 0;            // rank 0: the composited words to the image (wall clock)
-  uint64_t bytesMoved = 0;         // sent to the composite: 8 B a pixel from every rank but 0 (HQS: 32)
-  std::optional<PostStats> post;   // the resolve stage on rank 0
+  double renderMs = 0;              // the slowest rank's median GPU time of a frame
+  std::vector<double> rankMs;       // each rank's median, rank 0 first
+  uint64_t points = 0;              // points drawn by all ranks
+  std::vector<uint64_t> rankPoints; // points drawn by each rank, rank 0 first
+  double readbackMs = 0;            // rank 0: its words read back from the device
+  double compositeMs = 0;           // rank 0: the MIN over all ranks' words (wall clock)
+  double resolveMs = 0;             // rank 0: the composited words to the image (wall clock)
+  uint64_t bytesMoved = 0;          // sent to the composite: 8 B a pixel from every rank but 0 (HQS: 32)
+  std::optional<PostStats> post;    // the resolve stage on rank 0
   std::vector<std::string> devices; // "host: device" per rank
 };
 

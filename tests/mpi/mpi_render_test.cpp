@@ -16,6 +16,7 @@
 
 #include "cli/cli_harness.h"
 #include "mpi/mpi_job.h"
+#include "test_data.h"
 
 namespace fs = std::filesystem;
 using pointrast::test::cliTempDir;
@@ -220,6 +221,34 @@ TEST(MpiRender, BlendingInBatchesIsRefusedWithOneLine) {
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_NE(r.err.find("pointrast: batch-hqs blends points in batches or octree nodes"), std::string::npos)
       << r.err;
+}
+
+// A LAS file: each rank reads only its records (whole batches, as the whole file would be cut), and the
+// composite is the one-rank frame.
+TEST(MpiRender, LasSharesAreReadPerRankAndComposeTheOneRankFrame) {
+  REQUIRE_MPI();
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const std::string args = (pointrast::test::dataDir() / "las/autzen_trim.las").string() + " -o " +
+                           (cliTempDir() / "autzen.png").string() + kImage +
+                           " --eye 636590,848500,1400 --target 636590,849216,463";
+  const Frame one = renderOn(1, args);
+  const Frame three = renderOn(3, args);
+  ASSERT_FALSE(one.words.empty());
+  ASSERT_FALSE(three.words.empty());
+  const Difference d = compare(one.words, three.words);
+  EXPECT_GT(d.covered, d.pixels / 10) << "the frame must show the file";
+  EXPECT_EQ(d.differ, 0u);
+  EXPECT_EQ(three.json["image_hash"], one.json["image_hash"]);
+  EXPECT_EQ(three.json["points"], 110000);
+  const nlohmann::json& points = three.json["mpi"]["rank_points"];
+  ASSERT_EQ(points.size(), 3u);
+  for (uint32_t r = 0; r < 3; ++r)
+    EXPECT_EQ(points[r].get<double>(), double(pointrast::mpi::rangeOf(110000, 10240, r, 3).count)) << r;
+  EXPECT_LT(points[0].get<double>(), 110000.0);
+  // And the whole file read by one process gives the same frame.
+  const pointrast::test::CliResult plain = runPointrast("render " + args + " --json -q");
+  ASSERT_EQ(plain.exitCode, 0) << plain.err;
+  EXPECT_EQ(nlohmann::json::parse(plain.out)["image_hash"], one.json["image_hash"]);
 }
 
 TEST(MpiRender, TcpTransportGivesTheSameFrame) {

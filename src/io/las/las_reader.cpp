@@ -10,6 +10,7 @@
 #include "base/progress.h"
 #include "io/formats.h"
 #include "io/las/las_format.h"
+#include "io/las/las_range.h"
 #include "io/las/las_records.h"
 
 namespace pointrast::io {
@@ -25,6 +26,12 @@ constexpr uint64_t kBlockPoints = uint64_t(1) << 16; // parallel work unit withi
 // Calls fn(records, firstIndex, count) for consecutive chunks of point records (see forEachRecordChunk).
 template <class Fn> void forEachChunk(const InputFile& file, const LasHeader& hd, Fn&& fn) {
   forEachRecordChunk(file, hd.pointOffset, hd.pointCount, hd.recordLength, lasChunkBytes(), fn);
+}
+// The same for records [first, first + count) (inside the header's count); firstIndex counts from first.
+template <class Fn>
+void forEachChunk(const InputFile& file, const LasHeader& hd, uint64_t first, uint64_t count, Fn&& fn) {
+  forEachRecordChunk(file, hd.pointOffset + first * hd.recordLength, count, hd.recordLength, lasChunkBytes(),
+                     fn);
 }
 
 // 8-bit value from a 16-bit LAS color channel: shift is 8 for files with 16-bit colors, else 0.
@@ -63,9 +70,15 @@ std::string describeGlobalEncoding(uint16_t bits) {
 } // namespace
 
 PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options) {
+  return readLasRecords(path, options, 0, UINT64_MAX, nullptr);
+}
+
+PointCloud readLasRecords(const std::filesystem::path& path, const ReadOptions& options, uint64_t firstRecord,
+                          uint64_t recordCount, uint16_t* colorMax) {
   InputFile file(path);
   const LasHeader hd = readLasHeader(file);
-  const uint64_t n = hd.pointCount;
+  firstRecord = std::min(firstRecord, hd.pointCount);
+  const uint64_t n = std::min(recordCount, hd.pointCount - firstRecord);
   const bool extended = las::isExtended(hd.pointFormat);
   const int rgbOffset = hd.rgbOffset();
 
@@ -99,7 +112,8 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
   RecordStats total;
   bool colors16 = false; // decided per file: any channel above 255 means 16-bit colors
   std::vector<RecordStats> stats;
-  forEachChunk(file, hd, [&](const uint8_t* records, uint64_t first, uint64_t count) {
+  uint16_t fileColorMax = 0;
+  forEachChunk(file, hd, firstRecord, n, [&](const uint8_t* records, uint64_t first, uint64_t count) {
     stats.assign((count + kBlockPoints - 1) / kBlockPoints, RecordStats{});
     int shift = colors16 ? 8 : 0;
     parallelBlocks(count, kBlockPoints, [&](uint64_t block, uint64_t begin, uint64_t end) {
@@ -119,6 +133,7 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
       }
       chunkColorMax = std::max(chunkColorMax, s.colorMax);
     }
+    fileColorMax = std::max(fileColorMax, chunkColorMax);
     if (all.colors && !colors16 && chunkColorMax > 255) {
       // The first value above 255: the file is 16-bit. Earlier chunks held only values <= 255, which
       // are 0 in 8-bit terms; this chunk is converted again with the 16-bit shift.
@@ -132,6 +147,7 @@ PointCloud readLas(const std::filesystem::path& path, const ReadOptions& options
     }
   });
   if (progress) progress->finish();
+  if (colorMax) *colorMax = fileColorMax;
 
   if (n > 0) {
     cloud.bounds = boundsFromQuantized(total.qmin, total.qmax, cloud.scale, cloud.offset);
