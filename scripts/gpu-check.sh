@@ -216,6 +216,13 @@ for what in "$@"; do
     echo "== filter cost: ${FILTER_POINTS:-1G} points"
     POINTRAST_VALIDATION=0 timeout 560 scripts/bench-filter-cost.sh "$pr" "$OUT" "${FILTER_POINTS:-1G}" || status=1
     ;;
+  deviceloss)
+    # A lost GPU under serve (scripts/bench-device-loss.py): the 1 G stand-in with the device lost at the
+    # INJECT-th submission; the page must be told and the process exit 1 within 5 s. Writes device-loss.*.
+    echo "== device loss under serve: ${LOSS_POINTS:-1G} points"
+    POINTRAST_VALIDATION=0 INJECT=${INJECT:-2000} timeout 300 python3 scripts/bench-device-loss.py "$pr" "$OUT" \
+      terrain --points "${LOSS_POINTS:-1G}" || status=1
+    ;;
   python)
     # The Python module against the CLI (scripts/bench-python.py): pointrast.render of NumPy arrays, upload
     # GB/s and frame ms beside `pointrast render` of the same points. Needs .gpu/python/pointrast, the
@@ -231,7 +238,7 @@ for what in "$@"; do
     timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" "${MPI_POINTS:-1G}" "${MPI_OCTREE:-}" || status=1
     ;;
   *)
-    echo "unknown check '$what' (tests, mpi, python, filtercost, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
+    echo "unknown check '$what' (tests, mpi, python, filtercost, deviceloss, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
   esac
 done
 echo "gpu-check: exit $status"

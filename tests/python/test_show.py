@@ -70,11 +70,14 @@ def test_show_serves_on_localhost_only_with_a_token_and_stops_when_collected(cli
         policy = page.headers["Content-Security-Policy"]
         assert "frame-ancestors 'self' http://localhost:*" in policy
         assert page.headers.get("X-Frame-Options") is None
-    # Without the token: refused (the page's script and style alone load without it).
+    # Without the token: refused; the page's script and style alone load without it (a framed page sends
+    # no cookie), as they hold no data.
     for path in ("healthz", ""):
         with pytest.raises(urllib.error.HTTPError) as refused:
             urllib.request.urlopen("http://127.0.0.1:%d/%s" % (port, path), timeout=10)
         assert refused.value.code == 403
+    with urllib.request.urlopen("http://127.0.0.1:%d/app.js" % port, timeout=10) as script:
+        assert script.status == 200
     with urllib.request.urlopen("http://127.0.0.1:%d/healthz?token=%s" % (port, token), timeout=10) as ok:
         assert ok.read() == b"ok\n"
     html = viewer._repr_html_()

@@ -18,7 +18,8 @@ namespace pointrast::view::web {
 struct HttpRequest {
   std::string_view method, path; // path as sent, still percent-encoded
   RequestFacts facts;
-  bool publicPageFile = false; // the path names one of the page's script or style files (no data in them)
+  bool publicPageFile = false; // one of the page's script or style files (no data in them), public when the
+                               // viewer may be framed by other sites (serve --frame-ancestors)
 };
 
 struct HttpRefusal {

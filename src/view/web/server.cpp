@@ -313,7 +313,9 @@ int Server::gate(mg_connection* conn) {
   std::string upgrade = header("Upgrade"), host = header("Host"), origin = header("Origin");
   HttpRequest request{info->request_method, info->local_uri ? info->local_uri : "",
                       RequestFacts{host, origin, queryToken, cookieToken, bearer, !upgrade.empty()}, false};
-  request.publicPageFile = isPublicPageFile(request.path);
+  // The page's script and style load without the token only when pages of other sites may frame the viewer
+  // (--frame-ancestors: a notebook), whose requests carry no cookie there.
+  request.publicPageFile = !options_.frameAncestors.empty() && isPublicPageFile(request.path);
   std::optional<HttpRefusal> refusal = gateRequest(access_, request, stopping_);
   if (!refusal) return 0; // on to the page or the WebSocket
   int status = refusal->status;
