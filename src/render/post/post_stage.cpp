@@ -105,7 +105,7 @@ void PostStage::record(VkCommandBuffer cmd, std::span<const PostView> views, con
                        gpu::TimestampPool* timestamps, uint32_t firstSpan) {
   assert(!views.empty() && views.size() <= kMaxPostViews);
   const PostView& first = views[0];
-  for (const PostView& v : views)
+  for ([[maybe_unused]] const PostView& v : views)
     assert(v.width == first.width && v.height == first.height && "the views of one run share a size");
   const uint64_t pixels = uint64_t(first.width) * first.height;
   // Each view ping-pongs between its own window of the two scratch buffers.
