@@ -163,6 +163,17 @@ RenderSettings rankSettings(const RenderSettings& settings) {
   return s;
 }
 
+// Every rank's render time and points into `out` (a collective: every rank calls it).
+static void gatherRankStats(const FrameStats& stats, CompositeStats& out) {
+  mpi::Job& job = mpi::Job::get();
+  out.ranks = job.size();
+  out.rankMs = job.gatherOf(stats.medianMs);
+  out.renderMs = job.maxOf(stats.medianMs);
+  out.points = job.sumOf(stats.points);
+  for (double points : job.gatherOf(double(stats.points)))
+    out.rankPoints.push_back(uint64_t(points));
+}
+
 std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, const Camera& camera,
                                      const RenderSettings& settings, double int40Scale,
                                      const FrameStats& stats, CompositeStats& out) {
@@ -170,12 +181,7 @@ std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, 
   auto start = std::chrono::steady_clock::now();
   std::vector<uint64_t> words = renderer.framebufferWords();
   out.readbackMs = msSince(start);
-  out.ranks = job.size();
-  out.rankMs = job.gatherOf(stats.medianMs);
-  out.renderMs = job.maxOf(stats.medianMs);
-  out.points = job.sumOf(stats.points);
-  for (double points : job.gatherOf(double(stats.points)))
-    out.rankPoints.push_back(uint64_t(points));
+  gatherRankStats(stats, out);
   job.check(); // all ranks are here: the composite's time is its own, not a wait for the slowest rank
   start = std::chrono::steady_clock::now();
   job.minToRoot(words);
@@ -194,12 +200,7 @@ std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuS
                                         const Camera& camera, const RenderSettings& settings,
                                         const FrameStats& stats, CompositeStats& out) {
   mpi::Job& job = mpi::Job::get();
-  out.ranks = job.size();
-  out.rankMs = job.gatherOf(stats.medianMs);
-  out.renderMs = job.maxOf(stats.medianMs);
-  out.points = job.sumOf(stats.points);
-  for (double points : job.gatherOf(double(stats.points)))
-    out.rankPoints.push_back(uint64_t(points));
+  gatherRankStats(stats, out);
   RenderSettings step = rankSettings(settings);
   step.captureWords = false;
   step.frames = 1;
