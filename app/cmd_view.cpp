@@ -18,6 +18,7 @@
 #include "io/annotations_file.h"
 #include "io/format_table.h"
 #include "view/desktop/viewer.h"
+#include "view/flight.h"
 
 namespace pointrast::app {
 
@@ -29,6 +30,7 @@ struct ViewArgs {
   std::string annotations; // --annotations: measurements loaded and saved
   uint32_t width = 1280, height = 720;
   double fov = 60;
+  double flight = 0, flightRate = 120; // --flight SECONDS: a scripted flight (view/flight.h), then close
   uint64_t seed = 1;
   std::optional<uint32_t> device;
   bool noPanel = false, noVsync = false, events = false, quiet = false;
@@ -49,7 +51,7 @@ void checkStatsFile(const std::string& stats) {
 // The statistics of every frame the session rendered, as one JSON document (a file written whole, or one
 // line on stdout for `-`).
 void writeStats(const ViewArgs& a, const view::SceneInput& input, const view::FrameLog& log,
-                const view::ViewerOptions& options) {
+                const view::ViewerOptions& options, const view::Flight* flight) {
   report::ReportInfo info;
   std::filesystem::path file(a.stats);
   info.name = a.stats == "-" ? "view" : file.stem().string();
@@ -57,7 +59,7 @@ void writeStats(const ViewArgs& a, const view::SceneInput& input, const view::Fr
   info.commandLine = commandLine("pointrast view");
   info.date = report::utcNow();
   const nlohmann::json j =
-      view::viewStatsJson(log, {input.name, input.points, options.vsync, options.panel}, info);
+      view::viewStatsJson(log, {input.name, input.points, options.vsync, options.panel}, info, flight);
   if (a.stats == "-")
     std::printf("%s\n", jsonText(j).c_str());
   else
@@ -89,6 +91,10 @@ int runView(const ViewArgs& a) {
   options.device = a.device;
   if (!a.target.empty() && a.eye.empty()) throw InputError("--target needs --eye");
   checkStatsFile(a.stats);
+  std::optional<view::Flight> flight;
+  if (a.flight == 0 && a.flightRate != 120) throw InputError("--flight-rate needs --flight SECONDS");
+  if (a.flight != 0) flight.emplace(view::FlightOptions{a.flight, a.flightRate});
+  if (flight) options.flight = &*flight;
   const InputSpec spec = inputSpec(a.input, a.points, a.seed, a.order, a.quiet);
   checkSceneMethod(spec, options.method);
   view::FrameLog log;
@@ -103,7 +109,8 @@ int runView(const ViewArgs& a) {
     options.camera = camera;
   options.title = "pointrast - " + input.name;
   const int status = view::runViewer(input, options);
-  if (!a.stats.empty()) writeStats(a, input, log, options);
+  if (!a.stats.empty()) writeStats(a, input, log, options, flight ? &*flight : nullptr);
+  if (flight) std::fprintf(stderr, "%s\n", flight->summary().c_str());
   return status;
 }
 
@@ -169,6 +176,13 @@ Command addView(CLI::App& app) {
   cmd->add_option("--stats", a->stats,
                   "At the close, write the GPU time per pass and per frame over the frames rendered to "
                   "this JSON file (- for one line on stdout)");
+  cmd->add_option(
+      "--flight", a->flight,
+      "Fly a scripted flight for this many seconds, then close: wheel steps down low, pan strokes "
+      "across the cloud, then eight jumps, each until its view converged; --stats and --events "
+      "get frames/s, input to frame and frames to converge");
+  cmd->add_option("--flight-rate", a->flightRate, "Inputs a second during the flight's strokes")
+      ->capture_default_str();
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
   return [a] { return runView(*a); };

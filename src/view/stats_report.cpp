@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "report/run_json.h"
+#include "view/flight.h"
 
 namespace pointrast::view {
 
@@ -24,8 +25,8 @@ nlohmann::json msJson(const std::vector<FrameTiming>& frames,
 
 } // namespace
 
-nlohmann::json viewStatsJson(const FrameLog& log, const ViewSession& session,
-                             const report::ReportInfo& info) {
+nlohmann::json viewStatsJson(const FrameLog& log, const ViewSession& session, const report::ReportInfo& info,
+                             const Flight* flight) {
   nlohmann::json j = report::identityJson(info, log.device, log.deviceLocalBytes, log.seconds);
   j["input"] = session.input;
   j["points"] = session.points;
@@ -54,6 +55,7 @@ nlohmann::json viewStatsJson(const FrameLog& log, const ViewSession& session,
   j["passes"]["present"]["what"] = "the image copied into the swapchain image, and the panel when shown";
   j["frame"]["gpu"] = msJson(f, [](const FrameTiming& t) { return t.renderMs + t.presentMs; });
   j["frame"]["host"] = msJson(f, [](const FrameTiming& t) { return t.hostMs; });
+  if (flight) j["flight"] = flight->result();
   return j;
 }
 

@@ -21,6 +21,10 @@ struct ViewSession {
   bool panel = true; // the panel was shown at the start (its drawing is part of the present pass)
 };
 
-nlohmann::json viewStatsJson(const FrameLog& log, const ViewSession& session, const report::ReportInfo& info);
+class Flight;
+
+// With a flight (`view --flight`), its figures (Flight::result) under "flight".
+nlohmann::json viewStatsJson(const FrameLog& log, const ViewSession& session, const report::ReportInfo& info,
+                             const Flight* flight = nullptr);
 
 } // namespace pointrast::view

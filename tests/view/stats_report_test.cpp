@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/build_info.h"
+#include "view/flight.h"
 #include "view/stats_report.h"
 
 namespace {
@@ -58,6 +59,16 @@ TEST(ViewStatsReport, NoFramesGiveZerosNotNonsense) {
   EXPECT_EQ(j["passes"]["render"]["median_ms"].get<double>(), 0);
   EXPECT_EQ(j["frame"]["host"]["p95_ms"].get<double>(), 0);
   EXPECT_TRUE(j["methods"].is_array());
+}
+
+TEST(ViewStatsReport, AFlightsFiguresComeUnderFlight) {
+  view::Flight flight({1, 120});
+  flight.frameShown(0.5, true);
+  nlohmann::json j = view::viewStatsJson(madeUpLog(), {"oct", 1, false, false}, {}, &flight);
+  ASSERT_TRUE(j.contains("flight"));
+  EXPECT_EQ(j["flight"], flight.result());
+  EXPECT_FALSE(j["flight"]["complete"].get<bool>());
+  EXPECT_FALSE(view::viewStatsJson(madeUpLog(), {"oct", 1, false, false}, {}).contains("flight"));
 }
 
 } // namespace

@@ -20,6 +20,7 @@
 #include "view/desktop/input.h"
 #include "view/desktop/panel.h"
 #include "view/desktop/presenter.h"
+#include "view/flight.h"
 #include "view/scene_view.h"
 
 namespace pointrast::view {
@@ -268,6 +269,9 @@ void Viewer::takeScreenshot() {
 }
 
 void Viewer::handleRequests() {
+  if (Flight* flight = options_.flight)
+    for (const FlightInput& in : flight->take(glfw::glfwGetTime()))
+      applyFlightInput(session_, scene_, in);
   if (auto wheel = input_.takeWheel()) zoomAtCursor(session_, scene_, wheel->position, wheel->steps);
   Requests r = session_.takeRequests();
   if (r.pick) {
@@ -326,6 +330,11 @@ void Viewer::showFrame() {
   report.presentMs = result.gpuMs;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   session_.frameRendered(report);
+  if (Flight* flight = options_.flight) {
+    // A cloud drawn whole is complete in every frame; an octree's frame says whether it converged.
+    flight->frameShown(glfw::glfwGetTime(), !report.lod || report.lod->converged);
+    if (flight->done()) running_ = false;
+  }
   if (options_.frameLog)
     options_.frameLog->add({report.renderMs, report.presentMs, report.seconds * 1e3},
                            methodName(session_.settings().method), {shown_.width, shown_.height});
@@ -363,10 +372,14 @@ int Viewer::run() {
   double last = opened;
   while (running_ && !glfw::glfwWindowShouldClose(window_)) {
     bool busy = session_.animating() || presentsPending_ > 0 || session_.needsFrame() || swapchainStale_;
-    if (busy)
+    // A flight's next input falls due on the clock, not with an event.
+    const double idle = options_.flight
+                            ? std::min(kIdleWaitSeconds, options_.flight->wait(glfw::glfwGetTime()))
+                            : kIdleWaitSeconds;
+    if (busy || idle <= 0)
       glfw::glfwPollEvents();
     else
-      glfw::glfwWaitEventsTimeout(kIdleWaitSeconds);
+      glfw::glfwWaitEventsTimeout(idle);
     // Input changes the panel's look (hover, clicks): show two frames, the second with the settled state.
     if (input_.takeArrived()) presentsPending_ = std::max(presentsPending_, 2);
     double now = glfw::glfwGetTime();
@@ -395,6 +408,7 @@ int Viewer::run() {
     log->seconds = glfw::glfwGetTime() - opened;
   }
   uint32_t errors = context_.validationErrors();
+  if (options_.events && options_.flight) emit({{"event", "flight"}, {"flight", options_.flight->result()}});
   if (options_.events)
     emit({{"event", "exit"},
           {"frames", session_.statistics().frames},

@@ -14,6 +14,7 @@
 namespace pointrast::view {
 
 struct SceneInput;
+class Flight;
 
 struct ViewerOptions {
   uint32_t width = 1280, height = 720; // the window's initial size in pixels
@@ -35,6 +36,9 @@ struct ViewerOptions {
   std::string title = "pointrast";
   // When set, receives every frame rendered and the device, for the statistics written at the close.
   FrameLog* frameLog = nullptr;
+  // When set, the viewer plays this flight (flight.h) from its first frame, reports each frame shown to
+  // it, and closes when the flight is done.
+  Flight* flight = nullptr;
 };
 
 // Whether a display is there to open a window on: X11 (DISPLAY) or Wayland (WAYLAND_DISPLAY).

@@ -1,0 +1,113 @@
+// A scripted flight over an octree for the desktop viewer (`pointrast view --flight SECONDS`): the inputs
+// the browser viewer's load client sends with `serve_load --flight`, played into the session on the
+// viewer's clock, and what a user feels measured from them:
+//
+//   approach  six wheel steps of 2 towards (0.5, 0.6) of the viewport, each sent once the previous one
+//             was shown: the camera comes down low over the cloud;
+//   settle    0.5 s;
+//   strokes   for SECONDS, an input every 1/rate s: pan drags (right button) from (0.5, 0.9) to
+//             (0.5, 0.1) in 1.5 s each, swaying sideways by 0.05, carry the camera over new ground;
+//             frames/s and input to frame (the time an input fell due to the frame that showed it
+//             handed to the display);
+//   jumps     after 0.3 s each: a standard view (a key) or a zoom of 12-14 steps towards another place,
+//             then the frames until one says the level-of-detail view converged (every selected node
+//             resident and drawn), 30 s at most.
+//
+// An input falls due at its scheduled time whether or not the loop is busy, so a slow frame makes the
+// inputs behind it wait, as they would in the window system's queue. Times in seconds on any clock; no
+// GPU, no window: the viewer applies the inputs and reports the frames it showed.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "view/session.h"
+
+namespace pointrast::view {
+
+struct FlightInput {
+  enum class Kind { Down, Move, Up, Wheel, Key };
+  Kind kind = Kind::Move;
+  glm::dvec2 at{0.5, 0.5}; // relative to the viewport: 0..1, x right, y down
+  MouseButton button = MouseButton::Right;
+  double steps = 0;       // Wheel
+  Key key = Key::ViewTop; // Key: pressed and released
+};
+
+struct FlightOptions {
+  double seconds = 10; // of the strokes
+  double rate = 120;   // inputs a second during the strokes: the display's refresh rate
+};
+
+// The bounds `view --flight` and `--flight-rate` take.
+constexpr double kMaxFlightSeconds = 3600;
+constexpr double kMaxFlightRate = 1000;
+// Seconds a jump may take to converge before it counts as not converged, as serve_load's bound.
+constexpr double kJumpTimeoutSeconds = 30;
+
+class SceneView;
+
+// Applies one input to the session as the desktop window's events would (a wheel through zoomAtCursor,
+// which reads the depth under the cursor from the view).
+void applyFlightInput(Session& session, SceneView& view, const FlightInput& input);
+
+class Flight {
+public:
+  // Throws InputError for seconds outside (0, kMaxFlightSeconds] or a rate outside (0, kMaxFlightRate].
+  explicit Flight(const FlightOptions& options);
+
+  // The inputs due at `now`, in order: the viewer applies them all before it renders the next frame.
+  std::vector<FlightInput> take(double now);
+  // A rendered frame was handed to the display at `now`; `converged`: its level-of-detail view converged
+  // (a frame of a cloud drawn whole is always complete: true).
+  void frameShown(double now, bool converged);
+  // Seconds from `now` until the flight needs the loop again without a frame (an input due, a bound).
+  double wait(double now) const;
+  bool done() const { return phase_ == Phase::Done; }
+
+  // The figures: "strokes" (frames/s, frames converged, input to frame: inputs, p50, p95, max in ms),
+  // "jumps" (each one's frames and ms to converge), whether all converged, the most frames one took, and
+  // whether the flight ran to its end ("complete": not when the window was closed first).
+  nlohmann::json result() const;
+  // One line of the same figures.
+  std::string summary() const;
+
+private:
+  enum class Phase { Start, Approach, Settle, Strokes, Pause, Jump, Done };
+  struct Jumped {
+    std::string name;
+    bool converged = false;
+    uint64_t frames = 0;
+    double ms = 0;
+  };
+  void strokeInputs(double at, std::vector<FlightInput>& out);
+  void endStrokes(double now, std::vector<FlightInput>& out);
+  void finishJump(bool converged, double now);
+
+  FlightOptions options_;
+  Phase phase_ = Phase::Start;
+  double until_ = 0; // Settle, Pause: when the phase ends
+  // Approach
+  int approachSent_ = 0;
+  std::optional<double> approachShownBy_; // the last wheel's send time, until a frame showed it
+  // Strokes
+  double start_ = 0, end_ = 0;
+  uint64_t inputIndex_ = 0; // inputs fall due at start_ + index / rate
+  bool down_ = false;
+  double strokeStart_ = 0;
+  std::vector<double> pending_;   // due times of inputs applied and not yet shown
+  std::vector<double> latencies_; // ms
+  uint64_t framesFlown_ = 0, framesConverged_ = 0;
+  // Jumps
+  size_t jump_ = 0;
+  double jumpSent_ = 0;
+  uint64_t jumpFrames_ = 0;
+  std::vector<Jumped> jumped_;
+};
+
+} // namespace pointrast::view

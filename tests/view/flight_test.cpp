@@ -1,0 +1,156 @@
+// The scripted flight (`view --flight`) on a made-up clock: its phases, the inputs it plays, and the
+// figures it reports from the frames a viewer says it showed. No GPU or window needed.
+#include <gtest/gtest.h>
+
+#include "base/error.h"
+#include "view/flight.h"
+
+namespace {
+
+using namespace pointrast;
+using view::Flight;
+using view::FlightInput;
+
+// Drives a flight as a viewer loop that renders all the time does: take the inputs due, then show a frame.
+struct Loop {
+  Flight& flight;
+  double now = 0;
+  std::vector<FlightInput> inputs;
+  // One iteration at `now`: inputs taken, then a frame shown `frameSeconds` later.
+  void step(double frameSeconds, bool converged) {
+    std::vector<FlightInput> due = flight.take(now);
+    inputs.insert(inputs.end(), due.begin(), due.end());
+    now += frameSeconds;
+    flight.frameShown(now, converged);
+  }
+};
+
+// Plays the approach, the strokes and the pause with a converged frame every 10 ms, up to the first jump's
+// input (taken, its frame not yet shown).
+void untilFirstJump(Loop& loop) {
+  for (int i = 0; i < 100000; ++i) {
+    std::vector<FlightInput> due = loop.flight.take(loop.now);
+    loop.inputs.insert(loop.inputs.end(), due.begin(), due.end());
+    if (!due.empty() && due.back().kind == FlightInput::Kind::Key) return;
+    loop.flight.frameShown(loop.now += 0.01, true);
+  }
+}
+
+TEST(Flight, RefusesSecondsAndRatesOutOfRange) {
+  EXPECT_THROW(Flight({0, 120}), InputError);
+  EXPECT_THROW(Flight({-1, 120}), InputError);
+  EXPECT_THROW(Flight({view::kMaxFlightSeconds * 2, 120}), InputError);
+  EXPECT_THROW(Flight({1, 0}), InputError);
+  EXPECT_THROW(Flight({1, view::kMaxFlightRate + 1}), InputError);
+  EXPECT_NO_THROW(Flight({1, 120}));
+}
+
+TEST(Flight, WaitsForTheFirstFrameThenApproachesOneWheelPerFrame) {
+  Flight flight({2, 100});
+  EXPECT_TRUE(flight.take(0).empty()) << "nothing before the first frame";
+  flight.frameShown(0.1, false);
+  std::vector<FlightInput> first = flight.take(0.2);
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0].kind, FlightInput::Kind::Wheel);
+  EXPECT_DOUBLE_EQ(first[0].steps, 2);
+  EXPECT_TRUE(flight.take(0.3).empty()) << "the next wheel waits for the frame that shows this one";
+  flight.frameShown(0.4, false);
+  EXPECT_EQ(flight.take(0.5).size(), 1u);
+}
+
+TEST(Flight, StrokesPlayInputsAtTheRateAndMeasureInputToFrame) {
+  Flight flight({1, 100});
+  Loop loop{flight};
+  // Frames of 50 ms while flying: 5 inputs wait behind each frame, so input to frame spans 50 to 100 ms.
+  for (int i = 0; i < 100000 && !flight.done(); ++i)
+    loop.step(0.05, true);
+  ASSERT_TRUE(flight.done());
+  const nlohmann::json r = flight.result();
+  EXPECT_TRUE(r["complete"].get<bool>());
+  const nlohmann::json& s = r["strokes"];
+  EXPECT_NEAR(s["seconds"].get<double>(), 1.0, 0.06);
+  EXPECT_NEAR(s["frames_per_second"].get<double>(), 20.0, 1.5);
+  EXPECT_EQ(s["frames"], s["frames_converged"]);
+  const nlohmann::json& ms = s["input_to_frame_ms"];
+  // 100 moves in a second, plus the presses and releases of the strokes (one stroke is 1.5 s: one press).
+  EXPECT_GE(ms["inputs"].get<size_t>(), 90u);
+  EXPECT_LE(ms["inputs"].get<size_t>(), 102u);
+  EXPECT_GE(ms["p50"].get<double>(), 50.0 - 1e-6);
+  EXPECT_LE(ms["max"].get<double>(), 100.0 + 1e-6);
+  EXPECT_GT(ms["p95"].get<double>(), ms["p50"].get<double>());
+  // Pan drags with the right button from the bottom towards the top of the viewport.
+  size_t downs = 0, moves = 0;
+  double lowestY = 1;
+  for (const FlightInput& in : loop.inputs) {
+    if (in.kind == FlightInput::Kind::Down) {
+      ++downs;
+      EXPECT_EQ(in.button, view::MouseButton::Right);
+    }
+    if (in.kind == FlightInput::Kind::Move) {
+      ++moves;
+      lowestY = std::min(lowestY, in.at.y);
+    }
+  }
+  EXPECT_EQ(downs, 1u);
+  EXPECT_GE(moves, 99u);
+  EXPECT_LT(lowestY, 0.9 - 0.8 / 1.5 * 0.9) << "a second carries the stroke two thirds of its way";
+}
+
+TEST(Flight, EachJumpCountsItsFramesUntilOneConverged) {
+  Flight flight({0.1, 100});
+  Loop loop{flight};
+  untilFirstJump(loop);
+  // The first jump (a key): three frames not converged, then one that is.
+  ASSERT_EQ(loop.inputs.back().key, view::Key::ViewTop);
+  for (int i = 0; i < 3; ++i)
+    flight.frameShown(loop.now += 0.02, false);
+  flight.frameShown(loop.now += 0.02, true);
+  // The rest converge at once.
+  for (int i = 0; i < 100000 && !flight.done(); ++i)
+    loop.step(0.01, true);
+  ASSERT_TRUE(flight.done());
+  const nlohmann::json r = flight.result();
+  ASSERT_EQ(r["jumps"].size(), 8u);
+  EXPECT_EQ(r["jumps"][0]["jump"], "top view");
+  EXPECT_EQ(r["jumps"][0]["frames_to_converge"], 4);
+  EXPECT_NEAR(r["jumps"][0]["ms_to_converge"].get<double>(), 80, 1e-6);
+  EXPECT_EQ(r["jumps"][1]["frames_to_converge"], 1);
+  EXPECT_TRUE(r["jumps_all_converged"].get<bool>());
+  EXPECT_EQ(r["jump_frames_to_converge_max"], 4);
+  size_t keys = 0, zooms = 0;
+  for (const FlightInput& in : loop.inputs) {
+    keys += in.kind == FlightInput::Kind::Key;
+    zooms += in.kind == FlightInput::Kind::Wheel && in.steps >= 12;
+  }
+  EXPECT_EQ(keys, 4u);
+  EXPECT_EQ(zooms, 4u);
+}
+
+TEST(Flight, AJumpThatNeverConvergesEndsAtItsBoundAndIsSaid) {
+  Flight flight({0.1, 100});
+  Loop loop{flight};
+  untilFirstJump(loop);
+  // Frames that never converge, one a second, past the bound.
+  for (int i = 0; i < 31; ++i)
+    loop.step(1.0, false);
+  for (int i = 0; i < 100000 && !flight.done(); ++i)
+    loop.step(0.01, true);
+  ASSERT_TRUE(flight.done());
+  const nlohmann::json r = flight.result();
+  EXPECT_FALSE(r["jumps"][0]["converged"].get<bool>());
+  EXPECT_FALSE(r["jumps"][0].contains("ms_to_converge"));
+  EXPECT_FALSE(r["jumps_all_converged"].get<bool>());
+  EXPECT_NE(flight.summary().find("NOT all converged"), std::string::npos) << flight.summary();
+}
+
+TEST(Flight, AFlightCutShortIsNotComplete) {
+  Flight flight({5, 100});
+  flight.frameShown(0, true);
+  flight.take(0.1);
+  const nlohmann::json r = flight.result();
+  EXPECT_FALSE(r["complete"].get<bool>());
+  EXPECT_FALSE(r["jumps_all_converged"].get<bool>());
+  EXPECT_EQ(r["strokes"]["frames"], 0);
+}
+
+} // namespace
