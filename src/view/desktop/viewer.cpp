@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <system_error>
 
@@ -12,6 +13,7 @@
 
 #include "base/error.h"
 #include "cloud/cloud.h"
+#include "gpu/buffer.h"
 #include "gpu/context.h"
 #include "gpu/swapchain.h"
 #include "io/annotations_file.h"
@@ -108,6 +110,7 @@ public:
 
 private:
   void showFrame();
+  void drawMeasurements();
   void handleRequests();
   void handlePanel(const PanelActions& actions);
   void takeScreenshot();
@@ -127,6 +130,8 @@ private:
   PanelInfo info_;
   PanelItems items_;
   ShownImage shown_;
+  // The shown frame with the measurements drawn over it (host-visible; the presenter reads it by address).
+  gpu::Buffer overlay_;
   int presentsPending_ = 1;
   size_t savedKeyframes_ = 0;
   bool swapchainStale_ = false;
@@ -256,6 +261,9 @@ void Viewer::takeScreenshot() {
   Viewport viewport = session_.viewport();
   std::vector<uint32_t> pixels =
       scene_.screenshot(session_.camera(), session_.settings(), viewport, session_.options().supersample);
+  const Annotations annotations = session_.measurements().complete();
+  if (!annotations.items.empty())
+    scene_.drawOverlay(session_.camera(), session_.settings(), viewport, annotations, pixels);
   io::writePng(file, viewport.width, viewport.height, pixels.data());
   session_.invalidate(); // a supersampled shot used another renderer; draw the window's image again
   if (options_.events)
@@ -319,6 +327,7 @@ void Viewer::showFrame() {
   if (session_.needsFrame()) {
     report = scene_.render(session_.camera(), session_.settings(), session_.viewport());
     shown_ = {scene_.renderer().imageAddress(), scene_.renderer().width(), scene_.renderer().height()};
+    drawMeasurements();
     rendered = true;
   }
   if (!rendered && presentsPending_ == 0) return;
@@ -365,6 +374,22 @@ void Viewer::showFrame() {
     event["panel_items"] = items;
   }
   emit(event);
+}
+
+// The measurements over the frame just rendered, as render --annotations draws them (render/overlay.h):
+// the image comes to the host, is drawn over there and shown from a buffer of its own.
+void Viewer::drawMeasurements() {
+  const Annotations annotations = session_.measurements().complete();
+  const Viewport viewport = session_.viewport();
+  if (annotations.items.empty() || applicable(session_.settings()).stereo) return;
+  if (shown_.width != viewport.width || shown_.height != viewport.height) return;
+  std::vector<uint32_t> rgba = scene_.renderer().image();
+  scene_.drawOverlay(session_.camera(), session_.settings(), viewport, annotations, rgba);
+  const uint64_t bytes = rgba.size() * sizeof(uint32_t);
+  if (!overlay_ || overlay_.size() != bytes)
+    overlay_ = gpu::Buffer(context_, bytes, gpu::kBufferUsage, gpu::MemoryKind::Upload, "view overlay image");
+  std::memcpy(overlay_.mapped(), rgba.data(), bytes);
+  shown_.address = overlay_.address();
 }
 
 int Viewer::run() {

@@ -1,0 +1,188 @@
+// The desktop viewer's tools in a real window on Xvfb (lavapipe, validation layer on): measurements and
+// annotations drawn over the window as `render --annotations` draws them over its PNG.
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include <stb_image.h>
+
+#include "cloud/annotations.h"
+#include "io/annotations_file.h"
+#include "viewer_harness.h"
+
+namespace pointrast::test {
+namespace {
+
+constexpr uint32_t kWidth = 480, kHeight = 360;
+
+// Over autzen_trim looking north-east and down, so that most pixels hold points.
+const char* kCamera = "--eye 636300,848700,900 --target 636600,849200,450 --up 0,0,1 --fov 60";
+
+std::string autzen() {
+  return (dataDir() / "las" / "autzen_trim.las").string();
+}
+
+std::filesystem::path toolsTempDir() {
+  static std::filesystem::path dir = [] {
+    auto d = std::filesystem::temp_directory_path() / ("pointrast_window_tools_" + std::to_string(getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::vector<uint32_t> loadRgba(const std::filesystem::path& file, uint32_t& width, uint32_t& height) {
+  int w = 0, h = 0, comp = 0;
+  uint8_t* data = stbi_load(file.c_str(), &w, &h, &comp, 4);
+  std::vector<uint32_t> pixels;
+  if (!data) return pixels;
+  width = uint32_t(w);
+  height = uint32_t(h);
+  pixels.resize(size_t(w) * size_t(h));
+  std::memcpy(pixels.data(), data, pixels.size() * 4);
+  stbi_image_free(data);
+  for (uint32_t& p : pixels)
+    p |= 0xFF000000u;
+  return pixels;
+}
+
+// `pointrast render` of autzen_trim with `args` at the window's size: its pixels.
+std::vector<uint32_t> renderAutzen(const std::string& args) {
+  const std::filesystem::path out = toolsTempDir() / "reference.png";
+  std::filesystem::remove(out);
+  const std::string command = "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() +
+                              "' render '" + autzen() + "' " + args + " --width " + std::to_string(kWidth) +
+                              " --height " + std::to_string(kHeight) + " -o '" + out.string() +
+                              "' -q --frames 1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  uint32_t w = 0, h = 0;
+  std::vector<uint32_t> pixels = loadRgba(out, w, h);
+  EXPECT_EQ(w, kWidth);
+  EXPECT_EQ(h, kHeight);
+  return pixels;
+}
+
+double equalFraction(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+  if (a.size() != b.size() || a.empty()) return 0;
+  size_t same = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    same += a[i] == b[i];
+  return double(same) / double(a.size());
+}
+
+// Of the pixels where `overlay` differs from `plain` (what the annotations changed), the fraction that
+// `shown` has as `overlay` has them.
+double overlayMatch(const std::vector<uint32_t>& shown, const std::vector<uint32_t>& overlay,
+                    const std::vector<uint32_t>& plain, size_t& changed) {
+  changed = 0;
+  size_t same = 0;
+  if (shown.size() != overlay.size() || plain.size() != overlay.size()) return 0;
+  for (size_t i = 0; i < overlay.size(); ++i)
+    if (overlay[i] != plain[i]) {
+      ++changed;
+      same += shown[i] == overlay[i];
+    }
+  return changed ? double(same) / double(changed) : 0;
+}
+
+Capture captureMatching(const std::string& display, unsigned long window,
+                        const std::vector<uint32_t>& expected, double fraction, double seconds = 20) {
+  auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+  Capture capture;
+  do {
+    capture = captureWindow(display, window);
+    if (equalFraction(capture.rgba, expected) >= fraction) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  } while (Clock::now() < deadline);
+  return capture;
+}
+
+// A distance (three points, one above the ground), a height, an area and a label over the middle of the
+// camera's view.
+Annotations surveyAnnotations() {
+  Annotations a;
+  a.unit = "m";
+  Annotation distance;
+  distance.kind = AnnotationKind::Distance;
+  distance.points = {{636450, 849050, 440}, {636650, 849150, 445}, {636700, 849300, 480}};
+  Annotation height;
+  height.kind = AnnotationKind::Height;
+  height.points = {{636500, 849250, 430}, {636560, 849260, 470}};
+  height.text = "mast";
+  Annotation area;
+  area.kind = AnnotationKind::Area;
+  area.points = {{636350, 848950, 450}, {636420, 848960, 450}, {636400, 849020, 450}};
+  Annotation label;
+  label.kind = AnnotationKind::Label;
+  label.points = {{636600, 849200, 460}};
+  label.text = "survey mark";
+  a.items = {distance, height, area, label};
+  return a;
+}
+
+class ViewerTools : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() { xvfb_ = new Xvfb(); }
+  static void TearDownTestSuite() {
+    delete xvfb_;
+    xvfb_ = nullptr;
+  }
+  void SetUp() override {
+    ASSERT_FALSE(xvfb_->display().empty()) << "Xvfb did not start (scripts/install-deps.sh installs xvfb)";
+    ASSERT_EQ(std::system("command -v xdotool >/dev/null"), 0)
+        << "xdotool is missing (scripts/install-deps.sh)";
+  }
+  std::unique_ptr<Viewer> start(const std::string& args) {
+    auto viewer = std::make_unique<Viewer>(
+        xvfb_->display(),
+        args + " --width " + std::to_string(kWidth) + " --height " + std::to_string(kHeight) + " --path '" +
+            (toolsTempDir() / "path.json").string() + "' --screenshot-dir '" + toolsTempDir().string() + "'");
+    first_ = viewer->waitEvent("frame", 0, 120);
+    EXPECT_TRUE(first_) << viewer->errors();
+    return viewer;
+  }
+  void finish(Viewer& viewer) {
+    EXPECT_EQ(viewer.quit(), 0) << viewer.errors();
+    auto exit = viewer.waitEvent("exit", 0, 5);
+    ASSERT_TRUE(exit) << viewer.errors();
+    EXPECT_EQ((*exit)["validation_errors"].get<int>(), 0) << viewer.errors();
+  }
+  const std::string& display() const { return xvfb_->display(); }
+  static Xvfb* xvfb_;
+  std::optional<nlohmann::json> first_;
+};
+Xvfb* ViewerTools::xvfb_ = nullptr;
+
+TEST_F(ViewerTools, AnnotationsOverTheWindowEqualRenderAnnotations) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const std::filesystem::path file = toolsTempDir() / "survey.json";
+  io::saveAnnotations(file, surveyAnnotations());
+  const std::vector<uint32_t> plain = renderAutzen(kCamera);
+  const std::vector<uint32_t> expected =
+      renderAutzen(std::string(kCamera) + " --annotations '" + file.string() + "'");
+  size_t changed = 0;
+  overlayMatch(expected, expected, plain, changed);
+  // The overlay is there to be seen: lines, markers and labels change a good number of pixels.
+  ASSERT_GT(changed, 1500u);
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel --annotations '" + file.string() + "'");
+  ASSERT_TRUE(first_);
+  Capture shown = captureMatching(display(), viewer->window(), expected, 0.999);
+  ASSERT_EQ(shown.width, kWidth);
+  ASSERT_EQ(shown.height, kHeight);
+  EXPECT_GE(equalFraction(shown.rgba, expected), 0.999);
+  EXPECT_GE(overlayMatch(shown.rgba, expected, plain, changed), 0.99);
+  // F12's screenshot holds the overlay too.
+  const size_t from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 200 200 key F12");
+  auto shot = viewer->waitEvent("screenshot", from, 30);
+  ASSERT_TRUE(shot) << viewer->errors();
+  uint32_t w = 0, h = 0;
+  const std::vector<uint32_t> png = loadRgba((*shot)["file"].get<std::string>(), w, h);
+  EXPECT_EQ(equalFraction(png, expected), 1.0);
+  finish(*viewer);
+}
+
+} // namespace
+} // namespace pointrast::test
