@@ -140,7 +140,8 @@ Command addView(CLI::App& app) {
       "  pointrast view lone-star.copc.laz --method lod-hqs\n"
       "  pointrast view terrain --points 10M --method batch-prefetch\n"
       "  pointrast view autzen.las --eye 636000,848900,700 --target 636600,849200,450 --no-panel\n"
-      "  pointrast view terrain --points 10M --no-vsync --stats view.json  # then drag, and Escape");
+      "  pointrast view terrain --points 10M --no-vsync --stats view.json  # then drag, and Escape\n"
+      "  pointrast view octree/ --no-vsync --flight 15 --stats flight.json # flies, measures, closes");
   cmd->add_option("FILE", a->input,
                   "A cloud file (" + io::formatList(io::FormatUse::Cloud) + "), an octree (" +
                       io::formatList(io::FormatUse::Octree) +
