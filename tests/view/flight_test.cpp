@@ -1,5 +1,7 @@
 // The scripted flight (`view --flight`) on a made-up clock: its phases, the inputs it plays, and the
 // figures it reports from the frames a viewer says it showed. No GPU or window needed.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "base/error.h"
