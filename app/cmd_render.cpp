@@ -39,6 +39,7 @@
 #include "render/spheres/sphere_renderer.h"
 #include "render_filter.h"
 #include "render_path.h"
+#include "report/pick_json.h"
 #include "report/stats_json.h"
 
 namespace pointrast::app {
@@ -450,6 +451,9 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
   const ColorChoice colors = colorChoice(a.look);
   const bool distributed = distributedRun(); // under mpirun: this rank draws its share of the selection
   if (distributed) checkDistributed(settings, false, false);
+  if (!a.pick.empty() && (distributed || settings.method.info().output != MethodOutput::Closest))
+    throw InputError("--pick on an octree reads the lod method's frame on one process, not " + a.method +
+                     (distributed ? " under mpirun" : ""));
   if (a.input.empty() || isSceneName(a.input))
     throw InputError((a.input.empty() ? std::string("the demo scene") : a.input) + " is a generated scene; " +
                      a.method + " draws octrees (" + io::formatList(io::FormatUse::Octree) +
@@ -494,6 +498,11 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
       [&] {
         nlohmann::json j = octreeJson(context, settings, octree, colors, stats, camera, a, pixels);
         if (distributed) j["mpi"] = compositeJson(composite); // batch and LOD counts are rank 0's
+        if (!a.pick.empty()) {
+          const PixelPos pixel = parsePick(a.pick, a.width, a.height);
+          // The point in the lod pass's visibility buffer, its node read from the source.
+          j["pick"] = pointrast::pickJson(renderer, scene, pixel.x, pixel.y);
+        }
         return j;
       },
       [&] {
@@ -539,9 +548,9 @@ RenderSettings pointSettings(const RenderArgs& a) {
   settings.background = parseRgb(a.background, "--background");
   settings.frames = a.frames;
   settings.filter = renderFilter(a.filter);
-  if (!a.pick.empty() && (a.eyes.stereo || !a.path.path.empty() || layout == SceneLayout::Octree || !a.json))
-    throw InputError("--pick reports the point at a pixel of a mono image of a cloud drawn from memory, in "
-                     "--json output (not with --stereo, --path or a LOD method)");
+  if (!a.pick.empty() && (a.eyes.stereo || !a.path.path.empty() || !a.json))
+    throw InputError("--pick reports the point at a pixel of a mono image, in --json output (not with "
+                     "--stereo or --path)");
   if (!a.pick.empty()) parsePick(a.pick, a.width, a.height);
   settings.captureWords = settings.captureWords || !a.pick.empty(); // the word at the pixel
   if (layout == SceneLayout::Octree) return settings; // runRenderOctree checks the octree's own options

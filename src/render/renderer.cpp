@@ -354,6 +354,15 @@ FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, cons
                          : lod::renderOctree(context_, octree, passes, t, eyes, settings, epilogue);
   if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), postFrames);
   wordsCaptured_ = settings.captureWords && (hasCanonicalWords(methodInfo(settings.method)) || post);
+  pickableOctree_ = nullptr;
+  if (t.eyes != 1)
+    lodWhy_ = "a stereo frame shows two cameras";
+  else if (methodInfo(settings.method).output != MethodOutput::Closest)
+    lodWhy_ = "only the lod method keeps the point drawn at each pixel";
+  else if (stats.lod && stats.lod->passes != 1)
+    lodWhy_ = "the selection was larger than the node cache and drawn in passes (raise --gpu-memory)";
+  else
+    pickableOctree_ = &octree;
   return stats;
 }
 
@@ -364,6 +373,25 @@ FrameStats Renderer::render(lod::LodScene& octree, const Camera& camera, const R
 FrameStats Renderer::renderFrame(lod::LodScene& octree, const Camera& camera,
                                  const RenderSettings& settings) {
   return renderLod(octree, camera, settings, true);
+}
+
+std::optional<Renderer::LodPixel> Renderer::lodPointAt(uint32_t x, uint32_t y) {
+  assert(x < targets_->width && y < targets_->height && "outside the image");
+  if (!pickableOctree_) throw InputError(lodWhy_);
+  // The lod pass's visibility word: float depth << 32 | the point's index in the pass (shared.h, LodNode).
+  uint64_t word = 0;
+  gpu::readBuffer(context_, targets_->framebuffer, (uint64_t(y) * targets_->width + x) * 8, &word, 8);
+  if (word == shared::kEmptyPixel) return std::nullopt;
+  const uint32_t index = uint32_t(word);
+  const lod::LodDrawList& list = pickableOctree_->drawList();
+  const std::vector<uint32_t>& ids = pickableOctree_->drawnNodes();
+  // The last node whose first index is <= index, as resolve_lod.comp.glsl finds it.
+  auto after = std::upper_bound(list.nodes.begin(), list.nodes.end(), index,
+                                [](uint32_t i, const shared::LodNode& n) { return i < n.firstIndex; });
+  if (after == list.nodes.begin()) return std::nullopt;
+  const size_t k = size_t(after - list.nodes.begin()) - 1;
+  if (k >= ids.size() || index - list.nodes[k].firstIndex >= list.nodes[k].pointCount) return std::nullopt;
+  return LodPixel{ids[k], index - list.nodes[k].firstIndex};
 }
 
 std::vector<uint32_t> Renderer::image() {

@@ -156,6 +156,15 @@ public:
   // Device address of the RGBA8 image of the last frame (width() x height() words, row 0 at the top), for
   // front ends that show it without a copy to the host. Valid until the Renderer is destroyed.
   uint64_t imageAddress() const;
+  // The point a mono frame of `lod` drew in one pass (every viewer frame; render's when the selection fits
+  // the node cache) at pixel (x, y), read from its visibility buffer: the node's id in the octree's
+  // hierarchy and the point's index among the node's records (NodeSource::readNode's order). nullopt for an
+  // empty pixel. Throws InputError, saying why in a few words, after any other frame.
+  struct LodPixel {
+    uint32_t node = 0;
+    uint32_t index = 0;
+  };
+  std::optional<LodPixel> lodPointAt(uint32_t x, uint32_t y);
 
   // The buffers between the steps of an HQS frame (HqsPass), after a frame of an HQS method: the depth
   // words of the depth pass (depth << 32, all ones where empty), and the blend sums, two words a pixel
@@ -193,6 +202,10 @@ private:
   std::map<Method, std::unique_ptr<lod::LodPasses>> lodPasses_;
   bool wordsCaptured_ = false; // the last frame wrote canonical words
   PointMethod* last_ = nullptr; // the method of the last render() frame
+  // The octree of the last frame when lodPointAt can read it (mono, the lod method, one pass), else null;
+  // lodWhy_ says why not.
+  lod::LodScene* pickableOctree_ = nullptr;
+  std::string lodWhy_ = "the last frame did not draw an octree";
 };
 
 } // namespace pointrast

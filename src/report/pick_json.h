@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cloud/cloud.h"
+#include "render/renderer.h"
 
 namespace pointrast {
 
@@ -15,5 +16,14 @@ namespace pointrast {
 // classification, return number, point source id, color).
 nlohmann::json pickJson(const PointCloud& cloud, uint32_t x, uint32_t y, bool empty,
                         std::optional<uint64_t> index);
+
+namespace lod {
+class LodScene;
+}
+// The same for the point the renderer's last frame of `scene` drew at pixel (x, y) (Renderer::lodPointAt):
+// its node is read from the octree's source, and "point" holds "node" (the node's Potree name, "r04"),
+// "index" (the point's among the node's records) and every attribute the octree stores; "unavailable: ..."
+// says why a frame cannot be picked from (Renderer::lodPointAt). Throws InputError for a damaged node.
+nlohmann::json pickJson(Renderer& renderer, lod::LodScene& scene, uint32_t x, uint32_t y);
 
 } // namespace pointrast

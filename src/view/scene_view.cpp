@@ -233,9 +233,14 @@ nlohmann::json SceneView::pickAttributes(const Camera& camera, const ViewSetting
   };
   if (applicable(settings).stereo) return unavailable("a stereo frame shows two cameras; turn stereo off to pick");
   auto* cloud = dynamic_cast<GpuCloud*>(&source_);
-  if (!cloud) return unavailable("picking reads a cloud in memory; an octree's points are streamed");
+  auto* octree = dynamic_cast<GpuOctree*>(&source_);
+  if (!cloud && !octree) return unavailable("this input keeps no points to pick from");
   ensureRenderer(viewport, 1);
   RenderSettings rs = pickSettings(settings);
+  // An octree's point is read from the lod pass's visibility buffer, whose pixels the resolve stage does
+  // not widen: the nearest pixel is searched in words without it.
+  if (octree) rs.post = {};
+  const bool redraw = rs.method != settings.method || (octree && applicable(settings).post.enabled());
   std::string status;
   if (source_.draw(*renderer_, camera, rs, settings, status).frames == 0) return unavailable(status);
   const int r = int(kPickRadius);
@@ -257,7 +262,20 @@ nlohmann::json SceneView::pickAttributes(const Camera& camera, const ViewSetting
       bestWord = word;
       bestDistance = distance;
     }
-  if (rs.method != settings.method) render(camera, settings, viewport);
+  const auto [bx, by] = best ? *best : std::pair<int, int>{px, py};
+  if (octree && best) {
+    nlohmann::json j;
+    try {
+      j = pickJson(*renderer_, octree->scene(), uint32_t(bx), uint32_t(by));
+    } catch (const InputError& e) {
+      j = unavailable(e.what());
+    }
+    if (redraw) render(camera, settings, viewport);
+    const nlohmann::json p = j["point"];
+    if (p.is_object()) j["world"] = {p["x"], p["y"], p["z"]};
+    return j;
+  }
+  if (redraw) render(camera, settings, viewport);
   if (!best) return {{"pixel", {px, py}}, {"point", "none"}};
   PickRequest request;
   request.cloud = &cloud->cloud();
@@ -267,7 +285,6 @@ nlohmann::json SceneView::pickAttributes(const Camera& camera, const ViewSetting
   request.width = viewport.width;
   request.height = viewport.height;
   request.depth = DepthMode::Float;
-  const auto [bx, by] = *best;
   std::optional<uint64_t> index = pointrast::pickPoint(request, uint32_t(bx), uint32_t(by), bestWord);
   nlohmann::json j = pickJson(cloud->cloud(), uint32_t(bx), uint32_t(by), false, index);
   if (index) {

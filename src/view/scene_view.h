@@ -96,7 +96,8 @@ public:
   // The pick tool: the point of the cloud drawn closest within kPickRadius pixels of a viewport position
   // (the nearest pixel first), with every attribute the cloud holds, as render --pick reports it
   // (report/pick_json.h) plus "world": its position as a point of the measurements, when one was found.
-  // A "point" of "unavailable: ..." says why a frame cannot be picked from (stereo, an octree source).
+  // An octree's point is the one the lod method drew there (report/pick_json.h), with "node" and its index
+  // in the node. A "point" of "unavailable: ..." says why a frame cannot be picked from (stereo).
   nlohmann::json pickAttributes(const Camera& camera, const ViewSettings& settings, Viewport viewport,
                                 glm::dvec2 position);
   // Draws the annotations over a mono frame `rgba` this view just rendered at `viewport` with `camera`,

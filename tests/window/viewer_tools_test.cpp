@@ -184,5 +184,76 @@ TEST_F(ViewerTools, AnnotationsOverTheWindowEqualRenderAnnotations) {
   finish(*viewer);
 }
 
+glm::dvec3 vec3(const nlohmann::json& j) {
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+std::string cameraArgs(const nlohmann::json& camera) {
+  char text[512];
+  const glm::dvec3 e = vec3(camera["eye"]), t = vec3(camera["target"]), u = vec3(camera["up"]);
+  std::snprintf(text, sizeof text,
+                " --eye %.17g,%.17g,%.17g --target %.17g,%.17g,%.17g --up %.17g,%.17g,%.17g --fov %.17g", e.x,
+                e.y, e.z, t.x, t.y, t.z, u.x, u.y, u.z, camera["fov"].get<double>());
+  return text;
+}
+
+// render --method lod --pick of `input` at a pixel of the window's size with a frame event's camera.
+nlohmann::json renderLodPick(const std::string& input, const nlohmann::json& camera,
+                             const nlohmann::json& pixel) {
+  const std::string command =
+      "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() + "' render '" + input +
+      "' --method lod" + cameraArgs(camera) + " --width " + std::to_string(kWidth) + " --height " +
+      std::to_string(kHeight) + " -q --json --frames 1 --pick " + std::to_string(pixel[0].get<int>()) + "," +
+      std::to_string(pixel[1].get<int>()) + " -o '" + (toolsTempDir() / "pick.png").string() + "'";
+  const nlohmann::json j = nlohmann::json::parse(shellOutput(command), nullptr, false);
+  if (!j.is_object() || !j.contains("pick")) {
+    ADD_FAILURE() << command;
+    return nlohmann::json::object();
+  }
+  return j["pick"];
+}
+
+TEST_F(ViewerTools, CtrlClickOnAnOctreePicksThePointRenderLodPicksAndMeasures) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const std::filesystem::path octree = toolsTempDir() / "autzen_octree";
+  std::filesystem::remove_all(octree);
+  const std::string build =
+      "'" + pointrastBinary() + "' lod '" + autzen() + "' -o '" + octree.string() + "' -q";
+  ASSERT_EQ(std::system(build.c_str()), 0) << build;
+  auto viewer = start("'" + octree.string() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  auto converged = viewer->waitFor(
+      [](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && e.contains("lod") && e["lod"].value("converged", false);
+      },
+      0, 120);
+  ASSERT_TRUE(converged) << viewer->errors();
+  const nlohmann::json camera = (*converged)["camera"];
+  size_t from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 240 200 keydown ctrl click 1 keyup ctrl");
+  auto picked = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(picked) << viewer->errors();
+  nlohmann::json shown = (*picked)["pick"];
+  ASSERT_TRUE(shown["point"].is_object()) << shown.dump();
+  EXPECT_TRUE(shown["point"].contains("node")) << shown.dump();
+  EXPECT_TRUE(shown["point"].contains("intensity")) << shown.dump();
+  shown.erase("world");
+  EXPECT_EQ(shown, renderLodPick(octree.string(), camera, shown["pixel"]));
+  // Ctrl+Shift+click twice: a distance between the two points picked on the octree.
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 120 250 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
+  auto a = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(a) << viewer->errors();
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 380 150 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
+  auto b = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(b) << viewer->errors();
+  const glm::dvec3 pa = vec3((*a)["pick"]["world"]), pb = vec3((*b)["pick"]["world"]);
+  const nlohmann::json list = (*b)["measurements"];
+  ASSERT_EQ(list.size(), 1u) << list.dump();
+  EXPECT_NEAR(list[0]["value"].get<double>(), glm::length(pa - pb), 1e-9 * glm::length(pa - pb));
+  finish(*viewer);
+}
+
 } // namespace
 } // namespace pointrast::test

@@ -108,8 +108,10 @@ public:
   void recordUploads(VkCommandBuffer cmd) const; // the copies of this update's nodes, then a barrier
   void uploadsFinished();                        // their staging blocks are free again
   const LodDrawList& drawList() const { return drawList_; }
+  const std::vector<uint32_t>& drawnNodes() const { return drawn_; } // hierarchy ids of drawList().nodes
   const LodStats& stats() const { return stats_; }
   const Hierarchy& hierarchy() const { return *hierarchy_; }
+  NodeSource& source() const { return source_; }
 
   // --- Offline ---
   // The whole selection for a camera (no cache limit), after reading every hierarchy part it reaches.
