@@ -122,6 +122,7 @@ void Flight::endStrokes(double now, std::vector<FlightInput>& out) {
   if (down_) out.push_back(pointerInput(FlightInput::Kind::Up, {0.5, 0.1}));
   down_ = false;
   end_ = now;
+  if (streamed_) strokesTo_ = *streamed_;
   pending_.clear(); // as serve_load: the figures are those of the frames shown while flying
   phase_ = Phase::Pause;
   until_ = now + kPauseSeconds;
@@ -170,6 +171,7 @@ std::vector<FlightInput> Flight::take(double now) {
     framesFlown_ = framesConverged_ = 0;
     latencies_.clear();
     pending_.clear();
+    if (streamed_) strokesFrom_ = *streamed_;
     [[fallthrough]];
   case Phase::Strokes:
     for (;;) {
@@ -218,6 +220,12 @@ void Flight::frameShown(double now, bool converged) {
   }
 }
 
+void Flight::frameShown(double now, const lod::LodStats& lod) {
+  streamed_ = Streamed{lod.nodesLoaded, lod.nodesEvicted, lod.bytesStreamed};
+  cacheBytes_ = lod.cacheBytes;
+  frameShown(now, lod.converged);
+}
+
 double Flight::wait(double now) const {
   switch (phase_) {
   case Phase::Settle:
@@ -250,14 +258,31 @@ nlohmann::json Flight::result() const {
     all = all && j.converged;
     worst = std::max(worst, j.frames);
   }
-  return {{"what", "serve_load --flight's inputs played into the viewer's session: six wheel steps down low, "
-                   "pan strokes across the cloud, then jumps, each followed until a frame converged; input "
-                   "to frame from the time an input fell due to its frame handed to the display"},
-          {"strokes", strokes},
-          {"jumps", jumps},
-          {"jumps_all_converged", all},
-          {"jump_frames_to_converge_max", worst},
-          {"complete", done()}};
+  nlohmann::json result = {
+      {"what", "serve_load --flight's inputs played into the viewer's session: six wheel steps down low, "
+               "pan strokes across the cloud, then jumps, each followed until a frame converged; input "
+               "to frame from the time an input fell due to its frame handed to the display"},
+      {"strokes", strokes},
+      {"jumps", jumps},
+      {"jumps_all_converged", all},
+      {"jump_frames_to_converge_max", worst},
+      {"complete", done()}};
+  if (streamed_) {
+    auto json = [](const Streamed& s) {
+      return nlohmann::json{{"nodes_loaded", s.nodesLoaded},
+                            {"nodes_evicted", s.nodesEvicted},
+                            {"bytes_streamed", s.bytesStreamed}};
+    };
+    // Totals count from the node cache's making; none is made again during a flight, and strokes cut short
+    // count nothing.
+    auto since = [](uint64_t to, uint64_t from) { return to >= from ? to - from : 0; };
+    const Streamed flown{since(strokesTo_.nodesLoaded, strokesFrom_.nodesLoaded),
+                         since(strokesTo_.nodesEvicted, strokesFrom_.nodesEvicted),
+                         since(strokesTo_.bytesStreamed, strokesFrom_.bytesStreamed)};
+    result["streaming"] = {
+        {"cache_bytes", cacheBytes_}, {"strokes", json(flown)}, {"session", json(*streamed_)}};
+  }
+  return result;
 }
 
 std::string Flight::summary() const {

@@ -26,6 +26,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "render/lod/lod_stats.h"
 #include "view/session.h"
 
 namespace pointrast::view {
@@ -66,13 +67,18 @@ public:
   // A rendered frame was handed to the display at `now`; `converged`: its level-of-detail view converged
   // (a frame of a cloud drawn whole is always complete: true).
   void frameShown(double now, bool converged);
+  // The same for a frame drawn with level of detail: whether it converged, and the node cache's totals,
+  // from which the flight reports the nodes streamed while the strokes flew and over the whole session.
+  void frameShown(double now, const lod::LodStats& lod);
   // Seconds from `now` until the flight needs the loop again without a frame (an input due, a bound).
   double wait(double now) const;
   bool done() const { return phase_ == Phase::Done; }
 
   // The figures: "strokes" (frames/s, frames converged, input to frame: inputs, p50, p95, max in ms),
   // "jumps" (each one's frames and ms to converge), whether all converged, the most frames one took, and
-  // whether the flight ran to its end ("complete": not when the window was closed first).
+  // whether the flight ran to its end ("complete": not when the window was closed first); with level of
+  // detail, "streaming": the node cache's budget and the nodes loaded and evicted and the bytes streamed
+  // during the strokes and over the whole session.
   nlohmann::json result() const;
   // One line of the same figures.
   std::string summary() const;
@@ -84,6 +90,9 @@ private:
     bool converged = false;
     uint64_t frames = 0;
     double ms = 0;
+  };
+  struct Streamed {
+    uint64_t nodesLoaded = 0, nodesEvicted = 0, bytesStreamed = 0;
   };
   void strokeInputs(double at, std::vector<FlightInput>& out);
   void endStrokes(double now, std::vector<FlightInput>& out);
@@ -108,6 +117,10 @@ private:
   double jumpSent_ = 0;
   uint64_t jumpFrames_ = 0;
   std::vector<Jumped> jumped_;
+  // Level of detail: the totals of the last frame, and when the strokes began and ended
+  std::optional<Streamed> streamed_;
+  Streamed strokesFrom_, strokesTo_;
+  uint64_t cacheBytes_ = 0;
 };
 
 } // namespace pointrast::view

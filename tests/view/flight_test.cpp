@@ -145,6 +145,41 @@ TEST(Flight, AJumpThatNeverConvergesEndsAtItsBoundAndIsSaid) {
   EXPECT_NE(flight.summary().find("NOT all converged"), std::string::npos) << flight.summary();
 }
 
+TEST(Flight, NodesStreamedDuringTheStrokesAndTheSessionFromTheCachesTotals) {
+  Flight flight({1, 100});
+  lod::LodStats lod;
+  lod.cacheBytes = 1 << 20;
+  lod.converged = true;
+  double now = 0;
+  // Every frame loads 2 nodes (1000 bytes) and evicts 1, from the first frame to the last.
+  auto frame = [&] {
+    flight.take(now);
+    lod.nodesLoaded += 2;
+    lod.nodesEvicted += 1;
+    lod.bytesStreamed += 1000;
+    flight.frameShown(now += 0.05, lod);
+  };
+  uint64_t strokesFrames = 0;
+  for (int i = 0; i < 100000 && !flight.done(); ++i) {
+    frame();
+    strokesFrames = flight.result()["strokes"]["frames"].get<uint64_t>();
+  }
+  ASSERT_TRUE(flight.done());
+  const nlohmann::json r = flight.result();
+  ASSERT_TRUE(r.contains("streaming")) << r.dump();
+  const nlohmann::json& s = r["streaming"];
+  EXPECT_EQ(s["cache_bytes"], 1 << 20);
+  EXPECT_EQ(s["session"]["nodes_loaded"], lod.nodesLoaded);
+  EXPECT_EQ(s["session"]["nodes_evicted"], lod.nodesEvicted);
+  EXPECT_EQ(s["session"]["bytes_streamed"], lod.bytesStreamed);
+  // The strokes' share: the frames shown while they flew (the frame that ends them loads after the end).
+  ASSERT_GT(strokesFrames, 10u);
+  EXPECT_NEAR(s["strokes"]["nodes_evicted"].get<double>(), double(strokesFrames), 1.0);
+  EXPECT_NEAR(s["strokes"]["nodes_loaded"].get<double>(), 2.0 * strokesFrames, 2.0);
+  EXPECT_NEAR(s["strokes"]["bytes_streamed"].get<double>(), 1000.0 * strokesFrames, 1000.0);
+  EXPECT_FALSE(Flight({1, 100}).result().contains("streaming")) << "no level of detail, no streaming figures";
+}
+
 TEST(Flight, AFlightCutShortIsNotComplete) {
   Flight flight({5, 100});
   flight.frameShown(0, true);

@@ -97,6 +97,12 @@ TEST(ViewerFlight, FliesOverAStreamedOctreeAndReportsFramesLatencyAndJumps) {
   }
   EXPECT_EQ(frames, j["frames"].get<uint64_t>());
   EXPECT_GT(evicted, 0u) << "nodes stream through a cache an eighth of the octree";
+  ASSERT_TRUE(f.contains("streaming")) << f.dump();
+  EXPECT_EQ(f["streaming"]["cache_bytes"].get<uint64_t>() > 0, true);
+  EXPECT_LE(f["streaming"]["cache_bytes"].get<uint64_t>(), bytes / 8);
+  EXPECT_GT(f["streaming"]["session"]["nodes_evicted"].get<uint64_t>(), 0u);
+  EXPECT_GE(f["streaming"]["session"]["nodes_loaded"].get<uint64_t>(),
+            f["streaming"]["strokes"]["nodes_loaded"].get<uint64_t>());
   EXPECT_TRUE(flightEvent) << "--events has the same figures";
   EXPECT_EQ(validationErrors, 0) << errors;
 }

@@ -341,7 +341,10 @@ void Viewer::showFrame() {
   session_.frameRendered(report);
   if (Flight* flight = options_.flight) {
     // A cloud drawn whole is complete in every frame; an octree's frame says whether it converged.
-    flight->frameShown(glfw::glfwGetTime(), !report.lod || report.lod->converged);
+    if (report.lod)
+      flight->frameShown(glfw::glfwGetTime(), *report.lod);
+    else
+      flight->frameShown(glfw::glfwGetTime(), true);
     if (flight->done()) running_ = false;
   }
   if (options_.frameLog)
