@@ -72,6 +72,21 @@ md += f"| flight | {s['frames_per_second']:.1f} | {ms['p50']:.1f} | {ms['p95']:.
 md += "| jump | converged | frames to converge | ms |\n| --- | --- | ---: | ---: |\n"
 for x in f["jumps"]:
     md += f"| {x['jump']} | {'yes' if x['converged'] else 'no'} | {x['frames_to_converge']} | {x.get('ms_to_converge', 0):.0f} |\n"
+st = f.get("streaming")
+if "points_drawn" in s:
+    d = s["points_drawn"]
+    md += (f"\nPoints drawn a frame while the strokes flew: median {d['median']:,.0f}, min {d['min']:,.0f}, "
+           f"max {d['max']:,.0f}.\n")
+    if d["median"] == 0:
+        md += ("Most stroke frames draw nothing: a pan drag from the bottom of the viewport to the top moves the "
+               "camera down along its up vector (the ground follows the cursor), so the strokes carry the camera, "
+               "which looks down at the ground, back and down through it within the first stroke. "
+               "`serve_load --flight` sends the same strokes.\n")
+if st:
+    md += (f"\nNodes streamed through the node cache ({st['cache_bytes']:,} bytes): while the strokes flew "
+           f"{st['strokes']['nodes_loaded']} loaded, {st['strokes']['nodes_evicted']} evicted, "
+           f"{st['strokes']['bytes_streamed'] / 1e6:.1f} MB read; over the session {st['session']['nodes_loaded']} "
+           f"loaded, {st['session']['nodes_evicted']} evicted, {st['session']['bytes_streamed'] / 1e6:.1f} MB read.\n")
 gpu = j["frame"]["gpu"]
 md += (f"\nEvery frame of the session ({j['frames']}): GPU {gpu['median_ms']:.1f} ms median, {gpu['p95_ms']:.1f} ms p95 "
        f"(render and present passes, timestamp queries); host {j['frame']['host']['median_ms']:.1f} ms median.\n")

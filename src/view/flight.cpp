@@ -148,6 +148,10 @@ std::vector<FlightInput> Flight::take(double now) {
   std::vector<FlightInput> out;
   switch (phase_) {
   case Phase::Start:
+    // The flight starts from the first converged view, or from whatever is drawn after the bound.
+    if (!startSeen_) startSeen_ = now;
+    if (now - *startSeen_ > kJumpTimeoutSeconds) phase_ = Phase::Approach;
+    break;
   case Phase::Done:
     break;
   case Phase::Approach:
@@ -171,6 +175,7 @@ std::vector<FlightInput> Flight::take(double now) {
     framesFlown_ = framesConverged_ = 0;
     latencies_.clear();
     pending_.clear();
+    strokesPointsDrawn_.clear();
     if (streamed_) strokesFrom_ = *streamed_;
     [[fallthrough]];
   case Phase::Strokes:
@@ -199,14 +204,17 @@ std::vector<FlightInput> Flight::take(double now) {
 void Flight::frameShown(double now, bool converged) {
   switch (phase_) {
   case Phase::Start:
-    phase_ = Phase::Approach; // the first frame: the cloud is there to fly over
+    if (converged) phase_ = Phase::Approach; // the cloud is there to fly over
     break;
   case Phase::Approach:
-    approachShownBy_.reset();
+    // The next wheel step zooms towards the depth under the cursor: it waits until every node of the
+    // view is drawn, so that the camera comes down over the ground wherever the streaming stood.
+    if (converged) approachShownBy_.reset();
     break;
   case Phase::Strokes:
     ++framesFlown_;
     framesConverged_ += converged;
+    if (pointsDrawn_) strokesPointsDrawn_.push_back(double(*pointsDrawn_));
     for (double due : pending_)
       latencies_.push_back((now - due) * 1e3);
     pending_.clear();
@@ -223,7 +231,9 @@ void Flight::frameShown(double now, bool converged) {
 void Flight::frameShown(double now, const lod::LodStats& lod) {
   streamed_ = Streamed{lod.nodesLoaded, lod.nodesEvicted, lod.bytesStreamed};
   cacheBytes_ = lod.cacheBytes;
+  pointsDrawn_ = lod.pointsDrawn;
   frameShown(now, lod.converged);
+  pointsDrawn_.reset();
 }
 
 double Flight::wait(double now) const {
@@ -279,6 +289,10 @@ nlohmann::json Flight::result() const {
     const Streamed flown{since(strokesTo_.nodesLoaded, strokesFrom_.nodesLoaded),
                          since(strokesTo_.nodesEvicted, strokesFrom_.nodesEvicted),
                          since(strokesTo_.bytesStreamed, strokesFrom_.bytesStreamed)};
+    const std::vector<double>& p = strokesPointsDrawn_;
+    result["strokes"]["points_drawn"] = {{"median", report::percentile(p, 0.5)},
+                                         {"min", report::percentile(p, 0.0)},
+                                         {"max", report::percentile(p, 1.0)}};
     result["streaming"] = {
         {"cache_bytes", cacheBytes_}, {"strokes", json(flown)}, {"session", json(*streamed_)}};
   }

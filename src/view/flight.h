@@ -2,8 +2,10 @@
 // the browser viewer's load client sends with `serve_load --flight`, played into the session on the
 // viewer's clock, and what a user feels measured from them:
 //
-//   approach  six wheel steps of 2 towards (0.5, 0.6) of the viewport, each sent once the previous one
-//             was shown: the camera comes down low over the cloud;
+//   approach  from the first converged frame, six wheel steps of 2 towards (0.5, 0.6) of the viewport,
+//             each sent once a frame showed the previous one converged (serve_load waits for a frame;
+//             waiting for the view to converge makes the depth each step zooms towards that of the
+//             ground, however fast nodes stream): the camera comes down low over the cloud;
 //   settle    0.5 s;
 //   strokes   for SECONDS, an input every 1/rate s: pan drags (right button) from (0.5, 0.9) to
 //             (0.5, 0.1) in 1.5 s each, swaying sideways by 0.05, carry the camera over new ground;
@@ -78,7 +80,8 @@ public:
   // "jumps" (each one's frames and ms to converge), whether all converged, the most frames one took, and
   // whether the flight ran to its end ("complete": not when the window was closed first); with level of
   // detail, "streaming": the node cache's budget and the nodes loaded and evicted and the bytes streamed
-  // during the strokes and over the whole session.
+  // during the strokes and over the whole session, and the strokes' points drawn a frame (median, min,
+  // max: a camera flown off the cloud or under its ground draws none).
   nlohmann::json result() const;
   // One line of the same figures.
   std::string summary() const;
@@ -100,7 +103,8 @@ private:
 
   FlightOptions options_;
   Phase phase_ = Phase::Start;
-  double until_ = 0; // Settle, Pause: when the phase ends
+  double until_ = 0;                // Settle, Pause: when the phase ends
+  std::optional<double> startSeen_; // Start: when the viewer first asked
   // Approach
   int approachSent_ = 0;
   std::optional<double> approachShownBy_; // the last wheel's send time, until a frame showed it
@@ -119,6 +123,8 @@ private:
   std::vector<Jumped> jumped_;
   // Level of detail: the totals of the last frame, and when the strokes began and ended
   std::optional<Streamed> streamed_;
+  std::optional<uint64_t> pointsDrawn_; // of the frame being reported
+  std::vector<double> strokesPointsDrawn_;
   Streamed strokesFrom_, strokesTo_;
   uint64_t cacheBytes_ = 0;
 };

@@ -47,17 +47,29 @@ TEST(Flight, RefusesSecondsAndRatesOutOfRange) {
   EXPECT_NO_THROW(Flight({1, 120}));
 }
 
-TEST(Flight, WaitsForTheFirstFrameThenApproachesOneWheelPerFrame) {
+TEST(Flight, WaitsForTheFirstConvergedFrameThenApproachesOneWheelPerConvergedFrame) {
   Flight flight({2, 100});
   EXPECT_TRUE(flight.take(0).empty()) << "nothing before the first frame";
   flight.frameShown(0.1, false);
-  std::vector<FlightInput> first = flight.take(0.2);
+  EXPECT_TRUE(flight.take(0.15).empty()) << "nothing before the view converged";
+  flight.frameShown(0.2, true);
+  std::vector<FlightInput> first = flight.take(0.25);
   ASSERT_EQ(first.size(), 1u);
   EXPECT_EQ(first[0].kind, FlightInput::Kind::Wheel);
   EXPECT_DOUBLE_EQ(first[0].steps, 2);
   EXPECT_TRUE(flight.take(0.3).empty()) << "the next wheel waits for the frame that shows this one";
   flight.frameShown(0.4, false);
-  EXPECT_EQ(flight.take(0.5).size(), 1u);
+  EXPECT_TRUE(flight.take(0.45).empty()) << "... converged";
+  flight.frameShown(0.5, true);
+  EXPECT_EQ(flight.take(0.55).size(), 1u);
+}
+
+TEST(Flight, AViewThatNeverConvergesStartsTheApproachAfterTheBound) {
+  Flight flight({2, 100});
+  flight.frameShown(0.1, false);
+  EXPECT_TRUE(flight.take(0.2).empty());
+  EXPECT_TRUE(flight.take(0.2 + view::kJumpTimeoutSeconds + 0.1).empty()) << "the bound passed: approach";
+  EXPECT_EQ(flight.take(0.2 + view::kJumpTimeoutSeconds + 0.2).size(), 1u);
 }
 
 TEST(Flight, StrokesPlayInputsAtTheRateAndMeasureInputToFrame) {
@@ -151,9 +163,11 @@ TEST(Flight, NodesStreamedDuringTheStrokesAndTheSessionFromTheCachesTotals) {
   lod.cacheBytes = 1 << 20;
   lod.converged = true;
   double now = 0;
-  // Every frame loads 2 nodes (1000 bytes) and evicts 1, from the first frame to the last.
+  // Every frame loads 2 nodes (1000 bytes) and evicts 1, from the first frame to the last, and draws 10 more
+  // points than the one before.
   auto frame = [&] {
     flight.take(now);
+    lod.pointsDrawn += 10;
     lod.nodesLoaded += 2;
     lod.nodesEvicted += 1;
     lod.bytesStreamed += 1000;
@@ -177,6 +191,10 @@ TEST(Flight, NodesStreamedDuringTheStrokesAndTheSessionFromTheCachesTotals) {
   EXPECT_NEAR(s["strokes"]["nodes_evicted"].get<double>(), double(strokesFrames), 1.0);
   EXPECT_NEAR(s["strokes"]["nodes_loaded"].get<double>(), 2.0 * strokesFrames, 2.0);
   EXPECT_NEAR(s["strokes"]["bytes_streamed"].get<double>(), 1000.0 * strokesFrames, 1000.0);
+  const nlohmann::json& drawn = r["strokes"]["points_drawn"];
+  EXPECT_LT(drawn["min"].get<double>(), drawn["median"].get<double>());
+  EXPECT_LT(drawn["median"].get<double>(), drawn["max"].get<double>());
+  EXPECT_NEAR(drawn["max"].get<double>() - drawn["min"].get<double>(), 10.0 * (strokesFrames - 1), 10.0);
   EXPECT_FALSE(Flight({1, 100}).result().contains("streaming")) << "no level of detail, no streaming figures";
 }
 
