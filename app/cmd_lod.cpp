@@ -36,6 +36,7 @@ struct LodArgs {
   std::string format; // potree or copc; empty: by the output's name (".laz": copc)
   double spacing = 0;
   unsigned threads = 0;
+  bool noColorFilter = false;
   bool json = false, quiet = false;
 };
 
@@ -153,6 +154,7 @@ int runLod(LodArgs a) {
   options.progress = !a.quiet && !a.json;
   if (a.colorFilter != "average" && a.colorFilter != "none")
     throw InputError("--color-filter expects average or none, got '" + a.colorFilter + "'");
+  if (a.noColorFilter) a.colorFilter = "none";
   options.averageColors = a.colorFilter == "average";
   io::PotreeWriteOptions write;
   if (a.encoding == "brotli")
@@ -209,7 +211,15 @@ Command addLod(CLI::App& app) {
       "levels. Several inputs merge into one octree (the finest of their scales; 8-bit colors widened\n"
       "next to 16-bit ones).\n"
       "\n"
-      "Points are read once and indexed in memory when they fit --memory (about 56 bytes a point);\n"
+      "Every attribute of a LAS/LAZ input travels with its point: GPS time, number of returns, scan\n"
+      "angle, user data, classification flags, scanner channel, scan direction, edge of flight line, NIR\n"
+      "and extra bytes are written as Potree attributes named as PotreeConverter names them (DEFAULT\n"
+      "encoding; BROTLI keeps the fields above only). With --no-color-filter every point keeps its own\n"
+      "color, and `convert OCTREE out.las` gives back every input record byte for byte, in the input's\n"
+      "point format with its extra bytes descriptions.\n"
+      "\n"
+      "Points are read once and indexed in memory when they fit --memory (about 56 bytes a point, plus\n"
+      "8 and their attributes' bytes for LAS inputs);\n"
       "otherwise the build runs out of core, reading the input three times and keeping temporary chunk\n"
       "files in the output's temporary folder. Either way the result is the same, byte for byte, whatever\n"
       "--memory and --threads are. The folder appears only when complete: an error or Ctrl-C leaves\n"
@@ -245,6 +255,8 @@ Command addLod(CLI::App& app) {
   cmd->add_option("--color-filter", a->colorFilter,
                   "Colors of subsampled points: average (of the points they stand for) or none (their own)")
       ->capture_default_str();
+  cmd->add_flag("--no-color-filter", a->noColorFilter,
+                "The same as --color-filter none: every point keeps its own color (an exact round trip)");
   cmd->add_flag("--json", a->json,
                 "Print one JSON object: points, nodes, levels, bytes, phases with seconds");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines or summary");

@@ -20,8 +20,10 @@ class NodeSink {
 public:
   virtual ~NodeSink() = default;
   // One node's points; every node once, in the order the builder decides. Called from one thread at a
-  // time (not always the same one).
-  virtual void writeNode(const NodeKey& key, const PointRecord* records, size_t count) = 0;
+  // time (not always the same one). tails: the records' tails one after another (LodParams::tailBytes
+  // each), null where points carry none.
+  virtual void writeNode(const NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                         size_t count) = 0;
 
   // Optional split of writeNode for sinks with work that needs no order (encoding a node, writing its
   // bytes once their place is known): prepare() runs on any thread, several at once, as soon as a node's
@@ -32,9 +34,9 @@ public:
   // through writeNode().
   // The default prepares nothing, writes through writeNode() and has nothing to finish.
   virtual std::unique_ptr<PreparedNode> prepare(const NodeKey& key, const PointRecord* records,
-                                                size_t count) const;
+                                                const uint8_t* tails, size_t count) const;
   virtual void writePrepared(const NodeKey& key, PreparedNode* prepared, const PointRecord* records,
-                             size_t count);
+                             const uint8_t* tails, size_t count);
   virtual void finishPrepared(std::unique_ptr<PreparedNode> prepared) const;
 };
 
@@ -46,7 +48,8 @@ struct AssembleStats {
 
 class OctreeAssembler {
 public:
-  explicit OctreeAssembler(NodeSink& sink) : sink_(sink) {}
+  // tailBytes: LodParams::tailBytes of the chunks.
+  explicit OctreeAssembler(NodeSink& sink, uint32_t tailBytes = 0) : sink_(sink), tailBytes_(tailBytes) {}
 
   // The sink's prepare() for the chunk's own nodes, on the calling thread (any, several at once).
   void prepare(ChunkNodes& chunk) const;
@@ -59,15 +62,18 @@ public:
   const AssembleStats& stats() const { return stats_; }
 
 private:
-  void write(const NodeKey& key, const PointRecord* records, size_t count);
+  void write(const NodeKey& key, const PointRecord* records, const uint8_t* tails, size_t count);
   void counted(const NodeKey& key, uint64_t count);
+  const uint8_t* tailsOf(const std::vector<uint8_t>& tails, uint64_t first) const;
   void closeDeeperThan(int level);
 
   struct Open {
     NodeKey key;
     std::vector<PointRecord> records;
+    std::vector<uint8_t> tails;
   };
   NodeSink& sink_;
+  uint32_t tailBytes_ = 0;
   std::vector<Open> open_; // open_[L]: the open ancestor at level L (the current chunk's path)
   AssembleStats stats_;
 };

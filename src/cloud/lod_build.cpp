@@ -101,7 +101,10 @@ std::vector<uint64_t> countPoints(const LodGrid& grid, const Pieces& pieces, con
 }
 
 LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uint64_t>& counts,
-                                      Pieces& pieces, const LodRunOptions& options) {
+                                      Pieces& pieces, const LodRunOptions& options, bool refs) {
+  std::vector<uint64_t> pieceFirst(pieces.size() + 1, 0);
+  for (size_t p = 0; p < pieces.size(); ++p)
+    pieceFirst[p + 1] = pieceFirst[p] + pieces[p].size();
   std::vector<uint64_t> next(counts.size());
   uint64_t total = 0;
   for (size_t c = 0; c < counts.size(); ++c) {
@@ -136,8 +139,9 @@ LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uin
         while (j < n && codes[j] >> shift == cell)
           ++j;
         uint64_t at = std::atomic_ref<uint64_t>(next[cell]).fetch_add(j - i, std::memory_order_relaxed);
+        const uint64_t ref = refs ? pieceFirst[task.piece] + b : 0;
         for (; i < j; ++i, ++at)
-          out[at] = {codes[i], src[b + i]};
+          out[at] = {codes[i], src[b + i], refs ? ref + i : 0};
       }
     }
     if (progress) progress->advance(task.end - task.begin);
@@ -175,7 +179,7 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
 
   auto worker = [&] {
     IndexScratch scratch;
-    std::vector<LodItem> storage;
+    ChunkStorage storage;
     std::unique_lock lock(mutex);
     for (;;) {
       wake.wait(lock, [&] { return stop || nextClaim >= n || nextClaim < released + window; });
@@ -191,12 +195,13 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
       lock.unlock();
       try {
         checkCancel(options);
-        const std::span<LodItem> items = load(i, storage);
+        const LoadedChunk loaded = load(i, storage);
+        const std::span<LodItem> items = loaded.items;
         const LodChunk& chunk = chunks[i];
         assert(items.size() == chunk.points);
         indexChunk(*result, scratch, grid, chunk.key, items.data(), items.size(),
                    counts.data() + chunk.firstCell, static_cast<size_t>(chunk.endCell - chunk.firstCell),
-                   params);
+                   params, loaded.tails);
         assembler.prepare(*result);
         if (progress) progress->advance(items.size());
         lock.lock();
@@ -268,7 +273,7 @@ uint64_t inMemoryChunkLimit(uint64_t points, unsigned threads, uint64_t leafPoin
 }
 
 LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams& params, NodeSink& sink,
-                            const LodRunOptions& options) {
+                            const LodRunOptions& options, const uint8_t* tails) {
   LodBuildStats stats;
   const uint64_t n = totalPoints(pieces);
   const unsigned threads = options.threads ? options.threads : hardwareThreads();
@@ -285,17 +290,18 @@ LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams&
   stats.phases.push_back(clock.done("chunk", n));
 
   clock = PhaseClock();
-  LargeBuffer<LodItem> all = distributePoints(grid, counts, pieces, options);
+  LargeBuffer<LodItem> all = distributePoints(grid, counts, pieces, options, params.tailBytes > 0);
   stats.phases.push_back(clock.done("distribute", n));
 
   // Chunk i is the contiguous range of its histogram cells in `all`.
   std::vector<uint64_t> firstPoint(chunks.size() + 1, 0);
   for (size_t c = 0; c < chunks.size(); ++c)
     firstPoint[c + 1] = firstPoint[c] + chunks[c].points;
-  ChunkLoader load = [&](size_t c, std::vector<LodItem>&) {
-    return std::span<LodItem>(all.data() + firstPoint[c], static_cast<size_t>(chunks[c].points));
+  ChunkLoader load = [&](size_t c, ChunkStorage&) {
+    return LoadedChunk{std::span<LodItem>(all.data() + firstPoint[c], static_cast<size_t>(chunks[c].points)),
+                       params.tailBytes ? tails : nullptr};
   };
-  OctreeAssembler assembler(sink);
+  OctreeAssembler assembler(sink, params.tailBytes);
   const IndexTimes times =
       indexChunks(chunks, counts, load, grid, params, assembler, 2 * size_t(threads), options);
   stats.phases.push_back(times.index);

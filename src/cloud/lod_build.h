@@ -58,13 +58,22 @@ std::vector<uint64_t> countPoints(const LodGrid& grid, const Pieces& pieces, con
 
 // Phase "distribute": every record, with its code, moved into one array grouped by count-level cell,
 // cells in Morton order (the order inside a cell is arbitrary: indexing sorts it). Pieces are freed as
-// they are moved.
+// they are moved. refs: each item's ref is its record's place in the pieces, one after another (the
+// index of its tail in an in-memory tail store); else 0.
 LargeBuffer<LodItem> distributePoints(const LodGrid& grid, const std::vector<uint64_t>& counts,
-                                      Pieces& pieces, const LodRunOptions& options);
+                                      Pieces& pieces, const LodRunOptions& options, bool refs = false);
 
 // Items of chunk i grouped by count-level cell (indexChunk's input): a view into memory the caller keeps,
-// or into storage, which the loader fills.
-using ChunkLoader = std::function<std::span<LodItem>(size_t chunk, std::vector<LodItem>& storage)>;
+// or into storage, which the loader fills; with the tail store their refs index, where points carry tails.
+struct ChunkStorage {
+  std::vector<LodItem> items;
+  std::vector<uint8_t> tails;
+};
+struct LoadedChunk {
+  std::span<LodItem> items;
+  const uint8_t* tails = nullptr;
+};
+using ChunkLoader = std::function<LoadedChunk(size_t chunk, ChunkStorage& storage)>;
 
 struct IndexTimes {
   LodPhase index; // indexing and writing together (they overlap)
@@ -97,8 +106,9 @@ struct LodBuildStats {
 };
 
 // The whole build of points held in memory, from "count" on (the caller has read them, and made the grid
-// from their extremes: quantBoxOf + makeLodGrid). Pieces are consumed.
+// from their extremes: quantBoxOf + makeLodGrid). Pieces are consumed. tails: with params.tailBytes > 0,
+// every record's tail, in the order of the pieces' records one after another.
 LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams& params, NodeSink& sink,
-                            const LodRunOptions& options);
+                            const LodRunOptions& options, const uint8_t* tails = nullptr);
 
 } // namespace pointrast::lod

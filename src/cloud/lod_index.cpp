@@ -17,7 +17,8 @@ inline uint64_t untagged(uint64_t code) {
 
 inline bool itemLess(const LodItem& a, const LodItem& b) {
   if (a.code != b.code) return a.code < b.code;
-  return std::memcmp(&a.record, &b.record, sizeof(PointRecord)) < 0;
+  const int c = std::memcmp(&a.record, &b.record, sizeof(PointRecord));
+  return c < 0 || (c == 0 && a.ref < b.ref);
 }
 
 void insertionSort(LodItem* a, size_t n) {
@@ -35,21 +36,30 @@ constexpr size_t kInsertionSortItems = 24;
 
 class Indexer {
 public:
-  Indexer(ChunkNodes& out, LodItem* items, const LodGrid& grid, const LodParams& params)
-      : out_(out), items_(items), grid_(grid), params_(params) {}
+  Indexer(ChunkNodes& out, LodItem* items, const LodGrid& grid, const LodParams& params, const uint8_t* tails)
+      : out_(out), items_(items), grid_(grid), params_(params), tails_(tails) {}
 
-  // Subsamples the points of [begin, end) that reach a node at `level` into dst (see lod_index.h).
+  // Subsamples the points of [begin, end) that reach a node at `level` into dst (see lod_index.h), and
+  // their tails into dstTails (where points carry them).
   // left[c]: points of child c that remain after it, for the node's children.
   // dst has room for every point of [begin, end); returns the end of what was written.
-  PointRecord* subsample(int level, size_t begin, size_t end, PointRecord* dst, uint64_t left[8]) {
-    if (grid_.isotropic) return subsampleCells<true>(level, begin, end, dst, left);
-    return subsampleCells<false>(level, begin, end, dst, left);
+  PointRecord* subsample(int level, size_t begin, size_t end, PointRecord* dst, uint8_t* dstTails,
+                         uint64_t left[8]) {
+    if (grid_.isotropic) return subsampleCells<true>(level, begin, end, dst, dstTails, left);
+    return subsampleCells<false>(level, begin, end, dst, dstTails, left);
+  }
+
+  void copyTail(uint8_t* dstTails, size_t at, const LodItem& item) const {
+    const uint32_t n = params_.tailBytes;
+    std::memcpy(dstTails + at * n, tails_ + item.ref * n, n);
   }
 
   // One pass over the cells' runs: the point nearest each cell's center, the color sums, the count. A
   // cell's center is computed only when a second point reaches it: most cells of deep nodes hold one.
   template <bool kIsotropic>
-  PointRecord* subsampleCells(int level, size_t begin, size_t end, PointRecord* dst, uint64_t left[8]) {
+  PointRecord* subsampleCells(int level, size_t begin, size_t end, PointRecord* dst, uint8_t* dstTails,
+                              uint64_t left[8]) {
+    PointRecord* const dst0 = dst;
     const int cellLevel = grid_.sampleLevel(level);
     const int shift = 3 * (kCodeLevels - cellLevel);
     const int childShift = 3 * (cellLevel - level - 1); // a cell's child index: (cell >> childShift) & 7
@@ -96,6 +106,7 @@ public:
       i = k;
       items_[best].code |= kTakenBit;
       *dst = items_[best].record;
+      if (tails_) copyTail(dstTails, static_cast<size_t>(dst - dst0), items_[best]);
       if (params_.averageColors && reached > 1)
         for (int c = 0; c < 3; ++c)
           dst->rgb[c] = static_cast<uint16_t>((sum[c] + reached / 2) / reached);
@@ -114,7 +125,7 @@ public:
     PointRecord* const start = out_.records.data() + used_;
     if (end - begin > params_.leafPoints && level < kMaxLevel) {
       uint64_t left[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-      n.count = static_cast<uint64_t>(subsample(level, begin, end, start, left) - start);
+      n.count = static_cast<uint64_t>(subsample(level, begin, end, start, tailsAt(used_), left) - start);
       used_ += n.count;
       const int childShift = 3 * (kCodeLevels - level - 1);
       size_t childBegin = begin;
@@ -132,8 +143,12 @@ public:
       }
     } else {
       PointRecord* dst = start;
+      uint8_t* const dstTails = tailsAt(used_);
       for (size_t k = begin; k < end; ++k)
-        if (!(items_[k].code & kTakenBit)) *dst++ = items_[k].record;
+        if (!(items_[k].code & kTakenBit)) {
+          if (tails_) copyTail(dstTails, static_cast<size_t>(dst - start), items_[k]);
+          *dst++ = items_[k].record;
+        }
       n.count = static_cast<uint64_t>(dst - start);
       used_ += n.count;
     }
@@ -142,11 +157,16 @@ public:
   }
 
 private:
+  uint8_t* tailsAt(uint64_t record) {
+    return tails_ ? out_.tails.data() + record * params_.tailBytes : nullptr;
+  }
+
   ChunkNodes& out_;
   uint64_t used_ = 0;
   LodItem* items_;
   const LodGrid& grid_;
   const LodParams& params_;
+  const uint8_t* tails_;
 };
 
 } // namespace
@@ -187,7 +207,8 @@ void sortItems(LodItem* items, size_t count, int freeBits, IndexScratch& scratch
 
 void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, const NodeKey& chunk,
                 LodItem* items, size_t count, const uint64_t* cellCounts, size_t cells,
-                const LodParams& params) {
+                const LodParams& params, const uint8_t* tails) {
+  assert((tails != nullptr) == (params.tailBytes > 0));
   assert(chunk.level >= 0 && chunk.level <= grid.countLevel());
   assert(cells == size_t(1) << 3 * (grid.countLevel() - chunk.level));
   out.chunk = chunk;
@@ -209,11 +230,15 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
   // no zeroing per chunk. Nodes and topCounts say how much of them is in use.
   if (out.records.size() < count) out.records.resize(count);
   if (out.top.size() < count) out.top.resize(count);
-  Indexer indexer(out, items, grid, params);
+  const size_t tailBytes = size_t(count) * params.tailBytes;
+  if (out.tails.size() < tailBytes) out.tails.resize(tailBytes);
+  if (out.topTails.size() < tailBytes) out.topTails.resize(tailBytes);
+  Indexer indexer(out, items, grid, params, tails);
   uint64_t taken = 0, unused[8];
   PointRecord* top = out.top.data();
   for (int level = 0; level < chunk.level; ++level) {
-    PointRecord* const levelEnd = indexer.subsample(level, 0, count, top, unused);
+    uint8_t* const topTails = tails ? out.topTails.data() + (top - out.top.data()) * params.tailBytes : nullptr;
+    PointRecord* const levelEnd = indexer.subsample(level, 0, count, top, topTails, unused);
     out.topCounts[static_cast<size_t>(level)] = static_cast<uint64_t>(levelEnd - top);
     taken += out.topCounts[static_cast<size_t>(level)];
     top = levelEnd;

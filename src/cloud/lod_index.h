@@ -12,8 +12,10 @@
 //   - Color filtering: the point that stays takes the average color of the points of its cell that
 //     reached the node (itself and all it stands for below), rounded to nearest; its position and other
 //     attributes stay its own, exactly.
-//   - Order: points sort by (Morton code, then the record's 24 bytes), a total order; a node's points are
-//     in that order, a tie in distance goes to the first point in it.
+//   - Order: points sort by (Morton code, then the record's 24 bytes, then the item's ref: the point's
+//     place in the input where points carry tails), a total order; a node's points are in that order, a
+//     tie in distance goes to the first point in it.
+//   - Tails (cloud/point_attributes.h): every point keeps its own; they travel beside the records.
 // Every grid cell of a node lies within one chunk (chunks are never smaller than a root grid cell), so a
 // chunk picks the points of its ancestors' subsamples by itself; only their nodes span chunks.
 #pragma once
@@ -30,6 +32,7 @@ namespace pointrast::lod {
 struct LodParams {
   uint64_t leafPoints = 20'000; // a node whose cube holds more input points is split
   bool averageColors = true;    // color filtering; false keeps every point's own color
+  uint32_t tailBytes = 0;       // bytes of each point's tail (0: no tails)
 };
 
 // A node's points as a sink prepared them for writing (an encoded node), see NodeSink::prepare().
@@ -44,6 +47,7 @@ struct ChunkNodes {
   // records for level L, level after level, from the start of `top` (which may be longer). The ancestors
   // are inner nodes: chunks are planned so.
   std::vector<PointRecord> top;
+  std::vector<uint8_t> topTails; // top's tails (LodParams::tailBytes each), where points carry them
   std::vector<uint64_t> topCounts;
   struct Node {
     NodeKey key;
@@ -51,16 +55,20 @@ struct ChunkNodes {
   };
   std::vector<Node> nodes; // the chunk's subtree (rooted at the chunk's cell), children before parents
   std::vector<PointRecord> records; // the nodes' points (where nodes say; it may be longer)
+  std::vector<uint8_t> tails;       // records' tails, where points carry them
   // What the sink's prepare() made of each node (lod_assemble.h); empty until then.
   std::vector<std::unique_ptr<PreparedNode>> prepared;
 };
 
-// A point with its Morton code, as chunks hold them while they are indexed (32 B).
+// A point with its Morton code, as chunks hold them while they are indexed (40 B).
 struct LodItem {
   uint64_t code; // LodGrid::code(record); bit 63 marks a point taken by a subsample while indexing
   PointRecord record;
+  // Where points carry tails: the index of the point's tail in the chunk's tail store, in input order
+  // (so it also decides the order of equal records); else 0.
+  uint64_t ref;
 };
-static_assert(sizeof(LodItem) == 32);
+static_assert(sizeof(LodItem) == 40);
 
 // Buffers one thread reuses from chunk to chunk.
 struct IndexScratch {
@@ -73,12 +81,13 @@ struct IndexScratch {
 // cellCounts: the points of each of those cells (the chunk's range of the histogram, empty cells
 // included). The items are sorted in place and marked. chunk.level <= grid.countLevel(), and the chunk's
 // ancestors must be inner nodes (their cubes hold more than params.leafPoints points), which planChunks
-// guarantees when chunkLimit >= leafPoints.
+// guarantees when chunkLimit >= leafPoints. tails: the tail store the items' refs index (params.tailBytes
+// bytes each), null when params.tailBytes is 0.
 void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, const NodeKey& chunk,
                 LodItem* items, size_t count, const uint64_t* cellCounts, size_t cells,
-                const LodParams& params);
+                const LodParams& params, const uint8_t* tails = nullptr);
 
-// Sorts items into canonical order: by code, then by the record's bytes. freeBits: the low bits in
+// Sorts items into canonical order: by code, then by the record's bytes, then by ref. freeBits: the low bits in
 // which the codes may differ (the others are equal). For a cell's items, and for tests.
 void sortItems(LodItem* items, size_t count, int freeBits, IndexScratch& scratch);
 

@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 namespace pointrast {
 
@@ -56,6 +57,18 @@ AttributeLayout attributeLayout(const PointAttributes& attributes);
 // tail: different extra bytes (their descriptors are the caller's to compare) or scan angles in different
 // units (one would be rounded).
 PointAttributes mergeAttributes(const PointAttributes& a, const PointAttributes& b, bool& ok);
+
+// What the tails of a set of points hold and where they came from: the attributes, their layout, and
+// for LAS inputs the point format and extra bytes descriptors (the payloads of the extra bytes VLRs,
+// 192 bytes each), so an export can write the records back in their own format.
+struct TailFormat {
+  PointAttributes attributes;
+  AttributeLayout layout;
+  int lasPointFormat = -1; // -1: not from LAS records
+  std::vector<uint8_t> extraBytesDescriptors;
+
+  uint32_t bytes() const { return layout.bytes; }
+};
 
 // Field access in a tail; the field must be present (offset >= 0: asserted by the caller's layout).
 template <class T> inline T loadTail(const uint8_t* tail, int offset) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cloud/cloud.h"
+#include "cloud/point_attributes.h"
 #include "cloud/point_record.h"
 
 namespace pointrast::io {
@@ -40,6 +41,17 @@ public:
   virtual void readPiece(size_t i, std::vector<PointRecord>& out) const = 0;
   // Bytes of the file the piece occupies (for throughput figures), 0 when not known.
   virtual uint64_t pieceBytes(size_t i) const = 0;
+
+  // The attributes beyond PointRecord's that the records carry (cloud/point_attributes.h); nothing
+  // (attributes.any() false) for sources without them.
+  virtual TailFormat tailFormat() const { return {}; }
+  // readPiece() plus each record's tail in `layout` (whose fields include the source's; fields it lacks
+  // are zero), layout.bytes bytes a record, one after another.
+  virtual void readPieceTails(size_t i, std::vector<PointRecord>& out, const TailFormat& layout,
+                              std::vector<uint8_t>& tails) const {
+    readPiece(i, out);
+    tails.assign(out.size() * layout.bytes(), 0);
+  }
 };
 
 // Opens any point format readCloud() reads. Throws InputError.

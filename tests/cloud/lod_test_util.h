@@ -26,7 +26,7 @@ struct WrittenNode {
 
 class MemorySink : public lod::NodeSink {
 public:
-  void writeNode(const NodeKey& key, const PointRecord* records, size_t count) override {
+  void writeNode(const NodeKey& key, const PointRecord* records, const uint8_t*, size_t count) override {
     nodes.push_back({key, std::vector<PointRecord>(records, records + count)});
     // FNV-1a over the key and the records, in write order: what an octree file's bytes depend on.
     mix(&key, sizeof key);

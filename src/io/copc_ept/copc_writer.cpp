@@ -12,6 +12,7 @@
 
 #include "io/copc_ept/copc.h"
 #include "io/io_util.h"
+#include "io/las/las_attributes.h"
 #include "io/las/las_format.h"
 #include "io/las/laz_encoder.h"
 #include "io/stale_partials.h"
@@ -74,6 +75,8 @@ struct CopcWriter::State {
   uint64_t count = 0;
   int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
   std::array<uint64_t, 15> byReturn{};
+  double gpsMin = 0, gpsMax = 0;
+  bool anyGps = false;
   // Encoders for the threads that encode at once; each keeps its models from chunk to chunk.
   mutable std::mutex encodersMutex;
   mutable std::vector<std::unique_ptr<laz::ChunkEncoder>> encoders;
@@ -90,7 +93,7 @@ struct CopcWriter::State {
     }
   }
   void header();
-  void records(const PointRecord* in, size_t n, std::vector<uint8_t>& out) const;
+  void records(const PointRecord* in, const uint8_t* tails, size_t n, std::vector<uint8_t>& out) const;
   std::vector<uint8_t> hierarchy(uint64_t dataOffset, uint64_t& rootOffset, uint64_t& rootSize) const;
 };
 
@@ -120,7 +123,11 @@ void CopcWriter::State::header() {
 // number and number of returns in byte 14 (4 bits each; the records keep no number of returns, so it is
 // written equal to the return number, which keeps the record valid); classification at 16; point source
 // id at 20; GPS time (0) at 22; RGB at 30 (format 7).
-void CopcWriter::State::records(const PointRecord* in, size_t n, std::vector<uint8_t>& out) const {
+// With tails, their attributes then fill the rest of each record (las_attributes.h).
+void CopcWriter::State::records(const PointRecord* in, const uint8_t* tails, size_t n,
+                                std::vector<uint8_t>& out) const {
+  const TailFormat& tail = options.tail;
+  const int rgbOffset = las::kRgbOffset[size_t(pointFormat)];
   const RecordFields& f = metadata.fields;
   out.assign(n * recordLength, 0);
   for (size_t k = 0; k < n; ++k) {
@@ -134,9 +141,10 @@ void CopcWriter::State::records(const PointRecord* in, size_t n, std::vector<uin
     r[14] = static_cast<uint8_t>(rn | (rn << 4));
     r[16] = f.classification ? p.classification : 0;
     storeLE<uint16_t>(r + 20, f.pointSourceId ? p.pointSourceId : 0);
-    if (pointFormat == 7)
+    if (rgbOffset >= 0)
       for (int c = 0; c < 3; ++c)
-        storeLE<uint16_t>(r + 30 + 2 * c, p.rgb[c]);
+        storeLE<uint16_t>(r + rgbOffset + 2 * c, p.rgb[c]);
+    if (tails) unpackLasAttributes(tails + k * tail.bytes(), tail.layout, tail.attributes, pointFormat, r);
   }
 }
 
@@ -203,7 +211,14 @@ CopcWriter::CopcWriter(std::filesystem::path path, const lod::OctreeMetadata& me
   s.averagedColors = averagedColors;
   assert(options.hierarchyStepSize >= 1);
   s.pointFormat = metadata.fields.color ? 7 : 6;
-  s.recordLength = las::kRecordSize[size_t(s.pointFormat)];
+  const TailFormat& tail = options.tail;
+  if (tail.lasPointFormat >= 0) {
+    if (tail.lasPointFormat >= 6 && tail.lasPointFormat <= 8)
+      s.pointFormat = tail.lasPointFormat;
+    else if (tail.attributes.nir)
+      s.pointFormat = 8;
+  }
+  s.recordLength = static_cast<uint16_t>(las::kRecordSize[size_t(s.pointFormat)] + tail.attributes.extraBytes);
   s.layout = laz::encoderLayout(s.pointFormat, s.recordLength, laz::kVariableChunks);
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(metadata.scale[a]) || metadata.scale[a] == 0.0 || !std::isfinite(metadata.offset[a]))
@@ -217,6 +232,12 @@ CopcWriter::CopcWriter(std::filesystem::path path, const lod::OctreeMetadata& me
   for (const auto& v : vlrs)
     s.prefix.insert(s.prefix.end(), v.begin(), v.end());
   uint32_t vlrCount = 2;
+  if (tail.attributes.extraBytes > 0 && !tail.extraBytesDescriptors.empty() &&
+      tail.extraBytesDescriptors.size() <= UINT16_MAX) {
+    const std::vector<uint8_t> v = las::vlrBytes("LASF_Spec", 4, "Extra bytes", tail.extraBytesDescriptors);
+    s.prefix.insert(s.prefix.end(), v.begin(), v.end());
+    ++vlrCount;
+  }
   if (!options.wkt.empty()) {
     if (options.wkt.size() + 1 > UINT16_MAX)
       fail(s.path, "the coordinate system's WKT is too long for a VLR");
@@ -264,7 +285,13 @@ const std::filesystem::path& CopcWriter::workingDir() const {
 
 CopcWriter::EncodedNode CopcWriter::encodeNode(const NodeKey& key, const PointRecord* records,
                                                size_t count) const {
+  return encodeNode(key, records, nullptr, count);
+}
+
+CopcWriter::EncodedNode CopcWriter::encodeNode(const NodeKey& key, const PointRecord* records,
+                                               const uint8_t* tails, size_t count) const {
   const State& s = *state_;
+  if (s.options.tail.bytes() == 0) tails = nullptr;
   // Hierarchy entries count points and bytes in int32.
   if (count > size_t(INT32_MAX))
     fail(s.path, strFormat("node %d-%d-%d-%d holds %zu points, more than a COPC node can (2^31 - 1); "
@@ -281,8 +308,17 @@ CopcWriter::EncodedNode CopcWriter::encodeNode(const NodeKey& key, const PointRe
     if (rn >= 1) ++node.byReturn[rn - 1];
   }
   if (count == 0) return node;
+  const TailFormat& tail = s.options.tail;
+  if (tails && tail.layout.gpsTime >= 0) {
+    node.gpsMin = node.gpsMax = loadTail<double>(tails, tail.layout.gpsTime);
+    for (size_t k = 1; k < count; ++k) {
+      const double t = loadTail<double>(tails + k * tail.bytes(), tail.layout.gpsTime);
+      node.gpsMin = std::min(node.gpsMin, t);
+      node.gpsMax = std::max(node.gpsMax, t);
+    }
+  }
   thread_local std::vector<uint8_t> raw;
-  s.records(records, count, raw);
+  s.records(records, tails, count, raw);
   std::unique_ptr<laz::ChunkEncoder> encoder;
   {
     std::lock_guard lock(s.encodersMutex);
@@ -316,6 +352,11 @@ uint64_t CopcWriter::place(const NodeKey& key, const EncodedNode& node) {
   }
   for (size_t i = 0; i < s.byReturn.size(); ++i)
     s.byReturn[i] += node.byReturn[i];
+  if (s.options.tail.layout.gpsTime >= 0) {
+    s.gpsMin = s.anyGps ? std::min(s.gpsMin, node.gpsMin) : node.gpsMin;
+    s.gpsMax = s.anyGps ? std::max(s.gpsMax, node.gpsMax) : node.gpsMax;
+    s.anyGps = true;
+  }
   return offset;
 }
 
@@ -324,7 +365,12 @@ void CopcWriter::writeAt(uint64_t offset, const EncodedNode& node) const {
 }
 
 void CopcWriter::writeNode(const NodeKey& key, const PointRecord* records, size_t count) {
-  const EncodedNode node = encodeNode(key, records, count);
+  writeNode(key, records, nullptr, count);
+}
+
+void CopcWriter::writeNode(const NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                           size_t count) {
+  const EncodedNode node = encodeNode(key, records, tails, count);
   writeAt(place(key, node), node);
 }
 
@@ -365,7 +411,9 @@ void CopcWriter::commit() {
   storeLE<double>(info + 32, s.metadata.spacing);
   storeLE<uint64_t>(info + 40, rootOffset);
   storeLE<uint64_t>(info + 48, rootSize);
-  // GPS time range 0..0 (the records hold none) and the reserved words stay 0.
+  // The GPS time range (0..0 where the records hold none); the reserved words stay 0.
+  storeLE<double>(info + 56, s.gpsMin);
+  storeLE<double>(info + 64, s.gpsMax);
 
   uint8_t* h = s.prefix.data();
   Bounds bounds;
@@ -401,21 +449,22 @@ uint64_t CopcWriter::bytes() const {
 
 // ---- CopcNodeSink -----------------------------------------------------------------------------------------
 
-void CopcNodeSink::writeNode(const NodeKey& key, const PointRecord* records, size_t count) {
-  writer_.writeNode(key, records, count);
+void CopcNodeSink::writeNode(const NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                             size_t count) {
+  writer_.writeNode(key, records, tails, count);
 }
 
 std::unique_ptr<lod::PreparedNode> CopcNodeSink::prepare(const NodeKey& key, const PointRecord* records,
-                                                         size_t count) const {
+                                                         const uint8_t* tails, size_t count) const {
   auto prepared = std::make_unique<Prepared>();
-  prepared->node = writer_.encodeNode(key, records, count);
+  prepared->node = writer_.encodeNode(key, records, tails, count);
   return prepared;
 }
 
 void CopcNodeSink::writePrepared(const NodeKey& key, lod::PreparedNode* prepared, const PointRecord* records,
-                                 size_t count) {
+                                 const uint8_t* tails, size_t count) {
   auto* p = dynamic_cast<Prepared*>(prepared);
-  if (!p) return writeNode(key, records, count);
+  if (!p) return writeNode(key, records, tails, count);
   p->offset = writer_.place(key, p->node);
   p->placed = true;
 }
@@ -470,6 +519,7 @@ CopcBuildReport buildCopc(const std::vector<std::filesystem::path>& inputs,
   OctreeBuilder builder(inputs, options);
   writeOptions.wkt = inputsWkt(inputs);
   const lod::OctreeMetadata& metadata = builder.scan();
+  writeOptions.tail = builder.tail();
   CopcWriter writer(output, metadata, options.averageColors, writeOptions);
   CopcNodeSink sink(writer);
   CopcBuildReport report;

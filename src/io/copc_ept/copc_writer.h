@@ -2,7 +2,11 @@
 // the octree's nodes, one chunk a node, in the order the builder finishes them.
 //
 // Layout of the file:
-//   public header (375 B, LAS 1.4, point format 6, or 7 with color; GPS times 0: the builder keeps none)
+//   public header (375 B, LAS 1.4). Points with the tails of LAS records (cloud/point_attributes.h) keep
+//     their input's point format where it is 6, 7 or 8, else become 8 with NIR, 7 with color, 6
+//     otherwise (formats 0-5's scan angle rank converted to 0.006 degree units), with their extra
+//     bytes and descriptors (an extra bytes VLR); points without tails are format 6, or 7 with color,
+//     GPS times 0
 //   VLR "copc" 1 (the info VLR, first, at offset 375: root cube center and half size, root spacing, the
 //     root hierarchy page's offset and size, GPS time range)
 //   VLR "laszip encoded" 22204 (chunk size 0xFFFFFFFF: variable chunks)
@@ -33,6 +37,8 @@ struct CopcWriteOptions {
   int hierarchyStepSize = 4;
   // The coordinate system to store (OGC WKT), empty for none.
   std::string wkt;
+  // The attributes the points carry beside their records (the builder's tail), written into the records.
+  TailFormat tail;
 };
 
 class CopcWriter {
@@ -55,14 +61,19 @@ public:
     uint64_t count = 0;
     int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
     std::array<uint64_t, 15> byReturn{};
+    double gpsMin = 0, gpsMax = 0; // GPS time range of the points (where the tails hold one)
   };
   EncodedNode encodeNode(const lod::NodeKey& key, const PointRecord* records, size_t count) const;
+  // With the records' tails (options' tail.bytes() each; null: none).
+  EncodedNode encodeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                         size_t count) const;
   // Gives the node its place in the file, in the caller's order (not thread-safe; the order decides the
   // bytes). Every node once.
   uint64_t place(const lod::NodeKey& key, const EncodedNode& node);
   // Writes a placed node's bytes; thread-safe, several at once.
   void writeAt(uint64_t offset, const EncodedNode& node) const;
   void writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count);
+  void writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails, size_t count);
 
   // Writes the chunk table, the hierarchy, the header and VLRs, and renames the file into place.
   void commit();
@@ -76,11 +87,12 @@ private:
 class CopcNodeSink final : public lod::NodeSink {
 public:
   explicit CopcNodeSink(CopcWriter& writer) : writer_(writer) {}
-  void writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count) override;
+  void writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                 size_t count) override;
   std::unique_ptr<lod::PreparedNode> prepare(const lod::NodeKey& key, const PointRecord* records,
-                                             size_t count) const override;
+                                             const uint8_t* tails, size_t count) const override;
   void writePrepared(const lod::NodeKey& key, lod::PreparedNode* prepared, const PointRecord* records,
-                     size_t count) override;
+                     const uint8_t* tails, size_t count) override;
   void finishPrepared(std::unique_ptr<lod::PreparedNode> prepared) const override;
 
 private:

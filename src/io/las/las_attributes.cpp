@@ -144,13 +144,17 @@ void unpackLasAttributes(const uint8_t* tail, const AttributeLayout& layout,
   const int16_t angle = layout.scanAngle >= 0 ? convertAngle(loadTail<int16_t>(tail, layout.scanAngle),
                                                              attributes.extendedScanAngle, extended)
                                               : int16_t(0);
+  // Without a number of returns in the tail, the record's own bits stay.
+  const bool hasReturns = layout.numberOfReturns >= 0;
   if (extended) {
-    record[14] = static_cast<uint8_t>((record[14] & 0x0F) | (std::min<uint8_t>(returns, 15) << 4));
+    record[14] = static_cast<uint8_t>(hasReturns ? (record[14] & 0x0F) | (std::min<uint8_t>(returns, 15) << 4)
+                                                 : record[14]);
     record[15] = flags;
     storeLE<int16_t>(record + 18, angle);
   } else {
-    record[14] =
-        static_cast<uint8_t>((record[14] & 0x07) | (std::min<uint8_t>(returns, 7) << 3) | (flags & 0xC0));
+    record[14] = static_cast<uint8_t>(
+        (hasReturns ? (record[14] & 0x07) | (std::min<uint8_t>(returns, 7) << 3) : record[14] & 0x3F) |
+        (flags & 0xC0));
     record[15] = static_cast<uint8_t>((record[15] & 0x1F) | ((flags & 0x07) << 5));
     record[16] = static_cast<uint8_t>(static_cast<int8_t>(angle));
   }
@@ -161,6 +165,38 @@ void unpackLasAttributes(const uint8_t* tail, const AttributeLayout& layout,
   if (layout.extraBytes >= 0)
     std::memcpy(record + las::kRecordSize[static_cast<size_t>(pointFormat)], tail + layout.extraBytes,
                 attributes.extraBytes);
+}
+
+TailFormat lasTailFormat(const InputFile& file, const LasHeader& header) {
+  TailFormat t;
+  const uint16_t base = las::kRecordSize[static_cast<size_t>(header.pointFormat)];
+  const uint16_t extra = header.recordLength > base ? uint16_t(header.recordLength - base) : uint16_t(0);
+  t.attributes = lasAttributes(header.pointFormat, extra);
+  t.layout = attributeLayout(t.attributes);
+  t.lasPointFormat = header.pointFormat;
+  if (extra > 0) {
+    for (const LasVlr& v : header.vlrs)
+      if (v.userId == "LASF_Spec" && v.recordId == 4) {
+        const size_t at = t.extraBytesDescriptors.size();
+        t.extraBytesDescriptors.resize(at + v.length);
+        file.readAt(v.dataOffset, t.extraBytesDescriptors.data() + at, v.length);
+      }
+    try {
+      parseExtraBytes(t.extraBytesDescriptors, extra, "");
+    } catch (const InputError&) {
+      t.extraBytesDescriptors.clear();
+    }
+  }
+  return t;
+}
+
+void packLasTails(const uint8_t* records, uint64_t stride, uint64_t count, int pointFormat,
+                  uint16_t extraBytes, const TailFormat& tail, uint8_t* tails) {
+  const uint32_t bytes = tail.bytes();
+  PointAttributes own = tail.attributes;
+  own.extraBytes = std::min(own.extraBytes, extraBytes);
+  for (uint64_t i = 0; i < count; ++i)
+    packLasAttributes(records + i * stride, pointFormat, tail.layout, own, tails + i * bytes);
 }
 
 } // namespace pointrast::io::detail

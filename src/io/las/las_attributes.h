@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "cloud/point_attributes.h"
+#include "io/io_util.h"
+#include "io/las/las_format.h"
 
 namespace pointrast::io::detail {
 
@@ -27,7 +29,8 @@ void packLasAttributes(const uint8_t* record, int pointFormat, const AttributeLa
 // Writes the tail's attributes into a record of pointFormat whose PointRecord fields are already there
 // (number of returns and the flags share their bytes with the return number and, in formats 0-5, the
 // classification: those bits are kept). Extra bytes go after the format's size when the layout has them.
-// The tail's attributes describe its values (the scan angle's unit).
+// The tail's attributes describe its values (the scan angle's unit). A layout without a number of
+// returns leaves the record's number of returns bits as they are.
 void unpackLasAttributes(const uint8_t* tail, const AttributeLayout& layout,
                          const PointAttributes& attributes, int pointFormat, uint8_t* record);
 
@@ -52,5 +55,14 @@ struct ExtraBytesField {
 // the records' extra bytes.
 std::vector<ExtraBytesField> parseExtraBytes(const std::vector<uint8_t>& descriptors, uint16_t extraBytes,
                                              const std::string& where);
+
+// The tails of a LAS file's records: lasAttributes() of its format and extra bytes (the record length
+// past the format's size), and the payloads of its extra bytes VLRs. Descriptors that parseExtraBytes()
+// refuses are left out (the bytes stay, undocumented).
+TailFormat lasTailFormat(const InputFile& file, const LasHeader& header);
+// Packs `count` records of pointFormat with extraBytes extra bytes (0, or tail's count), stride bytes
+// apart, into tails of tail.layout (see packLasAttributes).
+void packLasTails(const uint8_t* records, uint64_t stride, uint64_t count, int pointFormat,
+                  uint16_t extraBytes, const TailFormat& tail, uint8_t* tails);
 
 } // namespace pointrast::io::detail

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "io/las/las_attributes.h"
 #include "io/las/las_format.h"
 
 namespace pointrast::io::detail {
@@ -66,6 +67,7 @@ public:
     const uint64_t per = pieceRecords();
     for (uint64_t first = 0; first < header_.pointCount; first += per)
       pieces_.push_back({first, std::min(per, header_.pointCount - first)});
+    tail_ = lasTailFormat(file_, header_);
   }
 
   const PointSourceInfo& info() const override { return info_; }
@@ -88,11 +90,32 @@ public:
 
   uint64_t pieceBytes(size_t i) const override { return pieces_.at(i).count * header_.recordLength; }
 
+  TailFormat tailFormat() const override { return tail_; }
+
+  void readPieceTails(size_t i, std::vector<PointRecord>& out, const TailFormat& layout,
+                      std::vector<uint8_t>& tails) const override {
+    const PointPiece& piece = pieces_.at(i);
+    const uint64_t stride = header_.recordLength;
+    out.resize(piece.count);
+    tails.resize(piece.count * layout.bytes());
+    thread_local std::vector<uint8_t> buffer;
+    const uint64_t perRead = std::max<uint64_t>(1, kReadBytes / stride);
+    buffer.resize(static_cast<size_t>(std::min(perRead, piece.count) * stride));
+    for (uint64_t done = 0; done < piece.count; done += perRead) {
+      const uint64_t n = std::min(perRead, piece.count - done);
+      file_.readAt(header_.pointOffset + (piece.first + done) * stride, buffer.data(), n * stride);
+      decodeLasRecords(buffer.data(), stride, n, header_.pointFormat, out.data() + done);
+      packLasTails(buffer.data(), stride, n, header_.pointFormat, tail_.attributes.extraBytes, layout,
+                   tails.data() + done * layout.bytes());
+    }
+  }
+
 private:
   InputFile file_;
   LasHeader header_;
   PointSourceInfo info_;
   std::vector<PointPiece> pieces_;
+  TailFormat tail_;
 };
 
 } // namespace

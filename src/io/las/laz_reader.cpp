@@ -10,6 +10,7 @@
 #include "base/parallel.h"
 #include "base/progress.h"
 #include "io/copc_ept/copc.h"
+#include "io/las/las_attributes.h"
 #include "io/las/las_records.h"
 
 namespace pointrast::io {
@@ -311,6 +312,7 @@ public:
     info_.fields = lasRecordFields(hd.hasColor());
     for (const laz::Chunk& c : laz_.chunks)
       pieces_.push_back({c.firstPoint, c.pointCount});
+    tail_ = lasTailFormat(file_, hd);
   }
 
   const PointSourceInfo& info() const override { return info_; }
@@ -329,12 +331,31 @@ public:
       out[k] = toPointRecord(records.data() + k * hd.recordLength, extended, rgbOffset);
   }
 
+  TailFormat tailFormat() const override { return tail_; }
+
+  void readPieceTails(size_t i, std::vector<PointRecord>& out, const TailFormat& layout,
+                      std::vector<uint8_t>& tails) const override {
+    const LasHeader& hd = laz_.header;
+    std::vector<uint8_t> records;
+    pool_.decode(file_, laz_.chunks[i], strFormat("LAZ chunk %zu of %zu", i + 1, laz_.chunks.size()),
+                 records);
+    const bool extended = las::isExtended(hd.pointFormat);
+    const int rgbOffset = hd.rgbOffset();
+    out.resize(laz_.chunks[i].pointCount);
+    for (size_t k = 0; k < out.size(); ++k)
+      out[k] = toPointRecord(records.data() + k * hd.recordLength, extended, rgbOffset);
+    tails.resize(out.size() * layout.bytes());
+    packLasTails(records.data(), hd.recordLength, out.size(), hd.pointFormat, tail_.attributes.extraBytes,
+                 layout, tails.data());
+  }
+
 private:
   InputFile file_;
   laz::LazFile laz_;
   mutable ChunkDecoderPool pool_;
   PointSourceInfo info_;
   std::vector<PointPiece> pieces_;
+  TailFormat tail_;
 };
 
 } // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <optional>
@@ -113,6 +114,7 @@ struct OctreeBuilder::State {
   bool inMemory = true;
   bool scanned = false;
   lod::Pieces pieces; // in memory: every point, after scan()
+  LargeBuffer<uint8_t> tails; // in memory: every point's tail, in task order, after scan()
   lod::LodGrid grid;
   lod::OctreeMetadata metadata;
   std::vector<lod::LodPhase> phases;
@@ -120,6 +122,15 @@ struct OctreeBuilder::State {
 
   State(const std::vector<std::filesystem::path>& paths, const LodBuildOptions& o)
       : options(o), inputs(paths) {}
+
+  // The constants above, plus a tail and an item's ref per point where points carry tails (a tail is
+  // held twice while indexing: the chunk's store and its nodes').
+  uint64_t inMemoryBytesPerPoint() const {
+    return kInMemoryBytesPerPoint + (params.tailBytes ? 8 + params.tailBytes : 0);
+  }
+  uint64_t indexBytesPerPoint() const {
+    return kIndexBytesPerPoint + (params.tailBytes ? 16 + 3 * uint64_t(params.tailBytes) : 0);
+  }
 
   unsigned readThreads() const {
     return std::min<unsigned>(threads, static_cast<unsigned>(std::max<size_t>(inputs.tasks().size(), 1)));
@@ -153,11 +164,12 @@ OctreeBuilder::OctreeBuilder(const std::vector<std::filesystem::path>& inputs, c
   s.run.progress = options.progress;
   s.params.leafPoints = std::max<uint64_t>(options.leafPoints, 1);
   s.params.averageColors = options.averageColors;
+  s.params.tailBytes = s.inputs.tail().bytes();
   s.memory = options.memoryBytes ? options.memoryBytes : defaultBuildMemory();
   const uint64_t n = s.inputs.points();
   s.inMemoryChunk = lod::inMemoryChunkLimit(n, s.threads, s.params.leafPoints);
-  const uint64_t need =
-      n * kInMemoryBytesPerPoint + uint64_t(s.threads) * s.inMemoryChunk * kIndexBytesPerPoint + kFixedBytes;
+  const uint64_t need = n * s.inMemoryBytesPerPoint() +
+                        uint64_t(s.threads) * s.inMemoryChunk * s.indexBytesPerPoint() + kFixedBytes;
   s.inMemory = need <= s.memory;
 }
 
@@ -169,6 +181,9 @@ uint64_t OctreeBuilder::points() const {
 bool OctreeBuilder::inMemory() const {
   return state_->inMemory;
 }
+const TailFormat& OctreeBuilder::tail() const {
+  return state_->inputs.tail();
+}
 
 const lod::OctreeMetadata& OctreeBuilder::scan() {
   State& s = *state_;
@@ -177,20 +192,69 @@ const lod::OctreeMetadata& OctreeBuilder::scan() {
   const lod::PhaseClock readClock;
   const auto& tasks = s.inputs.tasks();
   std::vector<BuildInputs::Scan> scans(tasks.size());
+  // Tails are read whole, then fields that are zero everywhere are left out (BuildInputs::pruneTail).
+  const uint32_t readTailBytes = s.inputs.tail().bytes();
+  std::vector<std::vector<uint8_t>> masks(s.readThreads(), std::vector<uint8_t>(readTailBytes, 0));
+  std::vector<uint8_t> mask(readTailBytes, 0);
+  std::vector<char> returnsDiffer(masks.size(), 0);
+  auto pruneTail = [&] {
+    bool differ = false;
+    for (size_t w = 0; w < masks.size(); ++w) {
+      for (uint32_t b = 0; b < readTailBytes; ++b)
+        mask[b] |= masks[w][b];
+      differ = differ || returnsDiffer[w];
+    }
+    const TailFormat full = s.inputs.pruneTail(mask, differ);
+    s.params.tailBytes = s.inputs.tail().bytes();
+    return full;
+  };
   if (s.inMemory) {
     s.pieces.resize(tasks.size());
-    s.readAll("reading", [&](unsigned, size_t t, std::vector<PointRecord>&) {
-      s.inputs.read(tasks[t], s.pieces[t]);
+    std::vector<std::vector<uint8_t>> pieceTails(tasks.size());
+    s.readAll("reading", [&](unsigned worker, size_t t, std::vector<PointRecord>&) {
+      if (readTailBytes) {
+        s.inputs.read(tasks[t], s.pieces[t], pieceTails[t]);
+        if (s.pieces[t].size() != tasks[t].points)
+          fail(s.inputs.names(), "a file changed while the octree was built");
+        bool differ = returnsDiffer[worker];
+        s.inputs.orTails(s.pieces[t].data(), pieceTails[t].data(), s.pieces[t].size(), masks[worker].data(),
+                         differ);
+        returnsDiffer[worker] = differ;
+      } else {
+        s.inputs.read(tasks[t], s.pieces[t]);
+      }
       scans[t] = BuildInputs::scan(s.pieces[t]);
     });
+    const TailFormat full = pruneTail();
+    const uint32_t tailBytes = s.params.tailBytes;
+    if (tailBytes) {
+      std::vector<uint64_t> first(tasks.size() + 1, 0);
+      for (size_t t = 0; t < tasks.size(); ++t)
+        first[t + 1] = first[t] + tasks[t].points;
+      s.tails = LargeBuffer<uint8_t>(static_cast<size_t>(first.back() * tailBytes));
+      parallelBlocksOn(s.threads, tasks.size(), 1, [&](uint64_t t, uint64_t, uint64_t) {
+        BuildInputs::repack(full, s.inputs.tail(), pieceTails[t].data(), tasks[t].points,
+                            s.tails.data() + first[t] * tailBytes);
+        std::vector<uint8_t>().swap(pieceTails[t]);
+      });
+    }
     if (s.inputs.decideColors(scans))
       parallelBlocksOn(s.threads, tasks.size(), 1,
                        [&](uint64_t t, uint64_t, uint64_t) { s.inputs.widen(tasks[t], s.pieces[t]); });
   } else {
-    s.readAll("scanning", [&](unsigned, size_t t, std::vector<PointRecord>& records) {
-      s.inputs.read(tasks[t], records);
+    s.readAll("scanning", [&](unsigned worker, size_t t, std::vector<PointRecord>& records) {
+      if (readTailBytes) {
+        thread_local std::vector<uint8_t> tails;
+        s.inputs.read(tasks[t], records, tails);
+        bool differ = returnsDiffer[worker];
+        s.inputs.orTails(records.data(), tails.data(), records.size(), masks[worker].data(), differ);
+        returnsDiffer[worker] = differ;
+      } else {
+        s.inputs.read(tasks[t], records);
+      }
       scans[t] = BuildInputs::scan(records);
     });
+    pruneTail();
     s.inputs.decideColors(scans);
   }
   pointrast::detail::QuantBox box;
@@ -229,7 +293,9 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
   const lod::LodGrid& grid = s.grid;
 
   if (s.inMemory) {
-    lod::LodBuildStats stats = lod::buildInMemory(std::move(s.pieces), grid, s.params, sink, s.run);
+    lod::LodBuildStats stats = lod::buildInMemory(std::move(s.pieces), grid, s.params, sink, s.run,
+                                                  s.params.tailBytes ? s.tails.data() : nullptr);
+    s.tails = LargeBuffer<uint8_t>();
     s.phases.insert(s.phases.end(), stats.phases.begin(), stats.phases.end());
     report.octree = stats.octree;
     report.chunks = stats.chunks;
@@ -246,7 +312,7 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
     clock = lod::PhaseClock();
     // A chunk, indexed by one thread, may take its share of the memory bound.
     const uint64_t chunkLimit =
-        std::max<uint64_t>(s.params.leafPoints, s.memory / (uint64_t(s.threads) * kIndexBytesPerPoint * 2));
+        std::max<uint64_t>(s.params.leafPoints, s.memory / (uint64_t(s.threads) * s.indexBytesPerPoint() * 2));
     const std::vector<lod::LodChunk> chunks = lod::planChunks(counts, grid.countLevel(), chunkLimit);
     const std::vector<uint32_t> chunkOf = lod::chunkOfCell(chunks, grid.countLevel());
     uint64_t largest = 0;
@@ -262,7 +328,11 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
     s.phases.push_back(clock.done("chunk", n));
 
     clock = lod::PhaseClock();
-    ChunkSpill spill(tempDir, chunks.size());
+    const uint32_t tailBytes = s.params.tailBytes;
+    ChunkSpill spill(tempDir, chunks.size(), tailBytes);
+    std::vector<uint64_t> first(tasks.size() + 1, 0);
+    for (size_t t = 0; t < tasks.size(); ++t)
+      first[t + 1] = first[t] + tasks[t].points;
     const uint64_t bufferBytes =
         std::clamp<uint64_t>(s.memory / (4 * uint64_t(s.threads)), 1 << 16, 64 << 20);
     const int shift = 3 * (lod::kCodeLevels - grid.countLevel());
@@ -272,21 +342,54 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
         writers.push_back(std::make_unique<ChunkSpill::Writer>(spill, bufferBytes));
       s.readAll("distributing", [&](unsigned worker, size_t task, std::vector<PointRecord>& records) {
         ChunkSpill::Writer* writer = writers[worker].get();
-        s.inputs.read(tasks[task], records);
-        for (const PointRecord& r : records)
-          writer->add(chunkOf[grid.countCell(r)], r);
+        if (tailBytes) {
+          thread_local std::vector<uint8_t> tails;
+          s.inputs.read(tasks[task], records, tails);
+          for (size_t i = 0; i < records.size(); ++i)
+            writer->add(chunkOf[grid.countCell(records[i])], records[i], first[task] + i,
+                        tails.data() + i * tailBytes);
+        } else {
+          s.inputs.read(tasks[task], records);
+          for (const PointRecord& r : records)
+            writer->add(chunkOf[grid.countCell(r)], r);
+        }
       });
       for (auto& w : writers)
         w->flush();
     }
     s.phases.push_back(clock.done("distribute", n, s.inputs.fileBytes() + spill.bytesWritten()));
 
-    const size_t window = std::clamp<size_t>(s.memory / std::max<uint64_t>(1, largest * kIndexBytesPerPoint),
-                                             1, 2 * size_t(s.threads));
-    lod::ChunkLoader load = [&](size_t c, std::vector<lod::LodItem>& items) {
+    const size_t window =
+        std::clamp<size_t>(s.memory / std::max<uint64_t>(1, largest * s.indexBytesPerPoint()), 1,
+                           2 * size_t(s.threads));
+    lod::ChunkLoader load = [&](size_t c, lod::ChunkStorage& storage) {
       const lod::LodChunk& chunk = chunks[c];
-      thread_local std::vector<PointRecord> records;
-      spill.read(c, chunk.points, records);
+      std::vector<lod::LodItem>& items = storage.items;
+      thread_local std::vector<uint8_t> rows;
+      spill.read(c, chunk.points, rows);
+      const size_t rowBytes = spill.rowBytes();
+      const size_t count = static_cast<size_t>(chunk.points);
+      // With tails: the chunk's tail store in input order (by each point's place), so that a ref, the
+      // index into it, orders equal records as the input does whatever order the file holds them in.
+      thread_local std::vector<uint64_t> rank;
+      if (tailBytes) {
+        thread_local std::vector<std::pair<uint64_t, uint64_t>> places;
+        places.resize(count);
+        for (size_t i = 0; i < count; ++i) {
+          uint64_t place;
+          std::memcpy(&place, rows.data() + i * rowBytes + sizeof(PointRecord), sizeof place);
+          places[i] = {place, uint64_t(i)};
+        }
+        std::sort(places.begin(), places.end());
+        rank.resize(count);
+        storage.tails.resize(count * tailBytes);
+        for (size_t k = 0; k < count; ++k) {
+          rank[places[k].second] = k;
+          std::memcpy(storage.tails.data() + k * tailBytes,
+                      rows.data() + places[k].second * rowBytes + sizeof(PointRecord) + sizeof(uint64_t),
+                      tailBytes);
+        }
+      }
       // Grouped by histogram cell, the layout indexChunk takes (as distributePoints makes in memory).
       std::vector<uint64_t> next(static_cast<size_t>(chunk.endCell - chunk.firstCell));
       uint64_t at = 0;
@@ -294,20 +397,22 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
         next[i] = at;
         at += counts[chunk.firstCell + i];
       }
-      items.resize(records.size());
+      items.resize(count);
       auto changed = [&] { fail(spill.dir(), "a temporary chunk file changed while the octree was built"); };
-      for (const PointRecord& r : records) {
+      for (size_t i = 0; i < count; ++i) {
+        PointRecord r;
+        std::memcpy(&r, rows.data() + i * rowBytes, sizeof r);
         const uint64_t code = grid.code(r);
         const uint64_t cell = (code >> shift) - chunk.firstCell;
         if (cell >= next.size() || next[cell] >= items.size()) changed();
-        items[next[cell]++] = {code, r};
+        items[next[cell]++] = {code, r, tailBytes ? rank[i] : uint64_t(0)};
       }
       for (size_t i = 0; i < next.size(); ++i)
         if (next[i] != (i + 1 < next.size() ? next[i + 1] - counts[chunk.firstCell + i + 1] : items.size()))
           changed();
-      return std::span<lod::LodItem>(items);
+      return lod::LoadedChunk{std::span<lod::LodItem>(items), tailBytes ? storage.tails.data() : nullptr};
     };
-    lod::OctreeAssembler assembler(sink);
+    lod::OctreeAssembler assembler(sink, tailBytes);
     const lod::IndexTimes times =
         lod::indexChunks(chunks, counts, load, grid, s.params, assembler, window, s.run);
     s.phases.push_back(times.index);

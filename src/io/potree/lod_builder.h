@@ -21,6 +21,7 @@
 
 #include "cloud/lod_build.h"
 #include "cloud/octree.h"
+#include "cloud/point_attributes.h"
 
 namespace pointrast::io {
 
@@ -64,6 +65,9 @@ public:
 
   // Phase "read": what an octree writer needs before the first node (cube, spacing, frame, fields, count).
   const lod::OctreeMetadata& scan();
+  // The attributes every point carries beside its record (cloud/point_attributes.h), handed to the sink
+  // with the records.
+  const TailFormat& tail() const;
   // The other phases, into sink. Out of core, temporary files go into tempDir, which must not exist yet
   // and is removed before returning (also when an exception leaves).
   LodBuildReport build(lod::NodeSink& sink, const std::filesystem::path& tempDir);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstring>
 
 #include "io/io_util.h"
 
@@ -35,6 +36,29 @@ BuildInputs::BuildInputs(const std::vector<std::filesystem::path>& paths) {
     }
   }
   chooseFrame();
+  chooseTail();
+}
+
+void BuildInputs::chooseTail() {
+  bool first = true;
+  for (const Input& in : inputs_) {
+    const TailFormat t = in.source->tailFormat();
+    if (!t.attributes.any()) continue;
+    if (first) {
+      tail_ = t;
+      first = false;
+      continue;
+    }
+    bool ok = true;
+    tail_.attributes = mergeAttributes(tail_.attributes, t.attributes, ok);
+    if (!ok)
+      throw InputError(in.source->info().source + ": its extra bytes or scan angle unit differ from " +
+                       inputs_.front().source->info().source +
+                       "'s; one octree cannot hold the attributes of both");
+    if (tail_.lasPointFormat < 0) tail_.lasPointFormat = t.lasPointFormat;
+    if (tail_.extraBytesDescriptors.empty()) tail_.extraBytesDescriptors = t.extraBytesDescriptors;
+  }
+  tail_.layout = attributeLayout(tail_.attributes);
 }
 
 void BuildInputs::chooseFrame() {
@@ -107,6 +131,21 @@ std::string BuildInputs::names() const {
 void BuildInputs::read(const Task& task, std::vector<PointRecord>& out) const {
   const Input& in = inputs_[task.input];
   in.source->readPiece(task.piece, out);
+  convert(in, out);
+}
+
+void BuildInputs::read(const Task& task, std::vector<PointRecord>& out, std::vector<uint8_t>& tails) const {
+  const Input& in = inputs_[task.input];
+  if (tail_.bytes() == 0) {
+    in.source->readPiece(task.piece, out);
+    tails.clear();
+  } else {
+    in.source->readPieceTails(task.piece, out, tail_, tails);
+  }
+  convert(in, out);
+}
+
+void BuildInputs::convert(const Input& in, std::vector<PointRecord>& out) const {
   if (!in.identity) {
     for (PointRecord& r : out) {
       int32_t* q[3] = {&r.x, &r.y, &r.z};
@@ -120,7 +159,10 @@ void BuildInputs::read(const Task& task, std::vector<PointRecord>& out) const {
       }
     }
   }
-  if (in.widenColors) widen(task, out);
+  if (in.widenColors)
+    for (PointRecord& r : out)
+      for (uint16_t& c : r.rgb)
+        c = static_cast<uint16_t>(c * 257);
 }
 
 BuildInputs::Scan BuildInputs::scan(const std::vector<PointRecord>& records) {
@@ -167,6 +209,60 @@ void BuildInputs::widen(const Task& task, std::vector<PointRecord>& records) con
   for (PointRecord& r : records)
     for (uint16_t& c : r.rgb)
       c = static_cast<uint16_t>(c * 257);
+}
+
+void BuildInputs::orTails(const PointRecord* records, const uint8_t* tails, size_t n, uint8_t* mask,
+                          bool& returnsDiffer) const {
+  const uint32_t bytes = tail_.bytes();
+  for (size_t i = 0; i < n; ++i)
+    for (uint32_t b = 0; b < bytes; ++b)
+      mask[b] |= tails[i * bytes + b];
+  const int returns = tail_.layout.numberOfReturns;
+  if (returns >= 0)
+    for (size_t i = 0; i < n && !returnsDiffer; ++i)
+      returnsDiffer = tails[i * bytes + size_t(returns)] != records[i].returnNumber;
+}
+
+TailFormat BuildInputs::pruneTail(const std::vector<uint8_t>& mask, bool returnsDiffer) {
+  const TailFormat before = tail_;
+  const AttributeLayout& l = before.layout;
+  auto used = [&](int offset, int size) {
+    if (offset < 0) return false;
+    for (int b = 0; b < size; ++b)
+      if (mask[size_t(offset + b)]) return true;
+    return false;
+  };
+  PointAttributes& a = tail_.attributes;
+  a.gpsTime = used(l.gpsTime, 8);
+  a.scanAngle = used(l.scanAngle, 2);
+  a.nir = used(l.nir, 2);
+  a.numberOfReturns = l.numberOfReturns >= 0 && returnsDiffer;
+  a.flags = used(l.flags, 1);
+  a.userData = used(l.userData, 1);
+  tail_.layout = attributeLayout(a);
+  return before;
+}
+
+void BuildInputs::repack(const TailFormat& from, const TailFormat& to, const uint8_t* src, size_t n,
+                         uint8_t* dst) {
+  struct Move {
+    int from, to, size;
+  };
+  std::vector<Move> moves;
+  auto add = [&](int f, int t, int size) {
+    if (t >= 0) moves.push_back({f, t, size});
+  };
+  add(from.layout.gpsTime, to.layout.gpsTime, 8);
+  add(from.layout.scanAngle, to.layout.scanAngle, 2);
+  add(from.layout.nir, to.layout.nir, 2);
+  add(from.layout.numberOfReturns, to.layout.numberOfReturns, 1);
+  add(from.layout.flags, to.layout.flags, 1);
+  add(from.layout.userData, to.layout.userData, 1);
+  add(from.layout.extraBytes, to.layout.extraBytes, to.attributes.extraBytes);
+  const size_t f = from.bytes(), t = to.bytes();
+  for (size_t i = 0; i < n; ++i)
+    for (const Move& m : moves)
+      std::memmove(dst + i * t + size_t(m.to), src + i * f + size_t(m.from), size_t(m.size));
 }
 
 } // namespace pointrast::io::detail

@@ -25,21 +25,22 @@ uint64_t folderBytes(const std::filesystem::path& dir) {
 
 } // namespace
 
-void PotreeNodeSink::writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count) {
-  writer_.writeNode(key, records, count);
+void PotreeNodeSink::writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                               size_t count) {
+  writer_.writeNode(key, records, tails, count);
 }
 
 std::unique_ptr<lod::PreparedNode> PotreeNodeSink::prepare(const lod::NodeKey&, const PointRecord* records,
-                                                           size_t count) const {
+                                                           const uint8_t* tails, size_t count) const {
   auto encoded = std::make_unique<EncodedNode>();
-  encoded->node = writer_.encodeNode(records, count);
+  encoded->node = writer_.encodeNode(records, tails, count);
   return encoded;
 }
 
 void PotreeNodeSink::writePrepared(const lod::NodeKey& key, lod::PreparedNode* prepared,
-                                   const PointRecord* records, size_t count) {
+                                   const PointRecord* records, const uint8_t* tails, size_t count) {
   auto* encoded = dynamic_cast<EncodedNode*>(prepared);
-  if (!encoded) return writeNode(key, records, count);
+  if (!encoded) return writeNode(key, records, tails, count);
   encoded->offset = writer_.place(key, encoded->node);
   encoded->placed = true;
 }
@@ -54,7 +55,9 @@ PotreeBuildReport buildPotree(const std::vector<std::filesystem::path>& inputs,
                               const PotreeWriteOptions& writeOptions) {
   OctreeBuilder builder(inputs, options);
   const lod::OctreeMetadata& metadata = builder.scan();
-  PotreeWriter writer(output, metadata, writeOptions);
+  PotreeWriteOptions withTail = writeOptions;
+  withTail.tail = builder.tail();
+  PotreeWriter writer(output, metadata, withTail);
   PotreeNodeSink sink(writer);
   PotreeBuildReport report;
   // Temporary chunk files live in the writer's folder: whatever ends the build, they go with it.

@@ -16,11 +16,12 @@ namespace pointrast::io {
 class PotreeNodeSink final : public lod::NodeSink {
 public:
   explicit PotreeNodeSink(PotreeWriter& writer) : writer_(writer) {}
-  void writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count) override;
+  void writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                 size_t count) override;
   std::unique_ptr<lod::PreparedNode> prepare(const lod::NodeKey& key, const PointRecord* records,
-                                             size_t count) const override;
+                                             const uint8_t* tails, size_t count) const override;
   void writePrepared(const lod::NodeKey& key, lod::PreparedNode* prepared, const PointRecord* records,
-                     size_t count) override;
+                     const uint8_t* tails, size_t count) override;
   void finishPrepared(std::unique_ptr<lod::PreparedNode> prepared) const override;
 
 private:

@@ -1,13 +1,22 @@
 // Octree -> LAS or LAZ export (writer.h): every node's records straight into LasRecordWriter, nodes
-// decoded on all cores a batch at a time and written in forEachNode order.
+// decoded on all cores a batch at a time and written in forEachNode order. An octree whose points carry
+// the tails of LAS records (cloud/lod_tails.h) is written in the point format they came from, with its
+// extra bytes and their descriptors: the records as they were.
 #include <algorithm>
+#include <ctime>
 #include <optional>
 
 #include "base/parallel.h"
 #include "base/progress.h"
+#include "cloud/lod_tails.h"
+#include "io/io_util.h"
+#include "io/las/las_attributes.h"
+#include "io/las/las_format.h"
 #include "io/writer.h"
 
 namespace pointrast::io {
+
+using namespace detail;
 
 namespace {
 
@@ -25,6 +34,98 @@ FilterPoint filterPoint(const PointRecord& r, const lod::OctreeMetadata& meta) {
   p.pointSourceId = r.pointSourceId;
   return p;
 }
+
+// The format a tail's records are written in: waveform formats without their packets (not carried).
+int tailPointFormat(const TailFormat& tail) {
+  switch (tail.lasPointFormat) {
+  case 4:
+    return 1;
+  case 5:
+    return 3;
+  case 9:
+    return 6;
+  case 10:
+    return 8;
+  default:
+    return tail.lasPointFormat;
+  }
+}
+
+// Records with tails as LAS records of the tail's point format, through LasFileWriter.
+class TailRecordWriter {
+public:
+  TailRecordWriter(const std::filesystem::path& path, const lod::OctreeMetadata& meta, const TailFormat& tail)
+      : tail_(tail), format_(tailPointFormat(tail)) {
+    const bool extended = las::isExtended(format_);
+    recordLength_ = static_cast<uint16_t>(las::kRecordSize[size_t(format_)] + tail.attributes.extraBytes);
+    LasFileSetup setup;
+    setup.header.assign(extended ? las::kHeaderSize14 : las::kHeaderSize12, 0);
+    uint8_t* h = setup.header.data();
+    std::memcpy(h, "LASF", 4);
+    storeLE<uint16_t>(h + las::kGlobalEncoding, extended ? 0x10 : 0); // WKT, required for formats 6-10
+    h[las::kVersionMajor] = 1;
+    h[las::kVersionMinor] = extended ? 4 : 2;
+    las::copyString(h + las::kSystemId, 32, "pointrast");
+    las::copyString(h + las::kSoftware, 32, "pointrast");
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    gmtime_r(&now, &utc);
+    storeLE<uint16_t>(h + las::kCreationDay, static_cast<uint16_t>(utc.tm_yday + 1));
+    storeLE<uint16_t>(h + las::kCreationYear, static_cast<uint16_t>(utc.tm_year + 1900));
+    storeLE<uint16_t>(h + las::kHeaderSizeField, static_cast<uint16_t>(setup.header.size()));
+    for (int a = 0; a < 3; ++a) {
+      storeLE<double>(h + las::kScale + 8 * a, meta.scale[a]);
+      storeLE<double>(h + las::kOffset + 8 * a, meta.offset[a]);
+    }
+    if (tail.attributes.extraBytes > 0 && !tail.extraBytesDescriptors.empty() &&
+        tail.extraBytesDescriptors.size() <= UINT16_MAX)
+      setup.vlrs.push_back(las::vlrBytes("LASF_Spec", 4, "Extra bytes", tail.extraBytesDescriptors));
+    setup.pointFormat = format_;
+    setup.recordLength = recordLength_;
+    setup.laz = isLazPath(path);
+    out_.emplace(path, std::move(setup));
+  }
+
+  void write(const PointRecord* records, const uint8_t* tails, size_t count) {
+    const bool extended = las::isExtended(format_);
+    const int rgbOffset = las::kRgbOffset[size_t(format_)];
+    const uint32_t tailBytes = tail_.bytes();
+    buffer_.assign(count * recordLength_, 0);
+    for (size_t k = 0; k < count; ++k) {
+      const PointRecord& p = records[k];
+      uint8_t* r = buffer_.data() + k * recordLength_;
+      storeLE<int32_t>(r, p.x);
+      storeLE<int32_t>(r + 4, p.y);
+      storeLE<int32_t>(r + 8, p.z);
+      storeLE<uint16_t>(r + 12, p.intensity);
+      // The number of returns equal to the return number, where the tail holds none (pruneTail).
+      if (extended) {
+        r[14] = static_cast<uint8_t>((p.returnNumber & 0x0F) * 0x11);
+        r[16] = p.classification;
+        storeLE<uint16_t>(r + 20, p.pointSourceId);
+      } else {
+        r[14] = static_cast<uint8_t>((p.returnNumber & 0x07) * 9);
+        r[15] = p.classification & 0x1F;
+        storeLE<uint16_t>(r + 18, p.pointSourceId);
+      }
+      if (rgbOffset >= 0)
+        for (int c = 0; c < 3; ++c)
+          storeLE<uint16_t>(r + rgbOffset + 2 * c, p.rgb[c]);
+      if (tailBytes > 0)
+        detail::unpackLasAttributes(tails + k * tailBytes, tail_.layout, tail_.attributes, format_, r);
+    }
+    out_->write(buffer_.data(), count);
+  }
+  uint64_t pointsWritten() const { return out_->pointsWritten(); }
+  void commit() { out_->commit(); }
+
+private:
+  const TailFormat& tail_;
+  int format_;
+  uint16_t recordLength_ = 0;
+  std::optional<LasFileWriter> out_;
+  std::vector<uint8_t> buffer_;
+};
 
 } // namespace
 
@@ -62,7 +163,15 @@ uint64_t writeLasFromOctree(const std::filesystem::path& path, lod::NodeSource& 
     listed += node.pointCount;
     return true;
   });
-  LasRecordWriter writer(path, meta.scale, meta.offset, meta.fields, flavor);
+  auto* tailed = dynamic_cast<lod::NodeTails*>(&source);
+  if (tailed && tailed->tailFormat().lasPointFormat < 0) tailed = nullptr;
+  std::optional<LasRecordWriter> writer;
+  std::optional<TailRecordWriter> tailWriter;
+  if (tailed)
+    tailWriter.emplace(path, meta, tailed->tailFormat());
+  else
+    writer.emplace(path, meta.scale, meta.offset, meta.fields, flavor);
+  const uint32_t tailBytes = tailed ? tailed->tailFormat().bytes() : 0;
   std::optional<Progress> line;
   if (progress) line.emplace("exporting " + meta.source, listed);
   for (size_t begin = 0; begin < nodes.size();) {
@@ -71,21 +180,39 @@ uint64_t writeLasFromOctree(const std::filesystem::path& path, lod::NodeSource& 
     while (end < nodes.size() && (end == begin || points + nodes[end].pointCount <= kBatchPoints))
       points += nodes[end++].pointCount;
     std::vector<std::vector<PointRecord>> batch(end - begin);
+    std::vector<std::vector<uint8_t>> tails(end - begin);
     parallelBlocks(end - begin, 1, [&](uint64_t k, uint64_t, uint64_t) {
-      batch[k] = source.readNode(nodes[begin + k]);
+      if (tailed)
+        batch[k] = tailed->readNodeTails(nodes[begin + k], tails[k]);
+      else
+        batch[k] = source.readNode(nodes[begin + k]);
       if (line) line->advance(batch[k].size());
       if (filter) {
         const PointFilter& test = verdicts[begin + k] == BoxVerdict::All ? attributesOnly : *filter;
-        std::erase_if(batch[k], [&](const PointRecord& r) { return !passes(test, filterPoint(r, meta)); });
+        size_t kept = 0;
+        for (size_t i = 0; i < batch[k].size(); ++i) {
+          if (!passes(test, filterPoint(batch[k][i], meta))) continue;
+          batch[k][kept] = batch[k][i];
+          if (tailed && tailBytes)
+            std::memmove(&tails[k][kept * tailBytes], &tails[k][i * tailBytes], tailBytes);
+          ++kept;
+        }
+        batch[k].resize(kept);
       }
     });
-    for (const std::vector<PointRecord>& records : batch)
-      writer.write(records.data(), records.size());
+    for (size_t k = 0; k < batch.size(); ++k)
+      if (tailed)
+        tailWriter->write(batch[k].data(), tails[k].data(), batch[k].size());
+      else
+        writer->write(batch[k].data(), batch[k].size());
     begin = end;
   }
   if (line) line->finish();
-  const uint64_t written = writer.pointsWritten();
-  writer.commit();
+  const uint64_t written = tailed ? tailWriter->pointsWritten() : writer->pointsWritten();
+  if (tailed)
+    tailWriter->commit();
+  else
+    writer->commit();
   return written;
 }
 

@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "cloud/octree.h"
+#include "cloud/point_attributes.h"
 
 namespace pointrast::io {
 
@@ -54,6 +55,11 @@ struct PotreeWriteOptions {
   // levels below it; nodes of its last level with children are proxies for chunks of their own.
   // PotreeConverter and the Potree viewer use 4; tests lower it to cross chunk boundaries.
   int hierarchyStepSize = 4;
+  // Attributes beyond PointRecord's that the points carry as tails (cloud/point_attributes.h), written
+  // as PotreeConverter names them (io/potree/potree_attributes.h) after the record fields, and
+  // described in metadata.json's "lasAttributes" so that an export gives the LAS records back. DEFAULT
+  // encoding only: BROTLI writes the record fields alone.
+  TailFormat tail;
 };
 
 // Smallest and largest value of each record field over a set of points, for metadata.json's attribute
@@ -100,11 +106,14 @@ public:
   // caller writes in a deterministic order. Not thread-safe. Records' positions are in metadata's
   // scale/offset; at most 2^32 - 1 records a node (InputError otherwise).
   void writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count);
+  // With the records' tails (options' tail.bytes() bytes each; null: zeros).
+  void writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails, size_t count);
 
   // The two halves of writeNode() for callers that encode on several threads: encodeNode() is
   // thread-safe (and the slow half with BROTLI); writeEncoded() appends in the caller's order, not
   // thread-safe. writeNode(key, r, n) == writeEncoded(key, encodeNode(r, n)).
   PotreeEncodedNode encodeNode(const PointRecord* records, size_t count) const;
+  PotreeEncodedNode encodeNode(const PointRecord* records, const uint8_t* tails, size_t count) const;
   void writeEncoded(const lod::NodeKey& key, const PotreeEncodedNode& node);
 
   // The two halves of writeEncoded() for callers that also write on several threads: place() gives the

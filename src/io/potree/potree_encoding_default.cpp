@@ -114,4 +114,36 @@ void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointReco
   }
 }
 
+void encodeDefaultTails(const Layout& layout, const uint8_t* tails, size_t n, uint8_t* dst) {
+  const size_t stride = static_cast<size_t>(layout.defaultStride);
+  const size_t tailBytes = layout.tail.bytes();
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* t = tails + i * tailBytes;
+    uint8_t* p = dst + i * stride;
+    for (const TailSlot& s : layout.tailSlots) {
+      if (s.bits > 0)
+        p[s.pointOffset] = static_cast<uint8_t>((t[s.tailOffset] >> s.shift) & ((1 << s.bits) - 1));
+      else
+        std::memcpy(p + s.pointOffset, t + s.tailOffset, static_cast<size_t>(s.size));
+    }
+  }
+}
+
+void decodeDefaultTails(const Layout& layout, const uint8_t* src, size_t n, uint8_t* tails) {
+  const size_t stride = static_cast<size_t>(layout.defaultStride);
+  const size_t tailBytes = layout.tail.bytes();
+  std::memset(tails, 0, n * tailBytes);
+  for (size_t i = 0; i < n; ++i) {
+    uint8_t* t = tails + i * tailBytes;
+    const uint8_t* p = src + i * stride;
+    for (const TailSlot& s : layout.tailSlots) {
+      if (s.bits > 0)
+        t[s.tailOffset] = static_cast<uint8_t>(t[s.tailOffset] |
+                                               ((p[s.pointOffset] & ((1 << s.bits) - 1)) << s.shift));
+      else
+        std::memcpy(t + s.tailOffset, p + s.pointOffset, static_cast<size_t>(s.size));
+    }
+  }
+}
+
 } // namespace pointrast::io::potree

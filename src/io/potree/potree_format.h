@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cloud/octree.h"
+#include "cloud/point_attributes.h"
 #include "io/potree/potree.h"
 
 namespace pointrast::io::potree {
@@ -80,8 +81,19 @@ struct Attribute {
   Field field = Field::Other;
 };
 
+// Where a tail field (cloud/point_attributes.h) lies in a DEFAULT point: `size` bytes at pointOffset
+// copied from the tail's tailOffset, or for a bit field (bits > 0) the byte
+// (tail[tailOffset] >> shift) & ((1 << bits) - 1).
+struct TailSlot {
+  int pointOffset = 0, tailOffset = 0, size = 0, shift = 0, bits = 0;
+};
+
 struct Layout {
   std::vector<Attribute> attributes;
+  // Where points carry tails (pointrast's octrees of LAS inputs): the tail's description and where its
+  // fields lie among the attributes.
+  TailFormat tail;
+  std::vector<TailSlot> tailSlots;
   uint64_t defaultStride = 0; // bytes per point, DEFAULT
   uint64_t brotliStride = 0;  // decoded bytes per point, BROTLI (position 16, rgb 8, others their size)
   RecordFields fields;        // which record fields the attributes fill (colorMax from rgb's max)
@@ -91,7 +103,11 @@ struct Layout {
 Layout makeLayout(std::vector<Attribute> attributes);
 // The attributes pointrast writes for the given fields, in this order: position, intensity, return
 // number, classification, point source id, rgb (PotreeConverter's names and types).
-Layout writerLayout(const RecordFields& fields);
+// With tail attributes, those of io/potree/potree_attributes.h follow, in that order.
+Layout writerLayout(const RecordFields& fields, const TailFormat& tail = {});
+// Finds the tail's attributes (by name, as writerLayout lists them) among layout's and fills tailSlots;
+// false, with the tail left empty, when one is missing or has another size.
+bool attachTail(Layout& layout, const TailFormat& tail);
 // Bytes one point takes in an encoded attribute block.
 int encodedBytes(const Attribute& attribute, PotreeEncoding encoding);
 
@@ -163,6 +179,10 @@ void encodeDefault(const Layout& layout, const PointRecord* records, size_t n, u
                    PotreeValueRanges& ranges);
 // src holds n * layout.defaultStride bytes.
 void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointRecord* dst);
+// The tails' fields into (encode) or out of (decode) DEFAULT points, by layout.tailSlots; tails holds
+// n * layout.tail.bytes() bytes.
+void encodeDefaultTails(const Layout& layout, const uint8_t* tails, size_t n, uint8_t* dst);
+void decodeDefaultTails(const Layout& layout, const uint8_t* src, size_t n, uint8_t* tails);
 
 // BROTLI. Positions are stored as uint32 Morton codes of (q + positionBias) (mod 2^32); pointrast writes
 // bias 0, PotreeConverter effectively +1, and the decoder subtracts the bias it is given.

@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include "io/io_util.h"
+#include "io/las/las_attributes.h"
+#include "io/potree/potree_attributes.h"
 #include "io/potree/potree_format.h"
 
 namespace pointrast::io::potree {
@@ -187,6 +189,49 @@ void readAttributes(const Reader& r, const json& root, Metadata& m) {
   }
 }
 
+// The "lasAttributes" block of pointrast's octrees (see metadataJson); a block that does not describe the
+// attributes listed is ignored (the points are read without tails).
+void readTail(const json& root, Layout& layout) {
+  auto it = root.find("lasAttributes");
+  if (it == root.end() || !it->is_object()) return;
+  const json& j = *it;
+  auto flag = [&](const char* key) {
+    auto f = j.find(key);
+    return f != j.end() && f->is_boolean() && f->get<bool>();
+  };
+  TailFormat t;
+  PointAttributes& a = t.attributes;
+  a.gpsTime = flag("gpsTime");
+  a.scanAngle = flag("scanAngle");
+  a.extendedScanAngle = flag("extendedScanAngle");
+  a.nir = flag("nir");
+  a.numberOfReturns = flag("numberOfReturns");
+  a.flags = flag("flags");
+  a.userData = flag("userData");
+  auto extra = j.find("extraBytes");
+  if (extra != j.end() && extra->is_number_unsigned() && extra->get<uint64_t>() <= 0xFFFF)
+    a.extraBytes = static_cast<uint16_t>(extra->get<uint64_t>());
+  auto format = j.find("pointFormat");
+  if (format != j.end() && format->is_number_integer() && format->get<int64_t>() >= 0 &&
+      format->get<int64_t>() <= 10)
+    t.lasPointFormat = static_cast<int>(format->get<int64_t>());
+  auto hex = j.find("extraBytesDescriptors");
+  if (hex != j.end() && hex->is_string()) {
+    const std::string& h = hex->get_ref<const std::string&>();
+    auto digit = [](char c) {
+      return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+    };
+    if (h.size() % 2 != 0) return;
+    for (size_t i = 0; i < h.size(); i += 2) {
+      const int hi = digit(h[i]), lo = digit(h[i + 1]);
+      if (hi < 0 || lo < 0) return;
+      t.extraBytesDescriptors.push_back(static_cast<uint8_t>(hi << 4 | lo));
+    }
+  }
+  t.layout = attributeLayout(a);
+  attachTail(layout, t);
+}
+
 json jsonVec(const glm::dvec3& v) {
   return json::array({v.x, v.y, v.z});
 }
@@ -243,14 +288,70 @@ Layout makeLayout(std::vector<Attribute> attributes) {
   return layout;
 }
 
-Layout writerLayout(const RecordFields& fields) {
+namespace {
+
+// The tail's attributes as Potree names them (potree_attributes.h); extra bytes fields from the
+// descriptors, or one undocumented field where they do not parse.
+std::vector<TailAttribute> tailList(const TailFormat& tail) {
+  std::vector<ExtraBytesField> extra;
+  try {
+    extra = parseExtraBytes(tail.extraBytesDescriptors, tail.attributes.extraBytes, "");
+  } catch (const InputError&) {
+    extra = parseExtraBytes({}, tail.attributes.extraBytes, "");
+  }
+  return tailAttributes(tail.attributes, tail.layout, extra);
+}
+
+} // namespace
+
+Layout writerLayout(const RecordFields& fields, const TailFormat& tail) {
   std::vector<Attribute> list{makeAttribute("position", "int32", 3)};
   if (fields.intensity) list.push_back(makeAttribute("intensity", "uint16", 1));
   if (fields.returnNumber) list.push_back(makeAttribute("return number", "uint8", 1));
   if (fields.classification) list.push_back(makeAttribute("classification", "uint8", 1));
   if (fields.pointSourceId) list.push_back(makeAttribute("point source id", "uint16", 1));
   if (fields.color) list.push_back(makeAttribute("rgb", "uint16", 3));
-  return makeLayout(std::move(list));
+  if (tail.bytes() > 0)
+    for (const TailAttribute& t : tailList(tail)) {
+      Attribute a;
+      a.name = t.name;
+      a.description = t.description;
+      a.type = t.type;
+      a.size = t.size;
+      a.numElements = t.numElements;
+      a.elementSize = t.elementSize;
+      list.push_back(std::move(a));
+    }
+  Layout layout = makeLayout(std::move(list));
+  attachTail(layout, tail);
+  return layout;
+}
+
+bool attachTail(Layout& layout, const TailFormat& tail) {
+  layout.tail = {};
+  layout.tailSlots.clear();
+  if (tail.bytes() == 0) {
+    layout.tail = tail; // the point format alone
+    return true;
+  }
+  std::vector<TailSlot> slots;
+  for (const TailAttribute& t : tailList(tail)) {
+    int at = 0;
+    bool found = false;
+    for (const Attribute& a : layout.attributes) {
+      if (a.name == t.name && a.field == Field::Other) {
+        if (a.size != t.size) return false;
+        found = true;
+        break;
+      }
+      at += a.size;
+    }
+    if (!found) return false;
+    slots.push_back({at, t.tailOffset, t.size, t.shift, t.bits});
+  }
+  layout.tail = tail;
+  layout.tailSlots = std::move(slots);
+  return true;
 }
 
 std::string metadataJson(const Metadata& m) {
@@ -281,6 +382,28 @@ std::string metadataJson(const Metadata& m) {
   }
   // Not a Potree field (the viewer ignores it): tells a reader that the integers are exact.
   j["generator"] = m.generator;
+  // Not a Potree field either: what the tail attributes hold, and the LAS point format and extra bytes
+  // descriptions they came from, so an export writes the records back as they were.
+  const TailFormat& t = m.layout.tail;
+  if (t.bytes() > 0 || t.lasPointFormat >= 0) {
+    static const char kHex[] = "0123456789abcdef";
+    std::string hex;
+    for (uint8_t b : t.extraBytesDescriptors) {
+      hex += kHex[b >> 4];
+      hex += kHex[b & 15];
+    }
+    const PointAttributes& a = t.attributes;
+    j["lasAttributes"] = {{"pointFormat", t.lasPointFormat},
+                          {"gpsTime", a.gpsTime},
+                          {"scanAngle", a.scanAngle},
+                          {"extendedScanAngle", a.extendedScanAngle},
+                          {"nir", a.nir},
+                          {"numberOfReturns", a.numberOfReturns},
+                          {"flags", a.flags},
+                          {"userData", a.userData},
+                          {"extraBytes", a.extraBytes},
+                          {"extraBytesDescriptors", hex}};
+  }
   // A name taken from a file name in another encoding than UTF-8 is replaced, not an exception after the
   // whole build.
   return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
@@ -318,6 +441,7 @@ Metadata parseMetadata(const std::string& text, const std::filesystem::path& fil
   if (m.spacing < 0) r.bad("\"spacing\" is negative");
   m.cube = readCube(r, root);
   readAttributes(r, root, m);
+  if (m.fromPointrast() && m.encoding == PotreeEncoding::Default) readTail(root, m.layout);
   return m;
 }
 

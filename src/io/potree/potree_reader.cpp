@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "cloud/lod_tails.h"
 #include "io/io_util.h"
 #include "io/potree/potree_format.h"
 
@@ -57,7 +58,7 @@ private:
   std::map<uint64_t, uint64_t> used_; // start -> end
 };
 
-class PotreeSource final : public lod::NodeSource {
+class PotreeSource final : public lod::NodeSource, public lod::NodeTails {
 public:
   explicit PotreeSource(const std::filesystem::path& path);
 
@@ -65,6 +66,8 @@ public:
   lod::NodeInfo root() override;
   std::vector<lod::NodeInfo> children(const lod::NodeInfo& node) override;
   std::vector<PointRecord> readNode(const lod::NodeInfo& node) override;
+  const TailFormat& tailFormat() const override { return meta_.layout.tail; }
+  std::vector<PointRecord> readNodeTails(const lod::NodeInfo& node, std::vector<uint8_t>& tails) override;
   uint64_t nodeBytes(const lod::NodeInfo& node) override;
 
 private:
@@ -75,6 +78,8 @@ private:
     uint64_t offset = 0, size = 0;
     std::string damage; // why its chunk could not be read (said again on every later request)
   };
+
+  std::vector<PointRecord> read(const lod::NodeInfo& node, std::vector<uint8_t>* tails);
 
   // All below: mutex_ held.
   Node& find(const lod::NodeKey& key);
@@ -258,6 +263,15 @@ uint64_t PotreeSource::nodeBytes(const lod::NodeInfo& node) {
 }
 
 std::vector<PointRecord> PotreeSource::readNode(const lod::NodeInfo& node) {
+  return read(node, nullptr);
+}
+
+std::vector<PointRecord> PotreeSource::readNodeTails(const lod::NodeInfo& node, std::vector<uint8_t>& tails) {
+  tails.clear();
+  return read(node, &tails);
+}
+
+std::vector<PointRecord> PotreeSource::read(const lod::NodeInfo& node, std::vector<uint8_t>* tails) {
   Node n;
   {
     std::lock_guard lock(mutex_);
@@ -267,9 +281,13 @@ std::vector<PointRecord> PotreeSource::readNode(const lod::NodeInfo& node) {
   if (n.count == 0) return out;
   std::vector<uint8_t> bytes(static_cast<size_t>(n.size));
   octree_.readAt(n.offset, bytes.data(), bytes.size());
-  if (meta_.encoding == PotreeEncoding::Default)
+  if (meta_.encoding == PotreeEncoding::Default) {
     potree::decodeDefault(meta_.layout, bytes.data(), n.count, out.data());
-  else
+    if (tails && !meta_.layout.tailSlots.empty()) {
+      tails->resize(size_t(n.count) * meta_.layout.tail.bytes());
+      potree::decodeDefaultTails(meta_.layout, bytes.data(), n.count, tails->data());
+    }
+  } else
     potree::decodeBrotli(meta_.layout, bytes.data(), bytes.size(), n.count, positionBias_, out.data(),
                          octreePath_.string() + ": node " + node.key.potreeName());
   return out;

@@ -227,7 +227,9 @@ PotreeWriter::PotreeWriter(std::filesystem::path dir, const lod::OctreeMetadata&
   s.options = options;
   assert(options.hierarchyStepSize >= 1 && options.hierarchyStepSize <= potree::kMaxLevel);
   checkMetadata(s.dir, metadata);
-  s.layout = potree::writerLayout(metadata.fields);
+  s.layout = potree::writerLayout(metadata.fields, options.encoding == PotreeEncoding::Default
+                                                       ? options.tail
+                                                       : TailFormat{});
   std::error_code ec;
   if (std::filesystem::exists(std::filesystem::symlink_status(s.dir, ec)))
     fail(s.dir, "already exists (an octree is written into a new folder)");
@@ -264,6 +266,11 @@ uint64_t PotreeWriter::bytesWritten() const {
 }
 
 PotreeEncodedNode PotreeWriter::encodeNode(const PointRecord* records, size_t count) const {
+  return encodeNode(records, nullptr, count);
+}
+
+PotreeEncodedNode PotreeWriter::encodeNode(const PointRecord* records, const uint8_t* tails,
+                                           size_t count) const {
   const State& s = *state_;
   PotreeEncodedNode node;
   if (s.options.encoding == PotreeEncoding::Brotli) {
@@ -272,12 +279,19 @@ PotreeEncodedNode PotreeWriter::encodeNode(const PointRecord* records, size_t co
   } else {
     node.bytes.resize(count * static_cast<size_t>(s.layout.defaultStride));
     potree::encodeDefault(s.layout, records, count, node.bytes.data(), node.ranges);
+    if (tails && !s.layout.tailSlots.empty())
+      potree::encodeDefaultTails(s.layout, tails, count, node.bytes.data());
   }
   return node;
 }
 
 void PotreeWriter::writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count) {
   writeEncoded(key, encodeNode(records, count));
+}
+
+void PotreeWriter::writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails,
+                             size_t count) {
+  writeEncoded(key, encodeNode(records, tails, count));
 }
 
 void PotreeWriter::writeEncoded(const lod::NodeKey& key, const PotreeEncodedNode& node) {
