@@ -8,10 +8,16 @@ namespace pointrast {
 
 namespace {
 
+// Rounds t to the nearest integer, halves away from zero (std::llround), clamped to [0, max]; inline, as
+// a library call per axis was most of the encoding's time. Below 0 (and NaN) gives 0, as rounding first
+// and clamping after would; inside the range the fraction t - trunc(t) is exact.
 uint32_t quantize(double value, double min, double size) {
   if (!(size > 0)) return 0;
-  double t = (value - min) / size * double(kBatchCoordinateMax);
-  return uint32_t(std::clamp(std::llround(t), 0ll, (long long)kBatchCoordinateMax));
+  const double t = (value - min) / size * double(kBatchCoordinateMax);
+  if (!(t > 0)) return 0;
+  if (t >= double(kBatchCoordinateMax)) return kBatchCoordinateMax;
+  const auto whole = uint32_t(t); // truncates
+  return t - double(whole) >= 0.5 ? whole + 1 : whole;
 }
 
 // Bits [shift, shift + 10) of the three axes packed as x | y << 10 | z << 20.

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cassert>
 #include <cstring>
+#include <exception>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "base/error.h"
 #include "base/parallel.h"
@@ -138,52 +141,89 @@ void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const
   }
 }
 
-// Encodes whole batches into the staging buffer on all cores (bounds, three words, colors per batch, as
-// cloud/batch_words.h defines them), then copies them into the part's buffers.
+// Encodes whole batches into a staging buffer on all cores (bounds, three words, colors per batch, as
+// cloud/batch_words.h defines them), then copies them into the part's buffers. Two staging buffers take
+// turns: while the GPU copies one chunk, a second thread encodes the next into the other, so the copies
+// cost no time beside the encoding.
 void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
                              const DisplayColorMode& colorMode, bool progressShown) {
-  gpu::Buffer staging(context, kStagingBatches * kBatchBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                      gpu::MemoryKind::Upload, "upload staging");
+  struct Chunk {
+    const ScenePart* part;
+    uint64_t at, n; // points [at, at + n) of the part
+  };
+  std::vector<Chunk> chunks;
+  for (const ScenePart& part : parts_)
+    for (uint64_t at = 0; at < part.count; at += kStagingBatchPoints)
+      chunks.push_back({&part, at, std::min(kStagingBatchPoints, part.count - at)});
+  if (chunks.empty()) return;
+  gpu::Buffer staging[2] = {
+      gpu::Buffer(context, kStagingBatches * kBatchBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                  gpu::MemoryKind::Upload, "upload staging 0"),
+      gpu::Buffer(context, chunks.size() > 1 ? kStagingBatches * kBatchBytes : 16,
+                  VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload, "upload staging 1")};
   // Staging sections: high, medium, low words, colors (kStagingBatchPoints each), then the bounds.
-  auto* words = static_cast<uint32_t*>(staging.mapped());
-  uint32_t* section[4] = {words, words + kStagingBatchPoints, words + 2 * kStagingBatchPoints,
-                          words + 3 * kStagingBatchPoints};
-  auto* bounds = reinterpret_cast<shared::BatchBounds*>(words + 4 * kStagingBatchPoints);
+  auto section = [&](int s, int k) {
+    return static_cast<uint32_t*>(staging[s].mapped()) + k * kStagingBatchPoints;
+  };
+  auto encode = [&](int s, const Chunk& c) {
+    uint32_t* words[4] = {section(s, 0), section(s, 1), section(s, 2), section(s, 3)};
+    auto* bounds = reinterpret_cast<shared::BatchBounds*>(section(s, 4));
+    const uint64_t batches = (c.n + kBatchSize - 1) / kBatchSize;
+    parallelBlocks(batches, 4, [&](uint64_t, uint64_t begin, uint64_t end) {
+      for (uint64_t b = begin; b < end; ++b) {
+        const uint64_t local = b * kBatchSize; // in this chunk
+        const Batch batch =
+            makeBatch(cloud, c.part->first + c.at + local, uint32_t(std::min(kBatchSize, c.n - local)));
+        encodeBatchWords(words[0] + local, words[1] + local, words[2] + local, cloud, batch);
+        displayColors(words[3] + local, cloud, batch.first, batch.count, colorMode);
+        if (highlight_) highlightColors(words[3] + local, cloud, batch.first, batch.count, *highlight_);
+        const glm::dvec3 lo = batch.bounds.min - origin_, hi = batch.bounds.max - origin_;
+        bounds[b] = {glm::vec4(glm::vec3(lo), 0.0f), glm::vec4(glm::vec3(hi), 0.0f)};
+      }
+    });
+    // Zero the padding words of a part's last, partial group of four (batch-prefetch loads them).
+    for (uint64_t k = c.n; k < roundUp4(c.n); ++k)
+      words[0][k] = words[1][k] = words[2][k] = 0;
+  };
+  auto copy = [&](int s, const Chunk& c) {
+    const ScenePart& part = *c.part;
+    const uint64_t wordBytes = roundUp4(c.n) * 4, batches = (c.n + kBatchSize - 1) / kBatchSize;
+    const VkBuffer from = staging[s].handle();
+    context.submitAndWait([&](VkCommandBuffer cmd) {
+      const gpu::Buffer* targets[3] = {&part.high, &part.medium, &part.low};
+      for (int w = 0; w < 3; ++w) {
+        VkBufferCopy words{w * kStagingBatchPoints * 4, c.at * 4, wordBytes};
+        gpu::vkCmdCopyBuffer(cmd, from, targets[w]->handle(), 1, &words);
+      }
+      VkBufferCopy col{3 * kStagingBatchPoints * 4, c.at * 4, c.n * 4};
+      gpu::vkCmdCopyBuffer(cmd, from, part.colors.handle(), 1, &col);
+      VkBufferCopy box{4 * kStagingBatchPoints * 4, c.at / kBatchSize * sizeof(shared::BatchBounds),
+                       batches * sizeof(shared::BatchBounds)};
+      gpu::vkCmdCopyBuffer(cmd, from, part.batches.handle(), 1, &box);
+    });
+  };
   Progress progress("uploading to GPU (batched)", pointCount_, " points", progressShown);
-  for (const ScenePart& part : parts_) {
-    for (uint64_t at = 0; at < part.count; at += kStagingBatchPoints) {
-      const uint64_t n = std::min(kStagingBatchPoints, part.count - at);
-      const uint64_t batches = (n + kBatchSize - 1) / kBatchSize;
-      parallelBlocks(batches, 4, [&](uint64_t, uint64_t begin, uint64_t end) {
-        for (uint64_t b = begin; b < end; ++b) {
-          const uint64_t local = b * kBatchSize; // in this chunk
-          const Batch batch =
-              makeBatch(cloud, part.first + at + local, uint32_t(std::min(kBatchSize, n - local)));
-          encodeBatchWords(section[0] + local, section[1] + local, section[2] + local, cloud, batch);
-          displayColors(section[3] + local, cloud, batch.first, batch.count, colorMode);
-          if (highlight_) highlightColors(section[3] + local, cloud, batch.first, batch.count, *highlight_);
-          const glm::dvec3 lo = batch.bounds.min - origin_, hi = batch.bounds.max - origin_;
-          bounds[b] = {glm::vec4(glm::vec3(lo), 0.0f), glm::vec4(glm::vec3(hi), 0.0f)};
+  encode(0, chunks[0]);
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    std::exception_ptr failed;
+    std::thread next;
+    if (i + 1 < chunks.size())
+      next = std::thread([&, i] {
+        try {
+          encode(int((i + 1) % 2), chunks[i + 1]);
+        } catch (...) {
+          failed = std::current_exception();
         }
       });
-      // Zero the padding words of a part's last, partial group of four (batch-prefetch loads them).
-      for (uint64_t k = n; k < roundUp4(n); ++k)
-        section[0][k] = section[1][k] = section[2][k] = 0;
-      const uint64_t wordBytes = roundUp4(n) * 4;
-      context.submitAndWait([&](VkCommandBuffer cmd) {
-        const gpu::Buffer* targets[3] = {&part.high, &part.medium, &part.low};
-        for (int w = 0; w < 3; ++w) {
-          VkBufferCopy copy{w * kStagingBatchPoints * 4, at * 4, wordBytes};
-          gpu::vkCmdCopyBuffer(cmd, staging.handle(), targets[w]->handle(), 1, &copy);
-        }
-        VkBufferCopy col{3 * kStagingBatchPoints * 4, at * 4, n * 4};
-        gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.colors.handle(), 1, &col);
-        VkBufferCopy box{4 * kStagingBatchPoints * 4, at / kBatchSize * sizeof(shared::BatchBounds),
-                         batches * sizeof(shared::BatchBounds)};
-        gpu::vkCmdCopyBuffer(cmd, staging.handle(), part.batches.handle(), 1, &box);
-      });
-      progress.advance(n);
+    try {
+      copy(int(i % 2), chunks[i]);
+    } catch (...) {
+      if (next.joinable()) next.join();
+      throw;
     }
+    if (next.joinable()) next.join();
+    if (failed) std::rethrow_exception(failed);
+    progress.advance(chunks[i].n);
   }
 }
 

@@ -2,6 +2,8 @@
 // two and three words, on generated terrain (UTM-size coordinates) and on degenerate batches.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "cloud/batch_words.h"
@@ -27,6 +29,44 @@ TEST(BatchWords, BitLayoutPutsTenBitsPerAxisPerWord) {
   EXPECT_EQ(h[1], 0x3FFFFFFFu);
   EXPECT_EQ(m[1], 0x3FFFFFFFu);
   EXPECT_EQ(l[1], 0x3FFFFFFFu);
+}
+
+// The encoder rounds each axis inline; it must give exactly what std::llround and a clamp to [0, 2^30 - 1]
+// give, for every point of real-size batches (fractions of one half included: small integer extents
+// make (q - min) / size * (2^30 - 1) land on halves).
+TEST(BatchWords, InlineRoundingEqualsLlroundAndClamp) {
+  auto reference = [](double value, double min, double size) -> uint32_t {
+    if (!(size > 0)) return 0;
+    const double t = (value - min) / size * double(kBatchCoordinateMax);
+    return uint32_t(std::clamp(std::llround(t), 0ll, (long long)kBatchCoordinateMax));
+  };
+  GenerateOptions options;
+  options.points = 40'000;
+  options.progress = false;
+  PointCloud terrain = generateScene(Scene::Terrain, options);
+  PointCloud halves; // extent 2 on each axis: positions 0, 1, 2 put t on 0, (2^30 - 1) / 2, 2^30 - 1
+  halves.scale = glm::dvec3(1.0);
+  for (int32_t i = 0; i < 300; ++i)
+    halves.positions.insert(halves.positions.end(), {i % 3, (i / 3) % 3, (i / 9) % 3});
+  computeBounds(halves);
+  uint64_t checked = 0;
+  for (const PointCloud* cloud : {&terrain, &halves})
+    for (const Batch& batch : makeBatches(*cloud)) {
+      std::vector<uint32_t> h(batch.count), m(batch.count), l(batch.count);
+      encodeBatchWords(h.data(), m.data(), l.data(), *cloud, batch);
+      const glm::dvec3 min = batch.bounds.min, size = batch.bounds.size();
+      for (uint32_t k = 0; k < batch.count; ++k) {
+        const glm::dvec3 p = cloud->world(batch.first + k);
+        for (int a = 0; a < 3; ++a) {
+          const uint32_t q = reference(p[a], min[a], size[a]);
+          const uint32_t got = (h[k] >> (10 * a) & 1023u) << 20 | (m[k] >> (10 * a) & 1023u) << 10 |
+                               (l[k] >> (10 * a) & 1023u);
+          ASSERT_EQ(got, q) << "point " << batch.first + k << " axis " << a;
+          ++checked;
+        }
+      }
+    }
+  EXPECT_EQ(checked, 3u * (terrain.size() + halves.size()));
 }
 
 TEST(BatchWords, DecodingErrorStaysWithinTheBoundForEachPrecision) {

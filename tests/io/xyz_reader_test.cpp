@@ -1,8 +1,10 @@
 // XYZ / CSV / PTS text reader.
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "io/io_test_util.h"
+#include "io/io_util.h"
 
 using pointrast::InputError;
 using pointrast::packRgba;
@@ -26,6 +28,46 @@ std::string refusal(const std::string& text, const std::string& name = "t.csv") 
   std::string message;
   EXPECT_EQ(iotest::readOrRefuse(dir / name, &message), iotest::Outcome::Refused) << text;
   return message;
+}
+
+// The readers' quantization rounds inline; it must give what std::nearbyint (ties to even) and the clamp to
+// int32 give: on ties, on values around the clamp and on random values at UTM scale.
+TEST(Quantize, EqualsNearbyintAndClamp) {
+  auto reference = [](double v, double scale, double offset) {
+    double q = std::nearbyint((v - offset) / scale);
+    q = q < -2147483648.0 ? -2147483648.0 : (q > 2147483647.0 ? 2147483647.0 : q);
+    return static_cast<int32_t>(q);
+  };
+  std::vector<double> values = {0.0,
+                                -0.0,
+                                0.5,
+                                1.5,
+                                2.5,
+                                -0.5,
+                                -1.5,
+                                -2.5,
+                                0.49999999999999994,
+                                2147483646.5,
+                                2147483647.5,
+                                2147483648.5,
+                                1e12,
+                                -2147483648.5,
+                                -2147483649.5,
+                                -1e12,
+                                4503599627370495.5,
+                                1e300,
+                                -1e300};
+  uint64_t state = 12345;
+  for (int i = 0; i < 100000; ++i) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    values.push_back(double(state >> 11) * 0x1.0p-53 * 2e6 - 5e5 + 4.5e6); // northings
+    values.push_back(double(int64_t(state >> 40) - (1 << 23)) * 0.5);      // halves
+  }
+  for (double scale : {1.0, 0.001, 0.01, 0.25})
+    for (double offset : {0.0, 4.5e6, -12.5})
+      for (double v : values)
+        ASSERT_EQ(io::detail::quantize(v, scale, offset), reference(v, scale, offset))
+            << v << " scale " << scale << " offset " << offset;
 }
 
 TEST(XyzReader, GriddedDem) {
