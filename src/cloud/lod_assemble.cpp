@@ -26,7 +26,8 @@ void OctreeAssembler::prepare(ChunkNodes& chunk) const {
   chunk.prepared.reserve(chunk.nodes.size());
   for (const ChunkNodes::Node& node : chunk.nodes)
     chunk.prepared.push_back(sink_.prepare(node.key, chunk.records.data() + node.first,
-                                           tailsOf(chunk.tails, node.first), static_cast<size_t>(node.count)));
+                                           tailsOf(chunk.tails, node.first),
+                                           static_cast<size_t>(node.count)));
 }
 
 void OctreeAssembler::write(const NodeKey& key, const PointRecord* records, const uint8_t* tails,

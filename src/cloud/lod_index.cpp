@@ -237,7 +237,8 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
   uint64_t taken = 0, unused[8];
   PointRecord* top = out.top.data();
   for (int level = 0; level < chunk.level; ++level) {
-    uint8_t* const topTails = tails ? out.topTails.data() + (top - out.top.data()) * params.tailBytes : nullptr;
+    uint8_t* const topTails =
+        tails ? out.topTails.data() + (top - out.top.data()) * params.tailBytes : nullptr;
     PointRecord* const levelEnd = indexer.subsample(level, 0, count, top, topTails, unused);
     out.topCounts[static_cast<size_t>(level)] = static_cast<uint64_t>(levelEnd - top);
     taken += out.topCounts[static_cast<size_t>(level)];

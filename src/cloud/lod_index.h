@@ -87,8 +87,8 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
                 LodItem* items, size_t count, const uint64_t* cellCounts, size_t cells,
                 const LodParams& params, const uint8_t* tails = nullptr);
 
-// Sorts items into canonical order: by code, then by the record's bytes, then by ref. freeBits: the low bits in
-// which the codes may differ (the others are equal). For a cell's items, and for tests.
+// Sorts items into canonical order: by code, then by the record's bytes, then by ref. freeBits: the low bits
+// in which the codes may differ (the others are equal). For a cell's items, and for tests.
 void sortItems(LodItem* items, size_t count, int freeBits, IndexScratch& scratch);
 
 } // namespace pointrast::lod

@@ -68,6 +68,11 @@ TEST(LodAttributesCli, PotreeGivesBackEveryRecordOutOfCore) {
   expectRoundTrip("lod_attr_ooc", "--memory 2M --threads 2", true);
 }
 
+TEST(LodAttributesCli, BrotliPotreeGivesBackEveryRecord) {
+  POINTRAST_REQUIRE_DATA(kExtra);
+  expectRoundTrip("lod_attr_brotli", "--encoding brotli", false);
+}
+
 TEST(LodAttributesCli, CopcGivesBackEveryRecordInMemory) {
   POINTRAST_REQUIRE_DATA(kExtra);
   expectRoundTrip("lod_attr_mem.copc.laz", "", false);
@@ -81,16 +86,17 @@ TEST(LodAttributesCli, CopcGivesBackEveryRecordOutOfCore) {
 TEST(LodAttributesCli, MetadataNamesTheAttributesAsPotreeConverter) {
   POINTRAST_REQUIRE_DATA(kExtra);
   const fs::path octree = fresh("lod_attr_names");
-  ASSERT_EQ(runPointrast("lod " + (pointrast::test::dataDir() / kExtra).string() + " -q -o " + octree.string())
-                .exitCode,
-            0);
+  ASSERT_EQ(
+      runPointrast("lod " + (pointrast::test::dataDir() / kExtra).string() + " -q -o " + octree.string())
+          .exitCode,
+      0);
   const nlohmann::json m = nlohmann::json::parse(slurp(octree / "metadata.json"));
   std::vector<std::string> names;
   for (const auto& a : m["attributes"])
     names.push_back(a["name"].get<std::string>());
-  for (const char* name : {"gps-time", "number of returns", "classification flags", "scan angle", "nir",
-                           "scanner channel", "scan direction flag", "edge of flight line", "Deviation",
-                           "confidence"})
+  for (const char* name :
+       {"gps-time", "number of returns", "classification flags", "scan angle", "nir", "scanner channel",
+        "scan direction flag", "edge of flight line", "Deviation", "confidence"})
     EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
   // Every point's user data is 0 in this file: the field is left out (an export writes 0).
   EXPECT_EQ(std::find(names.begin(), names.end(), "user data"), names.end());

@@ -218,7 +218,8 @@ CopcWriter::CopcWriter(std::filesystem::path path, const lod::OctreeMetadata& me
     else if (tail.attributes.nir)
       s.pointFormat = 8;
   }
-  s.recordLength = static_cast<uint16_t>(las::kRecordSize[size_t(s.pointFormat)] + tail.attributes.extraBytes);
+  s.recordLength =
+      static_cast<uint16_t>(las::kRecordSize[size_t(s.pointFormat)] + tail.attributes.extraBytes);
   s.layout = laz::encoderLayout(s.pointFormat, s.recordLength, laz::kVariableChunks);
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(metadata.scale[a]) || metadata.scale[a] == 0.0 || !std::isfinite(metadata.offset[a]))

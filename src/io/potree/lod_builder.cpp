@@ -113,7 +113,7 @@ struct OctreeBuilder::State {
   uint64_t inMemoryChunk = 0;
   bool inMemory = true;
   bool scanned = false;
-  lod::Pieces pieces; // in memory: every point, after scan()
+  lod::Pieces pieces;         // in memory: every point, after scan()
   LargeBuffer<uint8_t> tails; // in memory: every point's tail, in task order, after scan()
   lod::LodGrid grid;
   lod::OctreeMetadata metadata;
@@ -311,8 +311,8 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
 
     clock = lod::PhaseClock();
     // A chunk, indexed by one thread, may take its share of the memory bound.
-    const uint64_t chunkLimit =
-        std::max<uint64_t>(s.params.leafPoints, s.memory / (uint64_t(s.threads) * s.indexBytesPerPoint() * 2));
+    const uint64_t chunkLimit = std::max<uint64_t>(
+        s.params.leafPoints, s.memory / (uint64_t(s.threads) * s.indexBytesPerPoint() * 2));
     const std::vector<lod::LodChunk> chunks = lod::planChunks(counts, grid.countLevel(), chunkLimit);
     const std::vector<uint32_t> chunkOf = lod::chunkOfCell(chunks, grid.countLevel());
     uint64_t largest = 0;
@@ -359,9 +359,8 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
     }
     s.phases.push_back(clock.done("distribute", n, s.inputs.fileBytes() + spill.bytesWritten()));
 
-    const size_t window =
-        std::clamp<size_t>(s.memory / std::max<uint64_t>(1, largest * s.indexBytesPerPoint()), 1,
-                           2 * size_t(s.threads));
+    const size_t window = std::clamp<size_t>(
+        s.memory / std::max<uint64_t>(1, largest * s.indexBytesPerPoint()), 1, 2 * size_t(s.threads));
     lod::ChunkLoader load = [&](size_t c, lod::ChunkStorage& storage) {
       const lod::LodChunk& chunk = chunks[c];
       std::vector<lod::LodItem>& items = storage.items;

@@ -54,7 +54,8 @@ public:
   // the number of returns unless returnsDiffer; returns the tail they were read in before, for repack().
   TailFormat pruneTail(const std::vector<uint8_t>& mask, bool returnsDiffer);
   // Tails of `from` into tails of `to` (whose fields are a subset), n of them.
-  static void repack(const TailFormat& from, const TailFormat& to, const uint8_t* src, size_t n, uint8_t* dst);
+  static void repack(const TailFormat& from, const TailFormat& to, const uint8_t* src, size_t n,
+                     uint8_t* dst);
   std::string names() const; // "a.las, b.las"
   size_t count() const { return inputs_.size(); }
 

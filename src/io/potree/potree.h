@@ -57,8 +57,7 @@ struct PotreeWriteOptions {
   int hierarchyStepSize = 4;
   // Attributes beyond PointRecord's that the points carry as tails (cloud/point_attributes.h), written
   // as PotreeConverter names them (io/potree/potree_attributes.h) after the record fields, and
-  // described in metadata.json's "lasAttributes" so that an export gives the LAS records back. DEFAULT
-  // encoding only: BROTLI writes the record fields alone.
+  // described in metadata.json's "lasAttributes" so that an export gives the LAS records back.
   TailFormat tail;
 };
 

@@ -153,11 +153,39 @@ uint64_t brotliDecodedLimit(uint64_t compressedBytes) {
 }
 
 std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* records, size_t n) {
+  return encodeBrotli(layout, records, nullptr, n);
+}
+
+namespace {
+
+// The tail slot of the attribute at `defaultOffset` in a DEFAULT point, or null.
+const TailSlot* slotAt(const Layout& layout, int defaultOffset) {
+  for (const TailSlot& s : layout.tailSlots)
+    if (s.pointOffset == defaultOffset) return &s;
+  return nullptr;
+}
+
+} // namespace
+
+std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* records, const uint8_t* tails,
+                                  size_t n) {
   if (n == 0) return {};
   std::vector<uint8_t> blocks(n * static_cast<size_t>(layout.brotliStride));
   uint8_t* block = blocks.data();
+  const size_t tailBytes = layout.tail.bytes();
+  int at = 0; // the attribute's offset in a DEFAULT point, which names its tail slot
   for (const Attribute& a : layout.attributes) {
     encodeBlock(a, records, n, block);
+    const TailSlot* slot = a.field == Field::Other && tails ? slotAt(layout, at) : nullptr;
+    if (slot)
+      for (size_t i = 0; i < n; ++i) {
+        const uint8_t* t = tails + i * tailBytes;
+        if (slot->bits > 0)
+          block[i] = static_cast<uint8_t>((t[slot->tailOffset] >> slot->shift) & ((1 << slot->bits) - 1));
+        else
+          std::memcpy(block + i * size_t(slot->size), t + slot->tailOffset, size_t(slot->size));
+      }
+    at += a.size;
     block += n * size_t(encodedBytes(a, PotreeEncoding::Brotli));
   }
   size_t size = BrotliEncoderMaxCompressedSize(blocks.size());
@@ -171,13 +199,27 @@ std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* recor
 }
 
 void decodeBrotli(const Layout& layout, const uint8_t* src, uint64_t size, size_t n, int32_t positionBias,
-                  PointRecord* dst, const std::string& where) {
+                  PointRecord* dst, const std::string& where, uint8_t* tails) {
   if (n == 0) return; // the viewer does not decode empty nodes either (PotreeConverter may store a byte)
   const std::vector<uint8_t> blocks = inflate(src, size, n * layout.brotliStride, where);
   const uint8_t* block = blocks.data();
   std::fill(dst, dst + n, PointRecord{});
+  const size_t tailBytes = layout.tail.bytes();
+  if (tails) std::memset(tails, 0, n * tailBytes);
+  int at = 0;
   for (const Attribute& a : layout.attributes) {
     decodeBlock(a, block, n, positionBias, dst);
+    const TailSlot* slot = a.field == Field::Other && tails ? slotAt(layout, at) : nullptr;
+    if (slot)
+      for (size_t i = 0; i < n; ++i) {
+        uint8_t* t = tails + i * tailBytes;
+        if (slot->bits > 0)
+          t[slot->tailOffset] = static_cast<uint8_t>(t[slot->tailOffset] |
+                                                     ((block[i] & ((1 << slot->bits) - 1)) << slot->shift));
+        else
+          std::memcpy(t + slot->tailOffset, block + i * size_t(slot->size), size_t(slot->size));
+      }
+    at += a.size;
     block += n * size_t(encodedBytes(a, PotreeEncoding::Brotli));
   }
 }

@@ -138,8 +138,8 @@ void decodeDefaultTails(const Layout& layout, const uint8_t* src, size_t n, uint
     const uint8_t* p = src + i * stride;
     for (const TailSlot& s : layout.tailSlots) {
       if (s.bits > 0)
-        t[s.tailOffset] = static_cast<uint8_t>(t[s.tailOffset] |
-                                               ((p[s.pointOffset] & ((1 << s.bits) - 1)) << s.shift));
+        t[s.tailOffset] =
+            static_cast<uint8_t>(t[s.tailOffset] | ((p[s.pointOffset] & ((1 << s.bits) - 1)) << s.shift));
       else
         std::memcpy(t + s.tailOffset, p + s.pointOffset, static_cast<size_t>(s.size));
     }

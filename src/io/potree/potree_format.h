@@ -187,9 +187,14 @@ void decodeDefaultTails(const Layout& layout, const uint8_t* src, size_t n, uint
 // BROTLI. Positions are stored as uint32 Morton codes of (q + positionBias) (mod 2^32); pointrast writes
 // bias 0, PotreeConverter effectively +1, and the decoder subtracts the bias it is given.
 std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* records, size_t n);
+// With the records' tails (layout.tail.bytes() each; null: zeros), their fields in their attributes'
+// blocks.
+std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* records, const uint8_t* tails,
+                                  size_t n);
 // Throws InputError (prefixed with `where`) unless the stream decodes to exactly n points.
+// tails: where not null, the points' tails (layout.tail.bytes() each) are decoded into it too.
 void decodeBrotli(const Layout& layout, const uint8_t* src, uint64_t size, size_t n, int32_t positionBias,
-                  PointRecord* dst, const std::string& where);
+                  PointRecord* dst, const std::string& where, uint8_t* tails = nullptr);
 // The most decoded bytes a reader accepts from a BROTLI node of `compressedBytes`: real point data
 // compresses 2-10x, so a node claiming more than 4096x (past a 64 KiB allowance for tiny nodes) lies
 // about its count, or is a decompression bomb; either way it is refused before anything is allocated.

@@ -441,7 +441,7 @@ Metadata parseMetadata(const std::string& text, const std::filesystem::path& fil
   if (m.spacing < 0) r.bad("\"spacing\" is negative");
   m.cube = readCube(r, root);
   readAttributes(r, root, m);
-  if (m.fromPointrast() && m.encoding == PotreeEncoding::Default) readTail(root, m.layout);
+  if (m.fromPointrast()) readTail(root, m.layout);
   return m;
 }
 

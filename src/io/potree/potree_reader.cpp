@@ -287,9 +287,13 @@ std::vector<PointRecord> PotreeSource::read(const lod::NodeInfo& node, std::vect
       tails->resize(size_t(n.count) * meta_.layout.tail.bytes());
       potree::decodeDefaultTails(meta_.layout, bytes.data(), n.count, tails->data());
     }
-  } else
+  } else {
+    const bool withTails = tails && !meta_.layout.tailSlots.empty();
+    if (withTails) tails->resize(size_t(n.count) * meta_.layout.tail.bytes());
     potree::decodeBrotli(meta_.layout, bytes.data(), bytes.size(), n.count, positionBias_, out.data(),
-                         octreePath_.string() + ": node " + node.key.potreeName());
+                         octreePath_.string() + ": node " + node.key.potreeName(),
+                         withTails ? tails->data() : nullptr);
+  }
   return out;
 }
 

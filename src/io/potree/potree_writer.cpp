@@ -227,9 +227,7 @@ PotreeWriter::PotreeWriter(std::filesystem::path dir, const lod::OctreeMetadata&
   s.options = options;
   assert(options.hierarchyStepSize >= 1 && options.hierarchyStepSize <= potree::kMaxLevel);
   checkMetadata(s.dir, metadata);
-  s.layout = potree::writerLayout(metadata.fields, options.encoding == PotreeEncoding::Default
-                                                       ? options.tail
-                                                       : TailFormat{});
+  s.layout = potree::writerLayout(metadata.fields, options.tail);
   std::error_code ec;
   if (std::filesystem::exists(std::filesystem::symlink_status(s.dir, ec)))
     fail(s.dir, "already exists (an octree is written into a new folder)");
@@ -275,7 +273,7 @@ PotreeEncodedNode PotreeWriter::encodeNode(const PointRecord* records, const uin
   PotreeEncodedNode node;
   if (s.options.encoding == PotreeEncoding::Brotli) {
     node.ranges.add(records, count);
-    node.bytes = potree::encodeBrotli(s.layout, records, count);
+    node.bytes = potree::encodeBrotli(s.layout, records, s.layout.tailSlots.empty() ? nullptr : tails, count);
   } else {
     node.bytes.resize(count * static_cast<size_t>(s.layout.defaultStride));
     potree::encodeDefault(s.layout, records, count, node.bytes.data(), node.ranges);
