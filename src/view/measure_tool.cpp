@@ -1,6 +1,7 @@
 #include "view/measure_tool.h"
 
 #include <cassert>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -40,6 +41,37 @@ bool MeasureTool::remove(size_t index) {
     --*open_;
   ++version_;
   return true;
+}
+
+bool MeasureTool::move(size_t index, size_t vertex, const glm::dvec3& point) {
+  if (index >= annotations_.items.size() || vertex >= annotations_.items[index].points.size()) return false;
+  annotations_.items[index].points[vertex] = point;
+  ++version_;
+  return true;
+}
+
+std::optional<std::pair<size_t, size_t>> MeasureTool::vertexNear(const Camera& camera, double nearW,
+                                                                 uint32_t width, uint32_t height,
+                                                                 glm::dvec2 position, double radius) const {
+  if (width == 0 || height == 0) return std::nullopt;
+  // Relative to the eye, in double, as the overlay projects them (render/overlay.cpp).
+  const glm::dmat4 vp = viewProjection(camera, camera.eye, double(width) / double(height));
+  std::optional<std::pair<size_t, size_t>> best;
+  double bestDistance = radius;
+  for (size_t i = 0; i < annotations_.items.size(); ++i)
+    for (size_t k = 0; k < annotations_.items[i].points.size(); ++k) {
+      const glm::dvec4 c = vp * glm::dvec4(annotations_.items[i].points[k] - camera.eye, 1.0);
+      if (!(c.w > nearW)) continue;
+      // The marker's pixel centre (docs/design.md, "Camera and image").
+      const glm::dvec2 at(std::floor((c.x / c.w + 1) / 2 * width) + 0.5,
+                          std::floor((1 - c.y / c.w) / 2 * height) + 0.5);
+      const double d = glm::length(at - position);
+      if (d <= bestDistance) {
+        bestDistance = d;
+        best = {i, k};
+      }
+    }
+  return best;
 }
 
 void MeasureTool::clear() {

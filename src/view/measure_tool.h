@@ -6,10 +6,12 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <glm/glm.hpp>
 
 #include "cloud/annotations.h"
+#include "render/camera.h"
 
 namespace pointrast::view {
 
@@ -25,6 +27,14 @@ public:
   void finish();
   // Removes annotation `index`; false when there is none.
   bool remove(size_t index);
+  // Moves vertex `vertex` of annotation `index` to `point`; false when there is no such vertex.
+  bool move(size_t index, size_t vertex, const glm::dvec3& point);
+  // The vertex drawn nearest a position of a width x height image seen by `camera` (nearW: the near plane
+  // the frame was drawn with), within `radius` pixels: (annotation, vertex). Vertices behind the near plane
+  // are not seen; the latest annotation wins a tie.
+  std::optional<std::pair<size_t, size_t>> vertexNear(const Camera& camera, double nearW, uint32_t width,
+                                                      uint32_t height, glm::dvec2 position,
+                                                      double radius) const;
   void clear();
   // Replaces the list (loaded from an annotations file); nothing is open.
   void load(Annotations annotations);

@@ -356,6 +356,26 @@ nlohmann::json pickTool(Session& session, SceneView& view, glm::dvec2 position,
   return picked;
 }
 
+nlohmann::json moveVertexTool(Session& session, SceneView& view, glm::dvec2 from, glm::dvec2 to) {
+  const Camera& camera = session.camera();
+  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(view.source().bounds());
+  const Viewport v = session.viewport();
+  MeasureTool& tool = session.measurements();
+  const auto grabbed = tool.vertexNear(camera, nearW, v.width, v.height, from, kVertexGrabPixels);
+  if (!grabbed) return {{"moved", false}};
+  nlohmann::json j = {{"index", grabbed->first}, {"vertex", grabbed->second}};
+  j["pick"] = view.pickAttributes(camera, session.settings(), v, to);
+  bool moved = false;
+  if (j["pick"].contains("world")) {
+    const nlohmann::json& w = j["pick"]["world"];
+    moved = tool.move(grabbed->first, grabbed->second,
+                      {w[0].get<double>(), w[1].get<double>(), w[2].get<double>()});
+  }
+  if (moved) session.invalidate(); // the overlay changed
+  j["moved"] = moved;
+  return j;
+}
+
 std::optional<glm::dvec3> pickPivot(Session& session, SceneView& view, glm::dvec2 position) {
   std::optional<glm::dvec3> point =
       view.pick(session.camera(), session.settings(), session.viewport(), position);

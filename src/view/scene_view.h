@@ -144,5 +144,11 @@ void zoomAtCursor(Session& session, SceneView& view, glm::dvec2 position, double
 nlohmann::json pickTool(Session& session, SceneView& view, glm::dvec2 position,
                         std::optional<AnnotationKind> measure);
 std::optional<glm::dvec3> pickPivot(Session& session, SceneView& view, glm::dvec2 position);
+// A measurement's vertex drawn within this many pixels of a press is grabbed by a Ctrl+drag.
+constexpr double kVertexGrabPixels = 8;
+// Moving a vertex, in every front end: the vertex of the session's measurements drawn nearest `from`
+// (within kVertexGrabPixels) moves to the point picked at `to` (pickTool's pick, without measuring).
+// Returns {"moved": whether it moved, "index" and "vertex" when one was grabbed, "pick": the pick at `to`}.
+nlohmann::json moveVertexTool(Session& session, SceneView& view, glm::dvec2 from, glm::dvec2 to);
 
 } // namespace pointrast::view

@@ -218,6 +218,11 @@ void Session::toolClick(glm::dvec2 position, bool measure) {
   requests_.toolMeasure = measure;
 }
 
+void Session::toolDrag(glm::dvec2 from, glm::dvec2 to) {
+  navigation_.endDrag();
+  requests_.vertexMove = {from, to};
+}
+
 void Session::wheel(glm::dvec2 position, double steps, std::optional<double> depth) {
   if (steps == 0) return;
   navigation_.zoom(position, steps, viewport_, depth);

@@ -149,6 +149,9 @@ struct Requests {
   std::optional<glm::dvec2> pick; // read the depth under this viewport position, then call pivotPicked
   std::optional<glm::dvec2> toolPick; // the pick tool at this position (scene_view.h pickTool)
   bool toolMeasure = false;           // ... adding the point to a measurement
+  // Ctrl+drag from a measurement's vertex: move it to the point under the second position
+  // (scene_view.h moveVertexTool).
+  std::optional<std::pair<glm::dvec2, glm::dvec2>> vertexMove;
   bool screenshot = false;
   bool printCamera = false;
   bool quit = false;
@@ -172,6 +175,8 @@ public:
   void mouseUp(MouseButton button, glm::dvec2 position);
   void doubleClick(glm::dvec2 position); // asks for a pick; pivotPicked sets the pivot
   void toolClick(glm::dvec2 position, bool measure); // Ctrl+click: asks for the pick tool (Requests::toolPick)
+  // Ctrl+drag: asks to move the measurement's vertex under `from` (Requests::vertexMove).
+  void toolDrag(glm::dvec2 from, glm::dvec2 to);
   // Wheel steps (positive: zoom in); `depth` is the linear depth under the cursor when the front end has
   // it (see Navigation::zoom).
   void wheel(glm::dvec2 position, double steps, std::optional<double> depth = std::nullopt);

@@ -61,6 +61,38 @@ TEST(MeasureTool, AnAreaClosesItsOutlineAndDeletionRenumbers) {
   EXPECT_TRUE(tool.all().items.empty());
 }
 
+TEST(MeasureTool, AVertexNearAPositionMovesAndTheValueFollows) {
+  MeasureTool tool;
+  tool.add(AnnotationKind::Distance, {0, 0, 0});
+  tool.add(AnnotationKind::Distance, {10, 0, 0});
+  tool.finish();
+  // Looking down the -z axis from 20 units above the origin: x to the right, y up, a 90 degree view of a
+  // 200 x 200 image, so that 1 unit at depth 20 is 100 / 20 = 5 pixels.
+  Camera camera;
+  camera.eye = {0, 0, 20};
+  camera.target = {0, 0, 0};
+  camera.up = {0, 1, 0};
+  camera.fovY = 90;
+  const auto first = tool.vertexNear(camera, 0.1, 200, 200, {100.5, 100.5}, 8);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(*first, std::make_pair(size_t(0), size_t(0)));
+  // (10, 0, 0) is drawn 50 pixels right of the centre.
+  const auto second = tool.vertexNear(camera, 0.1, 200, 200, {147, 102}, 8);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(*second, std::make_pair(size_t(0), size_t(1)));
+  EXPECT_FALSE(tool.vertexNear(camera, 0.1, 200, 200, {125, 100}, 8)) << "between the two, farther than 8 px";
+  // Behind the camera: not seen.
+  Camera away = camera;
+  away.target = {0, 0, 40};
+  EXPECT_FALSE(tool.vertexNear(away, 0.1, 200, 200, {100.5, 100.5}, 8));
+  const uint64_t version = tool.version();
+  ASSERT_TRUE(tool.move(0, 1, {0, 0, 5}));
+  EXPECT_GT(tool.version(), version);
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(tool.json())[0]["value"].get<double>(), 5.0);
+  EXPECT_FALSE(tool.move(0, 2, {0, 0, 0}));
+  EXPECT_FALSE(tool.move(1, 0, {0, 0, 0}));
+}
+
 TEST(MeasureTool, SavedMeasurementsLoadBackTheSame) {
   MeasureTool tool;
   tool.add(AnnotationKind::Distance, {636000.125, 849000.5, 420.25});

@@ -161,7 +161,9 @@ const scenarios = {
   },
   // The pick and measure tools: args.steps, each {tool, pixel: [x, y]} (a pixel of the frame) clicked with that
   // tool chosen in the panel; after each click, the pick the page received, the text it shows and the
-  // measurement list. args.ctrl: Ctrl+click with the tool left at "navigates".
+  // measurement list. args.ctrl: Ctrl+click with the tool left at "navigates". A step {tool, drag: [[x0, y0],
+  // [x1, y1]]} presses at the first pixel and releases at the second instead: the page's "moved" answer and
+  // the list that follows it.
   async tools(context) {
     const { page, errors } = await open(context, url);
     const shown = await waitFull(page);
@@ -170,10 +172,23 @@ const scenarios = {
       const tool = args.ctrl ? 'navigate' : step.tool;
       if (await page.inputValue('#tool') !== tool) await page.selectOption('#tool', tool); // a change finishes a measurement
       const [before, lists] = await page.evaluate(() => [window.pointrast.picks, window.pointrast.measurementUpdates || 0]);
-      const at = await page.evaluate(([x, y, w, h]) => {
+      const client = (pixel) => page.evaluate(([x, y, w, h]) => {
         const r = document.getElementById('view').getBoundingClientRect();
         return [r.left + (x + 0.5) * r.width / w, r.top + (y + 0.5) * r.height / h];
-      }, [...step.pixel, shown.frame.viewWidth, shown.frame.viewHeight]);
+      }, [...pixel, shown.frame.viewWidth, shown.frame.viewHeight]);
+      if (step.drag) {
+        const moves = await page.evaluate(() => window.pointrast.moves || 0);
+        const [from, to] = [await client(step.drag[0]), await client(step.drag[1])];
+        await page.mouse.move(from[0], from[1]);
+        await page.mouse.down();
+        await page.mouse.move(to[0], to[1], { steps: 4 });
+        await page.mouse.up();
+        await page.waitForFunction((n) => (window.pointrast.moves || 0) > n, moves, { timeout: TIMEOUT, polling: 50 });
+        await page.waitForFunction((n) => (window.pointrast.measurementUpdates || 0) > n, lists, { timeout: TIMEOUT, polling: 50 });
+        results.push(await page.evaluate(() => ({ moved: window.pointrast.moved, measurements: window.pointrast.measurements })));
+        continue;
+      }
+      const at = await client(step.pixel);
       if (args.ctrl) await page.keyboard.down('Control');
       await page.mouse.click(at[0], at[1]);
       if (args.ctrl) await page.keyboard.up('Control');

@@ -293,6 +293,41 @@ TEST_F(Browser, ADistanceBetweenTwoClicksIsTheDistanceOfThePickedPoints) {
   expectCleanExit(server);
 }
 
+TEST_F(Browser, DraggingAVertexMovesItToThePointUnderTheRelease) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  ServeProcess server(autzen() + " " + kAutzenCamera);
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  auto dir = scratchDir("browser_move");
+  const Json steps = {{{"tool", "distance"}, {"pixel", {410, 250}}},
+                      {{"tool", "distance"}, {"pixel", {460, 280}}},
+                      {{"tool", "pick"}, {"drag", {{410, 250}, {440, 230}}}}};
+  Json r = browser("tools", server.url(), dir, {{"steps", steps}});
+  ASSERT_EQ(r["results"].size(), 3u) << r.dump();
+  EXPECT_EQ(r["errors"], Json::array());
+  const Camera camera = cameraOf(r["shown"]["state"]);
+  const Json& moved = r["results"][2]["moved"];
+  ASSERT_TRUE(moved["moved"].get<bool>()) << moved.dump();
+  EXPECT_EQ(moved["index"], 0);
+  EXPECT_EQ(moved["vertex"], 0);
+  // The vertex is now the point render --pick finds where the drag ended.
+  const Json& at = moved["pick"]["pixel"];
+  EXPECT_LE(std::abs(at[0].get<int>() - 440), 2);
+  EXPECT_LE(std::abs(at[1].get<int>() - 230), 2);
+  const Json expected = renderPick(camera, at, dir);
+  ASSERT_TRUE(expected["point"].is_object()) << expected.dump();
+  const Json& list = r["results"][2]["measurements"];
+  ASSERT_EQ(list.size(), 1u) << list.dump();
+  const Json& p0 = list[0]["points"][0];
+  const glm::dvec3 first(p0[0].get<double>(), p0[1].get<double>(), p0[2].get<double>());
+  expectNear(first, pointOf(expected["point"]), 1e-9, "moved vertex");
+  const Json& p1 = list[0]["points"][1];
+  const glm::dvec3 second(p1[0].get<double>(), p1[1].get<double>(), p1[2].get<double>());
+  expectNear(second, pointOf(r["results"][1]["pick"]["point"]), 1e-9, "the other vertex stays");
+  EXPECT_NEAR(list[0]["value"].get<double>(), glm::length(first - second),
+              1e-9 * glm::length(first - second));
+  expectCleanExit(server);
+}
+
 // The point records of a LAS file (formats 0-10, legacy or 1.4 counts), each as its bytes, and the
 // scale/offset to read their positions: the test's own reading, not the library's.
 struct LasRecords {

@@ -41,6 +41,12 @@ TEST(ToolsProtocol, PickAndMeasureMessages) {
   EXPECT_EQ(accepted(R"({"t":"measure","op":"download"})").measureOp, MeasureOp::Download);
   EXPECT_EQ(refused(R"({"t":"measure","op":"delete"})"), "missing \"index\"");
   EXPECT_EQ(refused(R"({"t":"measure","op":"save","index":1})"), "unknown measure operation");
+  m = accepted(R"({"t":"measure","op":"move","x":0.25,"y":0.5,"tx":0.75,"ty":1})");
+  EXPECT_EQ(m.measureOp, MeasureOp::Move);
+  EXPECT_EQ(m.position, glm::dvec2(0.25, 0.5));
+  EXPECT_EQ(m.target, glm::dvec2(0.75, 1));
+  EXPECT_EQ(refused(R"({"t":"measure","op":"move","x":0.25,"y":0.5,"tx":0.75})"), "missing \"ty\"");
+  EXPECT_NE(refused(R"({"t":"measure","op":"move","x":0.25,"y":0.5,"tx":"a","ty":1})"), "");
 }
 
 TEST(ToolsProtocol, ClipBoxSettings) {

@@ -197,12 +197,12 @@ std::string cameraArgs(const nlohmann::json& camera) {
   return text;
 }
 
-// render --method lod --pick of `input` at a pixel of the window's size with a frame event's camera.
-nlohmann::json renderLodPick(const std::string& input, const nlohmann::json& camera,
-                             const nlohmann::json& pixel) {
+// render --pick of `input` with `options` at a pixel of the window's size with a frame event's camera.
+nlohmann::json renderPick(const std::string& input, const std::string& options, const nlohmann::json& camera,
+                          const nlohmann::json& pixel) {
   const std::string command =
-      "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() + "' render '" + input +
-      "' --method lod" + cameraArgs(camera) + " --width " + std::to_string(kWidth) + " --height " +
+      "POINTRAST_VALIDATION=1 XDG_RUNTIME_DIR=/tmp '" + pointrastBinary() + "' render '" + input + "'" +
+      options + cameraArgs(camera) + " --width " + std::to_string(kWidth) + " --height " +
       std::to_string(kHeight) + " -q --json --frames 1 --pick " + std::to_string(pixel[0].get<int>()) + "," +
       std::to_string(pixel[1].get<int>()) + " -o '" + (toolsTempDir() / "pick.png").string() + "'";
   const nlohmann::json j = nlohmann::json::parse(shellOutput(command), nullptr, false);
@@ -238,7 +238,7 @@ TEST_F(ViewerTools, CtrlClickOnAnOctreePicksThePointRenderLodPicksAndMeasures) {
   EXPECT_TRUE(shown["point"].contains("node")) << shown.dump();
   EXPECT_TRUE(shown["point"].contains("intensity")) << shown.dump();
   shown.erase("world");
-  EXPECT_EQ(shown, renderLodPick(octree.string(), camera, shown["pixel"]));
+  EXPECT_EQ(shown, renderPick(octree.string(), " --method lod", camera, shown["pixel"]));
   // Ctrl+Shift+click twice: a distance between the two points picked on the octree.
   from = viewer->eventCount();
   viewer->xdotool("mousemove --window $W 120 250 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
@@ -252,6 +252,51 @@ TEST_F(ViewerTools, CtrlClickOnAnOctreePicksThePointRenderLodPicksAndMeasures) {
   const nlohmann::json list = (*b)["measurements"];
   ASSERT_EQ(list.size(), 1u) << list.dump();
   EXPECT_NEAR(list[0]["value"].get<double>(), glm::length(pa - pb), 1e-9 * glm::length(pa - pb));
+  finish(*viewer);
+}
+
+TEST_F(ViewerTools, CtrlDragMovesAMeasurementsVertexToThePointUnderTheRelease) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  auto viewer = start("'" + autzen() + "' " + kCamera + " --no-panel");
+  ASSERT_TRUE(first_);
+  const nlohmann::json camera = (*first_)["camera"];
+  size_t from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 120 250 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
+  auto a = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(a) << viewer->errors();
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 380 150 keydown ctrl keydown shift click 1 keyup shift keyup ctrl");
+  auto b = viewer->waitEvent("picked", from, 30);
+  ASSERT_TRUE(b) << viewer->errors();
+  ASSERT_EQ((*b)["measurements"].size(), 1u);
+  // Ctrl+drag from the first vertex (drawn within the pick radius of the first click) to another point.
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 120 250 keydown ctrl mousedown 1 mousemove --window $W 160 230 "
+                  "mousemove --window $W 200 220 mouseup 1 keyup ctrl");
+  auto moved = viewer->waitEvent("moved", from, 30);
+  ASSERT_TRUE(moved) << viewer->errors();
+  const nlohmann::json& m = (*moved)["moved"];
+  ASSERT_TRUE(m["moved"].get<bool>()) << m.dump();
+  EXPECT_EQ(m["index"], 0);
+  EXPECT_EQ(m["vertex"], 0);
+  nlohmann::json pick = m["pick"];
+  pick.erase("world");
+  EXPECT_EQ(pick, renderPick(autzen(), "", camera, pick["pixel"]));
+  const nlohmann::json list = (*moved)["measurements"];
+  ASSERT_EQ(list.size(), 1u);
+  const glm::dvec3 first = vec3(list[0]["points"][0]), second = vec3(list[0]["points"][1]);
+  EXPECT_EQ(first, vec3(m["pick"]["world"]));
+  EXPECT_EQ(second, vec3((*b)["pick"]["world"]));
+  EXPECT_NEAR(list[0]["value"].get<double>(), glm::length(first - second),
+              1e-9 * glm::length(first - second));
+  // A Ctrl+drag that starts on no vertex moves nothing.
+  from = viewer->eventCount();
+  viewer->xdotool("mousemove --window $W 300 300 keydown ctrl mousedown 1 mousemove --window $W 320 310 "
+                  "mousemove --window $W 340 320 mouseup 1 keyup ctrl");
+  auto missed = viewer->waitEvent("moved", from, 30);
+  ASSERT_TRUE(missed) << viewer->errors();
+  EXPECT_FALSE((*missed)["moved"]["moved"].get<bool>());
+  EXPECT_EQ((*missed)["measurements"], list);
   finish(*viewer);
 }
 

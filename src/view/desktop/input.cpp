@@ -167,6 +167,16 @@ void DesktopInput::button(int button, int action, int mods) {
                       : button == GLFW_MOUSE_BUTTON_RIGHT ? MouseButton::Right
                                                           : MouseButton::Middle;
   if (action == GLFW_RELEASE) {
+    // A Ctrl+press released where it was is a click of the pick tool; released elsewhere, a drag that moves
+    // the measurement's vertex under the press.
+    if (which == MouseButton::Left && toolPress_) {
+      const auto [at, measure] = *std::exchange(toolPress_, std::nullopt);
+      if (glm::length(cursor_ - at) <= kDoubleClickPixels)
+        session_.toolClick(at, measure);
+      else
+        session_.toolDrag(at, cursor_);
+      return;
+    }
     if (dragging_) session_.mouseUp(which, cursor_);
     dragging_ = false;
     return;
@@ -174,7 +184,7 @@ void DesktopInput::button(int button, int action, int mods) {
   if (panelWantsMouse() || overPanel()) return;
   // Ctrl+click: the pick tool, not a drag; with Shift the picked point is the next vertex of a measurement.
   if (which == MouseButton::Left && (mods & GLFW_MOD_CONTROL)) {
-    session_.toolClick(cursor_, (mods & GLFW_MOD_SHIFT) != 0);
+    toolPress_ = {cursor_, (mods & GLFW_MOD_SHIFT) != 0};
     return;
   }
   double now = glfw::glfwGetTime();

@@ -71,6 +71,7 @@ private:
   glm::dvec2 lastClick_{0};
   double wheel_ = 0;
   bool saveMeasurements_ = false;
+  std::optional<std::pair<glm::dvec2, bool>> toolPress_; // a Ctrl+press: where, and whether Shift was held
 };
 
 } // namespace pointrast::view

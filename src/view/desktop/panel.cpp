@@ -334,6 +334,7 @@ void screenshotControls(Session& session, PanelActions& actions) {
 // their values, Delete and Save.
 void toolControls(Session& session, const PanelInfo& info, PanelActions& actions) {
   ImGui::TextUnformatted("Ctrl+click: pick  Ctrl+Shift+click: measure");
+  ImGui::TextUnformatted("Ctrl+drag a vertex: move it");
   if (!info.picked.empty()) ImGui::TextUnformatted(info.picked.c_str());
   MeasureTool& tool = session.measurements();
   const std::pair<AnnotationKind, const char*> kinds[] = {

@@ -303,6 +303,16 @@ void Viewer::handleRequests() {
             {"pick", picked},
             {"measurements", nlohmann::json::parse(session_.measurements().json())}});
   }
+  if (r.vertexMove) {
+    nlohmann::json moved = moveVertexTool(session_, scene_, r.vertexMove->first, r.vertexMove->second);
+    if (moved.contains("pick")) info_.picked = pickedText(moved["pick"]);
+    if (options_.events)
+      emit({{"event", "moved"},
+            {"from", {r.vertexMove->first.x, r.vertexMove->first.y}},
+            {"to", {r.vertexMove->second.x, r.vertexMove->second.y}},
+            {"moved", moved},
+            {"measurements", nlohmann::json::parse(session_.measurements().json())}});
+  }
   if (input_.takeSaveMeasurements()) saveMeasurements();
   if (r.printCamera) {
     if (options_.events)

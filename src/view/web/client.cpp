@@ -188,6 +188,10 @@ void WebClient::receive(const ClientMessage& m) {
     break;
   case MessageType::Measure: {
     MeasureTool& tool = session_->measurements();
+    if (m.measureOp == MeasureOp::Move) {
+      vertexMove_ = {pixels(m.position), pixels(m.target)}; // needs a pick: served with the requests
+      break;
+    }
     if (m.measureOp == MeasureOp::Finish) tool.finish();
     if (m.measureOp == MeasureOp::Delete && !tool.remove(m.index))
       stream_.submitText(Json{{"t", "refused"}, {"text", "no measurement " + std::to_string(m.index)}}.dump());
@@ -215,6 +219,11 @@ void WebClient::serveRequests() {
     Json picked = pickTool(*session_, full_, at, kind);
     stream_.submitText(Json{{"t", "picked"}, {"pick", picked}}.dump());
     if (kind) sendMeasurements();
+  }
+  if (vertexMove_) {
+    const auto [from, to] = *std::exchange(vertexMove_, std::nullopt);
+    stream_.submitText(Json{{"t", "moved"}, {"moved", moveVertexTool(*session_, full_, from, to)}}.dump());
+    sendMeasurements();
   }
   if (wheel_ != 0) {
     zoomAtCursor(*session_, full_, wheelAt_, std::exchange(wheel_, 0.0));

@@ -82,6 +82,8 @@ private:
   bool stateChanged_ = true; // something the panel shows changed without a frame
   // The pick tool's click, served with the other requests: the position and the measurement it extends.
   std::optional<std::pair<glm::dvec2, std::optional<AnnotationKind>>> toolPick_;
+  // A vertex dragged with the pick tool: from, to (viewport pixels).
+  std::optional<std::pair<glm::dvec2, glm::dvec2>> vertexMove_;
 };
 
 } // namespace pointrast::view::web

@@ -64,7 +64,7 @@ const TypeName kTypes[] = {
     {MessageType::Action, "action", {"name"}},
     {MessageType::Ack, "ack", {"frame"}},
     {MessageType::PickPoint, "pickpoint", {"x", "y", "measure"}},
-    {MessageType::Measure, "measure", {"op", "index"}},
+    {MessageType::Measure, "measure", {"op", "index", "x", "y", "tx", "ty"}},
 };
 
 // Thrown inside the parser only; parseClientMessage turns it into the refusal's sentence.
@@ -339,9 +339,16 @@ ClientMessage parse(const Json& j, std::span<const Method> methods) {
       m.measureOp = MeasureOp::Clear;
     else if (op == "download")
       m.measureOp = MeasureOp::Download;
+    else if (op == "move")
+      m.measureOp = MeasureOp::Move;
     else
       refuse("unknown measure operation");
     if (m.measureOp == MeasureOp::Delete) m.index = uint32_t(integer(j, "index", 0, UINT32_MAX));
+    if (m.measureOp == MeasureOp::Move) {
+      m.position = position(j);
+      m.target = {number(j, "tx", -kPositionMargin, 1 + kPositionMargin),
+                  number(j, "ty", -kPositionMargin, 1 + kPositionMargin)};
+    }
     break;
   }
   }

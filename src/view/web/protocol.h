@@ -47,10 +47,11 @@ enum class MessageType {
   Action,      // name: clearKeyframes, downloadPath
   Ack,         // frame: the id of a frame the page has drawn
   PickPoint,   // x, y, and measure ("distance", "height", "area"): the pick tool, adding a vertex if measuring
-  Measure,     // op ("finish", "delete" with index, "clear", "download"): the measurements' list
+  Measure,     // op: finish, delete (index), clear, download, move (x, y, tx, ty): the measurements
 };
 
-enum class MeasureOp { Finish, Delete, Clear, Download };
+// Move: the vertex drawn nearest (x, y) moves to the point picked at (tx, ty) (scene_view.h moveVertexTool).
+enum class MeasureOp { Finish, Delete, Clear, Download, Move };
 
 enum class ClientAction { ClearKeyframes, DownloadPath };
 
@@ -111,6 +112,7 @@ struct ClientMessage {
   uint32_t frame = 0;
   std::optional<AnnotationKind> measure; // PickPoint: the kind of measurement the point extends
   MeasureOp measureOp = MeasureOp::Finish;
+  glm::dvec2 target{0}; // Measure Move: where the vertex goes (position: where it was grabbed)
   uint32_t index = 0;
   double received = 0; // seconds on the steady clock: when the server read it (not from the wire)
 };

@@ -134,6 +134,7 @@ function receiveText(message) {
     case 'state': pointrast.state = message; showState(message); break;
     case 'pick': pointrast.lastPick = message; break;
     case 'picked': pointrast.picked = message.pick; pointrast.picks++; showPicked(message.pick); break;
+    case 'moved': pointrast.moved = message.moved; pointrast.moves = (pointrast.moves || 0) + 1; if (message.moved.pick) showPicked(message.moved.pick); break;
     case 'measurements': pointrast.measurements = message.list; pointrast.measurementUpdates = (pointrast.measurementUpdates || 0) + 1; showMeasurements(message.list); break;
     case 'annotations': download(new Blob([message.text], { type: 'application/json' }), 'annotations.json'); break;
     case 'camera': pointrast.cameraText = message.text; $('cameraText').textContent = 'pointrast render FILE ' + message.text; break;
@@ -463,13 +464,28 @@ function touchUp(e) {
 // --- tools: pick and measure -----------------------------------------------------------------------------
 
 // A left click with a tool chosen (or Ctrl+click in any) picks the point under it; measuring tools add it
-// as the next vertex of the open measurement.
+// as the next vertex of the open measurement. Pressed on a measurement's vertex and released elsewhere, the
+// vertex moves to the point under the release. The press is kept until its release decides which.
+let toolPress = null;
 function toolClick(e) {
   const tool = $('tool').value;
   if (e.button !== 0 || (tool === 'navigate' && !e.ctrlKey)) return false;
   flush();
-  const message = { t: 'pickpoint', ...clampPosition(position(e)) };
-  if (tool === 'distance' || tool === 'height' || tool === 'area') message.measure = tool;
+  toolPress = { at: clampPosition(position(e)), clientX: e.clientX, clientY: e.clientY, tool };
+  return true;
+}
+
+function toolRelease(e) {
+  if (!toolPress || e.button !== 0) return false;
+  const press = toolPress;
+  toolPress = null;
+  if (Math.hypot(e.clientX - press.clientX, e.clientY - press.clientY) > 4) {
+    const to = clampPosition(position(e));
+    send({ t: 'measure', op: 'move', x: press.at.x, y: press.at.y, tx: to.x, ty: to.y });
+    return true;
+  }
+  const message = { t: 'pickpoint', ...press.at };
+  if (press.tool === 'distance' || press.tool === 'height' || press.tool === 'area') message.measure = press.tool;
   send(message);
   return true;
 }
@@ -572,6 +588,7 @@ canvas.addEventListener('pointermove', (e) => {
 });
 const release = (e) => {
   if (e.pointerType === 'touch') return touchUp(e);
+  if (toolRelease(e)) return;
   if (e.button > 2 || buttonsDown === 0) return;
   flush();
   buttonsDown--;
