@@ -421,6 +421,7 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
     report.spillBytes = spill.bytesWritten();
   }
   report.seconds = since(s.start);
+  report.tailBytes = s.params.tailBytes;
   report.phases = s.phases;
   report.metadata = s.metadata;
   report.metadata.depth = report.octree.levels - 1;

@@ -48,6 +48,7 @@ struct LodBuildReport {
   unsigned threads = 0;
   uint64_t inputBytes = 0; // bytes of point records in the input files (0 where unknown)
   uint64_t spillBytes = 0; // bytes written to temporary chunk files
+  uint32_t tailBytes = 0;  // bytes of each point's attribute tail (OctreeBuilder::tail())
   double seconds = 0;      // from the first read to the last node
 };
 
