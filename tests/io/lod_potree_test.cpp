@@ -113,6 +113,11 @@ TEST_P(LodPotree, AutzenOnDiskHoldsEveryPointOnceAndRoundTrips) {
   // hierarchy.bin itself: child masks, counts and byte ranges agree with the nodes built, and the nodes'
   // byte ranges tile octree.bin exactly.
   const uint64_t octreeBytes = std::filesystem::file_size(dir / "o" / "octree.bin");
+  // DEFAULT: 24 bytes of record fields and the attributes autzen's points carry (GPS time...).
+  uint64_t stride = 0;
+  for (const io::PotreeAttributeInfo& a : io::probePotree(dir / "o").attributes)
+    stride += uint64_t(a.size);
+  EXPECT_GT(stride, 24u);
   std::vector<std::pair<uint64_t, uint64_t>> ranges;
   std::map<NodeKey, uint8_t> masks;
   for (const potreetest::DiskNode& n : potreetest::walkHierarchy(dir / "o")) {
@@ -121,7 +126,7 @@ TEST_P(LodPotree, AutzenOnDiskHoldsEveryPointOnceAndRoundTrips) {
     EXPECT_EQ(n.record.pointCount, byKey[n.key]->records.size()) << n.key.potreeName();
     EXPECT_EQ(n.record.type, n.record.childMask ? io::potree::kNormal : io::potree::kLeaf);
     if (GetParam() == io::PotreeEncoding::Default) {
-      EXPECT_EQ(uint64_t(n.record.byteSize), n.record.pointCount * 24u);
+      EXPECT_EQ(uint64_t(n.record.byteSize), n.record.pointCount * stride);
     }
     ranges.push_back({n.record.byteOffset, n.record.byteOffset + n.record.byteSize});
     masks[n.key] = n.record.childMask;
