@@ -84,6 +84,7 @@ int runView(const ViewArgs& a) {
   applyDrawOptions(a.draw, options.settings);
   options.pathFile = a.path;
   options.annotationsFile = a.annotations;
+  options.inputFile = a.input;
   // A file given but damaged is said now, not after the window opened.
   std::error_code exists;
   if (!a.annotations.empty() && std::filesystem::exists(a.annotations, exists)) io::loadAnnotations(a.annotations);

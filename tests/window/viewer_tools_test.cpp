@@ -1,5 +1,6 @@
 // The desktop viewer's tools in a real window on Xvfb (lavapipe, validation layer on): measurements and
 // annotations drawn over the window as `render --annotations` draws them over its PNG.
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -298,6 +299,84 @@ TEST_F(ViewerTools, CtrlDragMovesAMeasurementsVertexToThePointUnderTheRelease) {
   EXPECT_FALSE((*missed)["moved"]["moved"].get<bool>());
   EXPECT_EQ((*missed)["measurements"], list);
   finish(*viewer);
+}
+
+// The point records of a LAS file, each as its bytes, sorted: the file's multiset of points.
+std::vector<std::string> sortedRecords(const std::filesystem::path& file) {
+  const std::string bytes = shellOutput("cat '" + file.string() + "'");
+  std::vector<std::string> records;
+  if (bytes.size() < 227 || bytes.compare(0, 4, "LASF") != 0) {
+    ADD_FAILURE() << file << " is not a LAS file";
+    return records;
+  }
+  uint32_t start = 0, count32 = 0;
+  uint16_t length = 0;
+  std::memcpy(&start, bytes.data() + 96, 4);
+  std::memcpy(&length, bytes.data() + 105, 2);
+  std::memcpy(&count32, bytes.data() + 107, 4);
+  uint64_t count = count32;
+  if (count == 0 && bytes.size() >= 255) std::memcpy(&count, bytes.data() + 247, 8);
+  if (uint64_t(start) + count * length > bytes.size()) {
+    ADD_FAILURE() << file << " is shorter than its header says";
+    return records;
+  }
+  for (uint64_t i = 0; i < count; ++i)
+    records.push_back(bytes.substr(start + i * length, length));
+  std::sort(records.begin(), records.end());
+  return records;
+}
+
+std::optional<nlohmann::json> panelFrame(Viewer& viewer, size_t from, const std::string& item) {
+  return viewer.waitFor(
+      [&](const nlohmann::json& e) {
+        return e.value("event", "") == "frame" && e.contains("panel_items") &&
+               e["panel_items"].contains(item);
+      },
+      from, 30);
+}
+
+void clickItem(Viewer& viewer, const nlohmann::json& frame, const std::string& item) {
+  const std::vector<float> r = frame["panel_items"][item].get<std::vector<float>>();
+  viewer.xdotool("mousemove --window $W " + std::to_string(int(r[0] + r[2] / 2)) + " " +
+                 std::to_string(int(r[1] + r[3] / 2)) + " click 1");
+}
+
+TEST_F(ViewerTools, PanelClipBoxExportsWhatConvertClipBoxWrites) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const std::string box = "636400,849000,300,636800,849400,600";
+  Viewer viewer(display(), "'" + autzen() + "' " + kCamera + " --width 960 --height 1000 --screenshot-dir '" +
+                               toolsTempDir().string() + "'");
+  auto frame = viewer.waitEvent("frame", 0, 120);
+  ASSERT_TRUE(frame) << viewer.errors();
+  ASSERT_TRUE((*frame)["panel_items"].contains("Clip and export")) << (*frame)["panel_items"].dump();
+  clickItem(viewer, *frame, "Clip and export");
+  // A key that draws a frame, which reports the controls the header opened.
+  size_t from = viewer.eventCount();
+  viewer.xdotool("mousemove --window $W 950 990 key 8");
+  frame = panelFrame(viewer, from, "Export LAS");
+  ASSERT_TRUE(frame) << viewer.errors();
+  clickItem(viewer, *frame, "box");
+  viewer.xdotool("type --delay 20 '" + box + "'");
+  from = viewer.eventCount();
+  clickItem(viewer, *frame, "Apply");
+  // The clipped frame (the clip box is not among the options describeSettings prints).
+  auto clipped = panelFrame(viewer, from, "Export LAS");
+  ASSERT_TRUE(clipped) << viewer.errors();
+  from = viewer.eventCount();
+  clickItem(viewer, *clipped, "Export LAS");
+  auto exported = viewer.waitEvent("exported", from, 60);
+  ASSERT_TRUE(exported) << viewer.errors();
+  ASSERT_TRUE(exported->contains("file")) << exported->dump() << viewer.errors();
+  EXPECT_GT((*exported)["points"].get<uint64_t>(), 1000u);
+  EXPECT_EQ(viewer.quit(), 0) << viewer.errors();
+  const std::filesystem::path expected = toolsTempDir() / "convert-clip.las";
+  std::filesystem::remove(expected);
+  const std::string convert = "'" + pointrastBinary() + "' convert '" + autzen() + "' '" + expected.string() +
+                              "' --clip-box " + box + " -q";
+  ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+  const std::vector<std::string> mine = sortedRecords((*exported)["file"].get<std::string>());
+  EXPECT_EQ(mine.size(), (*exported)["points"].get<uint64_t>());
+  EXPECT_TRUE(mine == sortedRecords(expected)) << "the export differs from convert --clip-box";
 }
 
 } // namespace

@@ -371,9 +371,59 @@ void toolControls(Session& session, const PanelInfo& info, PanelActions& actions
   if (info.annotationsFile.empty()) ImGui::TextDisabled("--annotations FILE to save");
 }
 
+// Clip and export: a box typed as six numbers or taken from the view (around the pivot, as wide as the view
+// there, the cloud's height), the clip mode, Apply and Clear (the frame's clip volume), and Export LAS of
+// the points the applied box keeps, through convert's filter path.
+void clipControls(Session& session, PanelInfo& info, ViewSettings& settings, PanelActions& actions,
+                  PanelItems& items) {
+  char* text = info.clipBoxText.data();
+  if (ImGui::Button("From view")) {
+    const Camera& c = session.camera();
+    const glm::dvec3 p = session.pivot();
+    const double half = glm::length(c.eye - p) * std::tan(glm::radians(c.fovY) / 2);
+    const Bounds& b = session.navigation().bounds();
+    std::snprintf(text, info.clipBoxText.size(), "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f", p.x - half, p.y - half,
+                  b.min.z, p.x + half, p.y + half, b.max.z);
+  }
+  remember(items, "From view");
+  ImGui::InputText("box", text, info.clipBoxText.size());
+  remember(items, "box");
+  if (ImGui::RadioButton("inside", settings.filter.clipMode == ClipMode::Inside))
+    settings.filter.clipMode = ClipMode::Inside;
+  remember(items, "inside");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("outside", settings.filter.clipMode == ClipMode::Outside))
+    settings.filter.clipMode = ClipMode::Outside;
+  remember(items, "outside");
+  if (ImGui::Button("Apply")) {
+    double v[6];
+    ClipBox box;
+    if (std::sscanf(text, "%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == 6) {
+      box.min = {v[0], v[1], v[2]};
+      box.max = {v[3], v[4], v[5]};
+      if (box.min.x <= box.max.x && box.min.y <= box.max.y && box.min.z <= box.max.z)
+        settings.filter.boxes = {box};
+      else
+        info.exported = "the box is the min corner, then the max corner";
+    } else {
+      info.exported = "the box takes six numbers: x0,y0,z0,x1,y1,z1";
+    }
+  }
+  remember(items, "Apply");
+  ImGui::SameLine();
+  if (ImGui::Button("Clear")) settings.filter.boxes.clear();
+  remember(items, "Clear");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(settings.filter.boxes.empty());
+  if (ImGui::Button("Export LAS")) actions.exportLas = true;
+  remember(items, "Export LAS");
+  ImGui::EndDisabled();
+  if (!info.exported.empty()) ImGui::TextUnformatted(info.exported.c_str());
+}
+
 } // namespace
 
-PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& settings, PanelItems& items) {
+PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& settings, PanelItems& items) {
   PanelActions actions;
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
@@ -410,6 +460,9 @@ PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& s
   if (ImGui::CollapsingHeader("Keyframes")) keyframeControls(session, info, actions);
   if (ImGui::CollapsingHeader("Screenshot")) screenshotControls(session, actions);
   if (ImGui::CollapsingHeader("Pick and measure")) toolControls(session, info, actions);
+  const bool clipOpen = ImGui::CollapsingHeader("Clip and export");
+  remember(items, "Clip and export");
+  if (clipOpen) clipControls(session, info, settings, actions, items);
   ImGui::TextDisabled("drag: orbit  right/middle drag: pan  wheel: zoom\n"
                       "double-click: pivot  WASD QE: fly (Shift: fast)\n"
                       "8 2 5 0 4 6: views  F: frame all  K: keyframe\n"

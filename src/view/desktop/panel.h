@@ -22,6 +22,9 @@ struct PanelInfo {
   std::string pathFile;
   std::string annotationsFile; // where Save writes the measurements; empty: no Save
   std::string picked;          // the last pick, as lines of attributes
+  std::string exported;        // the last export's file and points, or why it failed
+  // The clip box as typed (min then max corner, six numbers), kept between frames.
+  std::array<char, 256> clipBoxText{};
 };
 
 struct PanelActions {
@@ -32,11 +35,12 @@ struct PanelActions {
   std::optional<StandardView> view;
   bool saveMeasurements = false;
   std::optional<size_t> deleteMeasurement;
+  bool exportLas = false; // write the points the clip box keeps (with the clip mode) as LAS
 };
 
 // Screen rectangles (x, y, width, height in pixels) of the panel's controls by label, for --events.
 using PanelItems = std::map<std::string, std::array<float, 4>>;
 
-PanelActions buildPanel(Session& session, const PanelInfo& info, ViewSettings& settings, PanelItems& items);
+PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& settings, PanelItems& items);
 
 } // namespace pointrast::view

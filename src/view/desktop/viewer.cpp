@@ -17,6 +17,7 @@
 #include "gpu/context.h"
 #include "gpu/swapchain.h"
 #include "io/annotations_file.h"
+#include "io/format_table.h"
 #include "io/writer.h"
 #include "view/desktop/glfw_api.h"
 #include "view/desktop/input.h"
@@ -91,11 +92,11 @@ void emit(const nlohmann::json& event) {
   std::fflush(stdout);
 }
 
-// pointrast-0001.png, pointrast-0002.png, ...: the first name not taken in the folder.
-std::filesystem::path screenshotName(const std::filesystem::path& folder) {
+// pointrast-0001.png, pointrast-0002.png, ... (`pattern`): the first name not taken in the folder.
+std::filesystem::path numberedName(const std::filesystem::path& folder, const char* pattern) {
   for (uint32_t n = 1;; ++n) {
-    char name[32];
-    std::snprintf(name, sizeof name, "pointrast-%04u.png", n);
+    char name[64];
+    std::snprintf(name, sizeof name, pattern, n);
     std::filesystem::path p = folder / name;
     std::error_code error;
     if (!std::filesystem::exists(p, error)) return p;
@@ -116,6 +117,7 @@ private:
   void takeScreenshot();
   void saveKeyframes();
   void saveMeasurements();
+  void exportClipped();
   ImDrawData* buildPanelFrame(double seconds);
 
   const ViewerOptions& options_;
@@ -216,6 +218,38 @@ void Viewer::handlePanel(const PanelActions& actions) {
   if (actions.screenshot) takeScreenshot();
   if (actions.deleteMeasurement && session_.measurements().remove(*actions.deleteMeasurement)) session_.invalidate();
   if (actions.saveMeasurements) saveMeasurements();
+  if (actions.exportLas) exportClipped();
+}
+
+// The input's points that the applied clip box keeps, as LAS beside the screenshots, through convert's
+// filter path (records byte for byte, as `convert --clip-box` writes them).
+void Viewer::exportClipped() {
+  const std::filesystem::path file = numberedName(options_.screenshotDir, "pointrast-export-%04u.las");
+  nlohmann::json event = {{"event", "exported"}};
+  try {
+    const std::filesystem::path& input = options_.inputFile;
+    std::error_code error;
+    const io::FormatInfo* format =
+        std::filesystem::is_regular_file(input, error) ? io::detectFormat(input) : nullptr;
+    const std::string name = format ? format->name : "";
+    if (name != "LAS" && name != "LAZ" && name != "COPC")
+      throw InputError("export writes the points of a LAS, LAZ or COPC file, not " + info_.input);
+    io::LasConvertOptions convert;
+    convert.filter = &session_.settings().filter;
+    const uint64_t points = io::convertLasFile(input, file, convert);
+    info_.exported = file.string() + ": " + std::to_string(points) + " points";
+    event["file"] = file.string();
+    event["points"] = points;
+  } catch (const InputError& e) {
+    info_.exported = e.what();
+    event["error"] = e.what();
+    if (!options_.events) std::fprintf(stderr, "%s\n", e.what());
+  }
+  if (options_.events)
+    emit(event);
+  else if (!event.contains("error"))
+    std::printf("export: %s\n", info_.exported.c_str());
+  std::fflush(stdout);
 }
 
 // The measurements that can be measured, to --annotations (written under a temporary name, then renamed).
@@ -257,7 +291,7 @@ void Viewer::saveKeyframes() {
 }
 
 void Viewer::takeScreenshot() {
-  std::filesystem::path file = screenshotName(options_.screenshotDir);
+  std::filesystem::path file = numberedName(options_.screenshotDir, "pointrast-%04u.png");
   Viewport viewport = session_.viewport();
   std::vector<uint32_t> pixels =
       scene_.screenshot(session_.camera(), session_.settings(), viewport, session_.options().supersample);

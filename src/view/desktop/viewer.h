@@ -32,6 +32,8 @@ struct ViewerOptions {
   // --annotations: measurements loaded at the start when the file exists, written by Ctrl+S and the
   // panel's Save; empty: measurements are not saved.
   std::filesystem::path annotationsFile;
+  // The input as given: the panel's Export LAS reads it when it is a LAS, LAZ or COPC file.
+  std::filesystem::path inputFile;
   std::optional<uint32_t> device;
   std::string title = "pointrast";
   // When set, receives every frame rendered and the device, for the statistics written at the close.
