@@ -214,9 +214,21 @@ void BuildInputs::widen(const Task& task, std::vector<PointRecord>& records) con
 void BuildInputs::orTails(const PointRecord* records, const uint8_t* tails, size_t n, uint8_t* mask,
                           bool& returnsDiffer) const {
   const uint32_t bytes = tail_.bytes();
-  for (size_t i = 0; i < n; ++i)
-    for (uint32_t b = 0; b < bytes; ++b)
-      mask[b] |= tails[i * bytes + b];
+  if (bytes == 0) return;
+  // In 64-bit words: `bytes` words span 8 tails, so word k of every such run holds the same tail bytes.
+  const size_t total = n * bytes, period = size_t(bytes) * 8, whole = total / period * period;
+  std::vector<uint64_t> words(bytes, 0);
+  for (size_t at = 0; at < whole; at += period)
+    for (uint32_t k = 0; k < bytes; ++k) {
+      uint64_t w;
+      std::memcpy(&w, tails + at + 8 * size_t(k), 8);
+      words[k] |= w;
+    }
+  for (uint32_t k = 0; k < bytes; ++k)
+    for (uint32_t j = 0; j < 8; ++j)
+      mask[(8 * k + j) % bytes] |= static_cast<uint8_t>(words[k] >> (8 * j)); // little endian bytes
+  for (size_t at = whole; at < total; ++at)
+    mask[at % bytes] |= tails[at];
   const int returns = tail_.layout.numberOfReturns;
   if (returns >= 0)
     for (size_t i = 0; i < n && !returnsDiffer; ++i)
