@@ -72,6 +72,9 @@ struct PotreeValueRanges {
   uint8_t returnMin = UINT8_MAX, returnMax = 0;
   uint8_t classMin = UINT8_MAX, classMax = 0;
   uint16_t sourceMin = UINT16_MAX, sourceMax = 0;
+  // Of the attributes of the points' tails (PotreeWriteOptions::tail), element after element in the
+  // order metadata.json lists them; empty until a tail was added.
+  std::vector<double> tailMin, tailMax;
 
   void add(const PointRecord* records, size_t n);
   void merge(const PotreeValueRanges& other);

@@ -156,17 +156,6 @@ std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* recor
   return encodeBrotli(layout, records, nullptr, n);
 }
 
-namespace {
-
-// The tail slot of the attribute at `defaultOffset` in a DEFAULT point, or null.
-const TailSlot* slotAt(const Layout& layout, int defaultOffset) {
-  for (const TailSlot& s : layout.tailSlots)
-    if (s.pointOffset == defaultOffset) return &s;
-  return nullptr;
-}
-
-} // namespace
-
 std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* records, const uint8_t* tails,
                                   size_t n) {
   if (n == 0) return {};
@@ -176,7 +165,7 @@ std::vector<uint8_t> encodeBrotli(const Layout& layout, const PointRecord* recor
   int at = 0; // the attribute's offset in a DEFAULT point, which names its tail slot
   for (const Attribute& a : layout.attributes) {
     encodeBlock(a, records, n, block);
-    const TailSlot* slot = a.field == Field::Other && tails ? slotAt(layout, at) : nullptr;
+    const TailSlot* slot = a.field == Field::Other && tails ? tailSlotAt(layout, at) : nullptr;
     if (slot)
       for (size_t i = 0; i < n; ++i) {
         const uint8_t* t = tails + i * tailBytes;
@@ -209,7 +198,7 @@ void decodeBrotli(const Layout& layout, const uint8_t* src, uint64_t size, size_
   int at = 0;
   for (const Attribute& a : layout.attributes) {
     decodeBlock(a, block, n, positionBias, dst);
-    const TailSlot* slot = a.field == Field::Other && tails ? slotAt(layout, at) : nullptr;
+    const TailSlot* slot = a.field == Field::Other && tails ? tailSlotAt(layout, at) : nullptr;
     if (slot)
       for (size_t i = 0; i < n; ++i) {
         uint8_t* t = tails + i * tailBytes;

@@ -1,5 +1,7 @@
 // Potree 2.0 DEFAULT node encoding: each point's attributes one after another, little endian, in the
 // order metadata.json lists them (the Potree viewer's DecoderWorker.js reads them so).
+#include <algorithm>
+
 #include "io/io_util.h"
 #include "io/potree/potree_format.h"
 
@@ -142,6 +144,68 @@ void decodeDefaultTails(const Layout& layout, const uint8_t* src, size_t n, uint
             static_cast<uint8_t>(t[s.tailOffset] | ((p[s.pointOffset] & ((1 << s.bits) - 1)) << s.shift));
       else
         std::memcpy(t + s.tailOffset, p + s.pointOffset, static_cast<size_t>(s.size));
+    }
+  }
+}
+
+const TailSlot* tailSlotAt(const Layout& layout, int defaultOffset) {
+  for (const TailSlot& s : layout.tailSlots)
+    if (s.pointOffset == defaultOffset) return &s;
+  return nullptr;
+}
+
+namespace {
+
+// One element of an attribute's type (Potree 2.0's names) as a double.
+double elementValue(const std::string& type, const uint8_t* p) {
+  if (type == "int8") return double(int8_t(p[0]));
+  if (type == "uint16") return double(loadLE<uint16_t>(p));
+  if (type == "int16") return double(loadLE<int16_t>(p));
+  if (type == "uint32") return double(loadLE<uint32_t>(p));
+  if (type == "int32") return double(loadLE<int32_t>(p));
+  if (type == "uint64") return double(loadLE<uint64_t>(p));
+  if (type == "int64") return double(loadLE<int64_t>(p));
+  if (type == "float") return double(loadLE<float>(p));
+  if (type == "double") return loadLE<double>(p);
+  return double(p[0]); // uint8, and undocumented bytes
+}
+
+} // namespace
+
+void addTailRanges(const Layout& layout, const uint8_t* tails, size_t n, PotreeValueRanges& ranges) {
+  const size_t tailBytes = layout.tail.bytes();
+  std::vector<double> lo, hi;
+  int at = 0;
+  for (const Attribute& a : layout.attributes) {
+    const TailSlot* slot = a.field == Field::Other ? tailSlotAt(layout, at) : nullptr;
+    at += a.size;
+    if (!slot) continue;
+    for (int e = 0; e < a.numElements; ++e) {
+      double mn = 0, mx = 0;
+      for (size_t i = 0; i < n; ++i) {
+        const uint8_t* t = tails + i * tailBytes;
+        const double v =
+            slot->bits > 0
+                ? double((t[slot->tailOffset] >> slot->shift) & ((1 << slot->bits) - 1))
+                : elementValue(a.type, t + slot->tailOffset + size_t(e) * size_t(std::max(a.elementSize, 1)));
+        mn = i == 0 || v < mn ? v : mn;
+        mx = i == 0 || v > mx ? v : mx;
+      }
+      lo.push_back(mn);
+      hi.push_back(mx);
+    }
+  }
+  if (n == 0) return;
+  PotreeValueRanges node;
+  node.tailMin = std::move(lo);
+  node.tailMax = std::move(hi);
+  if (ranges.tailMin.empty()) {
+    ranges.tailMin = std::move(node.tailMin);
+    ranges.tailMax = std::move(node.tailMax);
+  } else {
+    for (size_t k = 0; k < ranges.tailMin.size() && k < node.tailMin.size(); ++k) {
+      ranges.tailMin[k] = std::min(ranges.tailMin[k], node.tailMin[k]);
+      ranges.tailMax[k] = std::max(ranges.tailMax[k], node.tailMax[k]);
     }
   }
 }

@@ -182,6 +182,10 @@ void decodeDefault(const Layout& layout, const uint8_t* src, size_t n, PointReco
 // The tails' fields into (encode) or out of (decode) DEFAULT points, by layout.tailSlots; tails holds
 // n * layout.tail.bytes() bytes.
 void encodeDefaultTails(const Layout& layout, const uint8_t* tails, size_t n, uint8_t* dst);
+// The tail slot of the attribute at `defaultOffset` in a DEFAULT point, or null.
+const TailSlot* tailSlotAt(const Layout& layout, int defaultOffset);
+// Adds the values of the tails' attributes to ranges.tailMin/tailMax (element after element).
+void addTailRanges(const Layout& layout, const uint8_t* tails, size_t n, PotreeValueRanges& ranges);
 void decodeDefaultTails(const Layout& layout, const uint8_t* src, size_t n, uint8_t* tails);
 
 // BROTLI. Positions are stored as uint32 Morton codes of (q + positionBias) (mod 2^32); pointrast writes

@@ -97,6 +97,15 @@ void PotreeValueRanges::merge(const PotreeValueRanges& o) {
   classMax = std::max(classMax, o.classMax);
   sourceMin = std::min(sourceMin, o.sourceMin);
   sourceMax = std::max(sourceMax, o.sourceMax);
+  if (tailMin.empty()) {
+    tailMin = o.tailMin;
+    tailMax = o.tailMax;
+  } else {
+    for (size_t i = 0; i < o.tailMin.size() && i < tailMin.size(); ++i) {
+      tailMin[i] = std::min(tailMin[i], o.tailMin[i]);
+      tailMax[i] = std::max(tailMax[i], o.tailMax[i]);
+    }
+  }
   count += o.count;
 }
 
@@ -215,6 +224,21 @@ potree::Metadata PotreeWriter::State::describe(const potree::HierarchyBytes& hie
       break;
     }
   }
+  // The tail attributes' ranges, element after element (zeros when no point carried one).
+  size_t element = 0;
+  int at = 0;
+  for (potree::Attribute& a : m.layout.attributes) {
+    const bool tail = a.field == potree::Field::Other && potree::tailSlotAt(m.layout, at);
+    at += a.size;
+    if (!tail) continue;
+    a.min.clear();
+    a.max.clear();
+    for (int e = 0; e < a.numElements; ++e, ++element) {
+      const bool known = element < r.tailMin.size();
+      a.min.push_back(known ? r.tailMin[element] : 0.0);
+      a.max.push_back(known ? r.tailMax[element] : 0.0);
+    }
+  }
   return m;
 }
 
@@ -280,6 +304,7 @@ PotreeEncodedNode PotreeWriter::encodeNode(const PointRecord* records, const uin
     if (tails && !s.layout.tailSlots.empty())
       potree::encodeDefaultTails(s.layout, tails, count, node.bytes.data());
   }
+  if (tails && !s.layout.tailSlots.empty()) potree::addTailRanges(s.layout, tails, count, node.ranges);
   return node;
 }
 
