@@ -100,6 +100,20 @@ TEST(LodAttributesCli, MetadataNamesTheAttributesAsPotreeConverter) {
     EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
   // Every point's user data is 0 in this file: the field is left out (an export writes 0).
   EXPECT_EQ(std::find(names.begin(), names.end(), "user data"), names.end());
+  // The GPS time range is the input's (format 8: a double at byte 22 of each record).
+  const Las in = readLasFile(pointrast::test::dataDir() / kExtra);
+  double lo = 1e300, hi = -1e300;
+  for (const std::string& r : in.records) {
+    const double t =
+        pointrast::test::las_records::load<double>(reinterpret_cast<const uint8_t*>(r.data()) + 22);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  for (const auto& a : m["attributes"])
+    if (a["name"] == "gps-time") {
+      EXPECT_EQ(a["min"][0].get<double>(), lo);
+      EXPECT_EQ(a["max"][0].get<double>(), hi);
+    }
   EXPECT_EQ(m["lasAttributes"]["pointFormat"], 8);
   EXPECT_EQ(m["lasAttributes"]["extraBytes"], 3);
 }
