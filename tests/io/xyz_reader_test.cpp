@@ -66,7 +66,7 @@ TEST(Quantize, EqualsNearbyintAndClamp) {
   for (double scale : {1.0, 0.001, 0.01, 0.25})
     for (double offset : {0.0, 4.5e6, -12.5})
       for (double v : values)
-        ASSERT_EQ(io::detail::quantize(v, scale, offset), reference(v, scale, offset))
+        ASSERT_EQ(pointrast::io::detail::quantize(v, scale, offset), reference(v, scale, offset))
             << v << " scale " << scale << " offset " << offset;
 }
 
