@@ -1,12 +1,16 @@
 // libFuzzer target for one LAZ chunk, past the container's checks: the first byte picks the item layout
 // (pointwise point formats 0-3, layered 6-8, with or without extra bytes), the next two the claimed point
-// count, the rest is the chunk's bytes (raw first point, layer table, arithmetic-coded streams). Every
-// input decodes or throws CorruptChunk; the decoded buffer must hold exactly the claimed records.
+// count (at most kMaxPoints: a larger claim decodes the first kMaxPoints points, so an input costs a few
+// hundred points' work however much it claims), the rest is the chunk's bytes (raw first point, layer
+// table, arithmetic-coded streams). Every input decodes or throws CorruptChunk; the decoded buffer must
+// hold exactly the claimed records.
 //
 // Seeds: with LAZCHUNK_FUZZ_SEEDS=DIR set, the target first writes into DIR the chunks of the shared LAZ
-// files whose items match one of its layouts (laz_seeds.h):
+// files (up to 8 KiB) whose items match one of its layouts, and for every layout chunks of up to 200
+// records of the shared files of the same family coded by pointrast's encoder (laz_seeds.h):
 //   LAZCHUNK_FUZZ_SEEDS=seeds ./lazchunk_fuzz -runs=0 seeds && ./lazchunk_fuzz -max_total_time=300 corpus
 //   seeds
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -20,9 +24,18 @@ namespace {
 
 using namespace pointrast::io::laz;
 
-Layout layoutFor(uint8_t selector) {
+// Points decoded per input at most: a few hundred points keep an input near a millisecond under the
+// sanitizers, and every model of the decoders still adapts (rescales) several times.
+constexpr uint64_t kMaxPoints = 512;
+constexpr uint64_t kSeedPoints = 200;
+
+int formatFor(uint8_t selector) {
   static const int kFormats[] = {0, 1, 2, 3, 6, 7, 8};
-  const int format = kFormats[(selector & 0x7F) % 7];
+  return kFormats[(selector & 0x7F) % 7];
+}
+
+Layout layoutFor(uint8_t selector) {
+  const int format = formatFor(selector);
   const bool extra = selector & 0x80;
   Layout layout;
   layout.compressor = format >= 6 ? Compressor::LayeredChunked : Compressor::PointwiseChunked;
@@ -56,18 +69,36 @@ bool sameItems(const Layout& a, const Layout& b) {
   return true;
 }
 
+std::vector<uint8_t> seedInput(unsigned selector, uint64_t count, const std::vector<uint8_t>& bytes) {
+  std::vector<uint8_t> input{uint8_t(selector), uint8_t((count - 1) & 0xFF), uint8_t((count - 1) >> 8)};
+  input.insert(input.end(), bytes.begin(), bytes.end());
+  return input;
+}
+
 void writeSeeds(const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
   int n = 0;
-  for (const fuzz::SeedChunk& chunk : fuzz::seedChunks(65536 - 3, 4))
+  for (const fuzz::SeedChunk& chunk : fuzz::seedChunks(8192, 4, kMaxPoints))
     for (unsigned selector = 0; selector < 256; ++selector)
       if (sameItems(layoutFor(uint8_t(selector)), chunk.layout)) {
-        std::vector<uint8_t> input{uint8_t(selector), uint8_t((chunk.count - 1) & 0xFF),
-                                   uint8_t((chunk.count - 1) >> 8)};
-        input.insert(input.end(), chunk.bytes.begin(), chunk.bytes.end());
-        fuzz::writeSeed(dir / ("chunk" + std::to_string(n++)), input);
+        fuzz::writeSeed(dir / ("chunk" + std::to_string(n++)), seedInput(selector, chunk.count, chunk.bytes));
         break;
       }
+  // Every layout (7 formats, with and without extra bytes), from each shared file of its family.
+  const std::vector<fuzz::SeedRecords> sources = fuzz::seedRecords(kSeedPoints);
+  for (unsigned selector : {0u, 1u, 2u, 3u, 4u, 5u, 6u, 0x80u, 0x81u, 0x82u, 0x83u, 0x84u, 0x85u, 0x86u}) {
+    const Layout layout = layoutFor(uint8_t(selector));
+    const int format = formatFor(uint8_t(selector));
+    const uint16_t extra =
+        uint16_t(layout.recordLength - pointrast::io::detail::las::kRecordSize[size_t(format)]);
+    for (const fuzz::SeedRecords& source : sources) {
+      if (!fuzz::sameFamily(source.pointFormat, format)) continue;
+      const std::vector<uint8_t> records = fuzz::convertRecords(source, format, extra);
+      fuzz::writeSeed(
+          dir / ("encoded" + std::to_string(n++)),
+          seedInput(selector, source.count, fuzz::encodeSeedChunk(layout, records.data(), source.count)));
+    }
+  }
 }
 
 } // namespace
@@ -80,7 +111,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 3) return 0;
   const Layout layout = layoutFor(data[0]);
-  const uint64_t count = 1 + (uint64_t(data[1]) | uint64_t(data[2]) << 8);
+  const uint64_t count = std::min(kMaxPoints, 1 + (uint64_t(data[1]) | uint64_t(data[2]) << 8));
   static ChunkDecoder* decoders[256] = {};
   ChunkDecoder*& decoder = decoders[data[0]];
   if (!decoder) decoder = new ChunkDecoder(layout); // reused like a reader thread's, state reset per chunk
