@@ -30,6 +30,7 @@
 #include "io/writer.h"
 #include "render/camera.h"
 #include "render/clip_volumes.h"
+#include "render/clock_settle.h"
 #include "render/lod/lod_scene.h"
 #include "render/renderer.h"
 #include "render/scene.h"
@@ -386,7 +387,16 @@ private:
         lastUploadS_ = 0;
       }
       Renderer& r = renderer(o);
-      stats = r.render(*scene_, c, s);
+      if (s.frames > 1) {
+        // Timed frames as the CLI times them: GPU clocks settled first, frames retimed while a clock
+        // change shows in them (render/clock_settle.h).
+        auto draw = [&](const RenderSettings& round) { return r.render(*scene_, c, round); };
+        settleClocksWith(*context_, s, draw);
+        bool settled = true;
+        stats = timeSettled(*context_, s, draw, settled);
+      } else {
+        stats = r.render(*scene_, c, s);
+      }
       pixels = r.image();
       if (wantDepth || wantIndex) words = indexWords(input, c, o);
     }
