@@ -72,6 +72,22 @@ inline constexpr std::array<int, 11> kRgbOffset = {-1, -1, 20, 28, -1, 28, -1, 3
 inline bool isExtended(int pointFormat) {
   return pointFormat >= 6;
 }
+// Waveform formats and the format of their records without the 29-byte wave packet: the packet starts
+// where the base format's record ends.
+inline int withoutWaveform(int pointFormat) {
+  switch (pointFormat) {
+  case 4:
+    return 1;
+  case 5:
+    return 3;
+  case 9:
+    return 6;
+  case 10:
+    return 8;
+  default:
+    return pointFormat;
+  }
+}
 
 // Bits 7 and 6 of the point format byte are set by LASzip in compressed files (the format is the low 6).
 inline constexpr uint8_t kCompressionBits = 0xC0;

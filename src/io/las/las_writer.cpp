@@ -274,23 +274,6 @@ void LasFileWriter::commit() {
 
 namespace {
 
-// Waveform formats and the format of their records without the 29-byte wave packet: the packet starts
-// where the base format's record ends.
-int withoutWaveform(int pointFormat) {
-  switch (pointFormat) {
-  case 4:
-    return 1;
-  case 5:
-    return 3;
-  case 9:
-    return 6;
-  case 10:
-    return 8;
-  default:
-    return pointFormat;
-  }
-}
-
 // The EVLRs of a LAS 1.4 file, each its 60-byte header and payload; COPC's are left out.
 std::vector<std::vector<uint8_t>> readEvlrs(const InputFile& file, const LasHeader& hd) {
   std::vector<std::vector<uint8_t>> out;
@@ -401,7 +384,7 @@ uint64_t convertLasFile(const std::filesystem::path& in, const std::filesystem::
   } else {
     hd = readLasHeader(file);
   }
-  const int baseFormat = withoutWaveform(hd.pointFormat);
+  const int baseFormat = las::withoutWaveform(hd.pointFormat);
   const bool dropWaves = baseFormat != hd.pointFormat;
   if (dropWaves && !options.dropWaveforms)
     fail(in, strFormat("point format %d carries waveform packets, which the output would lose; "

@@ -35,27 +35,12 @@ FilterPoint filterPoint(const PointRecord& r, const lod::OctreeMetadata& meta) {
   return p;
 }
 
-// The format a tail's records are written in: waveform formats without their packets (not carried).
-int tailPointFormat(const TailFormat& tail) {
-  switch (tail.lasPointFormat) {
-  case 4:
-    return 1;
-  case 5:
-    return 3;
-  case 9:
-    return 6;
-  case 10:
-    return 8;
-  default:
-    return tail.lasPointFormat;
-  }
-}
-
-// Records with tails as LAS records of the tail's point format, through LasFileWriter.
+// Records with tails as LAS records of the tail's point format (waveform formats without their packets,
+// which are not carried), through LasFileWriter.
 class TailRecordWriter {
 public:
   TailRecordWriter(const std::filesystem::path& path, const lod::OctreeMetadata& meta, const TailFormat& tail)
-      : tail_(tail), format_(tailPointFormat(tail)) {
+      : tail_(tail), format_(las::withoutWaveform(tail.lasPointFormat)) {
     const bool extended = las::isExtended(format_);
     recordLength_ = static_cast<uint16_t>(las::kRecordSize[size_t(format_)] + tail.attributes.extraBytes);
     LasFileSetup setup;
