@@ -320,15 +320,8 @@ public:
   uint64_t pieceBytes(size_t i) const override { return laz_.chunks[i].bytes; }
 
   void readPiece(size_t i, std::vector<PointRecord>& out) const override {
-    const LasHeader& hd = laz_.header;
     std::vector<uint8_t> records;
-    pool_.decode(file_, laz_.chunks[i], strFormat("LAZ chunk %zu of %zu", i + 1, laz_.chunks.size()),
-                 records);
-    const bool extended = las::isExtended(hd.pointFormat);
-    const int rgbOffset = hd.rgbOffset();
-    out.resize(laz_.chunks[i].pointCount);
-    for (size_t k = 0; k < out.size(); ++k)
-      out[k] = toPointRecord(records.data() + k * hd.recordLength, extended, rgbOffset);
+    decodePiece(i, out, records);
   }
 
   TailFormat tailFormat() const override { return tail_; }
@@ -337,6 +330,16 @@ public:
                       std::vector<uint8_t>& tails) const override {
     const LasHeader& hd = laz_.header;
     std::vector<uint8_t> records;
+    decodePiece(i, out, records);
+    tails.resize(out.size() * layout.bytes());
+    packLasTails(records.data(), hd.recordLength, out.size(), hd.pointFormat, tail_.attributes.extraBytes,
+                 layout, tails.data());
+  }
+
+private:
+  // Chunk i's raw records into `records` and its points into `out`.
+  void decodePiece(size_t i, std::vector<PointRecord>& out, std::vector<uint8_t>& records) const {
+    const LasHeader& hd = laz_.header;
     pool_.decode(file_, laz_.chunks[i], strFormat("LAZ chunk %zu of %zu", i + 1, laz_.chunks.size()),
                  records);
     const bool extended = las::isExtended(hd.pointFormat);
@@ -344,12 +347,8 @@ public:
     out.resize(laz_.chunks[i].pointCount);
     for (size_t k = 0; k < out.size(); ++k)
       out[k] = toPointRecord(records.data() + k * hd.recordLength, extended, rgbOffset);
-    tails.resize(out.size() * layout.bytes());
-    packLasTails(records.data(), hd.recordLength, out.size(), hd.pointFormat, tail_.attributes.extraBytes,
-                 layout, tails.data());
   }
 
-private:
   InputFile file_;
   laz::LazFile laz_;
   mutable ChunkDecoderPool pool_;
