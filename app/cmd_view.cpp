@@ -111,7 +111,13 @@ int runView(const ViewArgs& a) {
   options.title = "pointrast - " + input.name;
   const int status = view::runViewer(input, options);
   if (!a.stats.empty()) writeStats(a, input, log, options, flight ? &*flight : nullptr);
-  if (flight) std::fprintf(stderr, "%s\n", flight->summary().c_str());
+  if (flight) {
+    std::fprintf(stderr, "%s\n", flight->summary().c_str());
+    if (const std::string why = flight->emptyStrokes(); !why.empty() && status == 0) {
+      std::fprintf(stderr, "pointrast: %s\n", why.c_str());
+      return 1;
+    }
+  }
   return status;
 }
 

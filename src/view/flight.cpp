@@ -103,23 +103,24 @@ Flight::Flight(const FlightOptions& options) : options_(options) {
 
 void Flight::strokeInputs(double at, std::vector<FlightInput>& out) {
   if (!down_) {
-    out.push_back(pointerInput(FlightInput::Kind::Down, {0.5, 0.9}));
+    out.push_back(pointerInput(FlightInput::Kind::Down, flightStroke(strokes_, 0.0)));
     pending_.push_back(at);
     down_ = true;
     strokeStart_ = at;
   }
   const double u = std::min(1.0, (at - strokeStart_) / kStrokeSeconds);
-  out.push_back(pointerInput(FlightInput::Kind::Move, {0.5 + 0.05 * std::sin(u * M_PI), 0.9 - 0.8 * u}));
+  out.push_back(pointerInput(FlightInput::Kind::Move, flightStroke(strokes_, u)));
   pending_.push_back(at);
   if (u >= 1.0) {
-    out.push_back(pointerInput(FlightInput::Kind::Up, {0.5, 0.1}));
+    out.push_back(pointerInput(FlightInput::Kind::Up, flightStroke(strokes_, 1.0)));
     pending_.push_back(at);
     down_ = false;
+    ++strokes_;
   }
 }
 
 void Flight::endStrokes(double now, std::vector<FlightInput>& out) {
-  if (down_) out.push_back(pointerInput(FlightInput::Kind::Up, {0.5, 0.1}));
+  if (down_) out.push_back(pointerInput(FlightInput::Kind::Up, flightStroke(strokes_, 1.0)));
   down_ = false;
   end_ = now;
   if (streamed_) strokesTo_ = *streamed_;
@@ -297,6 +298,12 @@ nlohmann::json Flight::result() const {
         {"cache_bytes", cacheBytes_}, {"strokes", json(flown)}, {"session", json(*streamed_)}};
   }
   return result;
+}
+
+std::string Flight::emptyStrokes() const {
+  if (strokesPointsDrawn_.empty() || report::percentile(strokesPointsDrawn_, 0.5) > 0) return {};
+  return "the flight's strokes drew no points in their median frame: the camera left the cloud or went "
+         "under its ground, so the figures time empty frames";
 }
 
 std::string Flight::summary() const {

@@ -7,10 +7,12 @@
 //             waiting for the view to converge makes the depth each step zooms towards that of the
 //             ground, however fast nodes stream): the camera comes down low over the cloud;
 //   settle    0.5 s;
-//   strokes   for SECONDS, an input every 1/rate s: pan drags (right button) from (0.5, 0.9) to
-//             (0.5, 0.1) in 1.5 s each, swaying sideways by 0.05, carry the camera over new ground;
-//             frames/s and input to frame (the time an input fell due to the frame that showed it
-//             handed to the display);
+//   strokes   for SECONDS, an input every 1/rate s: horizontal pan drags (right button) across 0.8 of
+//             the viewport's width in 1.5 s each (flightStroke), swaying by 0.05 vertically, carry the
+//             camera sideways at its height over new ground: two strokes one way, then four the other
+//             way and four back, so that it sweeps across the cloud and stays over it; frames/s, input
+//             to frame (the time an input fell due to the frame that showed it handed to the display)
+//             and the points each frame drew (a flight whose frames draw nothing measures nothing);
 //   jumps     after 0.3 s each: a standard view (a key) or a zoom of 12-14 steps towards another place,
 //             then the frames until one says the level-of-detail view converged (every selected node
 //             resident and drawn), 30 s at most.
@@ -20,6 +22,7 @@
 // GPU, no window: the viewer applies the inputs and reports the frames it showed.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -55,6 +58,15 @@ constexpr double kJumpTimeoutSeconds = 30;
 
 class SceneView;
 
+// Where the pointer of a flight's pan stroke is, stroke `index` (from 0) at `u` (0 at its start, 1 at its
+// end) of its time, relative to the viewport. A horizontal drag moves the camera along its right vector,
+// which stays level, so the strokes keep the height the approach came down to; the directions sweep the
+// camera across the cloud and back (+,+,-,-,-,-,+,+,+,+,...). serve_load sends the same strokes.
+inline glm::dvec2 flightStroke(uint64_t index, double u) {
+  const double direction = ((index + 2) / 4) % 2 == 0 ? 1.0 : -1.0;
+  return {0.5 + direction * (0.4 - 0.8 * u), 0.6 + 0.05 * std::sin(u * 3.14159265358979323846)};
+}
+
 // Applies one input to the session as the desktop window's events would (a wheel through zoomAtCursor,
 // which reads the depth under the cursor from the view).
 void applyFlightInput(Session& session, SceneView& view, const FlightInput& input);
@@ -83,6 +95,9 @@ public:
   // during the strokes and over the whole session, and the strokes' points drawn a frame (median, min,
   // max: a camera flown off the cloud or under its ground draws none).
   nlohmann::json result() const;
+  // Why the strokes measured nothing: the median frame drawn with level of detail while they flew drew no
+  // point (the camera left the cloud or went under its ground). Empty when they drew, or for a cloud.
+  std::string emptyStrokes() const;
   // One line of the same figures.
   std::string summary() const;
 
@@ -113,6 +128,7 @@ private:
   uint64_t inputIndex_ = 0; // inputs fall due at start_ + index / rate
   bool down_ = false;
   double strokeStart_ = 0;
+  uint64_t strokes_ = 0;          // strokes finished
   std::vector<double> pending_;   // due times of inputs applied and not yet shown
   std::vector<double> latencies_; // ms
   uint64_t framesFlown_ = 0, framesConverged_ = 0;

@@ -92,22 +92,67 @@ TEST(Flight, StrokesPlayInputsAtTheRateAndMeasureInputToFrame) {
   EXPECT_GE(ms["p50"].get<double>(), 50.0 - 1e-6);
   EXPECT_LE(ms["max"].get<double>(), 100.0 + 1e-6);
   EXPECT_GT(ms["p95"].get<double>(), ms["p50"].get<double>());
-  // Pan drags with the right button from the bottom towards the top of the viewport.
+  // Horizontal pan drags with the right button: the first from the right towards the left of the viewport,
+  // at the height of the approach's wheel steps, swaying by at most 0.05.
   size_t downs = 0, moves = 0;
-  double lowestY = 1;
+  double lowestX = 1;
   for (const FlightInput& in : loop.inputs) {
     if (in.kind == FlightInput::Kind::Down) {
       ++downs;
       EXPECT_EQ(in.button, view::MouseButton::Right);
+      EXPECT_DOUBLE_EQ(in.at.x, 0.9);
     }
     if (in.kind == FlightInput::Kind::Move) {
       ++moves;
-      lowestY = std::min(lowestY, in.at.y);
+      lowestX = std::min(lowestX, in.at.x);
+      EXPECT_GE(in.at.y, 0.6 - 1e-9);
+      EXPECT_LE(in.at.y, 0.65 + 1e-9);
     }
   }
   EXPECT_EQ(downs, 1u);
   EXPECT_GE(moves, 99u);
-  EXPECT_LT(lowestY, 0.9 - 0.8 / 1.5 * 0.9) << "a second carries the stroke two thirds of its way";
+  EXPECT_LT(lowestX, 0.9 - 0.8 / 1.5 * 0.9) << "a second carries the stroke two thirds of its way";
+}
+
+TEST(Flight, StrokesKeepTheHeightAndSweepAcrossAndBack) {
+  // Each stroke ends at the height it started (a level camera move) and spans 0.8 of the width.
+  double position = 0; // where the camera is, in strokes to the right of where it started
+  double lowest = 0, highest = 0;
+  for (uint64_t i = 0; i < 40; ++i) {
+    const glm::dvec2 a = view::flightStroke(i, 0.0), b = view::flightStroke(i, 1.0);
+    EXPECT_DOUBLE_EQ(a.y, b.y);
+    EXPECT_NEAR(std::abs(a.x - b.x), 0.8, 1e-12);
+    EXPECT_GT(view::flightStroke(i, 0.5).y, a.y) << "sways while it drags";
+    position += a.x > b.x ? 1 : -1; // dragging the view left moves the camera right
+    lowest = std::min(lowest, position);
+    highest = std::max(highest, position);
+  }
+  // Two strokes one way, then four the other way and four back: it stays within two strokes of the start.
+  EXPECT_EQ(highest, 2);
+  EXPECT_EQ(lowest, -2);
+  EXPECT_EQ(position, 0);
+}
+
+TEST(Flight, StrokesWhoseFramesDrawNoPointsAreSaid) {
+  for (uint64_t drawn : {uint64_t(0), uint64_t(1000)}) {
+    Flight flight({0.5, 100});
+    lod::LodStats lod;
+    lod.converged = true;
+    lod.pointsDrawn = drawn;
+    double now = 0;
+    for (int i = 0; i < 100000 && !flight.done(); ++i) {
+      flight.take(now);
+      flight.frameShown(now += 0.02, lod);
+    }
+    ASSERT_TRUE(flight.done());
+    EXPECT_EQ(flight.emptyStrokes().empty(), drawn > 0) << drawn;
+  }
+  // A cloud drawn whole reports no points a frame: nothing to say.
+  Flight cloud({0.2, 100});
+  Loop loop{cloud};
+  for (int i = 0; i < 100000 && !cloud.done(); ++i)
+    loop.step(0.02, true);
+  EXPECT_TRUE(cloud.emptyStrokes().empty());
 }
 
 TEST(Flight, EachJumpCountsItsFramesUntilOneConverged) {

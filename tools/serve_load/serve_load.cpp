@@ -26,6 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "view/flight.h"
 #include "view/web/jpeg.h"
 #include "view/web/protocol.h"
 #include "ws_client.h"
@@ -65,7 +66,8 @@ struct Frame {
   view::web::FrameHeader header;
   size_t bytes = 0;
   double arrived = 0;
-  bool converged = false; // the state sent with it says the level-of-detail view converged
+  bool converged = false;            // the state sent with it says the level-of-detail view converged
+  std::optional<double> pointsDrawn; // the points its level-of-detail frame drew, from that state
 };
 
 class Load {
@@ -94,6 +96,7 @@ private:
   std::vector<Frame> frames_;         // received since the last reset
   std::vector<uint32_t> rgba_;
   std::map<uint32_t, bool> convergedByFrame_; // frame id -> its state's lod.converged
+  std::map<uint32_t, double> pointsByFrame_;  // frame id -> its state's lod.pointsDrawn
 };
 
 uint32_t Load::send(Json message) {
@@ -126,8 +129,11 @@ void Load::pump(double until) {
       if (j.is_object() && j.value("t", "") == "state") {
         state_ = j;
         const Json& lod = j.value("stats", Json::object()).value("lod", Json::object());
-        if (j.contains("frame") && j["frame"].is_number_unsigned())
+        if (j.contains("frame") && j["frame"].is_number_unsigned()) {
           convergedByFrame_[j["frame"].get<uint32_t>()] = lod.value("converged", false);
+          if (lod.contains("pointsDrawn") && lod["pointsDrawn"].is_number())
+            pointsByFrame_[j["frame"].get<uint32_t>()] = lod["pointsDrawn"].get<double>();
+        }
       }
       continue;
     }
@@ -146,6 +152,10 @@ void Load::pump(double until) {
     if (auto it = convergedByFrame_.find(f.header.frame); it != convergedByFrame_.end()) {
       f.converged = it->second;
       convergedByFrame_.erase(convergedByFrame_.begin(), std::next(it));
+    }
+    if (auto it = pointsByFrame_.find(f.header.frame); it != pointsByFrame_.end()) {
+      f.pointsDrawn = it->second;
+      pointsByFrame_.erase(pointsByFrame_.begin(), std::next(it));
     }
     ws_.sendText(Json{{"t", "ack"}, {"frame", f.header.frame}}.dump());
     // Every input up to the frame's sequence number is shown by it.
@@ -295,9 +305,10 @@ bool writeFile(const std::string& path, const std::string& text) {
 }
 
 // Low over the cloud, then across it: wheel steps towards a point below the middle of the canvas bring the
-// camera down, and strokes of a pan drag (right button) from the bottom of the canvas to the top carry it
-// forward over new ground for --seconds, a pointer move every 1/rate s. Every node the flight needs is
-// streamed while it flies; a frame never waits for one.
+// camera down, and horizontal strokes of a pan drag (right button, view::flightStroke: the desktop viewer's
+// `--flight` plays the same) carry it sideways at that height, across the cloud and back, for --seconds, a
+// pointer move every 1/rate s. Every node the flight needs is streamed while it flies; a frame never waits
+// for one.
 Json Load::flightPhase() {
   send({{"t", "stream"}, {"motionScale", 0.5}});
   for (int i = 0; i < 6; ++i) {
@@ -311,19 +322,26 @@ Json Load::flightPhase() {
   double start = clockSeconds(), next = start;
   const double stroke = 1.5; // seconds a stroke
   bool down = false;
+  uint64_t strokes = 0;
   double strokeStart = start;
+  auto pointer = [](const char* type, glm::dvec2 at) {
+    Json m = {{"t", type}, {"x", at.x}, {"y", at.y}};
+    if (std::strcmp(type, "move") != 0) m["b"] = 2;
+    return m;
+  };
   while (clockSeconds() - start < args_.seconds) {
     double now = clockSeconds();
     if (!down) {
-      send({{"t", "down"}, {"b", 2}, {"x", 0.5}, {"y", 0.9}});
+      send(pointer("down", view::flightStroke(strokes, 0.0)));
       down = true;
       strokeStart = now;
     }
     double u = std::min(1.0, (now - strokeStart) / stroke);
-    send({{"t", "move"}, {"x", 0.5 + 0.05 * std::sin(u * M_PI)}, {"y", 0.9 - 0.8 * u}});
+    send(pointer("move", view::flightStroke(strokes, u)));
     if (u >= 1.0) {
-      send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
+      send(pointer("up", view::flightStroke(strokes, 1.0)));
       down = false;
+      ++strokes;
     }
     // A pump that returned late does not make the next moves come in a burst: a page sends at most one
     // move per animation frame (--rate stands for the display's refresh rate), besides an acknowledgement
@@ -331,18 +349,27 @@ Json Load::flightPhase() {
     next = std::max(next + 1.0 / args_.rate, clockSeconds());
     pump(next);
   }
-  if (down) send({{"t", "up"}, {"b", 2}, {"x", 0.5}, {"y", 0.1}});
+  if (down) send(pointer("up", view::flightStroke(strokes, 1.0)));
   double elapsed = clockSeconds() - start;
   std::vector<Frame> flown = frames_;
   std::vector<double> latencies = latencies_;
   size_t converged = 0;
-  for (const Frame& f : flown)
+  std::vector<double> points;
+  for (const Frame& f : flown) {
     converged += f.converged;
-  return {{"seconds", elapsed},
-          {"frames", flown.size()},
-          {"frames_per_second", double(flown.size()) / elapsed},
-          {"frames_converged", converged},
-          {"input_to_frame_ms", summary(latencies)}};
+    if (f.pointsDrawn) points.push_back(*f.pointsDrawn);
+  }
+  Json out = {{"seconds", elapsed},
+              {"frames", flown.size()},
+              {"frames_per_second", double(flown.size()) / elapsed},
+              {"frames_converged", converged},
+              {"input_to_frame_ms", summary(latencies)}};
+  if (!points.empty()) {
+    std::sort(points.begin(), points.end());
+    out["points_drawn"] = {
+        {"median", points[points.size() / 2]}, {"min", points.front()}, {"max", points.back()}};
+  }
+  return out;
 }
 
 // Jumps: a standard view (a key), then a zoom towards another place (wheel steps); after each, the frames
@@ -369,8 +396,7 @@ Json Load::jumps() {
     frames_.clear();
     double sent = clockSeconds();
     uint32_t s = send(jump.message);
-    if (jump.message["t"] == "key")
-      send({{"t", "key"}, {"key", jump.message["key"]}, {"down", false}});
+    if (jump.message["t"] == "key") send({{"t", "key"}, {"key", jump.message["key"]}, {"down", false}});
     // Frames until one that shows the jump and says the view converged; 30 s is the failure bound.
     std::optional<size_t> convergedAt;
     double deadline = sent + 30.0;
@@ -409,14 +435,21 @@ int Load::runFlight(const Frame& first, Json result) {
   }
   result["jumps_all_converged"] = all;
   result["jump_frames_to_converge_max"] = worst;
+  // Frames that draw nothing are fast and measure nothing: a flight whose median frame drew no point failed.
+  const bool drew = !flight.contains("points_drawn") || flight["points_drawn"]["median"].get<double>() > 0;
+  result["flight_drew_points"] = drew;
   std::string text = result.dump(2);
   std::printf("%s\n", text.c_str());
-  std::fprintf(stderr,
-               "flight: %.1f frames/s at %ux%u, input to frame p50 %.1f ms p95 %.1f ms; jumps: %s, at most %zu "
-               "frames to converge\n",
-               flight["frames_per_second"].get<double>(), args_.width, args_.height,
-               flight["input_to_frame_ms"]["p50"].get<double>(), flight["input_to_frame_ms"]["p95"].get<double>(),
-               all ? "all converged" : "NOT all converged", worst);
+  std::fprintf(
+      stderr,
+      "flight: %.1f frames/s at %ux%u, input to frame p50 %.1f ms p95 %.1f ms; jumps: %s, at most %zu "
+      "frames to converge\n",
+      flight["frames_per_second"].get<double>(), args_.width, args_.height,
+      flight["input_to_frame_ms"]["p50"].get<double>(), flight["input_to_frame_ms"]["p95"].get<double>(),
+      all ? "all converged" : "NOT all converged", worst);
+  if (!drew)
+    std::fprintf(stderr, "serve_load: the flight's median frame drew no points: the camera left the cloud or "
+                         "went under its ground, so the figures time empty frames\n");
   if (!args_.output.empty() && !writeFile(args_.output, text + "\n")) return 1;
   if (!args_.markdown.empty()) {
     std::string md = "# pointrast serve: a flight with level of detail, one client at " +
@@ -425,18 +458,22 @@ int Load::runFlight(const Frame& first, Json result) {
           ", method " + result["method"].get<std::string>() +
           "; `serve_load --flight` over loopback: low over the cloud, pan strokes across it at " +
           format("%.0f", args_.rate) + " pointer moves/s, then jumps.\n\n";
-    md += "| phase | frames/s | input to frame p50 (ms) | p95 (ms) |\n| --- | ---: | ---: | ---: |\n";
+    md += "| phase | frames/s | input to frame p50 (ms) | p95 (ms) | points drawn a frame (median) |\n"
+          "| --- | ---: | ---: | ---: | ---: |\n";
     md += "| flight | " + format("%.1f", flight["frames_per_second"].get<double>()) + " | " +
           format("%.1f | %.1f", flight["input_to_frame_ms"]["p50"].get<double>(),
                  flight["input_to_frame_ms"]["p95"].get<double>()) +
+          " | " +
+          (flight.contains("points_drawn") ? format("%.0f", flight["points_drawn"]["median"].get<double>())
+                                           : std::string("-")) +
           " |\n\n| jump | converged | frames to converge | ms |\n| --- | --- | ---: | ---: |\n";
     for (const Json& j : jumped)
-      md += "| " + j["jump"].get<std::string>() + " | " + (j["converged"].get<bool>() ? "yes" : "no") + " | " +
-            std::to_string(j["frames_to_converge"].get<size_t>()) + " | " +
+      md += "| " + j["jump"].get<std::string>() + " | " + (j["converged"].get<bool>() ? "yes" : "no") +
+            " | " + std::to_string(j["frames_to_converge"].get<size_t>()) + " | " +
             format("%.0f", j.value("ms_to_converge", 0.0)) + " |\n";
     if (!writeFile(args_.markdown, md)) return 1;
   }
-  return all ? 0 : 1;
+  return all && drew ? 0 : 1;
 }
 
 int Load::run() {
@@ -518,9 +555,10 @@ int main(int argc, char** argv) {
   Args args;
   try {
     if (!parse(argc, argv, args)) {
-      std::fprintf(stderr,
-                   "usage: serve_load --port P [--host H] [--token T] [--width W] [--height H] [--seconds S] "
-                   "[--rate HZ] [--isolated N] [--flight] [--no-decode] [-o result.json] [--markdown result.md]\n");
+      std::fprintf(
+          stderr,
+          "usage: serve_load --port P [--host H] [--token T] [--width W] [--height H] [--seconds S] "
+          "[--rate HZ] [--isolated N] [--flight] [--no-decode] [-o result.json] [--markdown result.md]\n");
       return 1;
     }
   } catch (const std::exception&) {
