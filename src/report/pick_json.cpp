@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "base/error.h"
+#include "cloud/lod_tails.h"
 #include "cloud/octree.h"
 #include "cloud/point_record.h"
 #include "render/lod/hierarchy.h"
@@ -41,6 +42,32 @@ nlohmann::json pickJson(const PointCloud& cloud, uint32_t x, uint32_t y, bool em
   return j;
 }
 
+namespace {
+
+nlohmann::json number(const lod::TailValue::Number& n) {
+  return std::visit([](auto v) { return nlohmann::json(v); }, n);
+}
+
+// The tail's attributes beside the record's: LAS fields under their keys, extra bytes fields by name in
+// "extra_bytes" (a number, or a list for an array field).
+void addTailValues(nlohmann::json& point, const std::vector<lod::TailValue>& values) {
+  for (const lod::TailValue& v : values) {
+    if (v.values.empty()) continue;
+    nlohmann::json value = number(v.values[0]);
+    if (v.values.size() > 1) {
+      value = nlohmann::json::array();
+      for (const lod::TailValue::Number& n : v.values)
+        value.push_back(number(n));
+    }
+    if (v.extraBytes)
+      point["extra_bytes"][v.name] = value;
+    else
+      point[v.name] = value;
+  }
+}
+
+} // namespace
+
 nlohmann::json pickJson(Renderer& renderer, lod::LodScene& scene, uint32_t x, uint32_t y) {
   std::optional<Renderer::LodPixel> at;
   try {
@@ -50,7 +77,12 @@ nlohmann::json pickJson(Renderer& renderer, lod::LodScene& scene, uint32_t x, ui
   }
   if (!at) return pickJson(PointCloud(), x, y, true, std::nullopt);
   const lod::NodeInfo& node = scene.hierarchy().node(at->node).info;
-  const std::vector<PointRecord> records = scene.source().readNode(node);
+  // Sources whose points carry more than the record fields (cloud/lod_tails.h) give them with the node.
+  auto* tailed = dynamic_cast<lod::NodeTails*>(&scene.source());
+  if (tailed && tailed->tailFormat().bytes() == 0) tailed = nullptr;
+  std::vector<uint8_t> tails;
+  const std::vector<PointRecord> records =
+      tailed ? tailed->readNodeTails(node, tails) : scene.source().readNode(node);
   if (at->index >= records.size()) return pickJson(PointCloud(), x, y, false, std::nullopt);
   // The node's records as a cloud of their own, colors at 8 bits as the node cache shows them.
   const lod::OctreeMetadata& octree = scene.metadata();
@@ -63,7 +95,11 @@ nlohmann::json pickJson(Renderer& renderer, lod::LodScene& scene, uint32_t x, ui
       colorMax = std::max({colorMax, r.rgb[0], r.rgb[1], r.rgb[2]});
   appendRecords(cloud, records.data(), records.size(), octree.fields, colorMax > 255 ? 8 : 0);
   nlohmann::json j = pickJson(cloud, x, y, false, at->index);
-  j["point"]["node"] = node.key.potreeName();
+  nlohmann::json& p = j["point"];
+  p["node"] = node.key.potreeName();
+  const uint32_t tailBytes = tailed ? tailed->tailFormat().bytes() : 0;
+  if (tailBytes > 0 && tails.size() >= (at->index + 1) * tailBytes)
+    addTailValues(p, tailed->tailValues(tails.data() + at->index * tailBytes));
   return j;
 }
 

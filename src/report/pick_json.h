@@ -22,8 +22,12 @@ class LodScene;
 }
 // The same for the point the renderer's last frame of `scene` drew at pixel (x, y) (Renderer::lodPointAt):
 // its node is read from the octree's source, and "point" holds "node" (the node's Potree name, "r04"),
-// "index" (the point's among the node's records) and every attribute the octree stores; "unavailable: ..."
-// says why a frame cannot be picked from (Renderer::lodPointAt). Throws InputError for a damaged node.
+// "index" (the point's among the node's records) and every attribute the octree stores: the record's, as
+// above, and where the points carry more (cloud/lod_tails.h) "gps_time", "number_of_returns", "scan_angle"
+// (degrees), "user_data", "nir", the flags ("classification_flags", "scanner_channel",
+// "scan_direction_flag", "edge_of_flight_line") and "extra_bytes" ({"name": value or [values]});
+// "unavailable: ..." says why a frame cannot be picked from (Renderer::lodPointAt). Throws InputError for a
+// damaged node.
 nlohmann::json pickJson(Renderer& renderer, lod::LodScene& scene, uint32_t x, uint32_t y);
 
 } // namespace pointrast

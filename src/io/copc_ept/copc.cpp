@@ -7,8 +7,11 @@
 #include <set>
 #include <unordered_map>
 
+#include "cloud/lod_tails.h"
 #include "io/io_util.h"
+#include "io/las/las_attributes.h"
 #include "io/las/las_records.h"
+#include "io/las/las_tail_values.h"
 #include "io/las/laz_reader.h"
 
 namespace pointrast::io {
@@ -85,10 +88,13 @@ CopcInfo readInfo(const InputFile& file, const LasHeader& hd) {
   return info;
 }
 
-class CopcSource : public lod::NodeSource {
+// A COPC node's records are LAS records: their tails (GPS time, returns, flags, scan angle, NIR, extra
+// bytes) come with them (cloud/lod_tails.h).
+class CopcSource : public lod::NodeSource, public lod::NodeTails {
 public:
   explicit CopcSource(const std::filesystem::path& path)
-      : file_(path), laz_(laz::openLaz(file_)), pool_(laz_.layout) {
+      : file_(path), laz_(laz::openLaz(file_)), pool_(laz_.layout), tail_(lasTailFormat(file_, laz_.header)),
+        tailValues_(tail_) {
     const LasHeader& hd = laz_.header;
     info_ = readInfo(file_, hd);
     if (!laz_.layout.layered())
@@ -136,7 +142,26 @@ public:
     return out;
   }
 
-  std::vector<PointRecord> readNode(const NodeInfo& node) override {
+  std::vector<PointRecord> readNode(const NodeInfo& node) override { return read(node, nullptr); }
+
+  const TailFormat& tailFormat() const override { return tail_; }
+  std::vector<PointRecord> readNodeTails(const NodeInfo& node, std::vector<uint8_t>& tails) override {
+    tails.clear();
+    return read(node, &tails);
+  }
+  std::vector<lod::TailValue> tailValues(const uint8_t* tail) const override { return tailValues_(tail); }
+
+  uint64_t nodeBytes(const NodeInfo& node) override { return uint64_t(dataEntry(node.key).byteSize); }
+
+  const CopcInfo& copcInfo() const { return info_; }
+  const std::string& software() const { return laz_.header.software; }
+  size_t pagesLoaded() {
+    std::lock_guard lock(mutex_);
+    return pages_.size();
+  }
+
+private:
+  std::vector<PointRecord> read(const NodeInfo& node, std::vector<uint8_t>* tails) {
     const Entry entry = dataEntry(node.key);
     std::vector<PointRecord> out;
     if (entry.pointCount == 0) return out;
@@ -149,19 +174,14 @@ public:
     out.resize(chunk.pointCount);
     for (size_t k = 0; k < out.size(); ++k)
       out[k] = toPointRecord(records.data() + k * hd.recordLength, extended, rgbOffset);
+    if (tails && tail_.bytes() > 0) {
+      tails->resize(out.size() * tail_.bytes());
+      packLasTails(records.data(), hd.recordLength, out.size(), hd.pointFormat, tail_.attributes.extraBytes,
+                   tail_, tails->data());
+    }
     return out;
   }
 
-  uint64_t nodeBytes(const NodeInfo& node) override { return uint64_t(dataEntry(node.key).byteSize); }
-
-  const CopcInfo& copcInfo() const { return info_; }
-  const std::string& software() const { return laz_.header.software; }
-  size_t pagesLoaded() {
-    std::lock_guard lock(mutex_);
-    return pages_.size();
-  }
-
-private:
   Entry dataEntry(const NodeKey& key) {
     std::lock_guard lock(mutex_);
     auto it = entries_.find(key);
@@ -234,6 +254,8 @@ private:
   InputFile file_;
   laz::LazFile laz_;
   ChunkDecoderPool pool_;
+  TailFormat tail_;
+  TailValues tailValues_;
   CopcInfo info_;
   lod::OctreeMetadata meta_;
   std::mutex mutex_;

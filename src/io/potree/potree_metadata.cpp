@@ -1,6 +1,8 @@
 // Potree 2.0 metadata.json: the attribute layout, written in PotreeConverter's field order and read
 // defensively (every field the reader relies on checked for presence, type and range).
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <nlohmann/json.hpp>
 
@@ -232,6 +234,71 @@ void readTail(const json& root, Layout& layout) {
   attachTail(layout, t);
 }
 
+// The tail of an octree PotreeConverter wrote: the LAS attributes it names (potree_attributes.h) in their
+// tail fields, every other attribute past the record fields as an extra bytes field of its name and type
+// (a descriptor made up for it), so that a pick shows every attribute the points hold. The point format
+// stays unknown: an export writes the record fields alone. Attributes that do not fit (a name longer than
+// a descriptor holds, a field of more than 255 bytes) leave the points without a tail, as before.
+void inferTail(Layout& layout) {
+  static const char* const kFlags[] = {"classification flags", "scanner channel", "scan direction flag",
+                                       "edge of flight line"};
+  auto find = [&](const char* name, const char* type, int size) -> const Attribute* {
+    for (const Attribute& a : layout.attributes)
+      if (a.field == Field::Other && a.name == name && a.type == type && a.size == size) return &a;
+    return nullptr;
+  };
+  TailFormat t;
+  PointAttributes& a = t.attributes;
+  std::vector<const Attribute*> known;
+  auto take = [&](bool& flag, const char* name, const char* type, int size) {
+    if (const Attribute* at = find(name, type, size)) {
+      flag = true;
+      known.push_back(at);
+    }
+  };
+  take(a.gpsTime, "gps-time", "double", 8);
+  take(a.numberOfReturns, "number of returns", "uint8", 1);
+  take(a.userData, "user data", "uint8", 1);
+  take(a.nir, "nir", "uint16", 2);
+  take(a.scanAngle, "scan angle rank", "uint8", 1);
+  if (!a.scanAngle) {
+    take(a.scanAngle, "scan angle", "int16", 2);
+    a.extendedScanAngle = a.scanAngle;
+  }
+  // The flags byte only where all four of its fields are there; one alone is shown as a field of its own.
+  std::vector<const Attribute*> flags;
+  for (const char* name : kFlags)
+    if (const Attribute* at = find(name, "uint8", 1)) flags.push_back(at);
+  if (flags.size() == 4) {
+    a.flags = true;
+    known.insert(known.end(), flags.begin(), flags.end());
+  }
+  static const char* const kTypes[] = {"uint8", "int8",   "uint16", "int16", "uint32",
+                                       "int32", "uint64", "int64",  "float", "double"};
+  uint32_t extra = 0;
+  for (const Attribute& at : layout.attributes) {
+    if (at.field != Field::Other || std::find(known.begin(), known.end(), &at) != known.end()) continue;
+    if (at.name.empty() || at.name.size() > 32 || at.size <= 0 || at.size > 255) return;
+    int dataType = 0;
+    for (int k = 0; k < 10; ++k)
+      if (at.type == kTypes[k] && at.numElements >= 1 && at.numElements <= 3 &&
+          at.size == at.numElements * typeSize(at.type))
+        dataType = k + 1 + 10 * (at.numElements - 1);
+    // R15 Table 24: data type at byte 2, options (for type 0 the byte count) at 3, the name at 4.
+    uint8_t d[192] = {};
+    d[2] = static_cast<uint8_t>(dataType);
+    d[3] = static_cast<uint8_t>(dataType == 0 ? at.size : 0);
+    std::memcpy(d + 4, at.name.data(), at.name.size());
+    t.extraBytesDescriptors.insert(t.extraBytesDescriptors.end(), d, d + sizeof d);
+    extra += uint32_t(at.size);
+  }
+  if (extra > 0xFFFF) return;
+  a.extraBytes = static_cast<uint16_t>(extra);
+  if (!a.any()) return;
+  t.layout = attributeLayout(a);
+  attachTail(layout, t);
+}
+
 json jsonVec(const glm::dvec3& v) {
   return json::array({v.x, v.y, v.z});
 }
@@ -441,7 +508,10 @@ Metadata parseMetadata(const std::string& text, const std::filesystem::path& fil
   if (m.spacing < 0) r.bad("\"spacing\" is negative");
   m.cube = readCube(r, root);
   readAttributes(r, root, m);
-  if (m.fromPointrast()) readTail(root, m.layout);
+  if (m.fromPointrast())
+    readTail(root, m.layout);
+  else
+    inferTail(m.layout);
   return m;
 }
 

@@ -11,6 +11,7 @@
 
 #include "cloud/lod_tails.h"
 #include "io/io_util.h"
+#include "io/las/las_tail_values.h"
 #include "io/potree/potree_format.h"
 
 namespace pointrast::io {
@@ -68,6 +69,7 @@ public:
   std::vector<PointRecord> readNode(const lod::NodeInfo& node) override;
   const TailFormat& tailFormat() const override { return meta_.layout.tail; }
   std::vector<PointRecord> readNodeTails(const lod::NodeInfo& node, std::vector<uint8_t>& tails) override;
+  std::vector<lod::TailValue> tailValues(const uint8_t* tail) const override { return tailValues_(tail); }
   uint64_t nodeBytes(const lod::NodeInfo& node) override;
 
 private:
@@ -93,6 +95,7 @@ private:
 
   std::filesystem::path dir_, hierarchyPath_, octreePath_;
   potree::Metadata meta_;
+  TailValues tailValues_;
   InputFile hierarchy_, octree_;
   lod::OctreeMetadata info_;
   int32_t positionBias_ = 0;
@@ -103,7 +106,8 @@ private:
 
 PotreeSource::PotreeSource(const std::filesystem::path& path)
     : dir_(folderOf(path)), hierarchyPath_(dir_ / "hierarchy.bin"), octreePath_(dir_ / "octree.bin"),
-      meta_(readMetadata(dir_)), hierarchy_(hierarchyPath_), octree_(octreePath_) {
+      meta_(readMetadata(dir_)), tailValues_(meta_.layout.tail), hierarchy_(hierarchyPath_),
+      octree_(octreePath_) {
   info_.source = dir_.string();
   info_.format = std::string("Potree 2.0 (") + potree::encodingName(meta_.encoding) + ")";
   info_.cube = meta_.cube;
