@@ -60,8 +60,9 @@ class Frame:
     """A rendered frame: image (H, W, 4) uint8 RGBA, row 0 at the top; depth (H, W) float32 linear depth of
     the closest point (inf where none) and index (H, W) int64 index of that point (-1 where none) when
     asked for; the camera it was drawn from; gpu_ms, the GPU time of a frame (the median of `frames`);
-    upload_s, the seconds this render spent uploading the cloud (0 when a Renderer reused it). Shows itself
-    as a PNG in Jupyter."""
+    upload_s, the seconds this render spent uploading the cloud (0 when a Renderer reused it), of which
+    upload_encode_s encoding it on the host and upload_copy_wait_s waiting for copies the encoding did not
+    hide. Shows itself as a PNG in Jupyter."""
 
     def __init__(self, result):
         self.image = result["image"]
@@ -72,6 +73,8 @@ class Frame:
         self.points = result["points"]
         self.gpu_ms = result["gpu_ms"]
         self.upload_s = result.get("upload_s", 0.0)
+        self.upload_encode_s = result.get("upload_encode_s", 0.0)
+        self.upload_copy_wait_s = result.get("upload_copy_wait_s", 0.0)
 
     def _repr_png_(self):
         return png_bytes(self.image)

@@ -56,8 +56,8 @@ template <typename T> std::vector<T> copyVector(const py::array& a) {
 
 constexpr uint64_t kBlock = 1 << 20; // points per block of the parallel passes
 
-template <typename Src> std::shared_ptr<PointCloud> quantizeXyz(const Src* src, uint64_t n) {
-  // Bounds per block on every core; the first row that is not finite is the error.
+// The bounds of the rows on every core; the first row that is not finite is the error.
+template <typename Src> Bounds rawBounds(const Src* src, uint64_t n) {
   const uint64_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<Bounds> blockBounds(blocks);
   std::vector<uint64_t> firstBad(blocks, UINT64_MAX);
@@ -82,41 +82,18 @@ template <typename Src> std::shared_ptr<PointCloud> quantizeXyz(const Src* src, 
       raw.expand(blockBounds[b].max);
     }
   }
-  auto cloud = std::make_shared<PointCloud>();
-  cloud->source = "array";
-  // The readers' rule (io/io_util.h): offset = the minimum, scale = the power of ten that spans the extent.
-  const io::detail::Quantization q = io::detail::chooseQuantization("xyz", raw);
-  cloud->scale = q.scale;
-  cloud->offset = q.offset;
-  cloud->positions.resize(3 * n);
-  std::vector<std::array<int32_t, 6>> blockRange(blocks); // quantized min x y z, max x y z
-  int32_t* dst = cloud->positions.data();
-  parallelBlocks(n, kBlock, [&](uint64_t b, uint64_t begin, uint64_t end) {
-    std::array<int32_t, 6> r = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, INT32_MIN};
-    for (uint64_t i = begin; i < end; ++i)
-      for (int a = 0; a < 3; ++a) {
-        const int32_t v = io::detail::quantize(double(src[3 * i + a]), q.scale[a], q.offset[a]);
-        dst[3 * i + a] = v;
-        r[a] = std::min(r[a], v);
-        r[3 + a] = std::max(r[3 + a], v);
-      }
-    blockRange[b] = r;
-  });
-  if (n > 0) {
-    int32_t qmin[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, qmax[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-    for (const auto& r : blockRange)
-      for (int a = 0; a < 3; ++a) {
-        qmin[a] = std::min(qmin[a], r[a]);
-        qmax[a] = std::max(qmax[a], r[3 + a]);
-      }
-    cloud->bounds = io::detail::boundsFromQuantized(qmin, qmax, cloud->scale, cloud->offset);
-  }
-  return cloud;
+  return raw;
 }
 
-} // namespace
+template <typename Src>
+void quantizeRows(const Src* src, uint64_t count, const glm::dvec3& scale, const glm::dvec3& offset,
+                  int32_t* dst) {
+  for (uint64_t i = 0; i < count; ++i)
+    for (int a = 0; a < 3; ++a)
+      dst[3 * i + a] = io::detail::quantize(double(src[3 * i + a]), scale[a], offset[a]);
+}
 
-std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz) {
+const char* checkXyz(const py::array& xyz) {
   const bool f32 = xyz.dtype().is(py::dtype::of<float>());
   const bool f64 = xyz.dtype().is(py::dtype::of<double>());
   if (!f32 && !f64) throw py::type_error("xyz must be float32 or float64, not " + dtypeName(xyz));
@@ -129,10 +106,146 @@ std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz) {
   if (!(xyz.flags() & py::array::c_style))
     throw py::value_error("xyz must be C-contiguous (rows of x, y, z side by side); "
                           "numpy.ascontiguousarray(xyz) makes such a copy");
-  const uint64_t n = uint64_t(xyz.shape(0));
-  py::gil_scoped_release release; // the array stays referenced by the caller
-  return f32 ? quantizeXyz(static_cast<const float*>(xyz.data()), n)
-             : quantizeXyz(static_cast<const double*>(xyz.data()), n);
+  return f32 ? "float32" : "float64";
+}
+
+// Checks three color channels for n points; whether any uint16 channel holds a value above 255 (16-bit
+// data, scaled to 8 bits).
+bool checkColors(const py::array (&channels)[3], uint64_t n) {
+  const char* names[3] = {"red", "green", "blue"};
+  bool wide = false;
+  for (int c = 0; c < 3; ++c) {
+    checkVector(channels[c], names[c], n, isUint8or16, "uint8 or uint16");
+    if (isUint16(channels[c].dtype()))
+      for (uint64_t i = 0; i < n && !wide; ++i)
+        wide = at<uint16_t>(channels[c], i) > 255;
+  }
+  return wide;
+}
+
+// The packed color of point i from channels read without the interpreter.
+inline uint32_t channelColor(const char* const (&data)[3], const py::ssize_t (&stride)[3],
+                             const bool (&byte)[3], bool wide, uint64_t i) {
+  uint32_t v[3];
+  for (int c = 0; c < 3; ++c) {
+    const char* p = data[c] + py::ssize_t(i) * stride[c];
+    const uint32_t raw = byte[c] ? uint32_t(*reinterpret_cast<const uint8_t*>(p))
+                                 : uint32_t(*reinterpret_cast<const uint16_t*>(p));
+    v[c] = wide ? raw >> 8 : raw;
+  }
+  return packRgba(v[0], v[1], v[2]);
+}
+
+} // namespace
+
+ArrayPoints::ArrayPoints(const py::array& xyz) : xyz_(xyz) {
+  f32_ = std::string(checkXyz(xyz)) == "float32";
+  n_ = uint64_t(xyz.shape(0));
+  data_ = xyz.data();
+  Bounds raw;
+  {
+    py::gil_scoped_release release; // the array stays referenced by this object
+    raw = f32_ ? rawBounds(static_cast<const float*>(data_), n_)
+               : rawBounds(static_cast<const double*>(data_), n_);
+  }
+  shape_.source = "array";
+  // The readers' rule (io/io_util.h): offset = the minimum, scale = the power of ten that spans the extent.
+  const io::detail::Quantization q = io::detail::chooseQuantization("xyz", raw);
+  shape_.scale = q.scale;
+  shape_.offset = q.offset;
+  if (n_ > 0) {
+    // Quantization is monotonic: the quantized bounds are those of the raw bounds' corners.
+    int32_t qmin[3], qmax[3];
+    for (int a = 0; a < 3; ++a) {
+      qmin[a] = io::detail::quantize(raw.min[a], q.scale[a], q.offset[a]);
+      qmax[a] = io::detail::quantize(raw.max[a], q.scale[a], q.offset[a]);
+    }
+    shape_.bounds = io::detail::boundsFromQuantized(qmin, qmax, q.scale, q.offset);
+  }
+}
+
+void ArrayPoints::setColors(const py::object& red, const py::object& green, const py::object& blue) {
+  if (red.is_none() && green.is_none() && blue.is_none()) return;
+  if (red.is_none() || green.is_none() || blue.is_none())
+    throw py::value_error("colors need all three channels: red, green and blue");
+  const py::array channels[3] = {red.cast<py::array>(), green.cast<py::array>(), blue.cast<py::array>()};
+  wide_ = checkColors(channels, n_);
+  for (int c = 0; c < 3; ++c) {
+    channels_[c] = channels[c];
+    channelData_[c] = static_cast<const char*>(channels[c].data());
+    channelStride_[c] = n_ ? channels[c].strides(0) : 0;
+    channelByte_[c] = isUint8(channels[c].dtype());
+  }
+}
+
+uint32_t ArrayPoints::color(uint64_t i) const {
+  return channelColor(channelData_, channelStride_, channelByte_, wide_, i);
+}
+
+bool ArrayPoints::colorsShowAtOnce() const {
+  if (!hasColor()) return false;
+  for (uint64_t i = 0; i < std::min<uint64_t>(n_, 4096); ++i)
+    if (color(i) & 0x00FFFFFFu) return true;
+  return false;
+}
+
+void ArrayPoints::fill(uint64_t first, uint64_t count, PointCloud& out) const {
+  out.positions.resize(3 * count);
+  if (f32_)
+    quantizeRows(static_cast<const float*>(data_) + 3 * first, count, shape_.scale, shape_.offset,
+                 out.positions.data());
+  else
+    quantizeRows(static_cast<const double*>(data_) + 3 * first, count, shape_.scale, shape_.offset,
+                 out.positions.data());
+  if (hasColor()) {
+    out.colors.resize(count);
+    for (uint64_t i = 0; i < count; ++i)
+      out.colors[i] = color(first + i);
+  }
+}
+
+std::vector<glm::dvec3> ArrayPoints::framingSample(size_t maxPoints) const {
+  // The stride of render/camera.h's framingSample(), over the points' quantized positions.
+  std::vector<glm::dvec3> sample;
+  if (n_ == 0 || maxPoints == 0) return sample;
+  const uint64_t step = (n_ + maxPoints - 1) / maxPoints;
+  PointCloud one;
+  for (uint64_t i = 0; i < n_; i += step) {
+    one.scale = shape_.scale;
+    one.offset = shape_.offset;
+    fill(i, 1, one);
+    sample.push_back(one.world(0));
+  }
+  return sample;
+}
+
+std::shared_ptr<PointCloud> ArrayPoints::makeCloud() const {
+  auto cloud = std::make_shared<PointCloud>();
+  cloud->source = shape_.source;
+  cloud->scale = shape_.scale;
+  cloud->offset = shape_.offset;
+  cloud->bounds = shape_.bounds;
+  py::gil_scoped_release release; // the arrays stay referenced by this object
+  cloud->positions.resize(3 * n_);
+  if (hasColor()) cloud->colors.resize(n_);
+  int32_t* dst = cloud->positions.data();
+  uint32_t* colors = cloud->colors.data();
+  parallelBlocks(n_, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
+    if (f32_)
+      quantizeRows(static_cast<const float*>(data_) + 3 * begin, end - begin, shape_.scale, shape_.offset,
+                   dst + 3 * begin);
+    else
+      quantizeRows(static_cast<const double*>(data_) + 3 * begin, end - begin, shape_.scale, shape_.offset,
+                   dst + 3 * begin);
+    if (colors)
+      for (uint64_t i = begin; i < end; ++i)
+        colors[i] = color(i);
+  });
+  return cloud;
+}
+
+std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz) {
+  return ArrayPoints(xyz).makeCloud();
 }
 
 std::shared_ptr<PointCloud> cloudFromQuantized(const py::array& x, const py::array& y, const py::array& z,
@@ -166,15 +279,8 @@ void setColors(PointCloud& cloud, const py::object& red, const py::object& green
   if (red.is_none() || green.is_none() || blue.is_none())
     throw py::value_error("colors need all three channels: red, green and blue");
   const py::array channels[3] = {red.cast<py::array>(), green.cast<py::array>(), blue.cast<py::array>()};
-  const char* names[3] = {"red", "green", "blue"};
   const uint64_t n = cloud.size();
-  bool wide = false; // 16-bit data: a value above 255 in any channel
-  for (int c = 0; c < 3; ++c) {
-    checkVector(channels[c], names[c], n, isUint8or16, "uint8 or uint16");
-    if (isUint16(channels[c].dtype()))
-      for (uint64_t i = 0; i < n && !wide; ++i)
-        wide = at<uint16_t>(channels[c], i) > 255;
-  }
+  const bool wide = checkColors(channels, n);
   cloud.colors.resize(n);
   // Read without the interpreter: each channel's bytes, stride and width taken first.
   const char* data[3];
@@ -188,16 +294,8 @@ void setColors(PointCloud& cloud, const py::object& red, const py::object& green
   uint32_t* dst = cloud.colors.data();
   py::gil_scoped_release release; // the arrays stay referenced by the caller
   parallelBlocks(n, kBlock, [&](uint64_t, uint64_t begin, uint64_t end) {
-    for (uint64_t i = begin; i < end; ++i) {
-      uint32_t v[3];
-      for (int c = 0; c < 3; ++c) {
-        const char* p = data[c] + py::ssize_t(i) * stride[c];
-        const uint32_t raw = byte[c] ? uint32_t(*reinterpret_cast<const uint8_t*>(p))
-                                     : uint32_t(*reinterpret_cast<const uint16_t*>(p));
-        v[c] = wide ? raw >> 8 : raw;
-      }
-      dst[i] = packRgba(v[0], v[1], v[2]);
-    }
+    for (uint64_t i = begin; i < end; ++i)
+      dst[i] = channelColor(data, stride, byte, wide, i);
   });
 }
 

@@ -11,12 +11,53 @@
 #include <pybind11/pybind11.h>
 
 #include "cloud/cloud.h"
+#include "render/scene.h"
 
 namespace pointrast::python {
 
 namespace py = pybind11;
 
 // xyz: float32 or float64 (N, 3), C-contiguous, every value finite.
+// Points as the caller's arrays hold them, before any PointCloud is made: an (N, 3) float32 or float64
+// C-contiguous xyz, quantized as the readers would (io/io_util.h: offset the minimum, scale the power of
+// ten that spans the extent), and optionally three color channels. An upload reads them block by block
+// (PointBlocks: no copy of the input on the host); makeCloud() makes the PointCloud for everything else,
+// with the same positions and colors. It references the arrays: made and destroyed with the GIL held,
+// read without it.
+class ArrayPoints : public PointBlocks {
+public:
+  // Checks the array (dtype, shape, contiguity; every row finite: ValueError naming the first that is
+  // not) and takes its bounds on every core.
+  explicit ArrayPoints(const py::array& xyz);
+  const PointCloud& shape() const override { return shape_; }
+  uint64_t size() const override { return n_; }
+  void fill(uint64_t first, uint64_t count, PointCloud& out) const override;
+  // The three channels as setColors() takes them (uint8 or uint16, one value per point; 16-bit data, a
+  // value above 255, is scaled to 8 bits), referenced, not copied.
+  void setColors(const py::object& red, const py::object& green, const py::object& blue);
+  bool hasColor() const { return !channels_[0].is_none(); }
+  // Whether the colors show something in the first 4096 points: displayColorMode()'s quick test, which
+  // decides RGB without a scan of the whole input.
+  bool colorsShowAtOnce() const;
+  // framingSample() of the cloud these points make (render/camera.h), without making it.
+  std::vector<glm::dvec3> framingSample(size_t maxPoints = size_t(1) << 16) const;
+  // The PointCloud, made on every core.
+  std::shared_ptr<PointCloud> makeCloud() const;
+
+private:
+  uint32_t color(uint64_t i) const;
+  py::array xyz_;
+  const void* data_ = nullptr;
+  bool f32_ = false;
+  uint64_t n_ = 0;
+  PointCloud shape_;
+  py::object channels_[3] = {py::none(), py::none(), py::none()};
+  const char* channelData_[3] = {};
+  py::ssize_t channelStride_[3] = {};
+  bool channelByte_[3] = {};
+  bool wide_ = false;
+};
+
 std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz);
 // x, y, z: int32 (N,) of any stride (laspy's X, Y, Z: fields of its point records), world = q * scale +
 // offset per axis as LAS stores them.

@@ -39,8 +39,27 @@ namespace pointrast::python {
 
 namespace {
 
+// A cloud made in Python or read from a file. One made from arrays keeps them (ArrayPoints) and makes its
+// PointCloud only when something needs it: an upload of the batched layout with RGB colors reads the
+// arrays block by block, with no copy of the input on the host.
 struct Cloud {
-  std::shared_ptr<PointCloud> cloud;
+  explicit Cloud(std::shared_ptr<PointCloud> made) : made_(std::move(made)) {}
+  explicit Cloud(std::shared_ptr<ArrayPoints> arrays) : arrays_(std::move(arrays)) {}
+  // The PointCloud, made from the arrays the first time it is asked for. Called with the GIL held.
+  const std::shared_ptr<PointCloud>& get() const {
+    if (!made_) made_ = arrays_->makeCloud();
+    return made_;
+  }
+  // The arrays while no PointCloud was made from them (a change to the cloud makes it), else null.
+  const ArrayPoints* arrays() const { return made_ ? nullptr : arrays_.get(); }
+  const std::shared_ptr<ArrayPoints>& arrayPoints() const { return arrays_; }
+  const Bounds& bounds() const { return made_ ? made_->bounds : arrays_->shape().bounds; }
+  uint64_t size() const { return made_ ? made_->size() : arrays_->size(); }
+  const PointCloud& shape() const { return made_ ? *made_ : arrays_->shape(); }
+
+private:
+  mutable std::shared_ptr<PointCloud> made_;
+  std::shared_ptr<ArrayPoints> arrays_;
 };
 
 struct Octree {
@@ -123,10 +142,14 @@ PointFilter parseFilter(const py::dict& d) {
     }
   }
   const std::string mode = given("clip_mode") ? d["clip_mode"].cast<std::string>() : "inside";
-  if (mode == "inside") f.clipMode = ClipMode::Inside;
-  else if (mode == "outside") f.clipMode = ClipMode::Outside;
-  else if (mode == "highlight") f.clipMode = ClipMode::Highlight;
-  else throw InputError("clip_mode must be 'inside', 'outside' or 'highlight', not '" + mode + "'");
+  if (mode == "inside")
+    f.clipMode = ClipMode::Inside;
+  else if (mode == "outside")
+    f.clipMode = ClipMode::Outside;
+  else if (mode == "highlight")
+    f.clipMode = ClipMode::Highlight;
+  else
+    throw InputError("clip_mode must be 'inside', 'outside' or 'highlight', not '" + mode + "'");
   if (given("clip_mode") && !f.hasClip()) throw InputError("clip_mode needs clip_box or clip_polygon");
   if (given("classes")) {
     std::bitset<256> keep;
@@ -139,11 +162,16 @@ PointFilter parseFilter(const py::dict& d) {
   }
   if (given("returns")) {
     const std::string r = d["returns"].cast<std::string>();
-    if (r == "all") f.returns = ReturnFilter::All;
-    else if (r == "first") f.returns = ReturnFilter::First;
-    else if (r == "last") f.returns = ReturnFilter::Last;
-    else if (r == "only") f.returns = ReturnFilter::Only;
-    else throw InputError("returns must be 'all', 'first', 'last' or 'only', not '" + r + "'");
+    if (r == "all")
+      f.returns = ReturnFilter::All;
+    else if (r == "first")
+      f.returns = ReturnFilter::First;
+    else if (r == "last")
+      f.returns = ReturnFilter::Last;
+    else if (r == "only")
+      f.returns = ReturnFilter::Only;
+    else
+      throw InputError("returns must be 'all', 'first', 'last' or 'only', not '" + r + "'");
   }
   if (given("intensity_range")) f.intensity = rangeOf(d["intensity_range"], "intensity_range");
   if (given("gps_time")) f.gpsTime = rangeOf(d["gps_time"], "gps_time");
@@ -333,13 +361,13 @@ private:
     r["points"] = st.points;
     r["gpu_ms"] = st.medianMs;
     r["upload_s"] = lastUploadS_;
+    r["upload_encode_s"] = lastUpload_.encode;
+    r["upload_copy_wait_s"] = lastUpload_.copyWait;
     return r;
   }
 
   py::dict renderCloud(const Cloud& input, const py::object& camera, const Options& o, bool wantDepth,
                        bool wantIndex) {
-    const std::shared_ptr<PointCloud> drawn = filtered(input.cloud, o.filter);
-    const PointCloud& cloud = *drawn;
     const std::string method = o.method == "auto" ? "atomicmin" : o.method;
     RenderSettings s = settings(o, method);
     const SceneLayout layout = s.method.info().layout;
@@ -352,22 +380,38 @@ private:
     if (s.post.enabled() && s.method.info().output == MethodOutput::ColorOnly)
       throw InputError("point_size, dilate and edl need a compute method; " + method +
                        " keeps no depth per pixel to work on");
+    const std::optional<PointFilter> highlight =
+        o.filter.hasClip() && o.filter.clipMode == ClipMode::Highlight ? std::optional(o.filter)
+                                                                       : std::nullopt;
+    // Arrays with RGB colors drawn by a batch method upload straight from the arrays; everything else
+    // reads the PointCloud (made from them once).
+    const ArrayPoints* arrays = input.arrays();
+    if (arrays && !(layout == SceneLayout::Batched && !o.filter.hasAttributeFilter() && !highlight &&
+                    (o.color == "auto" || o.color == "rgb") && !o.colorRange && arrays->colorsShowAtOnce()))
+      arrays = nullptr;
+    std::shared_ptr<PointCloud> drawn;
+    if (!arrays) drawn = filtered(input.get(), o.filter);
+    const PointCloud& cloud = arrays ? arrays->shape() : *drawn;
+    const std::shared_ptr<const void> identity =
+        arrays ? std::shared_ptr<const void>(input.arrayPoints()) : std::shared_ptr<const void>(drawn);
     std::optional<DisplayColorMode> colors;
-    if (o.color != "auto")
+    if (arrays)
+      colors = DisplayColorMode{DisplayColorMode::Source::Rgb}; // what displayColorMode() decides for them
+    else if (o.color != "auto")
       colors = displayColorMode(cloud, parseColorSource(o.color), o.colorRange);
     else if (o.colorRange)
       throw InputError("color_range applies to color='intensity' and 'elevation'");
-    const Camera c = resolveCamera(camera, cloud.bounds, cloud.source, o, framingSample(cloud));
+    const Camera c = resolveCamera(camera, cloud.bounds, cloud.source, o,
+                                   arrays ? arrays->framingSample() : framingSample(cloud));
 
     std::vector<uint32_t> pixels;
     FrameStats stats;
     std::vector<uint64_t> words;
+    if (wantDepth || wantIndex) input.get(); // the index scene reads the PointCloud: made with the GIL
     {
       py::gil_scoped_release release;
       // One uploaded scene per layout and color mode of the cloud last drawn.
-      const std::optional<PointFilter> highlight =
-          o.filter.hasClip() && o.filter.clipMode == ClipMode::Highlight ? std::optional(o.filter) : std::nullopt;
-      const bool same = scene_ && sceneCloud_.lock() == drawn && sceneLayout_ == layout &&
+      const bool same = scene_ && sceneCloud_.lock() == identity && sceneLayout_ == layout &&
                         sameColors(sceneColors_, colors) && sceneHighlight_ == highlight;
       if (!same) {
         scene_.reset();
@@ -377,14 +421,17 @@ private:
         upload.colors = colors;
         upload.filter = highlight;
         const auto start = std::chrono::steady_clock::now();
-        scene_ = std::make_unique<GpuScene>(*context_, cloud, upload);
+        scene_ = arrays ? std::make_unique<GpuScene>(*context_, *arrays, upload)
+                        : std::make_unique<GpuScene>(*context_, cloud, upload);
         lastUploadS_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        sceneCloud_ = drawn;
+        lastUpload_ = scene_->uploadTimes();
+        sceneCloud_ = identity;
         sceneLayout_ = layout;
         sceneColors_ = colors;
         sceneHighlight_ = highlight;
       } else {
         lastUploadS_ = 0;
+        lastUpload_ = {};
       }
       Renderer& r = renderer(o);
       if (s.frames > 1) {
@@ -437,10 +484,11 @@ private:
   // float depth on a copy of the cloud whose colors are the points' indices, with the same resolve stage
   // (eye-dome lighting aside: it shades colors only). Every closest-point method picks the same depth.
   std::vector<uint64_t> indexWords(const Cloud& input, const Camera& c, const Options& o) {
-    const PointCloud& cloud = *input.cloud;
+    const std::shared_ptr<PointCloud>& made = input.get();
+    const PointCloud& cloud = *made;
     if (cloud.size() > kMaxIndexed)
       throw InputError("return_index and return_depth take clouds of at most 16,777,215 points");
-    if (!indexScene_ || indexCloud_.lock() != input.cloud) {
+    if (!indexScene_ || indexCloud_.lock() != made) {
       indexScene_.reset();
       PointCloud indexed;
       indexed.positions = cloud.positions;
@@ -455,7 +503,7 @@ private:
       upload.progress = false;
       upload.colors = DisplayColorMode{DisplayColorMode::Source::Rgb};
       indexScene_ = std::make_unique<GpuScene>(*context_, indexed, upload);
-      indexCloud_ = input.cloud;
+      indexCloud_ = made;
     }
     RenderSettings s;
     s.method = pointMethod("atomicmin");
@@ -493,6 +541,7 @@ private:
 
   py::dict renderOctree(const Octree& input, const py::object& camera, const Options& o) {
     lastUploadS_ = 0;
+    lastUpload_ = {};
     const lod::OctreeMetadata& meta = input.source->metadata();
     const std::string method = o.method == "auto" ? "lod" : o.method;
     RenderSettings s = settings(o, method);
@@ -505,7 +554,8 @@ private:
                        ", which draws an octree's nodes in their stored order");
     if (o.filter.hasAttributeFilter())
       throw InputError("classes, returns, intensity_range, gps_time and source_ids apply to clouds drawn "
-                       "from memory; " + method + " draws an octree, which takes clip volumes only");
+                       "from memory; " +
+                       method + " draws an octree, which takes clip volumes only");
     if (o.filter.hasClip() && o.filter.clipMode == ClipMode::Highlight)
       throw InputError("clip_mode='highlight' tints the colors of a cloud drawn from memory; " + method +
                        " draws an octree: use 'inside' or 'outside'");
@@ -553,7 +603,7 @@ private:
   std::unique_ptr<gpu::Context> context_;
   std::unique_ptr<Renderer> renderer_;
   std::unique_ptr<GpuScene> scene_;
-  std::weak_ptr<PointCloud> sceneCloud_;
+  std::weak_ptr<const void> sceneCloud_; // the PointCloud or the arrays the scene was uploaded from
   SceneLayout sceneLayout_ = SceneLayout::Float;
   std::optional<DisplayColorMode> sceneColors_;
   std::optional<PointFilter> sceneHighlight_;
@@ -561,6 +611,7 @@ private:
   std::weak_ptr<PointCloud> filteredFrom_;
   PointFilter filteredBy_;
   double lastUploadS_ = 0; // seconds the last render spent uploading its cloud (0: the upload was reused)
+  UploadTimes lastUpload_; // and how: encoding on the host, waiting for copies
   std::unique_ptr<GpuScene> indexScene_;
   std::weak_ptr<PointCloud> indexCloud_;
   std::unique_ptr<lod::LodScene> lod_;
@@ -578,7 +629,7 @@ Cloud readCloud(const std::string& path) {
     py::gil_scoped_release release;
     cloud = io::readCloud(path, options);
   }
-  return Cloud{std::make_shared<PointCloud>(std::move(cloud))};
+  return Cloud(std::make_shared<PointCloud>(std::move(cloud)));
 }
 
 Octree openOctree(const std::string& path) {
@@ -626,29 +677,35 @@ PYBIND11_MODULE(_core, m) {
   });
 
   py::class_<Cloud>(m, "Cloud")
-      .def("__len__", [](const Cloud& c) { return c.cloud->size(); })
-      .def_property_readonly("source", [](const Cloud& c) { return c.cloud->source; })
-      .def_property_readonly("bounds", [](const Cloud& c) { return boundsTuple(c.cloud->bounds); })
-      .def_property_readonly(
-          "scales",
-          [](const Cloud& c) { return py::make_tuple(c.cloud->scale.x, c.cloud->scale.y, c.cloud->scale.z); })
+      .def("__len__", [](const Cloud& c) { return c.size(); })
+      // Whether the points live only in the arrays they were made from (for tests).
+      .def_property_readonly("_arrays_only", [](const Cloud& c) { return c.arrays() != nullptr; })
+      .def_property_readonly("source", [](const Cloud& c) { return c.shape().source; })
+      .def_property_readonly("bounds", [](const Cloud& c) { return boundsTuple(c.bounds()); })
+      .def_property_readonly("scales",
+                             [](const Cloud& c) {
+                               return py::make_tuple(c.shape().scale.x, c.shape().scale.y, c.shape().scale.z);
+                             })
       .def_property_readonly("offsets",
                              [](const Cloud& c) {
-                               return py::make_tuple(c.cloud->offset.x, c.cloud->offset.y, c.cloud->offset.z);
+                               return py::make_tuple(c.shape().offset.x, c.shape().offset.y,
+                                                     c.shape().offset.z);
                              })
       .def("quantized", [](py::object self,
-                           int axis) { return positionView(*self.cast<const Cloud&>().cloud, axis, self); })
-      .def("world", [](const Cloud& c, int axis) { return worldCoordinates(*c.cloud, axis); })
+                           int axis) { return positionView(*self.cast<const Cloud&>().get(), axis, self); })
+      .def("world", [](const Cloud& c, int axis) { return worldCoordinates(*c.get(), axis); })
       .def("color", [](py::object self,
-                       int channel) { return colorView(*self.cast<const Cloud&>().cloud, channel, self); })
-      .def_property_readonly("has_color", [](const Cloud& c) { return c.cloud->hasColor(); })
+                       int channel) { return colorView(*self.cast<const Cloud&>().get(), channel, self); })
+      .def_property_readonly(
+          "has_color",
+          [](const Cloud& c) { return c.arrays() ? c.arrays()->hasColor() : c.get()->hasColor(); })
       .def("attribute",
            [](py::object self, const std::string& name) {
-             return attributeView(*self.cast<const Cloud&>().cloud, name, self);
+             return attributeView(*self.cast<const Cloud&>().get(), name, self);
            })
       .def("point", [](const Cloud& c, int64_t i) {
-        if (i < 0 || uint64_t(i) >= c.cloud->size()) throw py::index_error("point index out of range");
-        const glm::dvec3 p = c.cloud->world(uint64_t(i));
+        if (i < 0 || uint64_t(i) >= c.size()) throw py::index_error("point index out of range");
+        const glm::dvec3 p = c.get()->world(uint64_t(i));
         return py::make_tuple(p.x, p.y, p.z);
       });
 
@@ -662,26 +719,31 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("spacing", [](const Octree& o) { return o.source->metadata().spacing; })
       .def_property_readonly("depth", [](const Octree& o) { return o.source->metadata().depth; });
 
-  m.def("cloud_from_xyz", [](const py::array& xyz) { return Cloud{cloudFromXyz(xyz)}; });
+  m.def("cloud_from_xyz", [](const py::array& xyz) { return Cloud(std::make_shared<ArrayPoints>(xyz)); });
   m.def("cloud_from_quantized", [](const py::array& x, const py::array& y, const py::array& z,
                                    std::vector<double> scale, std::vector<double> offset) {
     if (scale.size() != 3 || offset.size() != 3)
       throw py::value_error("scales and offsets need three values");
-    return Cloud{
-        cloudFromQuantized(x, y, z, {scale[0], scale[1], scale[2]}, {offset[0], offset[1], offset[2]})};
+    return Cloud(
+        cloudFromQuantized(x, y, z, {scale[0], scale[1], scale[2]}, {offset[0], offset[1], offset[2]}));
   });
   m.def("set_colors", [](Cloud& c, const py::object& r, const py::object& g, const py::object& b) {
-    setColors(*c.cloud, r, g, b);
+    // Arrays take their colors as arrays too; a cloud already made takes them into its own.
+    if (ArrayPoints* arrays = c.arrays() ? c.arrayPoints().get() : nullptr)
+      arrays->setColors(r, g, b);
+    else
+      setColors(*c.get(), r, g, b);
   });
   m.def("set_attribute", [](Cloud& c, const std::string& name, const py::object& values) {
-    setAttribute(*c.cloud, name, values);
+    setAttribute(*c.get(), name, values);
   });
   // The cloud as a LAS file (its own scale and offset, colors, intensity, classification, returns, source
   // ids): what pointrast.show() hands to `pointrast serve` for a cloud made in Python.
   m.def("write_las", [](const Cloud& c, const std::string& path) {
+    const std::shared_ptr<PointCloud>& cloud = c.get();
     py::gil_scoped_release unlocked;
-    io::writeLas(path, *c.cloud,
-                 c.cloud->size() > 0xFFFFFFFFull ? io::LasFlavor::Las14Pf7 : io::LasFlavor::Las12Pf3);
+    io::writeLas(path, *cloud,
+                 cloud->size() > 0xFFFFFFFFull ? io::LasFlavor::Las14Pf7 : io::LasFlavor::Las12Pf3);
   });
   m.def("read_cloud", &readCloud);
   m.def("open_octree", &openOctree);
@@ -703,7 +765,8 @@ PYBIND11_MODULE(_core, m) {
                                        framingSample(*o.source)));
     }
     const Cloud& c = scene.cast<const Cloud&>();
-    return cameraDict(overviewCamera(c.cloud->bounds, aspect, fov, framingSample(*c.cloud)));
+    return cameraDict(overviewCamera(c.bounds(), aspect, fov,
+                                     c.arrays() ? c.arrays()->framingSample() : framingSample(*c.get())));
   });
   m.def("method_names", [] {
     std::vector<std::string> names;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <chrono>
 #include <cstring>
 #include <exception>
 #include <string>
@@ -76,11 +77,58 @@ bool sceneFits(const gpu::Context& context, SceneLayout layout, uint64_t points,
 
 GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadOptions& options)
     : layout_(options.layout), origin_(cloud.origin()), bounds_(cloud.bounds) {
+  const auto start = std::chrono::steady_clock::now();
   uint64_t first = std::min(options.first, cloud.size());
   uint64_t count = std::min(options.count, cloud.size() - first);
+  makeParts(context, first, count, options.maxPartPoints);
+  if (count == 0) return;
+  const DisplayColorMode colors = options.colors ? *options.colors : displayColorMode(cloud); // once
+  if (options.filter && options.filter->hasClip() && options.filter->clipMode == ClipMode::Highlight)
+    highlight_ = options.filter;
+  if (layout_ == SceneLayout::Float)
+    uploadFloat(context, cloud, colors, options.progress);
+  else
+    uploadBatched(
+        context,
+        [&](uint64_t at, uint64_t, PointCloud&) {
+          return std::pair{&cloud, at};
+        },
+        colors, options.progress);
+  times_.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+GpuScene::GpuScene(gpu::Context& context, const PointBlocks& blocks, const UploadOptions& options)
+    : layout_(options.layout), origin_(blocks.shape().origin()), bounds_(blocks.shape().bounds) {
+  const auto start = std::chrono::steady_clock::now();
+  if (layout_ != SceneLayout::Batched)
+    throw UnsupportedError(std::string("an upload from blocks makes the batched layout, not ") +
+                           sceneLayoutName(layout_));
+  if (!options.colors) throw InternalError("an upload from blocks needs its color mode");
+  const uint64_t first = std::min(options.first, blocks.size());
+  const uint64_t count = std::min(options.count, blocks.size() - first);
+  makeParts(context, first, count, options.maxPartPoints);
+  if (count == 0) return;
+  if (options.filter && options.filter->hasClip() && options.filter->clipMode == ClipMode::Highlight)
+    highlight_ = options.filter;
+  const PointCloud& shape = blocks.shape();
+  uploadBatched(
+      context,
+      [&](uint64_t at, uint64_t n, PointCloud& scratch) {
+        scratch.scale = shape.scale;
+        scratch.offset = shape.offset;
+        scratch.bounds = shape.bounds;
+        scratch.source = shape.source;
+        blocks.fill(at, n, scratch);
+        return std::pair<const PointCloud*, uint64_t>{&scratch, 0};
+      },
+      *options.colors, options.progress);
+  times_.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void GpuScene::makeParts(gpu::Context& context, uint64_t first, uint64_t count, uint64_t maxPartPoints) {
   pointCount_ = count;
   uint64_t limit = std::min(context.maxAllocationSize(), context.maxBufferSize());
-  uint64_t partPoints = partCapacity(layout_, options.maxPartPoints, limit);
+  uint64_t partPoints = partCapacity(layout_, maxPartPoints, limit);
   if (partPoints == 0)
     throw UnsupportedError("device buffers are too small to hold even one batch of points");
 
@@ -106,14 +154,6 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
     part.colors = buffer(part.count * 4, "colors");
     parts_.push_back(std::move(part));
   }
-  if (count == 0) return;
-  const DisplayColorMode colors = options.colors ? *options.colors : displayColorMode(cloud); // once
-  if (options.filter && options.filter->hasClip() && options.filter->clipMode == ClipMode::Highlight)
-    highlight_ = options.filter;
-  if (layout_ == SceneLayout::Float)
-    uploadFloat(context, cloud, colors, options.progress);
-  else
-    uploadBatched(context, cloud, colors, options.progress);
 }
 
 void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
@@ -141,11 +181,13 @@ void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const
   }
 }
 
-// Encodes whole batches into a staging buffer on all cores (bounds, three words, colors per batch, as
-// cloud/batch_words.h defines them), then copies them into the part's buffers. Two staging buffers take
-// turns: while the GPU copies one chunk, a second thread encodes the next into the other, so the copies
-// cost no time beside the encoding.
-void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
+// Encodes whole batches on all cores (bounds, three words, colors per batch, as cloud/batch_words.h
+// defines them), each group of batches first into memory of its thread and then copied into a staging
+// buffer in four long runs (staging memory may be uncached, write-combined: scattered small writes to it
+// are slow), then copies the staging buffer into the part's buffers. Two staging buffers take turns:
+// while the GPU copies one chunk, a second thread encodes the next into the other, so the copies cost no
+// time beside the encoding.
+void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
                              const DisplayColorMode& colorMode, bool progressShown) {
   struct Chunk {
     const ScenePart* part;
@@ -165,25 +207,38 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
   auto section = [&](int s, int k) {
     return static_cast<uint32_t*>(staging[s].mapped()) + k * kStagingBatchPoints;
   };
+  constexpr uint64_t kGroup = 4; // batches a thread encodes before it copies them to the staging buffer
   auto encode = [&](int s, const Chunk& c) {
+    const auto start = std::chrono::steady_clock::now();
     uint32_t* words[4] = {section(s, 0), section(s, 1), section(s, 2), section(s, 3)};
     auto* bounds = reinterpret_cast<shared::BatchBounds*>(section(s, 4));
     const uint64_t batches = (c.n + kBatchSize - 1) / kBatchSize;
-    parallelBlocks(batches, 4, [&](uint64_t, uint64_t begin, uint64_t end) {
+    parallelBlocks(batches, kGroup, [&](uint64_t, uint64_t begin, uint64_t end) {
+      std::vector<uint32_t> local(4 * kGroup * kBatchSize);
+      uint32_t* mine[4];
+      for (int k = 0; k < 4; ++k)
+        mine[k] = local.data() + k * kGroup * kBatchSize;
+      PointCloud scratch;
+      const uint64_t from = begin * kBatchSize, to = std::min(c.n, end * kBatchSize);
       for (uint64_t b = begin; b < end; ++b) {
-        const uint64_t local = b * kBatchSize; // in this chunk
-        const Batch batch =
-            makeBatch(cloud, c.part->first + c.at + local, uint32_t(std::min(kBatchSize, c.n - local)));
-        encodeBatchWords(words[0] + local, words[1] + local, words[2] + local, cloud, batch);
-        displayColors(words[3] + local, cloud, batch.first, batch.count, colorMode);
-        if (highlight_) highlightColors(words[3] + local, cloud, batch.first, batch.count, *highlight_);
+        const uint64_t at = b * kBatchSize; // in this chunk
+        const uint32_t n = uint32_t(std::min(kBatchSize, c.n - at));
+        const auto [cloud, index] = points(c.part->first + c.at + at, n, scratch);
+        const Batch batch = makeBatch(*cloud, index, n);
+        const uint64_t k = at - from;
+        encodeBatchWords(mine[0] + k, mine[1] + k, mine[2] + k, *cloud, batch);
+        displayColors(mine[3] + k, *cloud, batch.first, batch.count, colorMode);
+        if (highlight_) highlightColors(mine[3] + k, *cloud, batch.first, batch.count, *highlight_);
         const glm::dvec3 lo = batch.bounds.min - origin_, hi = batch.bounds.max - origin_;
         bounds[b] = {glm::vec4(glm::vec3(lo), 0.0f), glm::vec4(glm::vec3(hi), 0.0f)};
       }
+      for (int k = 0; k < 4; ++k)
+        std::memcpy(words[k] + from, mine[k], (to - from) * 4);
     });
     // Zero the padding words of a part's last, partial group of four (batch-prefetch loads them).
     for (uint64_t k = c.n; k < roundUp4(c.n); ++k)
       words[0][k] = words[1][k] = words[2][k] = 0;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   auto copy = [&](int s, const Chunk& c) {
     const ScenePart& part = *c.part;
@@ -203,26 +258,31 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointCloud& cloud,
     });
   };
   Progress progress("uploading to GPU (batched)", pointCount_, " points", progressShown);
-  encode(0, chunks[0]);
+  times_.encode += encode(0, chunks[0]);
   for (size_t i = 0; i < chunks.size(); ++i) {
     std::exception_ptr failed;
     std::thread next;
+    double encoded = 0;
     if (i + 1 < chunks.size())
       next = std::thread([&, i] {
         try {
-          encode(int((i + 1) % 2), chunks[i + 1]);
+          encoded = encode(int((i + 1) % 2), chunks[i + 1]);
         } catch (...) {
           failed = std::current_exception();
         }
       });
+    const auto copyStart = std::chrono::steady_clock::now();
     try {
       copy(int(i % 2), chunks[i]);
     } catch (...) {
       if (next.joinable()) next.join();
       throw;
     }
+    const double copied = std::chrono::duration<double>(std::chrono::steady_clock::now() - copyStart).count();
     if (next.joinable()) next.join();
     if (failed) std::rethrow_exception(failed);
+    times_.encode += encoded;
+    times_.copyWait += std::max(0.0, copied - encoded); // the copy's time the encoding did not cover
     progress.advance(chunks[i].n);
   }
 }

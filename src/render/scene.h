@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -79,6 +80,26 @@ uint64_t sceneBytes(SceneLayout layout, uint64_t points);
 // size) asks first, so that nothing is read or generated for a cloud the device cannot hold.
 bool sceneFits(const gpu::Context& context, SceneLayout layout, uint64_t points, std::string* why = nullptr);
 
+// An input an upload reads block by block instead of as a PointCloud in memory (arrays a caller holds):
+// each block becomes a small cloud of the input's scale and offset, whose batches encode exactly as the
+// same points of the whole cloud would, so nothing the size of the input is made on the host.
+class PointBlocks {
+public:
+  virtual ~PointBlocks() = default;
+  // The input without its points (size 0): its scale, offset, bounds and source.
+  virtual const PointCloud& shape() const = 0;
+  virtual uint64_t size() const = 0;
+  // Points [first, first + count) into `out`, made with shape()'s scale and offset: positions, and colors
+  // where the input has them. Called from several threads at once, each with its own `out`.
+  virtual void fill(uint64_t first, uint64_t count, PointCloud& out) const = 0;
+};
+
+// Seconds an upload spent: encoding on the host (its threads' wall time, chunk by chunk) and waiting for
+// copies to the GPU that the encoding did not hide.
+struct UploadTimes {
+  double total = 0, encode = 0, copyWait = 0;
+};
+
 class GpuScene {
 public:
   // Uploads through a staging buffer; positions are relative to cloud.origin() whatever the subrange,
@@ -86,6 +107,9 @@ public:
   // batches are cut from the first uploaded point on. Throws UnsupportedError when the device lacks the
   // memory.
   GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadOptions& options = {});
+  // The same upload from blocks (the Batched layout only: UnsupportedError for another). The colors come
+  // from UploadOptions::colors, which must be given (the whole input is never looked at to choose them).
+  GpuScene(gpu::Context& context, const PointBlocks& blocks, const UploadOptions& options);
 
   uint64_t pointCount() const { return pointCount_; }
   const glm::dvec3& origin() const { return origin_; }
@@ -94,6 +118,7 @@ public:
   SceneLayout layout() const { return layout_; }
   // Bytes of point data in GPU memory (sceneBytes()).
   uint64_t bytes() const { return sceneBytes(layout_, pointCount_); }
+  const UploadTimes& uploadTimes() const { return times_; }
 
   // Rewrites the colors of every part from `cloud` (the one uploaded, same subrange) in another mode:
   // 4 B a point instead of a whole upload, so a viewer switches modes without uploading positions again.
@@ -104,7 +129,12 @@ public:
 private:
   void uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
                    bool progress);
-  void uploadBatched(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
+  // The points [first, first + count) of the input as a cloud and the index of the first of them in it:
+  // the input cloud itself, or `scratch` filled from blocks.
+  using PointsView = std::function<std::pair<const PointCloud*, uint64_t>(uint64_t first, uint64_t count,
+                                                                          PointCloud& scratch)>;
+  void makeParts(gpu::Context& context, uint64_t first, uint64_t count, uint64_t maxPartPoints);
+  void uploadBatched(gpu::Context& context, const PointsView& points, const DisplayColorMode& colors,
                      bool progress);
   std::optional<PointFilter> highlight_; // the filter whose inside points are tinted, if any
   std::vector<ScenePart> parts_;
@@ -112,6 +142,7 @@ private:
   uint64_t pointCount_ = 0;
   glm::dvec3 origin_{0};
   Bounds bounds_;
+  UploadTimes times_;
 };
 
 } // namespace pointrast

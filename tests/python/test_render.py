@@ -125,3 +125,36 @@ def test_png_repr(data, tmp_path):
     path = tmp_path / "frame.png"
     path.write_bytes(frame._repr_png_())
     assert np.array_equal(read_png(path), frame.image)
+
+
+@pytest.mark.parametrize("method", ["batch-prefetch", "batch"])
+def test_arrays_uploaded_straight_equal_cli(tmp_path, cli, method):
+    """Arrays with RGB colors drawn by a batch method are encoded straight from the arrays, without a cloud
+    on the host: the image equals the CLI's of the same numbers, and the cloud made from the same arrays."""
+    rng = np.random.default_rng(11)
+    n = 25_000  # three batches, the last one short
+    xyz = np.empty((n, 3))
+    xyz[:, 0] = 500_000.0 + rng.random(n) * 300.0
+    xyz[:, 1] = 5_400_000.0 + rng.random(n) * 200.0
+    xyz[:, 2] = 100.0 + rng.random(n) * 20.0
+    colors = rng.integers(0, 256, (n, 3), dtype=np.uint8)
+    path = tmp_path / "utm.xyz"
+    with open(path, "w") as f:
+        for p, c in zip(xyz, colors):
+            f.write("%.17g %.17g %.17g %d %d %d\n" % (p[0], p[1], p[2], c[0], c[1], c[2]))
+    straight = pointrast.Renderer(xyz, colors, width=W, height=H, method=method)
+    image = straight.render().image
+    assert straight.scene._arrays_only  # no PointCloud was made on the host
+    assert np.array_equal(rgb(image), cli(path, "--width", W, "--height", H, "--method", method))
+    assert (rgb(image).sum(axis=2) > 0).mean() > 0.1
+    # The same Cloud once its PointCloud exists (reading its positions makes it): the same image.
+    cloud = pointrast._as_cloud(xyz, colors)
+    assert cloud._arrays_only
+    assert len(cloud.quantized(0)) == n
+    assert not cloud._arrays_only
+    made = pointrast.render(cloud, width=W, height=H, method=method)
+    assert np.array_equal(made, image)
+    # 16-bit colors in strided channels (laspy's) go the same way, scaled to 8 bits.
+    wide = colors.astype(np.uint16) * 257
+    image16 = pointrast.render(xyz, wide, width=W, height=H, method=method)
+    assert np.array_equal(image16, image)
