@@ -273,7 +273,13 @@ std::string pickedText(const nlohmann::json& pick) {
   if (!p.is_object()) return p.is_string() ? p.get<std::string>() : std::string();
   std::string text;
   for (const auto& [name, value] : p.items())
-    if (name != "index") text += name + " " + value.dump() + "\n";
+    if (name == "extra_bytes" && value.is_object()) {
+      // An octree's extra bytes fields, each under its own name.
+      for (const auto& [field, v] : value.items())
+        text += field + " " + v.dump() + "\n";
+    } else if (name != "index") {
+      text += name + " " + value.dump() + "\n";
+    }
   return text;
 }
 

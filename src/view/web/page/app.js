@@ -495,9 +495,16 @@ function showPicked(pick) {
   if (typeof p !== 'object') { $('picked').textContent = 'pixel ' + pick.pixel.join(',') + ': ' + p; return; }
   const lines = [`x ${p.x}`, `y ${p.y}`, `z ${p.z}`];
   for (const [name, label] of [['intensity', 'intensity'], ['classification', 'class'], ['return_number', 'return'],
-                               ['number_of_returns', 'returns'], ['gps_time', 'GPS time'], ['point_source_id', 'source id']])
+                               ['number_of_returns', 'returns'], ['gps_time', 'GPS time'], ['point_source_id', 'source id'],
+                               ['scan_angle', 'scan angle'], ['user_data', 'user data'], ['nir', 'NIR'],
+                               ['classification_flags', 'class flags'], ['scanner_channel', 'channel'],
+                               ['scan_direction_flag', 'scan direction'], ['edge_of_flight_line', 'edge of flight line']])
     if (name in p) lines.push(`${label} ${p[name]}`);
   if (p.color) lines.push('color ' + p.color.join(', '));
+  // An octree's extra bytes fields, by their own names.
+  for (const [name, value] of Object.entries(p.extra_bytes || {}))
+    lines.push(`${name} ${Array.isArray(value) ? value.join(', ') : value}`);
+  if (p.node) lines.push(`node ${p.node}`);
   $('picked').textContent = lines.join('\n');
 }
 
