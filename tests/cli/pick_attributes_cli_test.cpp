@@ -5,6 +5,7 @@
 // itself; for PotreeConverter's octrees, those of the record of las/autzen_trim.las they were made from.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <tuple>
@@ -149,6 +150,23 @@ TEST_F(PickAttributesCli, CopcShowsEveryAttributeOfTheRecord) {
   POINTRAST_REQUIRE_DATA(kExtra);
   // A COPC node holds whole LAS records: the user data is there.
   expectPf8Picks(build("pick_attr.copc.laz", ""), true);
+}
+
+// An octree as PotreeConverter describes one: our octree's metadata.json without pointrast's generator and
+// "lasAttributes" block. The attributes are found by their names and types alone: the flags from their
+// four fields, "Deviation" and "confidence" as extra bytes fields of their own types.
+TEST_F(PickAttributesCli, AttributesNamedAsPotreeConverterNamesThem) {
+  POINTRAST_REQUIRE_DATA(kExtra);
+  const fs::path octree = build("pick_attr_named", "");
+  nlohmann::json m = nlohmann::json::parse(pointrast::test::slurp(octree / "metadata.json"));
+  ASSERT_TRUE(m.contains("lasAttributes"));
+  m.erase("lasAttributes");
+  m["generator"] = "PotreeConverter 2.1";
+  {
+    std::ofstream out(octree / "metadata.json", std::ios::trunc);
+    out << m.dump(2);
+  }
+  expectPf8Picks(octree, false);
 }
 
 // PotreeConverter truncates coordinates (up to one quantum, 0.01, below the LAS's): the record is the one
