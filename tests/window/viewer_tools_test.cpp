@@ -238,6 +238,9 @@ TEST_F(ViewerTools, CtrlClickOnAnOctreePicksThePointRenderLodPicksAndMeasures) {
   ASSERT_TRUE(shown["point"].is_object()) << shown.dump();
   EXPECT_TRUE(shown["point"].contains("node")) << shown.dump();
   EXPECT_TRUE(shown["point"].contains("intensity")) << shown.dump();
+  // What the octree keeps beyond the record's fields (autzen_trim is LAS point format 3).
+  EXPECT_TRUE(shown["point"].contains("gps_time")) << shown.dump();
+  EXPECT_TRUE(shown["point"].contains("number_of_returns")) << shown.dump();
   shown.erase("world");
   EXPECT_EQ(shown, renderPick(octree.string(), " --method lod", camera, shown["pixel"]));
   // Ctrl+Shift+click twice: a distance between the two points picked on the octree.
