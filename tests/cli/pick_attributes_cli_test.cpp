@@ -152,6 +152,63 @@ TEST_F(PickAttributesCli, CopcShowsEveryAttributeOfTheRecord) {
   expectPf8Picks(build("pick_attr.copc.laz", ""), true);
 }
 
+// LAS 1.2 point format 3 with 27 extra bytes in five fields: "Colors" uint16[3] (the deprecated array type
+// 23) at 34, "Reserved" 7 undocumented bytes at 40, "Flags" int8[2] at 47, "Intensity" uint32 at 49,
+// "Time" uint64 at 53. The pick lists arrays and undocumented bytes element by element.
+TEST_F(PickAttributesCli, ExtraBytesArraysAndUndocumentedBytes) {
+  const char* const input = "las/extrabytes.las";
+  POINTRAST_REQUIRE_DATA(input);
+  const Las in = readLasFile(pointrast::test::dataDir() / input);
+  ASSERT_EQ(in.pointFormat, 3);
+  ASSERT_EQ(in.recordLength, 61);
+  const fs::path octree = fresh("pick_attr_extrabytes");
+  const CliResult built = runPointrast("lod '" + (pointrast::test::dataDir() / input).string() + "' -o '" +
+                                       octree.string() + "' --no-color-filter -q");
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  int checked = 0;
+  // The default camera frames the whole cloud; at 40 x 30 most pixels near the middle show a point.
+  for (const auto& [x, y] : {std::pair{20, 15}, {15, 12}, {25, 18}, {10, 15}, {30, 10}, {20, 20}}) {
+    const fs::path png = pointrast::test::cliTempDir() / "pick_attributes_eb.png";
+    const CliResult r =
+        runPointrast("render '" + octree.string() + "' -o '" + png.string() +
+                     "' --width 40 --height 30 --frames 1 --json -q --method lod --min-node-px 0 "
+                     "--pick " +
+                     std::to_string(x) + "," + std::to_string(y));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json p = nlohmann::json::parse(r.out)["pick"]["point"];
+    if (!p.is_object()) continue;
+    ++checked;
+    const std::string* record = nullptr;
+    for (const std::string& candidate : in.records) {
+      const double t = load<double>(bytes(candidate) + 20);
+      if (world(in, candidate, 0) == p["x"].get<double>() &&
+          world(in, candidate, 1) == p["y"].get<double>() &&
+          world(in, candidate, 2) == p["z"].get<double>() && p.value("gps_time", -1.0) == t)
+        record = &candidate;
+    }
+    ASSERT_NE(record, nullptr) << "no record of the file has the point's place and GPS time: " << p.dump();
+    const uint8_t* b = bytes(*record);
+    nlohmann::json expected = {
+        {"number_of_returns", (b[14] >> 3) & 7}, {"scan_direction_flag", (b[14] >> 6) & 1},
+        {"edge_of_flight_line", b[14] >> 7},     {"classification_flags", b[15] >> 5},
+        {"scan_angle", int(int8_t(b[16]))},      {"user_data", b[17]}};
+    nlohmann::json extra;
+    extra["Colors"] = {load<uint16_t>(b + 34), load<uint16_t>(b + 36), load<uint16_t>(b + 38)};
+    extra["Reserved"] = nlohmann::json::array();
+    for (int k = 0; k < 7; ++k)
+      extra["Reserved"].push_back(b[40 + k]);
+    extra["Flags"] = {int(int8_t(b[47])), int(int8_t(b[48]))};
+    extra["Intensity"] = load<uint32_t>(b + 49);
+    extra["Time"] = load<uint64_t>(b + 53);
+    expected["extra_bytes"] = extra;
+    for (const auto& [key, value] : expected.items())
+      EXPECT_EQ(p.value(key, nlohmann::json()), value) << key << " in " << p.dump();
+    EXPECT_FALSE(p.contains("scanner_channel")) << "format 3 has no scanner channel: " << p.dump();
+    EXPECT_FALSE(p.contains("nir")) << p.dump();
+  }
+  EXPECT_GE(checked, 4);
+}
+
 // An octree as PotreeConverter describes one: our octree's metadata.json without pointrast's generator and
 // "lasAttributes" block. The attributes are found by their names and types alone: the flags from their
 // four fields, "Deviation" and "confidence" as extra bytes fields of their own types.
