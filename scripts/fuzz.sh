@@ -14,18 +14,85 @@
 #                                                time: each gets SECONDS x JOBS / targets (at least 10)
 #   scripts/fuzz.sh --report ...                 also appends the run to docs/fuzzing.md ("Runs" at its
 #                                                end): per target its seconds, executions, executions per
-#                                                second, coverage (cov / ft) and findings
+#                                                second, coverage (cov / ft) and findings, and updates the
+#                                                table of cumulative executions per target over all runs;
+#                                                the appended block is also kept in BUILD/logs/report.md
+#   scripts/fuzz.sh --merge FILE                 appends a block another machine's --report run kept
+#                                                (its BUILD/logs/report.md) to docs/fuzzing.md and updates
+#                                                the cumulative table
+#   scripts/fuzz.sh --pack DIR [NAME...]         builds, then puts what a run elsewhere needs into DIR:
+#                                                DIR/fuzz/NAME_fuzz (debug info stripped, symbols kept),
+#                                                DIR/seeds/NAME (the seeds generating targets write from
+#                                                the shared data) and DIR/corpus/NAME (this tree's corpus);
+#                                                run it there with POINTRAST_FUZZ_PREBUILT=1
+#                                                POINTRAST_FUZZ_BUILD=DIR
 #   POINTRAST_FUZZ_JOBS     targets run at once (default: the number of cores); 1 for long runs on a
 #                           shared machine
+#   POINTRAST_FUZZ_FORK     libFuzzer worker processes per target (-fork=N); default 0 (the target runs
+#                           in one process), but with POINTRAST_FUZZ_PREBUILT=1 the cores divided by the
+#                           targets running at once, so that a few targets use every core
+#   POINTRAST_FUZZ_PREBUILT 1: no configure and no build, the binaries of BUILD/fuzz are run as they are
+#                           (a machine without clang, running what --pack made)
 #   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
 #                           found, so a later run starts from there.
 #   POINTRAST_DATA_DIR      the shared test data (default ../shared/data beside the checkout)
 #   POINTRAST_FUZZ_FLAGS    more libFuzzer flags, e.g. "-use_value_profile=1" for long runs
+#   POINTRAST_FUZZ_COMMIT   the commit --report names, where the checkout has no git history
 set -euo pipefail
 cd "$(dirname "$0")/.."
+docs="docs/fuzzing.md"
+
+# Rewrites the table of cumulative executions per target in docs/fuzzing.md (between its
+# "<!-- cumulative -->" markers, added before "## Runs" when missing) from every row of the Runs section.
+updateCumulative() {
+  local table
+  table="$(awk -F'|' '
+    /^## Runs$/ { runs = 1; next }
+    runs && /^\| `[a-z0-9_]+` \| [0-9]+ s \| [0-9]+ \|/ {
+      name = $2; gsub(/[ `]/, "", name); secs = $3; gsub(/[ s]/, "", secs); ex = $4; gsub(/ /, "", ex)
+      if (!(name in total)) order[n++] = name
+      total[name] += ex; seconds[name] += secs; count[name]++
+    }
+    END {
+      print "| target | runs | seconds | executions | of 10^6 |"
+      print "| --- | --- | --- | --- | --- |"
+      for (i = 0; i < n; ++i) {
+        name = order[i]
+        share = total[name] >= 1000000 ? "reached" : sprintf("%d %%", total[name] / 10000)
+        printf "| `%s` | %d | %d | %d | %s |\n", name, count[name], seconds[name], total[name], share
+      }
+    }' "$docs")"
+  if ! grep -q '^<!-- cumulative -->$' "$docs"; then
+    awk '/^## Runs$/ && !done {
+      print "## Cumulative executions\n"
+      print "Every run recorded under Runs below, summed per target (updated by `scripts/fuzz.sh --report`"
+      print "and `--merge`); a target has had its 10^6 executions when the last column says so.\n"
+      print "<!-- cumulative -->\n<!-- /cumulative -->\n"
+      done = 1 }
+      { print }' "$docs" >"$docs.tmp" && mv "$docs.tmp" "$docs"
+  fi
+  awk -v table="$table" '
+    /^<!-- cumulative -->$/ { print; print table; skip = 1; next }
+    /^<!-- \/cumulative -->$/ { skip = 0 }
+    !skip { print }' "$docs" >"$docs.tmp" && mv "$docs.tmp" "$docs"
+}
+
+if [ "${1:-}" = "--merge" ]; then
+  block="${2:?--merge needs the report block of a run (BUILD/logs/report.md)}"
+  [ -f "$block" ] || { echo "fuzz: no report block $block" >&2; exit 1; }
+  cat "$block" >>"$docs"
+  updateCumulative
+  echo "fuzz: $block is appended to $docs"
+  exit 0
+fi
+pack=""
+if [ "${1:-}" = "--pack" ]; then
+  pack="${2:?--pack needs a folder}"
+  shift 2
+fi
 report=""
 if [ "${1:-}" = "--report" ]; then
-  report="docs/fuzzing.md"
+  report="$docs"
   shift
 fi
 total=""
@@ -48,18 +115,56 @@ if [ ${#names[@]} -eq 0 ]; then
   read -r -a names <<<"$(sed -n 's/^foreach(name \(.*\))[[:space:]]*$/\1/p' tests/fuzz/CMakeLists.txt)"
 fi
 [ ${#names[@]} -gt 0 ] || { echo "fuzz: no targets in tests/fuzz/CMakeLists.txt" >&2; exit 1; }
+if [ "$jobs" -gt ${#names[@]} ]; then jobs=${#names[@]}; fi
+fork="${POINTRAST_FUZZ_FORK:-0}"
+if [ "${POINTRAST_FUZZ_PREBUILT:-0}" = 1 ] && [ -z "${POINTRAST_FUZZ_FORK:-}" ]; then
+  fork=$(($(nproc) / jobs))
+  if [ "$fork" -lt 2 ]; then fork=0; fi
+fi
+forkFlags=()
+if [ "$fork" -gt 0 ]; then forkFlags=(-fork="$fork"); fi
 if [ -n "$total" ]; then
   seconds=$((total * jobs / ${#names[@]}))
   if [ "$seconds" -lt 10 ]; then seconds=10; fi
 fi
 
-launcher=()
-if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-# -O1 -g without -DNDEBUG: the asserts stay on (a file must never reach one), the stacks stay readable.
-CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
-  -DPOINTRAST_FUZZ=ON -DPOINTRAST_TESTS=OFF "${launcher[@]}" >/dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz
+if [ "${POINTRAST_FUZZ_PREBUILT:-0}" != 1 ]; then
+  launcher=()
+  if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+  # -O1 -g without -DNDEBUG: the asserts stay on (a file must never reach one), the stacks stay readable.
+  # The static runtime (libstdc++, libgcc, brotli) lets --pack's binaries run where only the C library is.
+  CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+    -DPOINTRAST_FUZZ=ON -DPOINTRAST_TESTS=OFF -DPOINTRAST_STATIC_RUNTIME=ON "${launcher[@]}" >/dev/null
+  if [ -n "$pack" ]; then
+    cmake --build "$build" -j"$(nproc)" --target $(printf '%s_fuzz ' "${names[@]}")
+  else
+    cmake --build "$build" -j"$(nproc)" --target fuzz
+  fi
+fi
+
+if [ -n "$pack" ]; then
+  mkdir -p "$pack/fuzz"
+  for name in "${names[@]}"; do
+    binary="$build/fuzz/${name}_fuzz"
+    [ -x "$binary" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
+    objcopy --strip-debug "$binary" "$pack/fuzz/${name}_fuzz.tmp" && mv "$pack/fuzz/${name}_fuzz.tmp" "$pack/fuzz/${name}_fuzz"
+    variable="$(echo "$name" | tr '[:lower:]' '[:upper:]')_FUZZ_SEEDS"
+    if grep -q "$variable" "tests/fuzz/${name}_fuzz.cpp"; then
+      rm -rf "$pack/seeds/$name" && mkdir -p "$pack/seeds/$name"
+      env "$variable=$pack/seeds/$name" "$binary" -runs=0 "$pack/seeds/$name" >/dev/null 2>&1
+    fi
+    if [ -d "$build/corpus/$name" ]; then
+      rm -rf "$pack/corpus/$name" && mkdir -p "$pack/corpus" && cp -r "$build/corpus/$name" "$pack/corpus/$name"
+    fi
+    libraries="$(ldd "$pack/fuzz/${name}_fuzz" | awk '{ print $1 }' |
+      grep -vE '^(linux-vdso|/lib64/ld-linux|ld-linux|libc|libm|libpthread|libdl|librt)[.-]' || true)"
+    if [ -n "$libraries" ]; then echo "fuzz: ${name}_fuzz needs" $libraries >&2; exit 1; fi
+  done
+  echo "fuzz: $pack holds ${names[*]}: $(du -sm "$pack" | cut -f 1) MiB; run there with" \
+    "POINTRAST_FUZZ_PREBUILT=1 POINTRAST_FUZZ_BUILD=$pack scripts/fuzz.sh ..."
+  exit 0
+fi
 
 if [ -z "${ASAN_SYMBOLIZER_PATH:-}" ] && ! command -v llvm-symbolizer >/dev/null; then
   for s in /usr/lib/llvm-*/bin/llvm-symbolizer; do
@@ -101,12 +206,13 @@ fuzzTarget() {
   echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
   local started=$SECONDS
   if "${generator[@]}" "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 \
-    -malloc_limit_mb=256 -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" \
+    -malloc_limit_mb=256 -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" "${forkFlags[@]}" \
     ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" >"$log" 2>&1; then
     {
       echo "== $name"
       # "#123456 DONE cov: 812 ft: 2931 corp: 401/1873Kb ..." and the executions from the final stats.
-      grep -E '^#[0-9]+[[:space:]]+DONE' "$log" | tail -n 1 || true
+      # With -fork, the last "#123456: cov: 812 ft: 2931 corp: 401 exec/s 1234 ..." line instead.
+      grep -E '^#[0-9]+([[:space:]]+DONE|:[[:space:]]+cov:)' "$log" | tail -n 1 || true
       grep -E '^stat::(number_of_executed_units|average_exec_per_sec):' "$log" | tr '\n' ' ' || true
       echo
     } >"$result"
@@ -132,10 +238,12 @@ reportRow() {
   local executions rate status cov ft finding="none"
   executions="$(sed -n 's/^stat::number_of_executed_units:[[:space:]]*//p' "$log" | tail -n 1)"
   rate="$(sed -n 's/^stat::average_exec_per_sec:[[:space:]]*//p' "$log" | tail -n 1)"
-  status="$(grep -E '^#[0-9]+[[:space:]].*cov: [0-9]+' "$log" | tail -n 1 || true)"
+  status="$(grep -E '^#[0-9]+:?[[:space:]].*cov: [0-9]+' "$log" | tail -n 1 || true)"
   cov="$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")"
   ft="$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$status")"
-  if [ -z "$executions" ]; then executions="$(sed -n 's/^#\([0-9]*\)[[:space:]].*/\1/p' <<<"$status")"; fi
+  # -fork prints no final stats: the executions of all workers are its last status line's count.
+  if [ -z "$executions" ]; then executions="$(sed -n 's/^#\([0-9]*\):\{0,1\}[[:space:]].*/\1/p' <<<"$status")"; fi
+  if [ -z "$rate" ] && [ -n "$executions" ] && [ "$wall" -gt 0 ]; then rate=$((executions / wall)); fi
   local input
   for input in "$findings/$name-"*; do
     if [ -e "$input" ]; then
@@ -178,17 +286,21 @@ if [ -n "$report" ]; then
   if ! grep -q '^## Runs$' "$report"; then
     printf '\n## Runs\n\nAppended by `scripts/fuzz.sh --report`, newest last.\n' >>"$report"
   fi
+  forkNote=""
+  if [ "$fork" -gt 0 ]; then forkNote=", $fork workers each (-fork)"; fi
   {
     echo
-    echo "$(date -u +'%Y-%m-%d %H:%M') UTC, commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)," \
-      "$seconds s per target, $jobs at once on $(nproc) cores (load average $(cut -d ' ' -f 1 /proc/loadavg)):"
+    echo "$(date -u +'%Y-%m-%d %H:%M') UTC, commit ${POINTRAST_FUZZ_COMMIT:-$(git rev-parse --short HEAD 2>/dev/null || echo unknown)}," \
+      "$seconds s per target, $jobs at once$forkNote on $(nproc) cores (load average $(cut -d ' ' -f 1 /proc/loadavg)):"
     echo
     echo "| target | time | executions | per second | cov / ft | findings |"
     echo "| --- | --- | --- | --- | --- | --- |"
     for name in "${names[@]}"; do
       cat "$build/logs/$name.row" 2>/dev/null || echo "| \`$name\` | | | | | no result |"
     done
-  } >>"$report"
+  } >"$build/logs/report.md"
+  cat "$build/logs/report.md" >>"$report"
+  updateCumulative
   echo "fuzz: the run is appended to $report"
 fi
 if [ ${#failed[@]} -gt 0 ]; then
