@@ -101,7 +101,7 @@ if [ "${1:-}" = "--total" ]; then
   shift 2
 fi
 seconds=25
-if [ -z "$total" ] && [ $# -gt 0 ]; then
+if [ -z "$total" ] && [ $# -gt 0 ] && [[ "$1" =~ ^[0-9]+$ ]]; then
   seconds="$1"
   shift
 fi

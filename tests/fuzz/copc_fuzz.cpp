@@ -3,11 +3,12 @@
 // root page at the start of the hierarchy EVLR). The first two bytes give the length of the point data
 // part (node chunks live there, at file offsets from kChunksStart); the rest is the root page (32-byte
 // entries: level, x, y, z int32, offset u64, byte size int32, point count int32). The whole hierarchy is
-// walked and every node with at most 2^16 points decoded.
+// walked and every node with at most kMaxPoints points decoded.
 //
-// Seeds: with COPC_FUZZ_SEEDS=DIR set, the target first writes into DIR inputs whose nodes are real
-// POINT14 chunks of the shared LAZ files (laz_seeds.h): a root alone, a root and a child sharing its chunk,
-// and a root page that references itself as a child page (a cycle).
+// Seeds: with COPC_FUZZ_SEEDS=DIR set, the target first writes into DIR inputs whose nodes are POINT14
+// chunks of up to 200 records of the shared LAS and LAZ files coded by pointrast's encoder (laz_seeds.h):
+// a root alone, a root and a child sharing its chunk, and a root page that references itself as a child
+// page (a cycle).
 //   COPC_FUZZ_SEEDS=seeds ./copc_fuzz -runs=0 seeds && ./copc_fuzz -max_total_time=300 corpus seeds
 #include <cstdlib>
 #include <cstring>
@@ -20,6 +21,10 @@
 #include "laz_seeds.h"
 
 namespace {
+
+// Points decoded per node at most: a few hundred keep an input near a millisecond under the sanitizers.
+constexpr uint32_t kMaxPoints = 512;
+constexpr uint64_t kSeedPoints = 200;
 
 template <class T> void put(std::vector<uint8_t>& b, size_t at, T v) {
   std::memcpy(b.data() + at, &v, sizeof v);
@@ -106,9 +111,14 @@ void putEntry(std::vector<uint8_t>& page, int32_t level, int32_t x, int32_t y, i
 void writeSeeds(const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
   int n = 0;
-  for (const fuzz::SeedChunk& chunk : fuzz::seedChunks(60000, 2)) {
-    const auto& items = chunk.layout.items;
-    if (items.size() != 1 || items[0].type != pointrast::io::laz::ItemType::Point14) continue;
+  using pointrast::io::laz::encoderLayout;
+  using pointrast::io::laz::kVariableChunks;
+  for (const fuzz::SeedRecords& seed : fuzz::seedRecords(kSeedPoints)) {
+    if (seed.pointFormat < 6) continue;
+    if (n == 12) break;
+    const std::vector<uint8_t> records = fuzz::convertRecords(seed, 6, 0);
+    fuzz::SeedChunk chunk{encoderLayout(6, 30, kVariableChunks), {}, seed.count};
+    chunk.bytes = fuzz::encodeSeedChunk(chunk.layout, records.data(), seed.count);
     const uint64_t split = chunk.bytes.size();
     const int32_t bytes = int32_t(split), points = int32_t(chunk.count);
     const uint64_t pageOffset = kChunksStart + split + 8 + 60;
@@ -139,7 +149,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const auto source = pointrast::io::openCopc(mem.path());
     pointrast::lod::forEachNode(*source, [&](const pointrast::lod::NodeInfo& node) {
-      if (node.pointCount <= (1u << 16)) {
+      if (node.pointCount <= kMaxPoints) {
         const std::vector<pointrast::PointRecord> records = source->readNode(node);
         if (records.size() != node.pointCount) __builtin_trap();
       }

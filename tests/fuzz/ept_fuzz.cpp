@@ -2,10 +2,11 @@
 // (two little-endian u16 lengths, then the three parts), written to a folder in memory (/dev/shm) as
 // ept.json, ept-hierarchy/0-0-0-0.json (and the same text as 1-0-0-0.json, so subtree references
 // resolve) and ept-data/0-0-0-0.{bin,zst,laz}. The dataset is opened, its hierarchy walked and every node
-// with at most 2^16 points read, then read whole and probed.
+// with at most kMaxPoints points read, then, when every node is that small, read whole and probed.
 //
 // Seeds: with EPT_FUZZ_SEEDS=DIR set, the target first writes into DIR small valid datasets in this layout:
-// binary and zstandard nodes, and a laszip node that is the shared simple.laz (laz_seeds.h):
+// binary and zstandard nodes, and laszip nodes of up to 200 records of the shared LAS and LAZ files
+// written by pointrast's LAZ writer (laz_seeds.h):
 //   EPT_FUZZ_SEEDS=seeds ./ept_fuzz -runs=0 seeds && ./ept_fuzz -dict=ept.dict -max_total_time=300 corpus
 //   seeds
 #include <cstdlib>
@@ -26,6 +27,10 @@
 namespace {
 
 namespace fs = std::filesystem;
+
+// Points read per node at most: a few hundred keep an input near a millisecond under the sanitizers.
+constexpr uint64_t kMaxPoints = 512;
+constexpr uint64_t kSeedPoints = 200;
 
 // The dataset's folder, in memory, removed when the fuzzer exits normally (a crash leaves it for a look).
 const fs::path& folder() {
@@ -89,11 +94,19 @@ void writeSeeds(const fs::path& dir) {
   std::vector<uint8_t> zst(ZSTD_compressBound(24));
   zst.resize(ZSTD_compress(zst.data(), zst.size(), points.data(), 24, 3));
   fuzz::writeSeed(dir / "zstandard", seedInput(eptJson("zstandard", 2, ""), R"({"0-0-0-0": 2})", zst));
-  // A laszip node: the shared simple.laz (LAS 1.2 point format 3, 1,065 points) when it is there.
-  std::ifstream in(fuzz::sharedLazDir() / "simple.laz", std::ios::binary);
-  const std::vector<uint8_t> laz{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (!laz.empty())
-    fuzz::writeSeed(dir / "laszip", seedInput(eptJson("laszip", 1065, colors), R"({"0-0-0-0": 1065})", laz));
+  // Laszip nodes: small LAZ files of the shared data's first records, in chunks of 50 points, one per
+  // point format.
+  int n = 0;
+  bool seen[11] = {};
+  for (const fuzz::SeedRecords& seed : fuzz::seedRecords(kSeedPoints)) {
+    if (seen[seed.pointFormat]) continue;
+    seen[seed.pointFormat] = true;
+    const std::vector<uint8_t> laz = fuzz::smallLazFile(seed, 50, dir / "scratch.laz");
+    const int count = int(seed.count);
+    fuzz::writeSeed(
+        dir / ("laszip" + std::to_string(n++)),
+        seedInput(eptJson("laszip", count, colors), "{\"0-0-0-0\": " + std::to_string(count) + "}", laz));
+  }
 }
 
 } // namespace
@@ -123,9 +136,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const auto source = pointrast::io::openEpt(dir);
     pointrast::lod::forEachNode(*source, [&](const pointrast::lod::NodeInfo& n) {
-      // A zstd or LAZ node may truly hold millions of points in a few bytes: claims above 2^16 are
-      // skipped (their memory is the claim, not a defect).
-      if (n.pointCount > (1u << 16)) {
+      // A zstd or LAZ node may truly hold millions of points in a few bytes: claims above kMaxPoints
+      // are skipped (their memory and time are the claim, not a defect).
+      if (n.pointCount > kMaxPoints) {
         small = false;
         return true;
       }

@@ -1,29 +1,61 @@
 // libFuzzer target for the LAZ encoder: random point records round-trip through the encoder and the
 // decoder byte for byte. The first byte picks the item layout (point formats 0-3 pointwise, 6-8
 // layered) and the count of extra bytes (0-7), the second how many chunks the records are cut into; the
-// rest are the raw records (whole records only, at least one). A decoded chunk that differs from the
-// records encoded, or a decoder that refuses the encoder's bytes, is a finding.
+// rest are the raw records (whole records only, at least one; at most kMaxPoints are coded, so an input
+// costs a few hundred points' work). A decoded chunk that differs from the records encoded, or a decoder
+// that refuses the encoder's bytes, is a finding.
 //
-// Seeds: las (LAS files' bytes read as records: real headers, real points)
+// Seeds: with LAZENC_FUZZ_SEEDS=DIR set, the target first writes into DIR up to 200 records of every
+// shared LAS and LAZ file in every point format of its family and with 0 or 3 extra bytes (laz_seeds.h):
+//   LAZENC_FUZZ_SEEDS=seeds ./lazenc_fuzz -runs=0 seeds && ./lazenc_fuzz -max_total_time=300 corpus seeds
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "io/las/las_format.h"
 #include "io/las/laz_chunk.h"
 #include "io/las/laz_common.h"
 #include "io/las/laz_encoder.h"
+#include "laz_seeds.h"
 
 using namespace pointrast::io;
 
+namespace {
+
+constexpr uint64_t kMaxPoints = 512;
+constexpr uint64_t kSeedPoints = 200;
+const int kFormats[] = {0, 1, 2, 3, 6, 7, 8};
+
+void writeSeeds(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  int n = 0;
+  for (const fuzz::SeedRecords& seed : fuzz::seedRecords(kSeedPoints))
+    for (uint8_t f = 0; f < 7; ++f)
+      for (int extra : {0, 3}) {
+        if (!fuzz::sameFamily(seed.pointFormat, kFormats[f])) continue;
+        std::vector<uint8_t> input{uint8_t(f | extra << 5), uint8_t(n % 4)};
+        const std::vector<uint8_t> records = fuzz::convertRecords(seed, kFormats[f], uint16_t(extra));
+        input.insert(input.end(), records.begin(), records.end());
+        fuzz::writeSeed(dir / ("lazenc" + std::to_string(n++)), input);
+      }
+}
+
+} // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  if (const char* seeds = std::getenv("LAZENC_FUZZ_SEEDS"); seeds && *seeds) writeSeeds(seeds);
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 2) return 0;
-  static const int kFormats[] = {0, 1, 2, 3, 6, 7, 8};
   const int format = kFormats[(data[0] & 0x0F) % 7];
   const uint16_t extra = uint16_t(data[0] >> 5);
   const uint16_t rl = uint16_t(detail::las::kRecordSize[size_t(format)] + extra);
-  const uint64_t count = (size - 2) / rl;
+  const uint64_t count = std::min<uint64_t>((size - 2) / rl, kMaxPoints);
   if (count == 0) return 0;
   const uint8_t* records = data + 2;
   const uint64_t chunks = std::min<uint64_t>(count, 1 + data[1] % 4);
