@@ -199,8 +199,19 @@ void ArrayPoints::fill(uint64_t first, uint64_t count, PointCloud& out) const {
                  out.positions.data());
   if (hasColor()) {
     out.colors.resize(count);
-    for (uint64_t i = 0; i < count; ++i)
-      out.colors[i] = color(first + i);
+    uint32_t* dst = out.colors.data();
+    if (channelByte_[0] && channelByte_[1] && channelByte_[2]) {
+      // 8-bit channels (the usual (N, 3) uint8 array): plain loads, no width to test per point.
+      const auto* r = reinterpret_cast<const uint8_t*>(channelData_[0]) + first * channelStride_[0];
+      const auto* g = reinterpret_cast<const uint8_t*>(channelData_[1]) + first * channelStride_[1];
+      const auto* b = reinterpret_cast<const uint8_t*>(channelData_[2]) + first * channelStride_[2];
+      const py::ssize_t sr = channelStride_[0], sg = channelStride_[1], sb = channelStride_[2];
+      for (uint64_t i = 0; i < count; ++i)
+        dst[i] = packRgba(r[i * sr], g[i * sg], b[i * sb]);
+    } else {
+      for (uint64_t i = 0; i < count; ++i)
+        dst[i] = color(first + i);
+    }
   }
 }
 

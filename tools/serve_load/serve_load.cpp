@@ -354,16 +354,30 @@ Json Load::flightPhase() {
   std::vector<Frame> flown = frames_;
   std::vector<double> latencies = latencies_;
   size_t converged = 0;
-  std::vector<double> points;
-  for (const Frame& f : flown) {
+  std::vector<double> points, renderMs, encodeMs, gapMs;
+  for (size_t i = 0; i < flown.size(); ++i) {
+    const Frame& f = flown[i];
     converged += f.converged;
     if (f.pointsDrawn) points.push_back(*f.pointsDrawn);
+    renderMs.push_back(f.header.renderMs);
+    encodeMs.push_back(f.header.encodeMs);
+    if (i > 0) gapMs.push_back((f.arrived - flown[i - 1].arrived) * 1e3);
   }
+  auto spread = [](const std::vector<double>& ms) {
+    return Json{{"p50", percentile(ms, 0.5)},
+                {"p95", percentile(ms, 0.95)},
+                {"max", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())}};
+  };
   Json out = {{"seconds", elapsed},
               {"frames", flown.size()},
               {"frames_per_second", double(flown.size()) / elapsed},
               {"frames_converged", converged},
-              {"input_to_frame_ms", summary(latencies)}};
+              {"input_to_frame_ms", summary(latencies)},
+              // Where a late frame's time went: the server's render and JPEG encode of each frame (its
+              // header), and the time between frames arriving here.
+              {"frame_render_ms", spread(renderMs)},
+              {"frame_encode_ms", spread(encodeMs)},
+              {"frame_gap_ms", spread(gapMs)}};
   if (!points.empty()) {
     std::sort(points.begin(), points.end());
     out["points_drawn"] = {
