@@ -6,13 +6,22 @@
 // hierarchy. The COPC writer's tests compute the same lines from the points they built.
 //
 //   node tests/web/copc_nodes.mjs FILE.copc.laz
+//
+// With --records it prints, instead, what a lossless archive must hold: "RECORDS COUNT LENGTH SHA256",
+// SHA256 over the lowercase hex of every whole point record of every node (every attribute and the extra
+// bytes, as stored), sorted and joined by "\n"; "EB NAME..." the extra bytes dimensions copc.js parsed from
+// the file's VLR; and "SUM NAME VALUE" for GpsTime and each of them, summed over every point through
+// copc.js's own dimension getters (its reading of the extra bytes descriptors).
+//
+//   node tests/web/copc_nodes.mjs --records FILE.copc.laz
 import { createHash } from 'node:crypto';
 import copcPackage from 'copc';
 
 const { Copc, Hierarchy } = copcPackage;
-const file = process.argv[2];
+const records = process.argv[2] === '--records';
+const file = process.argv[records ? 3 : 2];
 if (!file) {
-  console.error('usage: node copc_nodes.mjs FILE.copc.laz');
+  console.error('usage: node copc_nodes.mjs [--records] FILE.copc.laz');
   process.exit(2);
 }
 const copc = await Copc.create(file);
@@ -28,6 +37,28 @@ while (pending.length) {
   const subtree = await Hierarchy.load(file, page);
   Object.assign(nodes, subtree.nodes);
   pending.push(...Object.values(subtree.pages));
+}
+
+if (records) {
+  const hex = [];
+  const names = copc.eb.map((e) => e.name);
+  const sums = Object.fromEntries(['GpsTime', ...names].map((n) => [n, 0]));
+  for (const node of Object.values(nodes)) {
+    if (node.pointCount === 0) continue;
+    const buffer = await Copc.loadPointDataBuffer(file, copc.header, node);
+    for (let at = 0; at < buffer.byteLength; at += length)
+      hex.push(Buffer.from(buffer.buffer, buffer.byteOffset + at, length).toString('hex'));
+    const view = await Copc.loadPointDataView(file, copc, node);
+    for (const name of Object.keys(sums)) {
+      const get = view.getter(name);
+      for (let i = 0; i < view.pointCount; ++i) sums[name] += get(i);
+    }
+  }
+  hex.sort();
+  console.log(`RECORDS ${hex.length} ${length} ${createHash('sha256').update(hex.join('\n')).digest('hex')}`);
+  console.log(['EB', ...names].join(' '));
+  for (const [name, sum] of Object.entries(sums)) console.log(`SUM ${name} ${sum.toPrecision(15)}`);
+  process.exit(0);
 }
 
 const keyOrder = (a, b) => {
