@@ -275,7 +275,9 @@ class Renderer:
         hit = r.pick(640, 360)      # the point under a pixel: index, position, depth
 
     Keyword options given here are the defaults of every render(); render() takes the same ones again.
-    device: the Vulkan device index (as `pointrast info --devices` lists them).
+    device: the Vulkan device index (as `pointrast info --devices` lists them). Arrays are referenced, not
+    copied (a batch method uploads them straight from where they lie): do not change them while the
+    Renderer draws them.
     """
 
     def __init__(self, data, colors=None, *, camera=None, device=None, **options):
