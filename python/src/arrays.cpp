@@ -255,10 +255,6 @@ std::shared_ptr<PointCloud> ArrayPoints::makeCloud() const {
   return cloud;
 }
 
-std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz) {
-  return ArrayPoints(xyz).makeCloud();
-}
-
 std::shared_ptr<PointCloud> cloudFromQuantized(const py::array& x, const py::array& y, const py::array& z,
                                                const glm::dvec3& scale, const glm::dvec3& offset) {
   const uint64_t n = uint64_t(x.ndim() == 1 ? x.shape(0) : 0);

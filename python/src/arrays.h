@@ -58,7 +58,6 @@ private:
   bool wide_ = false;
 };
 
-std::shared_ptr<PointCloud> cloudFromXyz(const py::array& xyz);
 // x, y, z: int32 (N,) of any stride (laspy's X, Y, Z: fields of its point records), world = q * scale +
 // offset per axis as LAS stores them.
 std::shared_ptr<PointCloud> cloudFromQuantized(const py::array& x, const py::array& y, const py::array& z,

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "cli/las_records_test_util.h"
 #include "io/copc_build_test_util.h"
 #include "io/io_test_util.h"
 #include "io/sha256.h"
@@ -131,18 +132,18 @@ struct LasRecords {
   std::set<std::string> scaled; // dimensions whose descriptor states a scale or an offset
 };
 
-template <typename T> T le(const std::vector<uint8_t>& b, size_t at) {
+template <typename T> T le(const uint8_t* b, size_t at) {
   T v;
-  std::memcpy(&v, b.data() + at, sizeof v);
+  std::memcpy(&v, b + at, sizeof v);
   return v;
 }
 
 LasRecords lasRecords(const std::filesystem::path& path) {
-  const std::vector<uint8_t> b = iotest::readBytes(path);
+  const std::vector<uint8_t> file = iotest::readBytes(path);
+  const uint8_t* b = file.data();
   const uint16_t headerSize = le<uint16_t>(b, 94);
-  const uint32_t pointsAt = le<uint32_t>(b, 96), vlrs = le<uint32_t>(b, 100);
-  const uint16_t length = le<uint16_t>(b, 105);
-  const uint64_t count = le<uint64_t>(b, 247); // LAS 1.4
+  const uint32_t vlrs = le<uint32_t>(b, 100);
+  const test::las_records::Las las = test::las_records::readLasFile(path);
   LasRecords r;
   struct Extra {
     std::string name;
@@ -153,11 +154,11 @@ LasRecords lasRecords(const std::filesystem::path& path) {
   static const size_t kSize[11] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
   size_t at = 38; // point format 8's record; the extra bytes follow it
   for (size_t v = 0, p = headerSize; v < vlrs; ++v) {
-    const std::string user(reinterpret_cast<const char*>(b.data() + p + 2), 16);
+    const std::string user(reinterpret_cast<const char*>(b + p + 2), 16);
     const uint16_t id = le<uint16_t>(b, p + 18), bytes = le<uint16_t>(b, p + 20);
     if (user.rfind("LASF_Spec", 0) == 0 && id == 4)
       for (size_t d = p + 54; d + 192 <= p + 54 + bytes; d += 192) {
-        Extra e{std::string(reinterpret_cast<const char*>(b.data() + d + 4)), b[d + 2], at};
+        Extra e{std::string(reinterpret_cast<const char*>(b + d + 4)), b[d + 2], at};
         e.name = e.name.substr(0, std::min<size_t>(e.name.size(), 32));
         if (b[d + 3] & 0x18) r.scaled.insert(e.name);
         at += e.type ? kSize[e.type] : b[d + 3];
@@ -168,45 +169,45 @@ LasRecords lasRecords(const std::filesystem::path& path) {
   }
   std::vector<std::string> hex;
   static const char* kDigits = "0123456789abcdef";
-  for (uint64_t i = 0; i < count; ++i) {
-    const size_t rec = pointsAt + i * length;
+  for (const std::string& record : las.records) {
+    const auto* rec = reinterpret_cast<const uint8_t*>(record.data());
     std::string h;
-    for (size_t k = 0; k < length; ++k)
-      h += {kDigits[b[rec + k] >> 4], kDigits[b[rec + k] & 15]};
+    for (const uint8_t byte : record)
+      h += {kDigits[byte >> 4], kDigits[byte & 15]};
     hex.push_back(h);
-    r.sums["GpsTime"] += le<double>(b, rec + 22);
+    r.sums["GpsTime"] += le<double>(rec, 22);
     for (const Extra& e : extras) {
       double v = 0;
       switch (e.type) {
       case 1:
-        v = b[rec + e.at];
+        v = rec[e.at];
         break;
       case 2:
-        v = int8_t(b[rec + e.at]);
+        v = int8_t(rec[e.at]);
         break;
       case 3:
-        v = le<uint16_t>(b, rec + e.at);
+        v = le<uint16_t>(rec, e.at);
         break;
       case 4:
-        v = le<int16_t>(b, rec + e.at);
+        v = le<int16_t>(rec, e.at);
         break;
       case 5:
-        v = le<uint32_t>(b, rec + e.at);
+        v = le<uint32_t>(rec, e.at);
         break;
       case 6:
-        v = le<int32_t>(b, rec + e.at);
+        v = le<int32_t>(rec, e.at);
         break;
       case 7:
-        v = double(le<uint64_t>(b, rec + e.at));
+        v = double(le<uint64_t>(rec, e.at));
         break;
       case 8:
-        v = double(le<int64_t>(b, rec + e.at));
+        v = double(le<int64_t>(rec, e.at));
         break;
       case 9:
-        v = le<float>(b, rec + e.at);
+        v = le<float>(rec, e.at);
         break;
       case 10:
-        v = le<double>(b, rec + e.at);
+        v = le<double>(rec, e.at);
         break;
       default:
         break;
@@ -218,7 +219,7 @@ LasRecords lasRecords(const std::filesystem::path& path) {
   std::string joined;
   for (size_t i = 0; i < hex.size(); ++i)
     joined += (i ? "\n" : "") + hex[i];
-  r.line = "RECORDS " + std::to_string(count) + " " + std::to_string(length) + " " +
+  r.line = "RECORDS " + std::to_string(las.records.size()) + " " + std::to_string(las.recordLength) + " " +
            iotest::sha256Hex(reinterpret_cast<const uint8_t*>(joined.data()), joined.size());
   return r;
 }

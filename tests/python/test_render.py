@@ -10,6 +10,22 @@ W, H = 256, 192
 EYE, TARGET = (636000.0, 848900.0, 700.0), (636600.0, 849200.0, 450.0)
 
 
+def utm_points(tmp_path, n, seed):
+    """n float64 points far from the origin (UTM) with uint8 colors, and the same numbers as an XYZ file
+    the CLI reads."""
+    rng = np.random.default_rng(seed)
+    xyz = np.empty((n, 3))
+    xyz[:, 0] = 500_000.0 + rng.random(n) * 300.0  # UTM easting
+    xyz[:, 1] = 5_400_000.0 + rng.random(n) * 200.0
+    xyz[:, 2] = 100.0 + rng.random(n) * 20.0
+    colors = rng.integers(0, 256, (n, 3), dtype=np.uint8)
+    path = tmp_path / "utm.xyz"
+    with open(path, "w") as f:
+        for p, c in zip(xyz, colors):
+            f.write("%.17g %.17g %.17g %d %d %d\n" % (p[0], p[1], p[2], c[0], c[1], c[2]))
+    return xyz, colors, path
+
+
 def test_las_cloud_equals_cli(data, cli):
     las = data / "las" / "autzen_trim.las"
     cloud = pointrast.open(las)
@@ -72,17 +88,7 @@ def test_options_equal_cli(data, cli):
 
 def test_float64_utm_array_equals_cli(tmp_path, cli):
     """float64 coordinates far from the origin render like the same numbers read by the CLI."""
-    rng = np.random.default_rng(7)
-    n = 20_000
-    xyz = np.empty((n, 3))
-    xyz[:, 0] = 500_000.0 + rng.random(n) * 300.0  # UTM easting
-    xyz[:, 1] = 5_400_000.0 + rng.random(n) * 200.0
-    xyz[:, 2] = 100.0 + rng.random(n) * 20.0
-    colors = rng.integers(0, 256, (n, 3), dtype=np.uint8)
-    path = tmp_path / "utm.xyz"
-    with open(path, "w") as f:
-        for p, c in zip(xyz, colors):
-            f.write("%.17g %.17g %.17g %d %d %d\n" % (p[0], p[1], p[2], c[0], c[1], c[2]))
+    xyz, colors, path = utm_points(tmp_path, 20_000, seed=7)
     image = pointrast.render(xyz, colors, width=W, height=H)
     assert np.array_equal(rgb(image), cli(path, "--width", W, "--height", H))
     assert (rgb(image).sum(axis=2) > 0).mean() > 0.1  # the points cover much of the image
@@ -131,17 +137,8 @@ def test_png_repr(data, tmp_path):
 def test_arrays_uploaded_straight_equal_cli(tmp_path, cli, method):
     """Arrays with RGB colors drawn by a batch method are encoded straight from the arrays, without a cloud
     on the host: the image equals the CLI's of the same numbers, and the cloud made from the same arrays."""
-    rng = np.random.default_rng(11)
     n = 25_000  # three batches, the last one short
-    xyz = np.empty((n, 3))
-    xyz[:, 0] = 500_000.0 + rng.random(n) * 300.0
-    xyz[:, 1] = 5_400_000.0 + rng.random(n) * 200.0
-    xyz[:, 2] = 100.0 + rng.random(n) * 20.0
-    colors = rng.integers(0, 256, (n, 3), dtype=np.uint8)
-    path = tmp_path / "utm.xyz"
-    with open(path, "w") as f:
-        for p, c in zip(xyz, colors):
-            f.write("%.17g %.17g %.17g %d %d %d\n" % (p[0], p[1], p[2], c[0], c[1], c[2]))
+    xyz, colors, path = utm_points(tmp_path, n, seed=11)
     straight = pointrast.Renderer(xyz, colors, width=W, height=H, method=method)
     image = straight.render().image
     assert straight.scene._arrays_only  # no PointCloud was made on the host
