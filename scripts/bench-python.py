@@ -90,15 +90,17 @@ def main():
             convert_s = time.perf_counter() - t
             renderer = pointrast.Renderer(cloud, width=WIDTH, height=HEIGHT, method=METHOD)
             first = renderer.render()
-            passes.append((convert_s, first.upload_s, first.upload_encode_s, first.upload_copy_wait_s))
+            passes.append((convert_s, first.upload_s, first.upload_encode_s, first.upload_copy_wait_s,
+                           first.upload_steps_cpu_s))
             if len(passes) == 1:
                 del renderer, first, cloud
         timed = renderer.render(frames=FRAMES)
-        convert_s, upload_s, encode_s, copy_wait_s = passes[1]
+        convert_s, upload_s, encode_s, copy_wait_s, steps = passes[1]
         row = {"points": n, "array_bytes": array_bytes, "device": renderer.device, "made_s": made_s,
                "convert_first_s": passes[0][0], "upload_first_s": passes[0][1],
                "convert_s": convert_s, "upload_s": upload_s,
                "upload_encode_s": encode_s, "upload_copy_wait_s": copy_wait_s,
+               "upload_steps_cpu_s": steps, "upload_steps_cpu_s_first": passes[0][4],
                "upload_gbps": array_bytes / upload_s / 1e9,
                "arrays_to_gpu_gbps": array_bytes / (convert_s + upload_s) / 1e9,
                "python_frame_ms": timed.gpu_ms, "python_points_drawn": timed.points}
@@ -151,6 +153,19 @@ def main():
                 format(r["points"], ","), r["array_bytes"] / 1e9, r["convert_s"], r["upload_s"],
                 r["upload_encode_s"], r["upload_copy_wait_s"],
                 r["upload_gbps"], r["arrays_to_gpu_gbps"], r["python_frame_ms"], r["cli_frame_ms"]))
+        f.write("\nThe encoding's steps, in nanoseconds of one thread per point (all threads' seconds over the "
+                "points): where the upload's host time goes.\n\n"
+                "| points | threads | read | bounds | words | colors | stage | sum | per point at the wall |\n"
+                "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n")
+        for r in rows:
+            st = r.get("upload_steps_cpu_s") or {}
+            if not st:
+                continue
+            names = ("read", "bounds", "words", "colors", "stage")
+            ns = [st.get(k, 0.0) / r["points"] * 1e9 for k in names]
+            f.write("| %s | %d | %s | %.1f | %.2f |\n" % (
+                format(r["points"], ","), st.get("threads", 0), " | ".join("%.1f" % v for v in ns), sum(ns),
+                r["upload_encode_s"] / r["points"] * 1e9 * max(1, st.get("threads", 1))))
 
 
 if __name__ == "__main__":

@@ -62,7 +62,8 @@ class Frame:
     asked for; the camera it was drawn from; gpu_ms, the GPU time of a frame (the median of `frames`);
     upload_s, the seconds this render spent uploading the cloud (0 when a Renderer reused it), of which
     upload_encode_s encoding it on the host and upload_copy_wait_s waiting for copies the encoding did not
-    hide. Shows itself as a PNG in Jupyter."""
+    hide; upload_steps_cpu_s, the encoding's steps in seconds of all its threads together (read, bounds,
+    words, colors, stage) and the threads it had. Shows itself as a PNG in Jupyter."""
 
     def __init__(self, result):
         self.image = result["image"]
@@ -75,6 +76,7 @@ class Frame:
         self.upload_s = result.get("upload_s", 0.0)
         self.upload_encode_s = result.get("upload_encode_s", 0.0)
         self.upload_copy_wait_s = result.get("upload_copy_wait_s", 0.0)
+        self.upload_steps_cpu_s = dict(result.get("upload_steps_cpu_s", {}))
 
     def _repr_png_(self):
         return png_bytes(self.image)

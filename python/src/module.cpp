@@ -363,6 +363,14 @@ private:
     r["upload_s"] = lastUploadS_;
     r["upload_encode_s"] = lastUpload_.encode;
     r["upload_copy_wait_s"] = lastUpload_.copyWait;
+    py::dict steps;
+    steps["read"] = lastUpload_.readCpu;
+    steps["bounds"] = lastUpload_.boundsCpu;
+    steps["words"] = lastUpload_.wordsCpu;
+    steps["colors"] = lastUpload_.colorsCpu;
+    steps["stage"] = lastUpload_.stageCpu;
+    steps["threads"] = lastUpload_.threads;
+    r["upload_steps_cpu_s"] = steps;
     return r;
   }
 

@@ -1,6 +1,7 @@
 #include "render/scene.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <chrono>
 #include <cstring>
@@ -199,6 +200,7 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
     for (uint64_t at = 0; at < part.count; at += kStagingBatchPoints)
       chunks.push_back({&part, at, std::min(kStagingBatchPoints, part.count - at)});
   if (chunks.empty()) return;
+  std::atomic<int64_t> stepNs[5] = {}; // the encoding's steps, as UploadTimes counts them
   gpu::Buffer staging[2] = {
       gpu::Buffer(context, kStagingBatches * kBatchBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                   gpu::MemoryKind::Upload, "upload staging 0"),
@@ -222,21 +224,38 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
       for (int k = 0; k < 4; ++k)
         mine[k] = local.get() + k * kGroup * kBatchSize;
       PointCloud scratch;
+      // Nanoseconds of each step in this job (a clock read per step of a batch: ~10,000 points each).
+      int64_t ns[5] = {};
+      auto clock = [] { return std::chrono::steady_clock::now(); };
+      auto lap = [&](std::chrono::steady_clock::time_point& t, int step) {
+        const auto now = clock();
+        ns[step] += std::chrono::duration_cast<std::chrono::nanoseconds>(now - t).count();
+        t = now;
+      };
       const uint64_t from = begin * kBatchSize, to = std::min(c.n, end * kBatchSize);
       for (uint64_t b = begin; b < end; ++b) {
         const uint64_t at = b * kBatchSize; // in this chunk
         const uint32_t n = uint32_t(std::min(kBatchSize, c.n - at));
+        auto t = clock();
         const auto [cloud, index] = points(c.part->first + c.at + at, n, scratch);
+        lap(t, 0);
         const Batch batch = makeBatch(*cloud, index, n);
+        lap(t, 1);
         const uint64_t k = at - from;
         encodeBatchWords(mine[0] + k, mine[1] + k, mine[2] + k, *cloud, batch);
+        lap(t, 2);
         displayColors(mine[3] + k, *cloud, batch.first, batch.count, colorMode);
         if (highlight_) highlightColors(mine[3] + k, *cloud, batch.first, batch.count, *highlight_);
+        lap(t, 3);
         const glm::dvec3 lo = batch.bounds.min - origin_, hi = batch.bounds.max - origin_;
         bounds[b] = {glm::vec4(glm::vec3(lo), 0.0f), glm::vec4(glm::vec3(hi), 0.0f)};
       }
+      auto t = clock();
       for (int k = 0; k < 4; ++k)
         std::memcpy(words[k] + from, mine[k], (to - from) * 4);
+      lap(t, 4);
+      for (int step = 0; step < 5; ++step)
+        stepNs[step].fetch_add(ns[step], std::memory_order_relaxed);
     });
     // Zero the padding words of a part's last, partial group of four (batch-prefetch loads them).
     for (uint64_t k = c.n; k < roundUp4(c.n); ++k)
@@ -261,6 +280,7 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
     });
   };
   Progress progress("uploading to GPU (batched)", pointCount_, " points", progressShown);
+  times_.threads = hardwareThreads();
   times_.encode += encode(0, chunks[0]);
   for (size_t i = 0; i < chunks.size(); ++i) {
     std::exception_ptr failed;
@@ -288,6 +308,10 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
     times_.copyWait += std::max(0.0, copied - encoded); // the copy's time the encoding did not cover
     progress.advance(chunks[i].n);
   }
+  double* cpu[5] = {&times_.readCpu, &times_.boundsCpu, &times_.wordsCpu, &times_.colorsCpu,
+                    &times_.stageCpu};
+  for (int step = 0; step < 5; ++step)
+    *cpu[step] += double(stepNs[step].load()) * 1e-9;
 }
 
 uint32_t highlightColor(uint32_t rgba) {

@@ -98,6 +98,11 @@ public:
 // copies to the GPU that the encoding did not hide.
 struct UploadTimes {
   double total = 0, encode = 0, copyWait = 0;
+  // The encoding's steps, in seconds of all its threads together (a batched upload): reading the points
+  // (positions and colors from the input), cutting batches (their bounds), the position words, the
+  // display colors, and copying each thread's words into the staging buffer.
+  double readCpu = 0, boundsCpu = 0, wordsCpu = 0, colorsCpu = 0, stageCpu = 0;
+  uint32_t threads = 0;
 };
 
 class GpuScene {

@@ -44,9 +44,11 @@ TEST(BatchWords, InlineRoundingEqualsLlroundAndClamp) {
   options.points = 40'000;
   options.progress = false;
   PointCloud terrain = generateScene(Scene::Terrain, options);
-  PointCloud halves; // extent 2 on each axis: positions 0, 1, 2 put t on 0, (2^30 - 1) / 2, 2^30 - 1
+  // Extent 2 on each axis: positions 0, 1, 2 put t on 0, (2^30 - 1) / 2, 2^30 - 1. 303 points: the encoder
+  // takes four points at a time, and the last three on their own.
+  PointCloud halves;
   halves.scale = glm::dvec3(1.0);
-  for (int32_t i = 0; i < 300; ++i)
+  for (int32_t i = 0; i < 303; ++i)
     halves.positions.insert(halves.positions.end(), {i % 3, (i / 3) % 3, (i / 9) % 3});
   computeBounds(halves);
   uint64_t checked = 0;

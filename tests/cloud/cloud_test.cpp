@@ -1,10 +1,14 @@
 #include "cloud/cloud.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "cloud/detail.h"
 #include "test_clouds.h"
 
 namespace pointrast {
@@ -177,3 +181,26 @@ TEST(DisplayColorMode, ExtremeElevationSpansStayDefined) {
 
 } // namespace
 } // namespace pointrast
+
+// The box of a range of points, taken four points at a time with the rest one by one, is the minimum and
+// maximum of each axis over exactly those points, whatever the range's start and length.
+TEST(QuantBox, EqualsEachAxisMinimumAndMaximumOverTheRange) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 500; ++trial) {
+    const uint64_t n = rng() % 60;
+    std::vector<int32_t> positions(3 * n);
+    for (int32_t& v : positions)
+      v = int32_t(rng()) >> (rng() % 31); // both signs, small and large
+    const uint64_t first = n ? rng() % n : 0, count = n - first - (n > first ? rng() % (n - first) : 0);
+    const pointrast::detail::QuantBox box = pointrast::detail::quantBox(positions.data(), first, count);
+    for (int a = 0; a < 3; ++a) {
+      int32_t lo = std::numeric_limits<int32_t>::max(), hi = std::numeric_limits<int32_t>::min();
+      for (uint64_t i = first; i < first + count; ++i) {
+        lo = std::min(lo, positions[3 * i + a]);
+        hi = std::max(hi, positions[3 * i + a]);
+      }
+      ASSERT_EQ(box.min[a], lo) << "trial " << trial << " axis " << a;
+      ASSERT_EQ(box.max[a], hi) << "trial " << trial << " axis " << a;
+    }
+  }
+}

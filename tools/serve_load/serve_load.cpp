@@ -68,6 +68,10 @@ struct Frame {
   double arrived = 0;
   bool converged = false;            // the state sent with it says the level-of-detail view converged
   std::optional<double> pointsDrawn; // the points its level-of-detail frame drew, from that state
+  double received = 0;               // when its message was read, before the JPEG was decoded
+  // From its state: how long the oldest input it shows waited on the server before the frame's drawing
+  // began, and how long the server's thread took to draw it (upload, render, readback).
+  std::optional<double> serverInputWaitMs, serverFrameWallMs;
 };
 
 class Load {
@@ -95,8 +99,10 @@ private:
   std::vector<double> latencies_;     // ms, of the inputs shown since the last reset
   std::vector<Frame> frames_;         // received since the last reset
   std::vector<uint32_t> rgba_;
-  std::map<uint32_t, bool> convergedByFrame_; // frame id -> its state's lod.converged
-  std::map<uint32_t, double> pointsByFrame_;  // frame id -> its state's lod.pointsDrawn
+  std::map<uint32_t, bool> convergedByFrame_;                     // frame id -> its state's lod.converged
+  std::map<uint32_t, double> pointsByFrame_;                      // frame id -> its state's lod.pointsDrawn
+  std::map<uint32_t, std::pair<double, double>> serverMsByFrame_; // frame id -> inputWaitMs, frameWallMs
+  std::vector<double> receivedLatencies_; // ms, as latencies_ but to the frame's message before decoding
 };
 
 uint32_t Load::send(Json message) {
@@ -133,6 +139,11 @@ void Load::pump(double until) {
           convergedByFrame_[j["frame"].get<uint32_t>()] = lod.value("converged", false);
           if (lod.contains("pointsDrawn") && lod["pointsDrawn"].is_number())
             pointsByFrame_[j["frame"].get<uint32_t>()] = lod["pointsDrawn"].get<double>();
+          const Json& stats = j.value("stats", Json::object());
+          if (stats.contains("inputWaitMs") && stats["inputWaitMs"].is_number() &&
+              stats.contains("frameWallMs") && stats["frameWallMs"].is_number())
+            serverMsByFrame_[j["frame"].get<uint32_t>()] = {stats["inputWaitMs"].get<double>(),
+                                                            stats["frameWallMs"].get<double>()};
         }
       }
       continue;
@@ -142,6 +153,7 @@ void Load::pump(double until) {
     f.header = view::web::readFrameHeader(m->data.data());
     if (f.header.magic != view::web::kFrameMagic) continue;
     f.bytes = m->data.size();
+    f.received = clockSeconds();
     if (args_.decode) {
       uint32_t w = 0, h = 0;
       view::web::decodeJpeg(
@@ -157,10 +169,16 @@ void Load::pump(double until) {
       f.pointsDrawn = it->second;
       pointsByFrame_.erase(pointsByFrame_.begin(), std::next(it));
     }
+    if (auto it = serverMsByFrame_.find(f.header.frame); it != serverMsByFrame_.end()) {
+      f.serverInputWaitMs = it->second.first;
+      f.serverFrameWallMs = it->second.second;
+      serverMsByFrame_.erase(serverMsByFrame_.begin(), std::next(it));
+    }
     ws_.sendText(Json{{"t", "ack"}, {"frame", f.header.frame}}.dump());
     // Every input up to the frame's sequence number is shown by it.
     for (auto it = sentAt_.begin(); it != sentAt_.end() && it->first <= f.header.seq;) {
       latencies_.push_back((f.arrived - it->second) * 1e3);
+      receivedLatencies_.push_back((f.received - it->second) * 1e3);
       it = sentAt_.erase(it);
     }
     frames_.push_back(f);
@@ -186,6 +204,7 @@ Json Load::motionPhase(double scale) {
   pump(clockSeconds() + 0.5);
   frames_.clear();
   latencies_.clear();
+  receivedLatencies_.clear();
   sentAt_.clear();
   send({{"t", "down"}, {"b", 0}, {"x", 0.5}, {"y", 0.5}});
   double start = clockSeconds(), next = start;
@@ -318,6 +337,7 @@ Json Load::flightPhase() {
   pump(clockSeconds() + 0.5);
   frames_.clear();
   latencies_.clear();
+  receivedLatencies_.clear();
   sentAt_.clear();
   double start = clockSeconds(), next = start;
   const double stroke = 1.5; // seconds a stroke
@@ -353,11 +373,15 @@ Json Load::flightPhase() {
   double elapsed = clockSeconds() - start;
   std::vector<Frame> flown = frames_;
   std::vector<double> latencies = latencies_;
+  const std::vector<double> receivedLatencies = receivedLatencies_;
   size_t converged = 0;
-  std::vector<double> points, renderMs, encodeMs, gapMs;
+  std::vector<double> points, renderMs, encodeMs, gapMs, decodeMs, waitMs, wallMs;
   for (size_t i = 0; i < flown.size(); ++i) {
     const Frame& f = flown[i];
     converged += f.converged;
+    decodeMs.push_back((f.arrived - f.received) * 1e3);
+    if (f.serverInputWaitMs) waitMs.push_back(*f.serverInputWaitMs);
+    if (f.serverFrameWallMs) wallMs.push_back(*f.serverFrameWallMs);
     if (f.pointsDrawn) points.push_back(*f.pointsDrawn);
     renderMs.push_back(f.header.renderMs);
     encodeMs.push_back(f.header.encodeMs);
@@ -377,7 +401,14 @@ Json Load::flightPhase() {
               // header), and the time between frames arriving here.
               {"frame_render_ms", spread(renderMs)},
               {"frame_encode_ms", spread(encodeMs)},
-              {"frame_gap_ms", spread(gapMs)}};
+              {"frame_gap_ms", spread(gapMs)},
+              // The input's way split up: to the frame's message read here (before decoding), the JPEG
+              // decode here, the oldest input's wait on the server before its frame began, and the
+              // server thread's time drawing a frame.
+              {"input_to_frame_received_ms", summary(receivedLatencies)},
+              {"frame_decode_ms", spread(decodeMs)},
+              {"server_input_wait_ms", spread(waitMs)},
+              {"server_frame_wall_ms", spread(wallMs)}};
   if (!points.empty()) {
     std::sort(points.begin(), points.end());
     out["points_drawn"] = {
@@ -480,7 +511,24 @@ int Load::runFlight(const Frame& first, Json result) {
           " | " +
           (flight.contains("points_drawn") ? format("%.0f", flight["points_drawn"]["median"].get<double>())
                                            : std::string("-")) +
-          " |\n\n| jump | converged | frames to converge | ms |\n| --- | --- | ---: | ---: |\n";
+          " |\n\n";
+    // Where the flight's input-to-frame time went, p50 / p95 / max in ms.
+    auto row = [&](const char* what, const Json& s) {
+      return std::string("| ") + what + " | " +
+             format("%.1f | %.1f | %.1f", s["p50"].get<double>(), s["p95"].get<double>(),
+                    s["max"].get<double>()) +
+             " |\n";
+    };
+    md += "| flight, ms | p50 | p95 | max |\n| --- | ---: | ---: | ---: |\n";
+    md += row("input to frame shown (decoded here)", flight["input_to_frame_ms"]);
+    md += row("input to frame received (before decoding)", flight["input_to_frame_received_ms"]);
+    md += row("server: oldest input's wait before its frame began", flight["server_input_wait_ms"]);
+    md += row("server: drawing a frame (upload, render, readback)", flight["server_frame_wall_ms"]);
+    md += row("server: GPU render", flight["frame_render_ms"]);
+    md += row("server: JPEG encode", flight["frame_encode_ms"]);
+    md += row("here: JPEG decode", flight["frame_decode_ms"]);
+    md += row("between frames arriving", flight["frame_gap_ms"]);
+    md += "\n| jump | converged | frames to converge | ms |\n| --- | --- | ---: | ---: |\n";
     for (const Json& j : jumped)
       md += "| " + j["jump"].get<std::string>() + " | " + (j["converged"].get<bool>() ? "yes" : "no") +
             " | " + std::to_string(j["frames_to_converge"].get<size_t>()) + " | " +

@@ -144,6 +144,7 @@ void WebClient::receive(const ClientMessage& m) {
     return;
   }
   if (!session_) return; // input before the canvas size means nothing yet
+  if (!inputSince_ && m.seq) inputSince_ = m.received;
   switch (m.type) {
   case MessageType::Down:
   case MessageType::Move:
@@ -194,7 +195,8 @@ void WebClient::receive(const ClientMessage& m) {
     }
     if (m.measureOp == MeasureOp::Finish) tool.finish();
     if (m.measureOp == MeasureOp::Delete && !tool.remove(m.index))
-      stream_.submitText(Json{{"t", "refused"}, {"text", "no measurement " + std::to_string(m.index)}}.dump());
+      stream_.submitText(
+          Json{{"t", "refused"}, {"text", "no measurement " + std::to_string(m.index)}}.dump());
     if (m.measureOp == MeasureOp::Clear) tool.clear();
     if (m.measureOp == MeasureOp::Download)
       stream_.submitText(Json{{"t", "annotations"}, {"text", io::annotationsJson(tool.complete())}}.dump());
@@ -283,6 +285,7 @@ std::optional<double> WebClient::step(double now) {
 
 void WebClient::renderFrame(double now, FrameQuality quality) {
   auto start = std::chrono::steady_clock::now();
+  inputWaitMs_ = inputSince_ ? std::max(0.0, now - *std::exchange(inputSince_, std::nullopt)) * 1e3 : 0.0;
   Viewport viewport = session_->viewport();
   bool cheap = quality == FrameQuality::Motion && settings_.motionScale < 1.0;
   Viewport size = cheap ? scaleViewport(viewport, settings_.motionScale) : viewport;
@@ -291,8 +294,10 @@ void WebClient::renderFrame(double now, FrameQuality quality) {
   RawFrame frame;
   frame.rgba = view.renderer().image();
   if (!session_->measurements().all().items.empty())
-    view.drawOverlay(session_->camera(), session_->settings(), size, session_->measurements().complete(), frame.rgba);
+    view.drawOverlay(session_->camera(), session_->settings(), size, session_->measurements().complete(),
+                     frame.rgba);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  frameWallMs_ = report.seconds * 1e3;
   session_->frameRendered(report);
   quality_.rendered(session_->camera(), quality, now);
 
@@ -329,7 +334,9 @@ std::string WebClient::stateJson(const FrameHeader* frame) const {
                 {"motionBytes", ss.motionBytes},
                 {"fullBytes", ss.fullBytes},
                 {"framesSent", ss.framesSent},
-                {"framesDropped", ss.framesDropped}};
+                {"framesDropped", ss.framesDropped},
+                {"inputWaitMs", inputWaitMs_},
+                {"frameWallMs", frameWallMs_}};
   if (st.batch)
     stats["batch"] = {{"batchesProcessed", st.batch->batchesProcessed},
                       {"batchesRendered", st.batch->batchesRendered},
@@ -354,24 +361,25 @@ std::string WebClient::stateJson(const FrameHeader* frame) const {
                     {"bytesPerSecond", st.streamedBytesPerSecond}};
   }
   if (!st.status.empty()) stats["status"] = st.status;
-  Json j = {{"t", "state"},
-            {"seq", seq_},
-            {"viewport", {s.viewport().width, s.viewport().height}},
-            {"camera", {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", c.fovY}}},
-            {"pivot", vec(s.pivot())},
-            {"bounds", {{"min", vec(s.navigation().bounds().min)}, {"max", vec(s.navigation().bounds().max)}}},
-            {"settings", settingsJson(s.settings())},
-            {"options",
-             {{"panel", s.options().panel},
-              {"supersample", s.options().supersample},
-              {"keyframeSeconds", s.options().keyframeSeconds}}},
-            {"stream",
-             {{"motionScale", settings_.motionScale},
-              {"quality", settings_.quality},
-              {"motionQuality", settings_.motionQuality}}},
-            {"keyframes",
-             {{"count", session_->path().keyframes().size()}, {"duration", session_->path().duration()}}},
-            {"stats", stats}};
+  Json j = {
+      {"t", "state"},
+      {"seq", seq_},
+      {"viewport", {s.viewport().width, s.viewport().height}},
+      {"camera", {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}, {"fov", c.fovY}}},
+      {"pivot", vec(s.pivot())},
+      {"bounds", {{"min", vec(s.navigation().bounds().min)}, {"max", vec(s.navigation().bounds().max)}}},
+      {"settings", settingsJson(s.settings())},
+      {"options",
+       {{"panel", s.options().panel},
+        {"supersample", s.options().supersample},
+        {"keyframeSeconds", s.options().keyframeSeconds}}},
+      {"stream",
+       {{"motionScale", settings_.motionScale},
+        {"quality", settings_.quality},
+        {"motionQuality", settings_.motionQuality}}},
+      {"keyframes",
+       {{"count", session_->path().keyframes().size()}, {"duration", session_->path().duration()}}},
+      {"stats", stats}};
   // The frame this state goes with: the one it precedes, else the last one sent.
   j["frame"] = frame ? frame->frame : nextFrame_ - 1;
   return j.dump();

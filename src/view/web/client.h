@@ -28,10 +28,10 @@ struct StreamSettings {
 // What every client starts from.
 struct ClientSetup {
   gpu::Context* context = nullptr;
-  SceneSource* cloud = nullptr;    // the input on the GPU, shared by every client
-  std::span<const Method> methods; // this device runs them
-  std::optional<Camera> camera;    // starting camera; the overview when absent
-  double fovY = 60;                // of the overview
+  SceneSource* cloud = nullptr;        // the input on the GPU, shared by every client
+  std::span<const Method> methods;     // this device runs them
+  std::optional<Camera> camera;        // starting camera; the overview when absent
+  double fovY = 60;                    // of the overview
   std::span<const glm::dvec3> framing; // the points the overview frames (SceneInput::framing)
   ViewSettings settings;
   Viewport maxSize{3840, 2160}; // frames are at most this large (aspect kept)
@@ -79,6 +79,11 @@ private:
   double wheel_ = 0;       // steps gathered since the last step(), zoomed at once
   glm::dvec2 wheelAt_{0};
   double lastStep_ = -1;
+  // When the oldest input that no frame has shown yet arrived (server clock), and what the last frame
+  // reports of it: how long that input waited before the frame's drawing began, and how long drawing the
+  // frame took on this thread (upload, render, readback, overlay).
+  std::optional<double> inputSince_;
+  double inputWaitMs_ = 0, frameWallMs_ = 0;
   bool stateChanged_ = true; // something the panel shows changed without a frame
   // The pick tool's click, served with the other requests: the position and the measurement it extends.
   std::optional<std::pair<glm::dvec2, std::optional<AnnotationKind>>> toolPick_;
