@@ -7,7 +7,7 @@
 
 namespace pointrast::io::laz {
 
-void BitModel::update() {
+POINTRAST_LAZ_NO_COVERAGE void BitModel::update() {
   // Halve the counts when they reach the maximum, so the model keeps adapting.
   if ((bitCount += updateCycle) > kBitMaxCount) {
     bitCount = (bitCount + 1) >> 1;
@@ -20,7 +20,7 @@ void BitModel::update() {
   bitsUntilUpdate = updateCycle;
 }
 
-void SymbolModel::create(uint32_t symbols) {
+POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols) {
   assert(symbols >= 2 && symbols <= 2048);
   symbols_ = symbols;
   lastSymbol_ = symbols - 1;
@@ -45,7 +45,7 @@ void SymbolModel::create(uint32_t symbols) {
   ready_ = false;
 }
 
-void SymbolModel::reset() {
+POINTRAST_LAZ_NO_COVERAGE void SymbolModel::reset() {
   assert(symbols_ != 0);
   totalCount_ = 0;
   updateCycle_ = symbols_;
@@ -55,7 +55,7 @@ void SymbolModel::reset() {
   ready_ = true;
 }
 
-void SymbolModel::update() {
+POINTRAST_LAZ_NO_COVERAGE void SymbolModel::update() {
   if ((totalCount_ += updateCycle_) > kMaxCount) {
     totalCount_ = 0;
     for (uint32_t n = 0; n < symbols_; ++n)
