@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstring>
+#include <vector>
 
 namespace pointrast::io::laz {
 
@@ -47,10 +49,22 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols) {
 
 POINTRAST_LAZ_NO_COVERAGE void SymbolModel::reset() {
   assert(symbols_ != 0);
-  totalCount_ = 0;
-  updateCycle_ = symbols_;
-  std::fill(symbolCount_, symbolCount_ + symbols_, 1u);
-  update();
+  // Every reset of an alphabet of a given size ends in the same tables (counts of 1, their
+  // distribution and decoder table): the first on a thread computes them, later ones copy them. A
+  // chunk resets a model per context it meets, often hundreds of 256-symbol models.
+  thread_local std::vector<std::vector<uint32_t>> uniform(2049);
+  std::vector<uint32_t>& tables = uniform[symbols_];
+  const size_t words = 2 * size_t(symbols_) + (decoderTable_ ? tableSize_ + 2 : 0);
+  if (tables.empty()) {
+    totalCount_ = 0;
+    updateCycle_ = symbols_;
+    std::fill(symbolCount_, symbolCount_ + symbols_, 1u);
+    update();
+    tables.assign(storage_.get(), storage_.get() + words);
+  } else {
+    std::memcpy(storage_.get(), tables.data(), words * sizeof(uint32_t));
+    totalCount_ = symbols_; // update()'s sum of the counts of 1
+  }
   symbolsUntilUpdate_ = updateCycle_ = (symbols_ + 6) >> 1;
   ready_ = true;
 }
