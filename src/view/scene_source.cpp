@@ -11,6 +11,9 @@ namespace pointrast::view {
 
 namespace {
 constexpr uint64_t kInteractiveUploadBytes = uint64_t(32) << 20;
+// Node readers keep every core busy while the camera meets new ground; below the frame's threads (render,
+// JPEG, the sockets) they take only the time those leave.
+constexpr int kInteractiveReaderNiceness = 10;
 } // namespace
 
 SceneInput::SceneInput() = default;
@@ -92,6 +95,7 @@ void GpuOctree::make(const Options& options) {
   // made the frames that met new ground several times slower than the rest); a jump that needs more
   // refines over a few more frames.
   o.uploadBytesPerFrame = kInteractiveUploadBytes;
+  o.readerNiceness = kInteractiveReaderNiceness;
   scene_.reset(); // its node cache goes before the new one is allocated
   scene_ = std::make_unique<lod::LodScene>(context_, source_, o);
   options_ = options;

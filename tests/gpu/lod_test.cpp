@@ -10,10 +10,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <thread>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "base/error.h"
@@ -511,6 +514,58 @@ TEST_F(GpuTest, LodFramesRefineFromResidentAncestorsToTheFullImage) {
   Camera moved = camera;
   moved.eye.z += 1.0;
   EXPECT_TRUE(loop.frame(moved, view));
+}
+
+namespace {
+// The niceness of each thread of this process (the 19th field of /proc/self/task/TID/stat).
+std::vector<int> threadNiceness() {
+  std::vector<int> out;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::FILE* f = std::fopen((task.path() / "stat").c_str(), "r");
+    if (!f) continue;
+    char line[1024] = {};
+    const size_t n = std::fread(line, 1, sizeof line - 1, f);
+    std::fclose(f);
+    const char* p = std::strrchr(line, ')'); // the command name may hold spaces
+    if (!p || n == 0) continue;
+    int field = 2, nice = 0;
+    for (const char* c = p + 1; *c; ++c)
+      if (*c == ' ' && ++field == 19) {
+        nice = std::atoi(c + 1);
+        break;
+      }
+    out.push_back(nice);
+  }
+  return out;
+}
+} // namespace
+
+// A viewer's readers run below the frame's threads: LodOptions::readerNiceness lowers exactly the reader
+// threads' priority (the calling thread keeps its own).
+TEST_F(GpuTest, LodReadersRunAtTheNicenessAskedFor) {
+  GenerateOptions options;
+  options.points = 20'000;
+  options.progress = false;
+  MemoryOctree tree;
+  buildOctree(tree, generateScene(Scene::Terrain, options), 1000);
+  auto countNice = [](int value) {
+    const std::vector<int> all = threadNiceness();
+    return std::count(all.begin(), all.end(), value);
+  };
+  const int own = getpriority(PRIO_PROCESS, 0);
+  ASSERT_LT(own, 9) << "the test runs at niceness " << own << " already";
+  const int lowered = own + 10 > 19 ? 19 : own + 10;
+  const auto before = countNice(lowered);
+  lod::LodOptions o = smallOptions(64ull << 20);
+  o.readers = 3;
+  o.readerNiceness = 10;
+  lod::LodScene scene(*context, tree, o);
+  // The readers set their niceness as they start: wait for all three, bounded.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (countNice(lowered) < before + 3 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::yield();
+  EXPECT_EQ(countNice(lowered), before + 3);
+  EXPECT_EQ(getpriority(PRIO_PROCESS, 0), own) << "the calling thread keeps its priority";
 }
 
 TEST_F(GpuTest, LodCacheEvictsAcrossCameraJumpsAndConvergesEachTime) {

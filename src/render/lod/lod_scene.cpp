@@ -72,7 +72,8 @@ LodScene::LodScene(gpu::Context& context, NodeSource& source, const LodOptions& 
   if (!options_.uploadBytesPerFrame) options_.uploadBytesPerFrame = kDefaultUploadBytes;
   stats_.cacheBytes = pool_->capacity() * shared::kLodPageBytes;
   readers_ = std::make_unique<NodeReaders>(source, *encoder_, *staging_,
-                                           options.readers ? options.readers : hardwareThreads());
+                                           options.readers ? options.readers : hardwareThreads(),
+                                           options.readerNiceness);
 }
 
 LodScene::~LodScene() {

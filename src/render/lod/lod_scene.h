@@ -53,6 +53,9 @@ struct LodOptions {
   uint32_t readers = 0;             // reader threads; 0: one per hardware thread
   uint64_t stagingBytes = 0;        // host staging for nodes read and not yet uploaded; 0: 256 MiB
   uint64_t uploadBytesPerFrame = 0; // node bytes one interactive frame copies at most; 0: 256 MiB
+  // The readers' scheduling priority below the process's (nice): a viewer lowers it so that the threads
+  // that draw, encode and send its frames never wait for a core behind the readers. 0: the same.
+  int readerNiceness = 0;
   // How points become colors (render --color), decided once from the root's points; nullopt: the automatic
   // choice (node_encoding.h). Colors are computed as nodes are encoded, so every LOD method draws them.
   std::optional<DisplayColorMode::Source> colorSource;

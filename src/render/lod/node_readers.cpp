@@ -2,16 +2,24 @@
 
 #include <chrono>
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include "base/error.h"
 #include "render/lod/selection.h"
 
 namespace pointrast::lod {
 
 NodeReaders::NodeReaders(NodeSource& source, const NodeEncoder& encoder, StagingBlocks& staging,
-                         uint32_t threads)
+                         uint32_t threads, int niceness)
     : source_(source), encoder_(encoder), staging_(staging) {
   for (uint32_t t = 0; t < std::max(1u, threads); ++t)
-    threads_.emplace_back([this] { run(); });
+    threads_.emplace_back([this, niceness] {
+      // Linux keeps a niceness per thread. Lowering one's own priority needs no privilege; where it is
+      // refused anyway the reader runs at the normal priority, which is only slower for the frames.
+      if (niceness > 0) (void)setpriority(PRIO_PROCESS, uint32_t(gettid()), niceness);
+      run();
+    });
 }
 
 NodeReaders::~NodeReaders() {

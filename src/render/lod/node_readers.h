@@ -43,7 +43,10 @@ struct ReadChildren {
 
 class NodeReaders {
 public:
-  NodeReaders(NodeSource& source, const NodeEncoder& encoder, StagingBlocks& staging, uint32_t threads);
+  // `niceness` > 0 runs the threads at that lower scheduling priority (nice), so that a viewer's threads
+  // that draw and send frames find a core at once while the readers keep every other core busy.
+  NodeReaders(NodeSource& source, const NodeEncoder& encoder, StagingBlocks& staging, uint32_t threads,
+              int niceness = 0);
   ~NodeReaders(); // stops the threads; work in progress is abandoned
   NodeReaders(const NodeReaders&) = delete;
   NodeReaders& operator=(const NodeReaders&) = delete;
