@@ -101,39 +101,6 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::update() {
 
 // ---- encoder ----------------------------------------------------------------------------------------
 
-void ArithmeticEncoder::encodeBit(BitModel& m, uint32_t bit) {
-  const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
-  if (bit == 0) {
-    length_ = x;
-    ++m.bit0Count;
-  } else {
-    const uint32_t initBase = base_;
-    base_ += x;
-    length_ -= x;
-    if (initBase > base_) propagateCarry();
-  }
-  if (length_ < kMinLength) renormalize();
-  if (--m.bitsUntilUpdate == 0) m.update();
-}
-
-void ArithmeticEncoder::encodeSymbol(SymbolModel& m, uint32_t sym) {
-  assert(sym < m.symbols_);
-  const uint32_t initBase = base_;
-  if (sym == m.lastSymbol_) {
-    const uint32_t x = m.distribution_[sym] * (length_ >> kLengthShift);
-    base_ += x;
-    length_ -= x;
-  } else {
-    const uint32_t x = m.distribution_[sym] * (length_ >>= kLengthShift);
-    base_ += x;
-    length_ = m.distribution_[sym + 1] * length_ - x;
-  }
-  if (initBase > base_) propagateCarry();
-  if (length_ < kMinLength) renormalize();
-  ++m.symbolCount_[sym];
-  if (--m.symbolsUntilUpdate_ == 0) m.update();
-}
-
 void ArithmeticEncoder::writeBits(uint32_t bits, uint32_t value) {
   assert(bits >= 1 && bits <= 32);
   if (bits > 19) {
@@ -144,10 +111,10 @@ void ArithmeticEncoder::writeBits(uint32_t bits, uint32_t value) {
   const uint32_t initBase = base_;
   base_ += value * (length_ >>= bits);
   if (initBase > base_) propagateCarry();
-  if (length_ < kMinLength) renormalize();
+  normalize();
 }
 
-std::vector<uint8_t> ArithmeticEncoder::finish() {
+std::span<const uint8_t> ArithmeticEncoder::flush() {
   const uint32_t initBase = base_;
   bool anotherByte = true;
   if (length_ > 2 * kMinLength) {
@@ -159,32 +126,44 @@ std::vector<uint8_t> ArithmeticEncoder::finish() {
     anotherByte = false;
   }
   if (initBase > base_) propagateCarry();
-  renormalize();
+  normalize(); // length is below 2^24 here: at least one byte, as FastAC's final renormalization
   // Zero bytes so the decoder's reads ahead stay inside the stream.
-  out_.push_back(0);
-  out_.push_back(0);
-  if (anotherByte) out_.push_back(0);
-  std::vector<uint8_t> bytes = std::move(out_);
-  *this = ArithmeticEncoder();
+  if (end_ - ptr_ < 4) grow();
+  const size_t zeros = anotherByte ? 3 : 2;
+  std::memset(ptr_, 0, zeros);
+  ptr_ += zeros;
+  const std::span<const uint8_t> bytes(buffer_.get(), ptr_);
+  ptr_ = buffer_.get();
+  base_ = 0;
+  length_ = kMaxLength;
   return bytes;
+}
+
+std::vector<uint8_t> ArithmeticEncoder::finish() {
+  const std::span<const uint8_t> bytes = flush();
+  return std::vector<uint8_t>(bytes.begin(), bytes.end());
+}
+
+void ArithmeticEncoder::grow() {
+  const size_t used = buffer_ ? size_t(ptr_ - buffer_.get()) : 0;
+  const size_t capacity = std::max<size_t>(4096, 2 * size_t(end_ - buffer_.get()));
+  auto bigger = std::make_unique<uint8_t[]>(capacity);
+  if (used) std::memcpy(bigger.get(), buffer_.get(), used);
+  buffer_ = std::move(bigger);
+  ptr_ = buffer_.get() + used;
+  end_ = buffer_.get() + capacity;
 }
 
 void ArithmeticEncoder::propagateCarry() {
   // FastAC's interval arithmetic guarantees a carry never runs past the first byte.
-  for (auto it = out_.rbegin(); it != out_.rend(); ++it) {
-    if (*it != 0xFF) {
-      ++*it;
+  for (uint8_t* p = ptr_; p != buffer_.get();) {
+    --p;
+    if (*p != 0xFF) {
+      ++*p;
       return;
     }
-    *it = 0;
+    *p = 0;
   }
-}
-
-void ArithmeticEncoder::renormalize() {
-  do {
-    out_.push_back(static_cast<uint8_t>(base_ >> 24));
-    base_ <<= 8;
-  } while ((length_ <<= 8) < kMinLength);
 }
 
 } // namespace pointrast::io::laz

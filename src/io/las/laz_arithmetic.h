@@ -12,10 +12,12 @@
 // symbols, never an out-of-range table index or an endless loop (length stays > 0 by construction).
 #pragma once
 
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <span>
 #include <vector>
 
 // The models' updates loop over every symbol of an alphabet (up to 2048) each time a model is reset or
@@ -222,22 +224,76 @@ private:
   uint32_t value_ = 0, length_ = kMaxLength;
 };
 
-// The matching encoder. pointrast writes no compressed points; it encodes LAZ chunk tables (the bench's
-// replicated files, test files with rebuilt or damaged tables), which use the same coder.
+// The matching encoder: LAZ chunks (the LAS/LAZ and COPC writers) and chunk tables.
+//
+// Its bytes go into a buffer it keeps from chunk to chunk. After a symbol it shifts out the bytes that
+// bring length back to 2^24 or more (clz(length) / 8 of them, 0 to 3) without a branch on length,
+// which mispredicts about every third symbol: the top four bytes of base are stored and the pointer
+// advances by that count (the same bytes FastAC's loop writes one at a time).
 class ArithmeticEncoder {
 public:
   ArithmeticEncoder() = default;
-  void encodeBit(BitModel& m, uint32_t bit);
-  void encodeSymbol(SymbolModel& m, uint32_t sym);
+  ArithmeticEncoder(ArithmeticEncoder&&) = default;
+  ArithmeticEncoder& operator=(ArithmeticEncoder&&) = default;
+
+  [[gnu::always_inline]] void encodeBit(BitModel& m, uint32_t bit) {
+    const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
+    const uint32_t initBase = base_;
+    if (bit == 0) {
+      length_ = x;
+      ++m.bit0Count;
+    } else {
+      base_ += x;
+      length_ -= x;
+    }
+    if (initBase > base_) [[unlikely]]
+      propagateCarry();
+    normalize();
+    if (--m.bitsUntilUpdate == 0) m.update();
+  }
+
+  [[gnu::always_inline]] void encodeSymbol(SymbolModel& m, uint32_t sym) {
+    assert(sym < m.symbols_);
+    const uint32_t initBase = base_;
+    if (sym == m.lastSymbol_) {
+      const uint32_t x = m.distribution_[sym] * (length_ >> kLengthShift);
+      base_ += x;
+      length_ -= x;
+    } else {
+      const uint32_t x = m.distribution_[sym] * (length_ >>= kLengthShift);
+      base_ += x;
+      length_ = m.distribution_[sym + 1] * length_ - x;
+    }
+    if (initBase > base_) [[unlikely]]
+      propagateCarry();
+    normalize();
+    ++m.symbolCount_[sym];
+    if (--m.symbolsUntilUpdate_ == 0) m.update();
+  }
+
   void writeBits(uint32_t bits, uint32_t value);
   // Flushes the interval (with the trailing zero bytes FastAC writes so a decoder never reads past the
-  // end) and returns the bytes.
+  // end) and returns the bytes, valid until this encoder is used again; it then starts a new stream.
+  std::span<const uint8_t> flush();
+  // flush() into a vector of its own.
   std::vector<uint8_t> finish();
 
 private:
+  [[gnu::always_inline]] void normalize() {
+    if (end_ - ptr_ < 4) [[unlikely]]
+      grow();
+    const uint32_t n = uint32_t(__builtin_clz(length_ | 1)) >> 3;
+    const uint32_t bytes = __builtin_bswap32(base_);
+    std::memcpy(ptr_, &bytes, 4);
+    ptr_ += n;
+    base_ <<= 8 * n;
+    length_ <<= 8 * n;
+  }
+  void grow();
   void propagateCarry();
-  void renormalize();
-  std::vector<uint8_t> out_;
+  std::unique_ptr<uint8_t[]> buffer_;
+  uint8_t* ptr_ = nullptr; // the next byte in buffer_
+  uint8_t* end_ = nullptr;
   uint32_t base_ = 0, length_ = kMaxLength;
 };
 

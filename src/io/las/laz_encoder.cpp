@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <span>
 
 #include "base/parallel.h"
 #include "io/io_util.h"
@@ -323,7 +324,7 @@ public:
     if (gps_) gps_->init(records + gpsOffset_);
     if (rgb_) rgb_->init(records + rgbOffset_);
     if (bytes_) bytes_->init(records + bytesOffset_);
-    ArithmeticEncoder enc;
+    ArithmeticEncoder& enc = enc_;
     for (uint64_t i = 1; i < count; ++i) {
       const uint8_t* record = records + i * rl;
       point_.write(enc, record);
@@ -331,9 +332,10 @@ public:
       if (rgb_) rgb_->write(enc, record + rgbOffset_);
       if (bytes_) bytes_->write(enc, record + bytesOffset_);
     }
-    std::vector<uint8_t> out(records, records + rl);
-    const std::vector<uint8_t> coded = enc.finish();
-    out.insert(out.end(), coded.begin(), coded.end());
+    const std::span<const uint8_t> coded = enc.flush();
+    std::vector<uint8_t> out(rl + coded.size());
+    std::memcpy(out.data(), records, rl);
+    std::memcpy(out.data() + rl, coded.data(), coded.size());
     return out;
   }
 
@@ -344,6 +346,7 @@ private:
   std::unique_ptr<Rgb12Encoder> rgb_;
   std::unique_ptr<Byte2Encoder> bytes_;
   size_t gpsOffset_ = 0, rgbOffset_ = 0, bytesOffset_ = 0;
+  ArithmeticEncoder enc_; // kept from chunk to chunk with its buffer
 };
 
 // ---- layered, version 3 ---------------------------------------------------------------------------------
@@ -355,13 +358,13 @@ constexpr int kPoint14Layers = 9;
 
 // A layer: its coder and whether any point's value differed from the value the decoder would keep
 // without it. A layer nothing changed in is written empty, and the decoder keeps the last values.
+// Its bytes stay in the coder's buffer until the chunk is put together.
 struct LayerOut {
   ArithmeticEncoder enc;
   bool changed = false;
-  std::vector<uint8_t> finish(bool keep) {
-    std::vector<uint8_t> bytes = enc.finish();
-    if (!keep) bytes.clear();
-    return bytes;
+  std::span<const uint8_t> finish(bool keep) {
+    const std::span<const uint8_t> bytes = enc.flush();
+    return keep ? bytes : std::span<const uint8_t>();
   }
 };
 
@@ -471,7 +474,7 @@ public:
   }
 
   // The layers' bytes, in order (the XY layer always, the others only where a value changed).
-  void finish(std::vector<std::vector<uint8_t>>& out) {
+  void finish(std::vector<std::span<const uint8_t>>& out) {
     for (int i = 0; i < kPoint14Layers; ++i)
       out.push_back(layers_[i].finish(i == kXY || layers_[i].changed));
   }
@@ -581,7 +584,7 @@ public:
     last[3] = v;
   }
 
-  void finish(std::vector<std::vector<uint8_t>>& out) {
+  void finish(std::vector<std::span<const uint8_t>>& out) {
     out.push_back(rgb_.finish(rgb_.changed));
     if (nir_) out.push_back(nirLayer_.finish(nirLayer_.changed));
   }
@@ -648,7 +651,7 @@ public:
     }
   }
 
-  void finish(std::vector<std::vector<uint8_t>>& out) {
+  void finish(std::vector<std::span<const uint8_t>>& out) {
     for (LayerOut& l : layers_)
       out.push_back(l.finish(l.changed));
   }
@@ -705,15 +708,16 @@ public:
       if (rgb_) rgb_->write(record + rgbOffset_, context);
       if (bytes_) bytes_->write(record + bytesOffset_, context);
     }
-    std::vector<std::vector<uint8_t>> layers;
+    std::vector<std::span<const uint8_t>>& layers = layers_;
+    layers.clear();
     point_.finish(layers);
     if (rgb_) rgb_->finish(layers);
     if (bytes_) bytes_->finish(layers);
-    std::vector<uint8_t> out(records, records + rl);
     size_t total = 0;
     for (const auto& l : layers)
       total += l.size();
-    out.resize(rl + 4 + 4 * layers.size() + total);
+    std::vector<uint8_t> out(rl + 4 + 4 * layers.size() + total);
+    std::memcpy(out.data(), records, rl);
     storeLE<uint32_t>(out.data() + rl, uint32_t(count));
     size_t at = rl + 4 + 4 * layers.size();
     for (size_t i = 0; i < layers.size(); ++i) {
@@ -730,6 +734,7 @@ private:
   std::unique_ptr<Rgb14Encoder> rgb_;
   std::unique_ptr<Byte14Encoder> bytes_;
   size_t rgbOffset_ = 0, bytesOffset_ = 0;
+  std::vector<std::span<const uint8_t>> layers_; // the last chunk's layers, in their coders' buffers
 };
 
 // ---- the chunk, the layout, the VLR ---------------------------------------------------------------------
