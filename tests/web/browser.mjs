@@ -229,6 +229,55 @@ const scenarios = {
     const shown = await page.evaluate(() => document.getElementById('exportStatus').textContent);
     return { errors, exported, shown, file };
   },
+  // The profile tool: args.pixels (pixels of the frame) clicked with "draws a profile line" chosen, args.width
+  // typed into Width when given (else the page's default stays), args.size into Size. After the clicks, the
+  // profile the page cut (its line, width, size and points), the picture it shows as profile.png, and for
+  // each of args.downloads ("las", "csv") the file its button downloaded as profile-download.KIND.
+  async profile(context) {
+    const { page, errors } = await open(context, url);
+    const shown = await waitFull(page);
+    const defaultWidth = await page.inputValue('#profileWidth');
+    if (args.width !== undefined) await page.fill('#profileWidth', String(args.width));
+    if (args.size) await page.fill('#profileSize', args.size);
+    await page.selectOption('#tool', 'profile');
+    for (const pixel of args.pixels) {
+      const cuts = await page.evaluate(() => window.pointrast.profileCuts);
+      const picks = await page.evaluate(() => window.pointrast.picks);
+      const at = await page.evaluate(([x, y, w, h]) => {
+        const r = document.getElementById('view').getBoundingClientRect();
+        return [r.left + (x + 0.5) * r.width / w, r.top + (y + 0.5) * r.height / h];
+      }, [...pixel, shown.frame.viewWidth, shown.frame.viewHeight]);
+      await page.mouse.click(at[0], at[1]);
+      await page.waitForFunction((n) => window.pointrast.picks > n, picks, { timeout: TIMEOUT, polling: 50 });
+      // From the second vertex on, every click cuts the profile again.
+      if (pixel !== args.pixels[0])
+        await page.waitForFunction((n) => window.pointrast.profileCuts > n, cuts, { timeout: TIMEOUT, polling: 50 });
+    }
+    const profile = await page.evaluate(() => window.pointrast.profile);
+    const visible = await page.evaluate(() => !document.getElementById('profilePanel').hidden);
+    const picture = await page.evaluate(async () => {
+      const image = document.getElementById('profileImage');
+      if (!window.pointrast.profileImage) return null;
+      const bytes = new Uint8Array(await window.pointrast.profileImage.arrayBuffer());
+      let text = '';
+      for (const b of bytes) text += String.fromCharCode(b);
+      return { base64: btoa(text), width: image.naturalWidth, height: image.naturalHeight };
+    });
+    let image = null;
+    if (picture) {
+      image = join(outdir, 'profile.png');
+      writeFileSync(image, Buffer.from(picture.base64, 'base64'));
+    }
+    const downloads = {};
+    for (const kind of (profile && profile.error ? [] : args.downloads || [])) {
+      const [download] = await Promise.all([page.waitForEvent('download', { timeout: TIMEOUT }), page.click('#profile' + kind[0].toUpperCase() + kind.slice(1))]);
+      const file = join(outdir, 'profile-download.' + kind);
+      await download.saveAs(file);
+      downloads[kind] = { file, ...(await page.evaluate(() => window.pointrast.profileDownload)) };
+    }
+    const status = await page.evaluate(() => document.getElementById('profileStatus').textContent);
+    return { errors, shown, defaultWidth, profile, visible, image, imageSize: picture && [picture.width, picture.height], downloads, status };
+  },
   // A picture of the page (panel and frame) for the README.
   async pageshot(context) {
     const { page, errors } = await open(context, url);

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "image_compare.h"
+#include "las_records.h"
 #include "serve_harness.h"
 #include "view/navigation.h"
 
@@ -326,37 +327,6 @@ TEST_F(Browser, DraggingAVertexMovesItToThePointUnderTheRelease) {
   EXPECT_NEAR(list[0]["value"].get<double>(), glm::length(first - second),
               1e-9 * glm::length(first - second));
   expectCleanExit(server);
-}
-
-// The point records of a LAS file (formats 0-10, legacy or 1.4 counts), each as its bytes, and the
-// scale/offset to read their positions: the test's own reading, not the library's.
-struct LasRecords {
-  std::vector<std::string> records;
-  glm::dvec3 scale{1}, offset{0};
-};
-LasRecords readLasRecords(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  LasRecords r;
-  if (bytes.size() < 227 || bytes.compare(0, 4, "LASF") != 0) {
-    ADD_FAILURE() << path << " is not a LAS file";
-    return r;
-  }
-  auto u32 = [&](size_t at) { uint32_t v; std::memcpy(&v, bytes.data() + at, 4); return v; };
-  auto u16 = [&](size_t at) { uint16_t v; std::memcpy(&v, bytes.data() + at, 2); return v; };
-  auto f64 = [&](size_t at) { double v; std::memcpy(&v, bytes.data() + at, 8); return v; };
-  const uint32_t start = u32(96), length = u16(105);
-  uint64_t count = u32(107);
-  if (count == 0 && bytes.size() >= 255) std::memcpy(&count, bytes.data() + 247, 8);
-  r.scale = {f64(131), f64(139), f64(147)};
-  r.offset = {f64(155), f64(163), f64(171)};
-  if (start + count * length > bytes.size()) {
-    ADD_FAILURE() << path << " is shorter than its header says";
-    return r;
-  }
-  for (uint64_t i = 0; i < count; ++i)
-    r.records.push_back(bytes.substr(start + i * length, length));
-  return r;
 }
 
 glm::dvec3 recordPosition(const LasRecords& las, const std::string& record) {

@@ -66,4 +66,8 @@ ImageDifference comparePngs(const std::string& a, const std::string& b) {
   return compareWithPng(image, w, h, b);
 }
 
+bool readPng(const std::string& file, std::vector<uint32_t>& rgba, uint32_t& width, uint32_t& height) {
+  return loadPng(file, rgba, width, height);
+}
+
 } // namespace pointrast::test

@@ -24,5 +24,7 @@ ImageDifference compareWithPng(const std::vector<uint32_t>& rgba, uint32_t width
                                const std::string& png);
 // Two PNG files.
 ImageDifference comparePngs(const std::string& a, const std::string& b);
+// A PNG file decoded as RGBA8 (r in the low byte, alpha 255); false when it does not decode.
+bool readPng(const std::string& file, std::vector<uint32_t>& rgba, uint32_t& width, uint32_t& height);
 
 } // namespace pointrast::test

@@ -5,12 +5,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <optional>
+#include <tuple>
 #include <unistd.h>
 #include <vector>
 
 #include "base/error.h"
 #include "io/format_table.h"
 #include "io/writer.h"
+#include "view/profile_tool.h"
 
 namespace pointrast::view::web {
 
@@ -58,8 +60,28 @@ double finiteNumber(std::string_view item, const std::string& what) {
   errno = 0;
   const double v = text.empty() || text.size() > 40 ? NAN : std::strtod(text.c_str(), &end);
   if (text.empty() || errno != 0 || end != text.c_str() + text.size() || !std::isfinite(v))
-    throw InputError("export: " + what + " takes finite numbers, got '" + text.substr(0, 40) + "'");
+    throw InputError(what + " takes finite numbers, got '" + text.substr(0, 40) + "'");
   return v;
+}
+
+// "WxH", digits only, each side in [lo, hi]; nullopt for anything else.
+std::optional<std::pair<uint32_t, uint32_t>> pictureSize(std::string_view text, uint32_t loW, uint32_t loH,
+                                                         uint32_t hi) {
+  const size_t x = text.find('x');
+  if (x == std::string_view::npos) return std::nullopt;
+  auto side = [&](std::string_view digits, uint32_t lo) -> std::optional<uint32_t> {
+    if (digits.empty() || digits.size() > 5) return std::nullopt;
+    uint32_t v = 0;
+    for (char c : digits) {
+      if (c < '0' || c > '9') return std::nullopt;
+      v = v * 10 + uint32_t(c - '0');
+    }
+    if (v < lo || v > hi) return std::nullopt;
+    return v;
+  };
+  const auto w = side(text.substr(0, x), loW), h = side(text.substr(x + 1), loH);
+  if (!w || !h) return std::nullopt;
+  return std::pair{*w, *h};
 }
 
 // A RAII temporary folder: removed with everything in it.
@@ -116,8 +138,8 @@ PointFilter parseExportQuery(std::string_view query) {
       if (items.size() != 6 || !f.boxes.empty()) throw InputError("export: box takes x0,y0,z0,x1,y1,z1 once");
       ClipBox b;
       for (int i = 0; i < 3; ++i) {
-        b.min[i] = finiteNumber(items[size_t(i)], "box");
-        b.max[i] = finiteNumber(items[size_t(i) + 3], "box");
+        b.min[i] = finiteNumber(items[size_t(i)], "export: box");
+        b.max[i] = finiteNumber(items[size_t(i) + 3], "export: box");
       }
       if (!(b.min.x <= b.max.x && b.min.y <= b.max.y && b.min.z <= b.max.z))
         throw InputError("export: the box's first corner must be its minimum, the second its maximum");
@@ -134,7 +156,7 @@ PointFilter parseExportQuery(std::string_view query) {
       if (f.classes) throw InputError("export: classes given twice");
       f.classes.emplace();
       for (std::string_view item : split(value, ',')) {
-        const double c = finiteNumber(item, "classes");
+        const double c = finiteNumber(item, "export: classes");
         if (c < 0 || c > 255 || c != std::floor(c)) throw InputError("export: classes take 0 to 255");
         f.classes->set(size_t(c));
       }
@@ -155,6 +177,81 @@ uint64_t exportLas(const std::filesystem::path& source, const PointFilter& filte
   const uint64_t points = io::convertLasFile(source, out, options);
   send(out, points);
   return points;
+}
+
+ProfileQuery parseProfileQuery(std::string_view query, ProfileOutput output) {
+  ProfileQuery q;
+  bool line = false, width = false, size = false;
+  for (std::string_view pair : split(query, '&')) {
+    if (pair.empty()) continue;
+    const size_t eq = pair.find('=');
+    const std::string_view key = pair.substr(0, eq);
+    const std::optional<std::string> decoded =
+        decodeQueryValue(eq == std::string_view::npos ? std::string_view() : pair.substr(eq + 1));
+    if (!decoded) throw InputError("profile: a broken %-escape in the query");
+    const std::string_view value = *decoded;
+    if (key == "token") continue; // the access rules read it
+    if (key == "line") {
+      if (line) throw InputError("profile: line given twice");
+      q.line.vertices = parseProfileVertices(std::string(value), "profile: line", kMaxProfileVertices);
+      line = true;
+    } else if (key == "width") {
+      if (width) throw InputError("profile: width given twice");
+      q.line.width = finiteNumber(value, "profile: width");
+      if (!(q.line.width > 0)) throw InputError("profile: width must be a positive length");
+      width = true;
+    } else if (key == "size" && output == ProfileOutput::Png) {
+      if (size) throw InputError("profile: size given twice");
+      const auto wh = pictureSize(value, kProfileMinWidth, kProfileMinHeight, kMaxProfilePictureSide);
+      if (!wh)
+        throw InputError("profile: size takes WxH, " + std::to_string(kProfileMinWidth) + "x" +
+                         std::to_string(kProfileMinHeight) + " to " + std::to_string(kMaxProfilePictureSide) +
+                         "x" + std::to_string(kMaxProfilePictureSide));
+      std::tie(q.width, q.height) = *wh;
+      size = true;
+    } else {
+      throw InputError("profile: unknown parameter '" + std::string(key.substr(0, 32)) + "'");
+    }
+  }
+  if (!line) throw InputError("profile: the line is missing (line=x1,y1,x2,y2[,...])");
+  if (!width) throw InputError("profile: the width is missing (width=W)");
+  if (output == ProfileOutput::Png && !size)
+    throw InputError("profile: the picture's size is missing (size=WxH)");
+  if (!(profileLength(q.line) > 0))
+    throw InputError("profile: the line has no length (its vertices coincide)");
+  return q;
+}
+
+uint64_t exportProfile(const std::string& input, const ProfileQuery& query, ProfileOutput output,
+                       const std::function<void(const std::filesystem::path&, uint64_t)>& send) {
+  std::error_code ec;
+  if (input.empty() || !std::filesystem::exists(input, ec))
+    throw InputError("profile: the input is a generated scene, not a file: a profile cuts the points of a "
+                     "point cloud file or an octree");
+  TemporaryFolder folder;
+  ProfileRequest request;
+  request.input = input;
+  request.line = query.line;
+  std::filesystem::path out = folder.path;
+  switch (output) {
+  case ProfileOutput::Png:
+    out /= "profile.png";
+    request.imageWidth = query.width;
+    request.imageHeight = query.height;
+    break;
+  case ProfileOutput::Las:
+    out /= "profile.las";
+    request.las = out.string();
+    break;
+  case ProfileOutput::Csv:
+    out /= "profile.csv";
+    request.csv = out.string();
+    break;
+  }
+  const ProfileResult result = cutProfile(request);
+  if (output == ProfileOutput::Png) io::writePng(out, query.width, query.height, result.pixels.data());
+  send(out, result.points);
+  return result.points;
 }
 
 } // namespace pointrast::view::web

@@ -149,6 +149,10 @@ private:
   static Server& of(const mg_connection* conn);
   static int beginRequest(mg_connection* conn);
   int serveExport(mg_connection* conn, const std::string& query);
+  int serveProfile(mg_connection* conn, const std::string& path, const std::string& query);
+  int sendDownload(mg_connection* conn, const std::filesystem::path& file, const std::string& name,
+                   const char* type, uint64_t points);
+  int refuseDownload(mg_connection* conn, int status, const std::string& why);
   static int logMessage(const mg_connection* conn, const char* message);
   static int httpError(mg_connection* conn, int status, const char* message);
   static int handleHttp(mg_connection* conn, void* self);
@@ -337,40 +341,75 @@ int Server::gate(mg_connection* conn) {
   return status;
 }
 
+// A download's failure: the status and the one sentence why, which the page shows.
+int Server::refuseDownload(mg_connection* conn, int status, const std::string& why) {
+  const std::string body = why + "\n";
+  const std::string head = "HTTP/1.1 " + std::to_string(status) +
+                           (status == 400 ? " Bad Request" : " Internal Server Error") +
+                           "\r\nContent-Type: text/plain; charset=utf-8\r\n" + pageHeaders_ +
+                           "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n";
+  cw::mg_write(conn, head.data(), head.size());
+  cw::mg_write(conn, body.data(), body.size());
+  return status;
+}
+
+// A written file streamed as the reply, with its point count in X-Points.
+int Server::sendDownload(mg_connection* conn, const std::filesystem::path& file, const std::string& name,
+                         const char* type, uint64_t points) {
+  std::ifstream in(file, std::ios::binary);
+  const uint64_t size = std::filesystem::file_size(file);
+  const std::string head = "HTTP/1.1 200 OK\r\nContent-Type: " + std::string(type) +
+                           "\r\nContent-Disposition: attachment; filename=\"" + name + "\"\r\n" +
+                           pageHeaders_ + "X-Points: " + std::to_string(points) +
+                           "\r\nContent-Length: " + std::to_string(size) + "\r\n\r\n";
+  cw::mg_write(conn, head.data(), head.size());
+  std::vector<char> buffer(1 << 20);
+  while (in) {
+    in.read(buffer.data(), std::streamsize(buffer.size()));
+    if (in.gcount() > 0 && cw::mg_write(conn, buffer.data(), size_t(in.gcount())) <= 0) break;
+  }
+  return 200;
+}
+
 // The points inside the page's clip box as LAS (export.h), or 400 with the one sentence why not.
 int Server::serveExport(mg_connection* conn, const std::string& query) {
-  auto fail = [&](const std::string& why) {
-    const std::string body = why + "\n";
-    const std::string head = "HTTP/1.1 400 Bad Request\r\nContent-Type: text/plain; charset=utf-8\r\n" +
-                             pageHeaders_ + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n";
-    cw::mg_write(conn, head.data(), head.size());
-    cw::mg_write(conn, body.data(), body.size());
-    return 400;
-  };
   const ExportSource source = exportSource(options_.inputFile);
-  if (!source.file) return fail("export: " + source.whyNot);
+  if (!source.file) return refuseDownload(conn, 400, "export: " + source.whyNot);
   try {
     const PointFilter filter = parseExportQuery(query);
     uint64_t points = 0;
     exportLas(*source.file, filter, [&](const std::filesystem::path& file, uint64_t count) {
       points = count;
-      std::ifstream in(file, std::ios::binary);
-      const uint64_t size = std::filesystem::file_size(file);
-      const std::string head = "HTTP/1.1 200 OK\r\nContent-Type: application/octet-stream\r\n"
-                               "Content-Disposition: attachment; filename=\"export.las\"\r\n" +
-                               pageHeaders_ + "X-Points: " + std::to_string(count) +
-                               "\r\nContent-Length: " + std::to_string(size) + "\r\n\r\n";
-      cw::mg_write(conn, head.data(), head.size());
-      std::vector<char> buffer(1 << 20);
-      while (in) {
-        in.read(buffer.data(), std::streamsize(buffer.size()));
-        if (in.gcount() > 0 && cw::mg_write(conn, buffer.data(), size_t(in.gcount())) <= 0) break;
-      }
+      sendDownload(conn, file, "export.las", "application/octet-stream", count);
     });
     emit({{"event", "export"}, {"points", points}});
     return 200;
   } catch (const InputError& e) {
-    return fail(e.what());
+    return refuseDownload(conn, 400, e.what());
+  }
+}
+
+// The profile along the page's line (export.h): /profile.png, /profile.las or /profile.csv, cut on this
+// worker thread (it reads the input from disk), not on the render thread every page shares.
+int Server::serveProfile(mg_connection* conn, const std::string& path, const std::string& query) {
+  const ProfileOutput output = path == "/profile.png"   ? ProfileOutput::Png
+                               : path == "/profile.las" ? ProfileOutput::Las
+                                                        : ProfileOutput::Csv;
+  const char* type = output == ProfileOutput::Png   ? "image/png"
+                     : output == ProfileOutput::Las ? "application/octet-stream"
+                                                    : "text/csv; charset=utf-8";
+  try {
+    const ProfileQuery q = parseProfileQuery(query, output);
+    const uint64_t points =
+        exportProfile(options_.inputFile, q, output, [&](const std::filesystem::path& file, uint64_t count) {
+          sendDownload(conn, file, file.filename().string(), type, count);
+        });
+    emit({{"event", "profile"}, {"output", path.substr(9)}, {"points", points}});
+    return 200;
+  } catch (const InputError& e) {
+    return refuseDownload(conn, 400, e.what());
+  } catch (const std::exception& e) {
+    return refuseDownload(conn, 500, std::string("profile: ") + e.what());
   }
 }
 
@@ -389,6 +428,8 @@ int Server::serveHttp(mg_connection* conn) {
     body = "ok\n";
   } else if (path == "/export.las") {
     return serveExport(conn, info->query_string ? info->query_string : "");
+  } else if (path == "/profile.png" || path == "/profile.las" || path == "/profile.csv") {
+    return serveProfile(conn, path, info->query_string ? info->query_string : "");
   } else if (const PageFile* file = findPageFile(path)) {
     type = file->contentType;
     body = file->body;

@@ -28,6 +28,7 @@ const $ = (id) => document.getElementById(id);
 const pointrast = window.pointrast = {
   info: null, state: null, frames: 0, fullFrames: 0, lastFrame: null, lastPick: null, cameraText: null,
   errors: [], refusals: [], closed: null, sentSeq: 0, picked: null, picks: 0, measurements: [], exported: null,
+  profile: null, profileCuts: 0, profileDownload: null, profileImage: null,
 };
 
 let socket = null;
@@ -131,9 +132,9 @@ function download(blob, name) {
 function receiveText(message) {
   switch (message.t) {
     case 'info': pointrast.info = message; buildPanel(message); break;
-    case 'state': pointrast.state = message; showState(message); break;
+    case 'state': pointrast.state = message; showState(message); defaultProfileWidth(message); break;
     case 'pick': pointrast.lastPick = message; break;
-    case 'picked': pointrast.picked = message.pick; pointrast.picks++; showPicked(message.pick); break;
+    case 'picked': pointrast.picked = message.pick; pointrast.picks++; showPicked(message.pick); profilePicked(message.pick); break;
     case 'moved': pointrast.moved = message.moved; pointrast.moves = (pointrast.moves || 0) + 1; if (message.moved.pick) showPicked(message.moved.pick); break;
     case 'measurements': pointrast.measurements = message.list; pointrast.measurementUpdates = (pointrast.measurementUpdates || 0) + 1; showMeasurements(message.list); break;
     case 'annotations': download(new Blob([message.text], { type: 'application/json' }), 'annotations.json'); break;
@@ -487,6 +488,7 @@ function toolRelease(e) {
   const message = { t: 'pickpoint', ...press.at };
   if (press.tool === 'distance' || press.tool === 'height' || press.tool === 'area') message.measure = press.tool;
   send(message);
+  profilePicks.push(press.tool === 'profile');
   return true;
 }
 
@@ -575,6 +577,121 @@ $('exportLas').addEventListener('click', async () => {
     $('exportStatus').textContent = String(error);
   }
 });
+
+// --- profile -----------------------------------------------------------------------------------------------
+
+// The profile tool's clicks pick points (answered in order, one 'picked' each): their x/y become the next
+// vertices of the line. The picture and the downloads are HTTP requests of their own, cut by the server
+// with `pointrast profile`'s code: the picture equals `pointrast profile FILE --line L --width W --size S -o`.
+const profilePicks = [];
+let profileRequest = 0;
+
+function profilePicked(pick) {
+  if (!profilePicks.length || !profilePicks.shift()) return;
+  const p = pick.point;
+  if (typeof p !== 'object') {
+    pointrast.profile = { error: 'no point under the click: ' + p };
+    pointrast.profileCuts++;
+    $('profileStatus').textContent = pointrast.profile.error;
+    return;
+  }
+  const line = $('profileLine').value.replace(/\s/g, '');
+  $('profileLine').value = (line ? line + ',' : '') + String(p.x) + ',' + String(p.y);
+  if (profileLineValue().length >= 4) cutProfile();
+  else $('profileStatus').textContent = 'click the next vertex';
+}
+
+// A width for the data: a hundredth of the cloud's larger horizontal side, two significant digits.
+function defaultProfileWidth(state) {
+  if ($('profileWidth').value !== '' || !state.bounds) return;
+  const side = Math.max(state.bounds.max[0] - state.bounds.min[0], state.bounds.max[1] - state.bounds.min[1]);
+  if (side > 0) $('profileWidth').value = String(Number((side / 100).toPrecision(2)));
+}
+
+function profileLineValue() {
+  const text = $('profileLine').value.replace(/\s/g, '');
+  return text ? text.split(',') : [];
+}
+
+// The query of a profile request, or a sentence saying what is missing.
+function profileQuery(picture) {
+  const line = profileLineValue();
+  if (line.length < 4 || line.length % 2 !== 0 || !line.every((v) => v !== '' && Number.isFinite(Number(v))))
+    return 'the profile needs a line of two or more x,y vertices: click them with the profile tool';
+  const width = $('profileWidth').value.trim();
+  if (!(Number(width) > 0)) return 'the profile needs a positive width';
+  const query = new URLSearchParams({ line: line.join(','), width });
+  if (picture) query.set('size', $('profileSize').value.trim());
+  return query;
+}
+
+async function profileFetch(file, query) {
+  const response = await fetch(file + '?' + query.toString());
+  if (!response.ok) throw new Error((await response.text()).trim());
+  return { blob: await response.blob(), points: Number(response.headers.get('X-Points')) };
+}
+
+async function cutProfile() {
+  const query = profileQuery(true);
+  if (typeof query === 'string') {
+    pointrast.profile = { error: query };
+    pointrast.profileCuts++;
+    $('profileStatus').textContent = query;
+    return;
+  }
+  const request = ++profileRequest;
+  $('profileStatus').textContent = 'cutting...';
+  try {
+    const { blob, points } = await profileFetch('profile.png', query);
+    if (request !== profileRequest) return; // a newer cut is on its way
+    const image = $('profileImage');
+    if (image.src) URL.revokeObjectURL(image.src);
+    image.src = URL.createObjectURL(blob);
+    pointrast.profileImage = blob; // the PNG's bytes as the server sent them
+    await image.decode();
+    $('profilePanel').hidden = false;
+    const width = query.get('width');
+    $('profileCaption').textContent = `${points} points within ${Number(width) / 2} of the line`;
+    $('profileStatus').textContent = `${points} points`;
+    pointrast.profile = { line: query.get('line'), width, size: query.get('size'), points };
+    pointrast.profileCuts++;
+  } catch (error) {
+    if (request !== profileRequest) return;
+    const why = error.message || String(error);
+    pointrast.profile = { error: why };
+    pointrast.profileCuts++;
+    $('profileStatus').textContent = why;
+    status(why, true);
+  }
+}
+
+async function downloadProfile(kind) {
+  const query = profileQuery(false);
+  if (typeof query === 'string') { $('profileStatus').textContent = query; return; }
+  $('profileStatus').textContent = 'cutting...';
+  try {
+    const { blob, points } = await profileFetch('profile.' + kind, query);
+    download(blob, 'profile.' + kind);
+    pointrast.profileDownload = { kind, points, line: query.get('line'), width: query.get('width') };
+    $('profileStatus').textContent = `${points} points in profile.${kind}`;
+  } catch (error) {
+    const why = error.message || String(error);
+    pointrast.profileDownload = { kind, error: why };
+    $('profileStatus').textContent = why;
+    status(why, true);
+  }
+}
+
+$('profileCut').addEventListener('click', cutProfile);
+$('profileLas').addEventListener('click', () => downloadProfile('las'));
+$('profileCsv').addEventListener('click', () => downloadProfile('csv'));
+$('profileClear').addEventListener('click', () => {
+  $('profileLine').value = '';
+  $('profileStatus').textContent = '';
+  $('profilePanel').hidden = true;
+  profileRequest++;
+});
+$('profileClose').addEventListener('click', () => { $('profilePanel').hidden = true; });
 
 let buttonsDown = 0;
 canvas.addEventListener('pointerdown', (e) => {
