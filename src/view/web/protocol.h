@@ -2,7 +2,8 @@
 // the server answers with JSON text messages (what the page shows) and binary frames (a fixed header and a
 // JPEG or PNG). Every client message is parsed and validated here, before anything acts on it: a message
 // that is not exactly one of the shapes below is refused whole (docs/design.md, "Serving": input from the
-// network is validated and bounded like file input).
+// network is validated and bounded like file input). The downloads (/export.las, and the profile's
+// /profile.png, /profile.las, /profile.csv) are HTTP requests of their own, whose queries export.h validates.
 //
 // Positions are normalized to the canvas (0..1 from the left and top edge): the server scales them to its
 // viewport, so they do not depend on the page's device pixel ratio or on --max-size clamping the image.
