@@ -4,7 +4,7 @@
 # test data (the folders its "// Seeds:" line names, else the folder NAME; a target that generates its
 # seeds reads the folder to write them to from NAME_FUZZ_SEEDS, e.g. POTREE_FUZZ_SEEDS) and from its
 # regression inputs (tests/fuzz/regressions/NAME/), with the dictionary tests/fuzz/NAME.dict where there
-# is one. Exits 1 if any target finds a crash, a leak, undefined behaviour, an input that takes over 10 s,
+# is one and the libFuzzer flags of the target's "// Fuzz flags:" line. Exits 1 if any target finds a crash, a leak, undefined behaviour, an input that takes over 10 s,
 # or an allocation over 256 MiB (an input is at most 64 KiB: a reader allocating that much trusts a count
 # it should have checked); the input that did it is kept under BUILD/findings/DATE-TIME/ and the command
 # that replays it is printed.
@@ -20,19 +20,27 @@
 #   scripts/fuzz.sh --merge FILE                 appends a block another machine's --report run kept
 #                                                (its BUILD/logs/report.md) to docs/fuzzing.md and updates
 #                                                the cumulative table
+#   scripts/fuzz.sh --until EXECUTIONS [--report] --total SECONDS [NAME...]
+#                                                every target (or NAME...) whose cumulative executions in
+#                                                docs/fuzzing.md are short of EXECUTIONS runs, all at once
+#                                                for SECONDS, each with -fork workers in proportion to the
+#                                                core-seconds it lacks (its missing executions divided by
+#                                                its rate per core in tests/fuzz/rates), every core used
 #   scripts/fuzz.sh --pack DIR [NAME...]         builds, then puts what a run elsewhere needs into DIR:
-#                                                DIR/fuzz/NAME_fuzz (debug info stripped, symbols kept),
-#                                                DIR/seeds/NAME (the seeds generating targets write from
-#                                                the shared data) and DIR/corpus/NAME (this tree's corpus);
-#                                                run it there with POINTRAST_FUZZ_PREBUILT=1
-#                                                POINTRAST_FUZZ_BUILD=DIR
+#                                                DIR/fuzz/NAME_fuzz.gz (debug info stripped, symbols kept,
+#                                                compressed), DIR/seeds/NAME (the seeds generating targets
+#                                                write from the shared data) and DIR/corpus/NAME (this
+#                                                tree's corpus, minimized by -merge=1); run it there with
+#                                                POINTRAST_FUZZ_PREBUILT=1 POINTRAST_FUZZ_BUILD=DIR, which
+#                                                unpacks the binaries first
 #   POINTRAST_FUZZ_JOBS     targets run at once (default: the number of cores); 1 for long runs on a
 #                           shared machine
 #   POINTRAST_FUZZ_FORK     libFuzzer worker processes per target (-fork=N); default 0 (the target runs
 #                           in one process), but with POINTRAST_FUZZ_PREBUILT=1 the cores divided by the
 #                           targets running at once, so that a few targets use every core
 #   POINTRAST_FUZZ_PREBUILT 1: no configure and no build, the binaries of BUILD/fuzz are run as they are
-#                           (a machine without clang, running what --pack made)
+#                           (a machine without clang, running what --pack made; a NAME_fuzz.gz there is
+#                           unpacked into NAME_fuzz first)
 #   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
 #                           found, so a later run starts from there.
 #   POINTRAST_DATA_DIR      the shared test data (default ../shared/data beside the checkout)
@@ -85,6 +93,12 @@ if [ "${1:-}" = "--merge" ]; then
   echo "fuzz: $block is appended to $docs"
   exit 0
 fi
+until=""
+if [ "${1:-}" = "--until" ]; then
+  until="${2:?--until needs EXECUTIONS}"
+  [[ "$until" =~ ^[0-9]+$ ]] || { echo "fuzz: --until needs a number of executions, not $until" >&2; exit 1; }
+  shift 2
+fi
 pack=""
 if [ "${1:-}" = "--pack" ]; then
   pack="${2:?--pack needs a folder}"
@@ -115,14 +129,83 @@ if [ ${#names[@]} -eq 0 ]; then
   read -r -a names <<<"$(sed -n 's/^foreach(name \(.*\))[[:space:]]*$/\1/p' tests/fuzz/CMakeLists.txt)"
 fi
 [ ${#names[@]} -gt 0 ] || { echo "fuzz: no targets in tests/fuzz/CMakeLists.txt" >&2; exit 1; }
+
+# --until: the targets short of EXECUTIONS and their workers. A target's need is its missing executions
+# divided by its rate per core (tests/fuzz/rates; 1000 per second where it has no line), in core-seconds.
+# The targets of smallest need first get the workers that finish them within SECONDS (with a tenth to
+# spare for the fork jobs' restarts), as long as every target after them keeps a core; the targets
+# left share the remaining cores in proportion to their needs (at least one each). Cores beyond every
+# target's need go to the targets of largest need per worker.
+declare -A workers=()
+if [ -n "$until" ]; then
+  [ -n "$total" ] || { echo "fuzz: --until needs --total SECONDS" >&2; exit 1; }
+  plan="$(awk -v until="$until" -v cores="$(nproc)" -v time="$total" -v wanted="${names[*]}" '
+    FILENAME ~ /rates$/ { if ($1 !~ /^#/ && NF >= 2) rate[$1] = $2; next }
+    /^<!-- cumulative -->$/ { table = 1; next }
+    /^<!-- \/cumulative -->$/ { table = 0 }
+    table && /^\| `/ { split($0, f, "|"); name = f[2]; gsub(/[ `]/, "", name); ex = f[5]; gsub(/ /, "", ex); done[name] = ex }
+    END {
+      n = split(wanted, list, " ")
+      for (i = 1; i <= n; ++i) {
+        name = list[i]; lack = until - done[name]
+        if (lack <= 0) continue
+        need[name] = lack / ((name in rate) ? rate[name] : 1000)
+        # Insertion into order[], smallest need first.
+        for (j = m++; j > 0 && need[order[j - 1]] > need[name]; --j) order[j] = order[j - 1]
+        order[j] = name
+      }
+      if (m == 0) exit
+      if (m > cores) { print "error " m " targets lack executions but there are only " cores " cores"; exit }
+      left = cores; first = 0
+      for (; first < m; ++first) {
+        name = order[first]; w[name] = int(need[name] * 1.1 / time) + 1
+        if (left - w[name] < m - first - 1) break
+        left -= w[name]
+      }
+      if (first < m) {
+        for (i = first; i < m; ++i) sum += need[order[i]]
+        for (i = first; i < m; ++i) {
+          name = order[i]; share = (left - (m - first)) * need[name] / sum
+          w[name] = 1 + int(share); rest[name] = share - int(share); given += w[name]
+        }
+        for (; given < left; ++given) {
+          best = ""
+          for (i = first; i < m; ++i) if (best == "" || rest[order[i]] > rest[best]) best = order[i]
+          ++w[best]; rest[best] = -1
+        }
+      } else {
+        for (; left > 0; --left) {
+          best = ""
+          for (i = 0; i < m; ++i) if (best == "" || need[order[i]] / w[order[i]] > need[best] / w[best]) best = order[i]
+          ++w[best]
+        }
+      }
+      for (i = 0; i < m; ++i) {
+        name = order[i]
+        printf "%s %d %d %.0f %s\n", name, w[name], until - done[name], need[name], \
+          (w[name] * time >= need[name] * 1.1 ? "all" : sprintf("about %d %%", 100 * w[name] * time / 1.1 / need[name]))
+      }
+    }' tests/fuzz/rates "$docs")"
+  if [[ "$plan" == error* ]]; then echo "fuzz: ${plan#error }" >&2; exit 1; fi
+  names=()
+  while read -r name count lack need outcome; do
+    [ -n "$name" ] || continue
+    names+=("$name")
+    workers[$name]=$count
+    echo "fuzz: $name lacks $lack executions, ~$need core-seconds at its rate: $count workers for $outcome of it in $total s"
+  done <<<"$plan"
+  if [ ${#names[@]} -eq 0 ]; then
+    echo "fuzz: every target has had $until executions"
+    exit 0
+  fi
+  jobs=${#names[@]}
+fi
 if [ "$jobs" -gt ${#names[@]} ]; then jobs=${#names[@]}; fi
 fork="${POINTRAST_FUZZ_FORK:-0}"
 if [ "${POINTRAST_FUZZ_PREBUILT:-0}" = 1 ] && [ -z "${POINTRAST_FUZZ_FORK:-}" ]; then
   fork=$(($(nproc) / jobs))
   if [ "$fork" -lt 2 ]; then fork=0; fi
 fi
-forkFlags=()
-if [ "$fork" -gt 0 ]; then forkFlags=(-fork="$fork"); fi
 if [ -n "$total" ]; then
   seconds=$((total * jobs / ${#names[@]}))
   if [ "$seconds" -lt 10 ]; then seconds=10; fi
@@ -148,18 +231,29 @@ if [ -n "$pack" ]; then
   for name in "${names[@]}"; do
     binary="$build/fuzz/${name}_fuzz"
     [ -x "$binary" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
-    objcopy --strip-debug "$binary" "$pack/fuzz/${name}_fuzz.tmp" && mv "$pack/fuzz/${name}_fuzz.tmp" "$pack/fuzz/${name}_fuzz"
+    objcopy --strip-debug "$binary" "$pack/fuzz/${name}_fuzz.tmp"
+    libraries="$(ldd "$pack/fuzz/${name}_fuzz.tmp" | awk '{ print $1 }' |
+      grep -vE '^(linux-vdso|/lib64/ld-linux|ld-linux|libc|libm|libpthread|libdl|librt)[.-]' || true)"
+    if [ -n "$libraries" ]; then echo "fuzz: ${name}_fuzz needs" $libraries >&2; exit 1; fi
+    # A sanitized, instrumented binary shrinks to about a quarter: nine of them fit a 64 MiB folder.
+    gzip -9 -n -c "$pack/fuzz/${name}_fuzz.tmp" >"$pack/fuzz/${name}_fuzz.gz.tmp"
+    mv "$pack/fuzz/${name}_fuzz.gz.tmp" "$pack/fuzz/${name}_fuzz.gz"
+    rm -f "$pack/fuzz/${name}_fuzz.tmp" "$pack/fuzz/${name}_fuzz"
     variable="$(echo "$name" | tr '[:lower:]' '[:upper:]')_FUZZ_SEEDS"
     if grep -q "$variable" "tests/fuzz/${name}_fuzz.cpp"; then
       rm -rf "$pack/seeds/$name" && mkdir -p "$pack/seeds/$name"
       env "$variable=$pack/seeds/$name" "$binary" -runs=0 "$pack/seeds/$name" >/dev/null 2>&1
     fi
     if [ -d "$build/corpus/$name" ]; then
-      rm -rf "$pack/corpus/$name" && mkdir -p "$pack/corpus" && cp -r "$build/corpus/$name" "$pack/corpus/$name"
+      # Only the inputs that add coverage (-merge=1 keeps the smallest input of each feature): the
+      # corpus of many runs is mostly redundant, and a smaller one starts every fork job sooner.
+      rm -rf "$pack/corpus/$name" && mkdir -p "$pack/corpus/$name"
+      if ! "$binary" -merge=1 -max_len=65536 -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=256 \
+        "$pack/corpus/$name" "$build/corpus/$name" >"$build/logs/$name.pack.log" 2>&1; then
+        echo "fuzz: $name: minimizing the corpus failed (see $build/logs/$name.pack.log)" >&2
+        exit 1
+      fi
     fi
-    libraries="$(ldd "$pack/fuzz/${name}_fuzz" | awk '{ print $1 }' |
-      grep -vE '^(linux-vdso|/lib64/ld-linux|ld-linux|libc|libm|libpthread|libdl|librt)[.-]' || true)"
-    if [ -n "$libraries" ]; then echo "fuzz: ${name}_fuzz needs" $libraries >&2; exit 1; fi
   done
   echo "fuzz: $pack holds ${names[*]}: $(du -sm "$pack" | cut -f 1) MiB; run there with" \
     "POINTRAST_FUZZ_PREBUILT=1 POINTRAST_FUZZ_BUILD=$pack scripts/fuzz.sh ..."
@@ -200,14 +294,19 @@ fuzzTarget() {
   fi
   if [ -d "tests/fuzz/regressions/$name" ]; then seeds+=("tests/fuzz/regressions/$name"); fi
   if [ -f "tests/fuzz/$name.dict" ]; then dict=(-dict="tests/fuzz/$name.dict"); fi
+  # libFuzzer flags of the target's own, from its "// Fuzz flags:" line (e.g. -entropic=0).
+  local targetFlags
+  targetFlags="$(sed -n 's|^// Fuzz flags:[[:space:]]*||p' "tests/fuzz/${name}_fuzz.cpp" | head -n 1)"
   local corpus="$build/corpus/$name"
   local log="$build/logs/$name.log"
+  local forkFlags=() workerCount="${workers[$name]:-$fork}"
+  if [ "$workerCount" -gt 0 ]; then forkFlags=(-fork="$workerCount"); fi
   mkdir -p "$corpus"
-  echo "== fuzz $name: ${seconds} s, seeds: ${seeds[*]:-none}"
+  echo "== fuzz $name: ${seconds} s${forkFlags[*]:+, ${forkFlags[*]}}, seeds: ${seeds[*]:-none}"
   local started=$SECONDS
   if "${generator[@]}" "$binary" -max_total_time="$seconds" -timeout=10 -max_len=65536 -rss_limit_mb=2048 \
     -malloc_limit_mb=256 -print_final_stats=1 -artifact_prefix="$findings/$name-" "${dict[@]}" "${forkFlags[@]}" \
-    ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" >"$log" 2>&1; then
+    $targetFlags ${POINTRAST_FUZZ_FLAGS:-} "$corpus" "${seeds[@]}" >"$log" 2>&1; then
     {
       echo "== $name"
       # "#123456 DONE cov: 812 ft: 2931 corp: 401/1873Kb ..." and the executions from the final stats.
@@ -258,6 +357,11 @@ reportRow() {
 }
 
 for name in "${names[@]}"; do
+  if [ "${POINTRAST_FUZZ_PREBUILT:-0}" = 1 ] && [ -f "$build/fuzz/${name}_fuzz.gz" ] &&
+    [ ! "$build/fuzz/${name}_fuzz" -nt "$build/fuzz/${name}_fuzz.gz" ]; then
+    gzip -d -c "$build/fuzz/${name}_fuzz.gz" >"$build/fuzz/${name}_fuzz.tmp"
+    chmod +x "$build/fuzz/${name}_fuzz.tmp" && mv "$build/fuzz/${name}_fuzz.tmp" "$build/fuzz/${name}_fuzz"
+  fi
   [ -x "$build/fuzz/${name}_fuzz" ] || { echo "fuzz: no target $name (tests/fuzz/${name}_fuzz.cpp)" >&2; exit 1; }
   rm -f "$build/logs/$name.result" "$build/logs/$name.row"
 done
@@ -288,6 +392,11 @@ if [ -n "$report" ]; then
   fi
   forkNote=""
   if [ "$fork" -gt 0 ]; then forkNote=", $fork workers each (-fork)"; fi
+  if [ -n "$until" ]; then
+    forkNote=", workers (-fork) in proportion to the executions each lacked for $until:"
+    for name in "${names[@]}"; do forkNote+=" $name ${workers[$name]},"; done
+    forkNote="${forkNote%,}"
+  fi
   {
     echo
     echo "$(date -u +'%Y-%m-%d %H:%M') UTC, commit ${POINTRAST_FUZZ_COMMIT:-$(git rev-parse --short HEAD 2>/dev/null || echo unknown)}," \
