@@ -2,6 +2,8 @@
 // the same points (per node, as multisets) as the Potree folder of the same build, the info VLR first with
 // the builder's cube and spacing, hierarchy pages crossed, the inputs' WKT kept, the same bytes from one
 // thread and out of core, and what `info` says of the colors.
+#include <thread>
+
 #include "io/copc_build_test_util.h"
 #include "io/io_test_util.h"
 #include "io/las/las_format.h"
@@ -144,6 +146,86 @@ TEST(CopcWriter, InputsWithDifferentCoordinateSystemsAreRefused) {
     EXPECT_NE(std::string(e.what()).find("coordinate system (WKT) differs"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+// Nodes take their offsets in the order their turns were reserved, whatever order their encodings
+// arrive in and on whichever thread: filled at once, filled backwards from several threads, or left
+// waiting by writeNode() and encoded later, the file is the same, and holds every node's points.
+TEST(CopcWriter, NodesFilledInAnyOrderGiveTheSameBytes) {
+  iotest::TempDir dir;
+  lod::OctreeMetadata m;
+  m.cube.min = glm::dvec3(0.0);
+  m.cube.max = glm::dvec3(64.0);
+  m.spacing = 0.5;
+  m.scale = glm::dvec3(0.001);
+  m.fields.color = m.fields.intensity = m.fields.classification = true;
+  // The root and its eight children, 50 to 750 points each, in post-order as the builder hands them.
+  std::vector<std::pair<lod::NodeKey, std::vector<PointRecord>>> nodes;
+  uint32_t seed = 7;
+  auto next = [&] { return seed = seed * 1664525u + 1013904223u; };
+  for (int i = 0; i <= 8; ++i) {
+    const lod::NodeKey key = i < 8 ? lod::NodeKey{}.child(i) : lod::NodeKey{};
+    const double edge = i < 8 ? 32.0 : 64.0;
+    std::vector<PointRecord> records(50 + 100 * size_t(i % 8));
+    for (PointRecord& r : records) {
+      const glm::dvec3 lo = m.nodeCube(key).min;
+      r.x = int32_t((lo.x + edge * (next() % 1000) / 1000.0) / m.scale.x);
+      r.y = int32_t((lo.y + edge * (next() % 1000) / 1000.0) / m.scale.y);
+      r.z = int32_t((lo.z + edge * (next() % 1000) / 1000.0) / m.scale.z);
+      r.rgb[0] = uint16_t(next()), r.rgb[1] = uint16_t(next()), r.rgb[2] = uint16_t(next());
+      r.intensity = uint16_t(next());
+      r.classification = uint8_t(next() % 32);
+      r.returnNumber = 1; // what a record without return numbers is written with
+    }
+    nodes.emplace_back(key, std::move(records));
+  }
+  auto write = [&](const std::filesystem::path& path, int mode) {
+    io::CopcWriter writer(path, m, false, {});
+    std::vector<uint64_t> turns;
+    if (mode == 0) {
+      for (const auto& [key, records] : nodes)
+        writer.fill(writer.reserve(key), writer.encodeNode(key, records.data(), records.size()));
+    } else if (mode == 1) {
+      for (const auto& [key, records] : nodes)
+        turns.push_back(writer.reserve(key));
+      std::vector<std::thread> threads;
+      for (int t = 0; t < 3; ++t)
+        threads.emplace_back([&, t] {
+          for (size_t i = nodes.size(); i-- > 0;)
+            if (int(i % 3) == t)
+              writer.fill(turns[i],
+                          writer.encodeNode(nodes[i].first, nodes[i].second.data(), nodes[i].second.size()));
+        });
+      for (std::thread& t : threads)
+        t.join();
+    } else {
+      // Every other node waits; the last ones are encoded by commit().
+      for (size_t i = 0; i < nodes.size(); ++i) {
+        const auto& [key, records] = nodes[i];
+        if (i % 2 == 0) {
+          writer.writeNode(key, records.data(), records.size());
+        } else {
+          writer.fill(writer.reserve(key), writer.encodeNode(key, records.data(), records.size()));
+          if (i == 5) writer.compressWaiting();
+        }
+      }
+    }
+    writer.commit();
+    return iotest::readBytes(path);
+  };
+  const std::vector<uint8_t> inOrder = write(dir / "a.copc.laz", 0);
+  EXPECT_TRUE(write(dir / "b.copc.laz", 1) == inOrder);
+  EXPECT_TRUE(write(dir / "c.copc.laz", 2) == inOrder);
+
+  std::unique_ptr<lod::NodeSource> copc = io::openCopc(dir / "c.copc.laz");
+  const Nodes read = readNodes(*copc);
+  ASSERT_EQ(read.size(), nodes.size());
+  for (auto [key, records] : nodes) {
+    std::sort(records.begin(), records.end(), recordLess);
+    const auto it = read.find(key);
+    ASSERT_NE(it, read.end()) << key.potreeName();
+    EXPECT_TRUE(it->second == records) << key.potreeName();
+  }
 }
 
 } // namespace

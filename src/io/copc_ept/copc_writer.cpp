@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cerrno>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <mutex>
 
@@ -50,8 +51,8 @@ void storeEntry(std::vector<uint8_t>& page, const NodeKey& key, const Entry& e) 
 
 struct Prepared final : lod::PreparedNode {
   CopcWriter::EncodedNode node;
-  uint64_t offset = 0;
-  bool placed = false;
+  uint64_t turn = 0;
+  bool reserved = false;
 };
 
 } // namespace
@@ -66,7 +67,7 @@ struct CopcWriter::State {
   laz::Layout layout;
   std::vector<uint8_t> prefix; // header and VLRs, rewritten at commit
   uint64_t pointOffset = 0;
-  uint64_t next = 0; // where the next chunk goes
+  uint64_t next = 0; // where the next chunk with an offset goes
   int fd = -1;
   bool committed = false;
   uint64_t fileBytes = 0;
@@ -77,6 +78,24 @@ struct CopcWriter::State {
   std::array<uint64_t, 15> byReturn{};
   double gpsMin = 0, gpsMax = 0;
   bool anyGps = false;
+  // Turns from the first without an offset (turn firstTurn) on: their nodes once filled.
+  struct Turn {
+    NodeKey key;
+    EncodedNode node;
+    bool filled = false;
+  };
+  std::mutex turnsMutex;
+  std::deque<Turn> turns;
+  uint64_t firstTurn = 0;
+  // Nodes given to writeNode() that wait to be encoded, each with its turn.
+  struct Waiting {
+    NodeKey key;
+    uint64_t turn = 0;
+    std::vector<PointRecord> records;
+    std::vector<uint8_t> tails;
+  };
+  std::mutex waitingMutex;
+  std::deque<Waiting> waiting;
   // Encoders for the threads that encode at once; each keeps its models from chunk to chunk.
   mutable std::mutex encodersMutex;
   mutable std::vector<std::unique_ptr<laz::ChunkEncoder>> encoders;
@@ -92,6 +111,7 @@ struct CopcWriter::State {
       done += static_cast<size_t>(w);
     }
   }
+  void place(const NodeKey& key, const EncodedNode& node, uint64_t offset);
   void header();
   void records(const PointRecord* in, const uint8_t* tails, size_t n, std::vector<uint8_t>& out) const;
   std::vector<uint8_t> hierarchy(uint64_t dataOffset, uint64_t& rootOffset, uint64_t& rootSize) const;
@@ -109,7 +129,7 @@ void CopcWriter::State::header() {
   las::copyString(h + las::kSystemId, 32, "pointrast");
   // The creation day and year stay 0 (unknown): the file's bytes depend on its points only.
   las::copyString(h + las::kSoftware, 32,
-             metadata.fields.color && averagedColors ? kCopcSoftwareAveraged : kCopcSoftwareExact);
+                  metadata.fields.color && averagedColors ? kCopcSoftwareAveraged : kCopcSoftwareExact);
   storeLE<uint16_t>(h + las::kHeaderSizeField, static_cast<uint16_t>(las::kHeaderSize14));
   for (int a = 0; a < 3; ++a) {
     storeLE<double>(h + las::kScale + 8 * a, metadata.scale[a]);
@@ -244,7 +264,8 @@ CopcWriter::CopcWriter(std::filesystem::path path, const lod::OctreeMetadata& me
       fail(s.path, "the coordinate system's WKT is too long for a VLR");
     std::vector<uint8_t> wkt(options.wkt.begin(), options.wkt.end());
     wkt.push_back(0); // null-terminated, as R15 2.5 asks of WKT
-    const std::vector<uint8_t> v = las::vlrBytes("LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt);
+    const std::vector<uint8_t> v =
+        las::vlrBytes("LASF_Projection", kWktRecord, "OGC WKT coordinate system", wkt);
     s.prefix.insert(s.prefix.end(), v.begin(), v.end());
     ++vlrCount;
   }
@@ -339,30 +360,56 @@ CopcWriter::EncodedNode CopcWriter::encodeNode(const NodeKey& key, const PointRe
   return node;
 }
 
-uint64_t CopcWriter::place(const NodeKey& key, const EncodedNode& node) {
-  State& s = *state_;
-  assert(!s.committed);
-  if (node.count == 0) return s.next;
-  const uint64_t offset = s.next;
-  s.next += node.bytes.size();
-  s.nodes.push_back({key, Entry{offset, int32_t(node.bytes.size()), int32_t(node.count)}});
-  s.count += node.count;
+// A node given its offset (in turn order): its entry and its share of the header's counts and bounds.
+void CopcWriter::State::place(const NodeKey& key, const EncodedNode& node, uint64_t offset) {
+  nodes.push_back({key, Entry{offset, int32_t(node.bytes.size()), int32_t(node.count)}});
+  count += node.count;
   for (int a = 0; a < 3; ++a) {
-    s.qmin[a] = std::min(s.qmin[a], node.qmin[a]);
-    s.qmax[a] = std::max(s.qmax[a], node.qmax[a]);
+    qmin[a] = std::min(qmin[a], node.qmin[a]);
+    qmax[a] = std::max(qmax[a], node.qmax[a]);
   }
-  for (size_t i = 0; i < s.byReturn.size(); ++i)
-    s.byReturn[i] += node.byReturn[i];
-  if (s.options.tail.layout.gpsTime >= 0) {
-    s.gpsMin = s.anyGps ? std::min(s.gpsMin, node.gpsMin) : node.gpsMin;
-    s.gpsMax = s.anyGps ? std::max(s.gpsMax, node.gpsMax) : node.gpsMax;
-    s.anyGps = true;
+  for (size_t i = 0; i < byReturn.size(); ++i)
+    byReturn[i] += node.byReturn[i];
+  if (options.tail.layout.gpsTime >= 0) {
+    gpsMin = anyGps ? std::min(gpsMin, node.gpsMin) : node.gpsMin;
+    gpsMax = anyGps ? std::max(gpsMax, node.gpsMax) : node.gpsMax;
+    anyGps = true;
   }
-  return offset;
 }
 
-void CopcWriter::writeAt(uint64_t offset, const EncodedNode& node) const {
-  state_->pwriteAll(offset, node.bytes.data(), node.bytes.size());
+uint64_t CopcWriter::reserve(const NodeKey& key) {
+  State& s = *state_;
+  assert(!s.committed);
+  std::lock_guard lock(s.turnsMutex);
+  s.turns.push_back({key, {}, false});
+  return s.firstTurn + s.turns.size() - 1;
+}
+
+void CopcWriter::fill(uint64_t turn, EncodedNode node) {
+  State& s = *state_;
+  // The nodes that this fill gives an offset, written after the lock is released.
+  std::vector<std::pair<uint64_t, EncodedNode>> ready;
+  {
+    std::lock_guard lock(s.turnsMutex);
+    assert(turn >= s.firstTurn && turn - s.firstTurn < s.turns.size());
+    State::Turn& t = s.turns[size_t(turn - s.firstTurn)];
+    assert(!t.filled);
+    t.node = std::move(node);
+    t.filled = true;
+    while (!s.turns.empty() && s.turns.front().filled) {
+      State::Turn& front = s.turns.front();
+      if (front.node.count > 0) {
+        const uint64_t offset = s.next;
+        s.next += front.node.bytes.size();
+        s.place(front.key, front.node, offset);
+        ready.emplace_back(offset, std::move(front.node));
+      }
+      s.turns.pop_front();
+      ++s.firstTurn;
+    }
+  }
+  for (const auto& [offset, n] : ready)
+    s.pwriteAll(offset, n.bytes.data(), n.bytes.size());
 }
 
 void CopcWriter::writeNode(const NodeKey& key, const PointRecord* records, size_t count) {
@@ -371,13 +418,38 @@ void CopcWriter::writeNode(const NodeKey& key, const PointRecord* records, size_
 
 void CopcWriter::writeNode(const NodeKey& key, const PointRecord* records, const uint8_t* tails,
                            size_t count) {
-  const EncodedNode node = encodeNode(key, records, tails, count);
-  writeAt(place(key, node), node);
+  State& s = *state_;
+  const size_t tailBytes = tails ? s.options.tail.bytes() : 0;
+  State::Waiting w{key, reserve(key), std::vector<PointRecord>(records, records + count), {}};
+  if (tailBytes) w.tails.assign(tails, tails + count * tailBytes);
+  std::lock_guard lock(s.waitingMutex);
+  s.waiting.push_back(std::move(w));
+}
+
+void CopcWriter::compressWaiting() {
+  State& s = *state_;
+  State::Waiting w;
+  {
+    std::lock_guard lock(s.waitingMutex);
+    if (s.waiting.empty()) return;
+    w = std::move(s.waiting.front());
+    s.waiting.pop_front();
+  }
+  fill(w.turn,
+       encodeNode(w.key, w.records.data(), w.tails.empty() ? nullptr : w.tails.data(), w.records.size()));
 }
 
 void CopcWriter::commit() {
   State& s = *state_;
   assert(!s.committed && s.fd >= 0);
+  for (;;) {
+    {
+      std::lock_guard lock(s.waitingMutex);
+      if (s.waiting.empty()) break;
+    }
+    compressWaiting();
+  }
+  assert(s.turns.empty());
   // The chunk table, in the order the chunks lie in the file.
   std::vector<laz::Chunk> table;
   table.reserve(s.nodes.size());
@@ -466,13 +538,16 @@ void CopcNodeSink::writePrepared(const NodeKey& key, lod::PreparedNode* prepared
                                  const uint8_t* tails, size_t count) {
   auto* p = dynamic_cast<Prepared*>(prepared);
   if (!p) return writeNode(key, records, tails, count);
-  p->offset = writer_.place(key, p->node);
-  p->placed = true;
+  p->turn = writer_.reserve(key);
+  p->reserved = true;
 }
 
 void CopcNodeSink::finishPrepared(std::unique_ptr<lod::PreparedNode> prepared) const {
+  // A node that spans chunks, left waiting by writeNode() in the builder's order, is encoded here on
+  // the indexing threads: the turns after it keep their bytes until it is.
+  writer_.compressWaiting();
   auto* p = dynamic_cast<Prepared*>(prepared.get());
-  if (p && p->placed) writer_.writeAt(p->offset, p->node);
+  if (p && p->reserved) writer_.fill(p->turn, std::move(p->node));
 }
 
 // ---- inputs and the build ---------------------------------------------------------------------------------

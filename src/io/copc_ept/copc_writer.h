@@ -20,6 +20,10 @@
 // children.
 //
 // The bytes depend on the points only (no creation date is written): the same build gives the same file.
+// Nodes take their offsets in the builder's order, whatever thread encodes them and whenever: a node
+// reserves its turn there, and offsets are handed out along the turns as their sizes become known (a
+// node whose earlier turn still waits keeps its bytes until then). The nodes that span chunks are only
+// copied in that order and encoded later on the indexing threads, beside the chunks' own nodes.
 // The file is written into a temporary folder beside it (which also holds an out-of-core build's chunk
 // files) and renamed into place at the end; an error or an interruption leaves nothing behind.
 #pragma once
@@ -67,13 +71,19 @@ public:
   // With the records' tails (options' tail.bytes() each; null: none).
   EncodedNode encodeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails,
                          size_t count) const;
-  // Gives the node its place in the file, in the caller's order (not thread-safe; the order decides the
-  // bytes). Every node once.
-  uint64_t place(const lod::NodeKey& key, const EncodedNode& node);
-  // Writes a placed node's bytes; thread-safe, several at once.
-  void writeAt(uint64_t offset, const EncodedNode& node) const;
+  // The node's turn in the file, in the caller's order (not thread-safe with itself; the order decides
+  // the bytes). Every node once.
+  uint64_t reserve(const lod::NodeKey& key);
+  // Hands over the encoded node of a reserved turn; thread-safe, several at once. Offsets are given in
+  // turn order as soon as every earlier turn's size is known, and the bytes of the nodes that then have
+  // one are written on the calling thread.
+  void fill(uint64_t turn, EncodedNode node);
+  // Reserves the node's turn and keeps a copy of its points, to be encoded by compressWaiting() on any
+  // thread, so the caller's order never waits for an encoding (not thread-safe with reserve()).
   void writeNode(const lod::NodeKey& key, const PointRecord* records, size_t count);
   void writeNode(const lod::NodeKey& key, const PointRecord* records, const uint8_t* tails, size_t count);
+  // Encodes and fills one node that writeNode() left waiting, if any; thread-safe.
+  void compressWaiting();
 
   // Writes the chunk table, the hierarchy, the header and VLRs, and renames the file into place.
   void commit();
