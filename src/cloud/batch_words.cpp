@@ -39,6 +39,7 @@ __attribute__((target_clones("avx2", "default"))) void quantizeGroups(const int3
                                                                       const Lanes& c, uint32_t* q) {
   constexpr double kMax = double(kBatchCoordinateMax);
   const Double4 zero = {0, 0, 0, 0}, max = {kMax, kMax, kMax, kMax}, half = {0.5, 0.5, 0.5, 0.5};
+  constexpr int64_t kOneBits = 0x3FF0000000000000; // the bits of 1.0
   for (uint64_t g = 0; g < groups; ++g)
     for (int j = 0; j < 3; ++j) {
       Int4 raw;
@@ -47,9 +48,14 @@ __attribute__((target_clones("avx2", "default"))) void quantizeGroups(const int3
           (__builtin_convertvector(raw, Double4) * c.scale[j] + c.offset[j] - c.min[j]) / c.size[j] * max;
       t = t > zero ? t : zero;
       t = t < max ? t : max;
-      const Int4 whole = __builtin_convertvector(t, Int4);                  // truncates; t <= kMax < 2^31
-      const Long4 up = t - __builtin_convertvector(whole, Double4) >= half; // -1 where the fraction rounds up
-      const Int4 r = (whole - __builtin_convertvector(up, Int4)) & c.keep[j];
+      // The whole part (the conversion truncates; t <= kMax < 2^31), plus one where the fraction is a half
+      // or more: added as doubles (exact for these integers), so that the comparison's 64-bit mask needs no
+      // narrowing to 32-bit lanes.
+      const Double4 whole = __builtin_convertvector(__builtin_convertvector(t, Int4), Double4);
+      const Long4 up = (t - whole >= half) & Long4{kOneBits, kOneBits, kOneBits, kOneBits};
+      Double4 rounded;
+      std::memcpy(&rounded, &up, sizeof rounded); // 1.0 or 0.0
+      const Int4 r = __builtin_convertvector(whole + rounded, Int4) & c.keep[j];
       std::memcpy(q + 12 * g + 4 * j, &r, sizeof r);
     }
 }

@@ -723,6 +723,11 @@ void Server::start() {
                                 "yes",
                                 "decode_url",
                                 "no",
+                                // Frames and their small state messages go out at once: with Nagle's
+                                // algorithm a message waits for the peer's delayed acknowledgement
+                                // (up to 40 ms on Linux) while a frame is on its way.
+                                "tcp_nodelay",
+                                "1",
                                 nullptr};
   mg_callbacks callbacks{};
   callbacks.begin_request = &Server::beginRequest;
