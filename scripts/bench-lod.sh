@@ -10,7 +10,8 @@
 #
 # Environment: POINTRAST_BIN (default .gpu/bin/pointrast, else build-rel/pointrast), OUT (default
 # ./gpu-out), WORK (scratch folder for inputs and octrees, default /tmp/pointrast-lod-bench), LOD_ARGS (extra
-# `pointrast lod` arguments), KEEP=1 (keep the generated LAS files).
+# `pointrast lod` arguments), KEEP=1 (keep the generated LAS files), LOD_FORMAT=copc (a COPC file out instead
+# of the Potree folder; the runs and report are then named copc-lod-build).
 # Space: N points need 26 N bytes of LAS plus 24 N of octree at once (1 G: 26 + 24 GB; each octree is
 # deleted after its run; a size that does not fit the free space of WORK is skipped, saying so) and about
 # 58 N bytes of memory to build in memory (1 G: 58 GB, under the default --memory of half the RAM on a
@@ -24,6 +25,8 @@ if [ -z "$PR" ]; then
   if [ -x .gpu/bin/pointrast ]; then PR=$PWD/.gpu/bin/pointrast; else PR=$PWD/build-rel/pointrast; fi
 fi
 mkdir -p "$OUT"
+name=lod-build ext=""
+if [ "${LOD_FORMAT:-potree}" = copc ]; then name=copc-lod-build ext=.copc.laz; fi
 
 machine_json() {
   local cpu gpu mem
@@ -50,7 +53,7 @@ run() {
       cores=${spec#*/}
       pin=(taskset -c "0-$((cores - 1))")
     fi
-    local las=$WORK/terrain-$size.las octree=$WORK/octree-$size
+    local las=$WORK/terrain-$size.las octree=$WORK/octree-$size$ext
     local need free
     need=$(($(count_of "$size") * 52)) # 26 B of LAS + 24 B of octree a point, and 2 B of slack
     [ -f "$las" ] && need=$((need - $(stat -c %s "$las")))
@@ -72,17 +75,17 @@ run() {
     json=$(/usr/bin/time -f "lod: %e s, %M KB" "${pin[@]}" "$PR" lod "$las" -o "$octree" --json \
       ${cores:+--threads $cores} ${LOD_ARGS:-})
     printf '{"size":"%s","cores":%s,"machine":%s,"build":%s}\n' "$size" "${cores:-$(nproc)}" "$(machine_json)" \
-      "$json" | tee -a "$OUT/lod-build.jsonl"
+      "$json" | tee -a "$OUT/$name.jsonl"
     rm -rf "$octree"
     [ "${KEEP:-0}" = 1 ] || rm -f "$las"
   done
 }
 
 report() {
-  local jsonl=${1:-$OUT/lod-build.jsonl}
-  python3 - "$jsonl" "$OUT/lod-build.json" "$OUT/lod-build.md" <<'PY'
+  local jsonl=${1:-$OUT/$name.jsonl}
+  python3 - "$jsonl" "$OUT/$name.json" "$OUT/$name.md" "$ext" <<'PY'
 import json, sys
-src, out_json, out_md = sys.argv[1:4]
+src, out_json, out_md, ext = sys.argv[1:5]
 runs = [json.loads(line) for line in open(src) if line.strip()]
 json.dump(runs, open(out_json, "w"), indent=1)
 # Anchors: PotreeConverter 2 measured on the 16-core NVIDIA machine on 100 M generated terrain points;
@@ -91,8 +94,8 @@ anchors = [("PotreeConverter 2, poisson (its default)", 7.7e6), ("PotreeConverte
            ("PotreeConverter 2, random", 14.3e6), ("SimLOD, in GPU memory, no files (RTX 4090)", 580e6)]
 def m(v): return f"{v / 1e6:,.1f} M"
 lines = ["# Octree build throughput (`pointrast lod`)", "",
-         "Generated terrain (`pointrast generate terrain --point-format 2`), LAS in from the page cache, Potree 2.0 "
-         "octree out (DEFAULT encoding), written by `scripts/bench-lod.sh`. Points/s are input points over wall "
+         "Generated terrain (`pointrast generate terrain --point-format 2`), LAS in from the page cache, "
+         + ("a COPC file out (LAZ, one chunk a node)" if ext else "Potree 2.0 octree out (DEFAULT encoding)") + ", written by `scripts/bench-lod.sh`. Points/s are input points over wall "
          "seconds; per core divides by the threads the build ran. `write` runs during `index` (its time is part "
          "of it), so the phases above it add up to the total.", ""]
 if runs:
