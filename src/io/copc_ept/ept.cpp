@@ -3,6 +3,8 @@
 // its entries), node data decoded by dataType.
 #include "io/copc_ept/ept.h"
 
+#include <algorithm>
+#include <cstring>
 #include <mutex>
 #include <set>
 #include <unordered_map>
@@ -10,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <zstd.h>
 
+#include "cloud/lod_tails.h"
 #include "io/io_util.h"
 #include "io/las/las_records.h"
 #include "io/las/laz_reader.h"
@@ -189,6 +192,10 @@ struct EptMeta {
                   *pointSourceId = nullptr;
   const Dimension* rgb[3] = {};
   lod::OctreeMetadata octree;
+  // The schema's dimensions beyond the record's fields, in schema order, and the tails that carry their
+  // bytes as they are stored (binary and zstandard data; a LAZ node's records carry none).
+  std::vector<const Dimension*> tail;
+  TailFormat tailFormat;
 };
 
 Bounds parseBounds(const std::filesystem::path& path, const json& j, const char* name) {
@@ -322,10 +329,44 @@ EptMeta parseEptJson(const std::filesystem::path& input) {
   m.fields.returnNumber = meta.returnNumber != nullptr;
   m.fields.classification = meta.classification != nullptr;
   m.fields.pointSourceId = meta.pointSourceId != nullptr;
+  if (meta.dataType != "laszip") {
+    uint32_t bytes = 0;
+    for (const Dimension& d : meta.schema) {
+      const bool record = &d == meta.xyz[0] || &d == meta.xyz[1] || &d == meta.xyz[2] ||
+                          &d == meta.intensity || &d == meta.returnNumber || &d == meta.classification ||
+                          &d == meta.pointSourceId ||
+                          (m.fields.color && (&d == meta.rgb[0] || &d == meta.rgb[1] || &d == meta.rgb[2]));
+      if (record) continue;
+      meta.tail.push_back(&d);
+      bytes += d.size;
+    }
+    // At most 1024 dimensions of 8 bytes (parseSchema).
+    meta.tailFormat.attributes.extraBytes = uint16_t(bytes);
+    meta.tailFormat.layout = attributeLayout(meta.tailFormat.attributes);
+  }
   return meta;
 }
 
-class EptSource : public lod::NodeSource {
+// The key a pick shows a dimension under (lod_tails.h): the LAS attributes' names for PDAL's dimensions of
+// them, else none (an extra dimension, shown by its own name).
+const char* tailKey(const std::string& name) {
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"GpsTime", "gps_time"},
+      {"NumberOfReturns", "number_of_returns"},
+      {"ScanAngleRank", "scan_angle"},
+      {"UserData", "user_data"},
+      {"Infrared", "nir"},
+      {"ClassFlags", "classification_flags"},
+      {"ScanChannel", "scanner_channel"},
+      {"ScanDirectionFlag", "scan_direction_flag"},
+      {"EdgeOfFlightLine", "edge_of_flight_line"},
+  };
+  for (const auto& [dimension, key] : kKeys)
+    if (name == dimension) return key;
+  return nullptr;
+}
+
+class EptSource : public lod::NodeSource, public lod::NodeTails {
 public:
   explicit EptSource(const std::filesystem::path& path) : meta_(parseEptJson(path)) {
     loadHierarchy(NodeKey{});
@@ -360,16 +401,34 @@ public:
     return out;
   }
 
-  std::vector<PointRecord> readNode(const NodeInfo& node) override {
-    const uint64_t count = countOf(node.key);
-    std::vector<PointRecord> out;
-    if (count == 0) return out;
-    const std::filesystem::path path = dataPath(node.key);
-    if (meta_.dataType == "laszip") return readLazNode(path, count);
-    std::vector<uint8_t> bytes = meta_.dataType == "binary" ? readBinary(path, count) : readZstd(path, count);
-    out.resize(count);
-    for (uint64_t i = 0; i < count; ++i)
-      out[i] = parsePoint(bytes.data() + i * meta_.pointSize);
+  std::vector<PointRecord> readNode(const NodeInfo& node) override { return readPoints(node, nullptr); }
+
+  const TailFormat& tailFormat() const override { return meta_.tailFormat; }
+
+  std::vector<PointRecord> readNodeTails(const NodeInfo& node, std::vector<uint8_t>& tails) override {
+    return readPoints(node, &tails);
+  }
+
+  std::vector<lod::TailValue> tailValues(const uint8_t* tail) const override {
+    std::vector<lod::TailValue> out;
+    const uint8_t* p = tail + std::max(meta_.tailFormat.layout.extraBytes, 0);
+    for (const Dimension* d : meta_.tail) {
+      lod::TailValue v;
+      const char* key = tailKey(d->name);
+      v.name = key ? key : d->name;
+      v.extraBytes = key == nullptr;
+      // Integers exact (an 8-byte one would round as a double); a scaled one as its value.
+      if (d->scaled)
+        v.values.push_back(loadNumber(p, *d) * d->scale + d->shift);
+      else if (d->kind == DimKind::Float)
+        v.values.push_back(loadNumber(p, *d));
+      else if (d->kind == DimKind::Signed)
+        v.values.push_back(d->size == 8 ? loadLE<int64_t>(p) : int64_t(loadNumber(p, *d)));
+      else
+        v.values.push_back(d->size == 8 ? loadLE<uint64_t>(p) : uint64_t(loadNumber(p, *d)));
+      out.push_back(std::move(v));
+      p += d->size;
+    }
     return out;
   }
 
@@ -381,6 +440,33 @@ public:
   }
 
 private:
+  // A node's records, and where `tails` is given the bytes of the schema's other dimensions beside them
+  // (tailFormat().bytes() a point).
+  std::vector<PointRecord> readPoints(const NodeInfo& node, std::vector<uint8_t>* tails) {
+    const uint64_t count = countOf(node.key);
+    std::vector<PointRecord> out;
+    if (tails) tails->clear();
+    if (count == 0) return out;
+    const std::filesystem::path path = dataPath(node.key);
+    if (meta_.dataType == "laszip") return readLazNode(path, count);
+    std::vector<uint8_t> bytes = meta_.dataType == "binary" ? readBinary(path, count) : readZstd(path, count);
+    out.resize(count);
+    for (uint64_t i = 0; i < count; ++i)
+      out[i] = parsePoint(bytes.data() + i * meta_.pointSize);
+    const uint32_t tailBytes = meta_.tailFormat.bytes();
+    if (tails && tailBytes > 0) {
+      tails->assign(count * tailBytes, 0);
+      for (uint64_t i = 0; i < count; ++i) {
+        uint8_t* t = tails->data() + i * tailBytes + meta_.tailFormat.layout.extraBytes;
+        for (const Dimension* d : meta_.tail) {
+          std::memcpy(t, bytes.data() + i * meta_.pointSize + d->offset, d->size);
+          t += d->size;
+        }
+      }
+    }
+    return out;
+  }
+
   std::filesystem::path hierarchyPath(const NodeKey& key) const {
     return meta_.root / "ept-hierarchy" / (keyName(key) + ".json");
   }
