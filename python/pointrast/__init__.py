@@ -63,7 +63,8 @@ class Frame:
     upload_s, the seconds this render spent uploading the cloud (0 when a Renderer reused it), of which
     upload_encode_s encoding it on the host and upload_copy_wait_s waiting for copies the encoding did not
     hide; upload_steps_cpu_s, the encoding's steps in seconds of all its threads together (read, bounds,
-    words, colors, stage) and the threads it had. Shows itself as a PNG in Jupyter."""
+    words, colors, stage), the threads it had, and allocate_wall, the seconds spent allocating buffers.
+    Shows itself as a PNG in Jupyter."""
 
     def __init__(self, result):
         self.image = result["image"]

@@ -370,6 +370,7 @@ private:
     steps["colors"] = lastUpload_.colorsCpu;
     steps["stage"] = lastUpload_.stageCpu;
     steps["threads"] = lastUpload_.threads;
+    steps["allocate_wall"] = lastUpload_.allocate;
     r["upload_steps_cpu_s"] = steps;
     return r;
   }

@@ -98,6 +98,7 @@ public:
 // copies to the GPU that the encoding did not hide.
 struct UploadTimes {
   double total = 0, encode = 0, copyWait = 0;
+  double allocate = 0; // the device buffers and the staging buffers
   // The encoding's steps, in seconds of all its threads together (a batched upload): reading the points
   // (positions and colors from the input), cutting batches (their bounds), the position words, the
   // display colors, and copying each thread's words into the staging buffer.
