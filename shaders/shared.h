@@ -565,6 +565,8 @@ struct PanelPush {
   uint fontWidth;
   uint fontHeight;
   float scaleX, scaleY; // pixels -> normalized device coordinates
+  uint image;           // 1: `font` is an RGBA8 image of fontWidth x fontHeight (one uint a texel)
+  uint unused;          // keeps the size a multiple of 8 in C++ and GLSL alike
 };
 
 PR_NAMESPACE_END

@@ -1,6 +1,8 @@
 #version 460
 // The panel's fragments: vertex color times the font atlas' coverage, bilinearly filtered by hand (the
 // atlas is a buffer, not an image: no sampler, no descriptor set). Blending is SRC_ALPHA, 1 - SRC_ALPHA.
+// An image draw (pc.image = 1, ImGui::Image) reads an RGBA8 buffer instead, nearest texel, so that a
+// picture shown at its own size keeps its pixels.
 #include "common.inc.glsl"
 
 layout(push_constant) uniform Push { PanelPush pc; };
@@ -15,6 +17,12 @@ float texel(ivec2 p) {
 }
 
 void main() {
+  if (pc.image != 0u) {
+    ivec2 q = clamp(ivec2(floor(uv * vec2(pc.fontWidth, pc.fontHeight))), ivec2(0),
+                    ivec2(pc.fontWidth - 1, pc.fontHeight - 1));
+    outColor = color * unpackUnorm4x8(UintArray(pc.font).v[uint(q.y) * pc.fontWidth + uint(q.x)]);
+    return;
+  }
   vec2 p = uv * vec2(pc.fontWidth, pc.fontHeight) - 0.5;
   ivec2 p0 = ivec2(floor(p));
   vec2 f = p - vec2(p0);

@@ -84,7 +84,7 @@ static_assert(sizeof(SphereRtPush) == 24 && offsetof(SphereRtPush, pieceParticle
 static_assert(kSphereTaskSpheres % kSphereTaskGroupSize == 0 && kSphereTaskGroupSize <= 32); // one mask word
 
 static_assert(sizeof(PresentPush) == 24 && offsetof(PresentPush, targetHeight) == 20);
-static_assert(sizeof(PanelPush) == 48 && offsetof(PanelPush, firstIndex) == 24 &&
-              offsetof(PanelPush, scaleY) == 44);
+static_assert(sizeof(PanelPush) == 56 && offsetof(PanelPush, firstIndex) == 24 &&
+              offsetof(PanelPush, scaleY) == 44 && offsetof(PanelPush, image) == 48);
 
 } // namespace pointrast::shared

@@ -101,10 +101,7 @@ DesktopInput::DesktopInput(GLFWwindow* window, Session& session) : window_(windo
   glfw::glfwSetScrollCallback(window, [](GLFWwindow* w, double, double y) { of(w).scroll(y); });
   glfw::glfwSetKeyCallback(
       window, [](GLFWwindow* w, int key, int, int action, int mods) { of(w).key(key, action, mods); });
-  glfw::glfwSetCharCallback(window, [](GLFWwindow* w, unsigned int c) {
-    ImGui::GetIO().AddInputCharacter(c);
-    of(w).arrived_ = true;
-  });
+  glfw::glfwSetCharCallback(window, [](GLFWwindow* w, unsigned int c) { of(w).character(c); });
   glfw::glfwSetWindowRefreshCallback(window, [](GLFWwindow* w) { of(w).arrived_ = true; });
 }
 
@@ -126,10 +123,18 @@ bool DesktopInput::panelWantsMouse() const {
   return panelVisible_ && ImGui::GetIO().WantCaptureMouse;
 }
 
+// Whether the cursor is the panel's: ImGui's word about the last frame, unless the cursor moved since (a
+// move and a wheel step or press in one batch of events), where the panel's windows' rectangles decide.
+bool DesktopInput::forPanel() const {
+  return movedSinceFrame_ ? overPanel() : panelWantsMouse();
+}
+
 bool DesktopInput::overPanel() const {
-  const std::array<float, 4>& r = panelRect_;
-  return panelVisible_ && cursor_.x >= r[0] && cursor_.y >= r[1] && cursor_.x < r[0] + r[2] &&
-         cursor_.y < r[1] + r[3];
+  if (!panelVisible_) return false;
+  for (const std::array<float, 4>& r : panelRects_)
+    if (cursor_.x >= r[0] && cursor_.y >= r[1] && cursor_.x < r[0] + r[2] && cursor_.y < r[1] + r[3])
+      return true;
+  return false;
 }
 
 void DesktopInput::panelFrameDone() {
@@ -140,6 +145,46 @@ void DesktopInput::panelFrameDone() {
     releasePending_[b] = false;
     pressedThisFrame_[b] = false;
   }
+  for (size_t k = 0; k < keyReleasePending_.size(); ++k)
+    if (keyReleasePending_[k]) io.KeysDown[k] = false;
+  // ImGui reads the modifiers and the cursor while it builds the frame: those that came after a held press
+  // or release change before the next frame.
+  if (modsPending_) modsDue_ = std::exchange(modsPending_, std::nullopt);
+  charsDue_.insert(charsDue_.end(), charsPending_.begin(), charsPending_.end());
+  charsPending_.clear();
+  if (cursorPending_) cursorDue_ = std::exchange(cursorPending_, std::nullopt);
+  if (keyReleasePending_.any() || modsDue_ || cursorDue_) arrived_ = true;
+  keyReleasePending_.reset();
+  keyPressedThisFrame_.reset();
+  movedSinceFrame_ = false;
+}
+
+// ImGui drops characters typed while Ctrl is down: those that follow a held Ctrl+key wait for its modifiers.
+void DesktopInput::character(unsigned int c) {
+  arrived_ = true;
+  if (modsPending_)
+    charsPending_.push_back(c);
+  else if (modsDue_ || !charsDue_.empty())
+    charsDue_.push_back(c);
+  else
+    ImGui::GetIO().AddInputCharacter(c);
+}
+
+void DesktopInput::panelFrameStart() {
+  if (modsDue_) applyMods(*std::exchange(modsDue_, std::nullopt));
+  for (unsigned int c : charsDue_)
+    ImGui::GetIO().AddInputCharacter(c);
+  charsDue_.clear();
+  if (cursorDue_) ImGui::GetIO().MousePos = ImVec2(float(cursorDue_->x), float(cursorDue_->y));
+  cursorDue_.reset();
+}
+
+void DesktopInput::applyMods(int mods) {
+  ImGuiIO& io = ImGui::GetIO();
+  io.KeyCtrl = mods & GLFW_MOD_CONTROL;
+  io.KeyShift = mods & GLFW_MOD_SHIFT;
+  io.KeyAlt = mods & GLFW_MOD_ALT;
+  io.KeySuper = mods & GLFW_MOD_SUPER;
 }
 
 bool DesktopInput::panelWantsKeyboard() const {
@@ -149,7 +194,16 @@ bool DesktopInput::panelWantsKeyboard() const {
 void DesktopInput::cursor(double x, double y) {
   arrived_ = true;
   cursor_ = toPixels(x, y);
-  ImGui::GetIO().MousePos = ImVec2(float(cursor_.x), float(cursor_.y));
+  movedSinceFrame_ = true;
+  // A button pressed since the last frame is seen by ImGui where it was pressed (a click, then a move
+  // away before the frame is built, is still a click on the control under the press).
+  const bool held = pressedThisFrame_[0] || pressedThisFrame_[1] || pressedThisFrame_[2];
+  if (held && panelVisible_) {
+    cursorPending_ = cursor_;
+  } else {
+    cursorDue_.reset();
+    ImGui::GetIO().MousePos = ImVec2(float(cursor_.x), float(cursor_.y));
+  }
   if (dragging_ || !panelWantsMouse()) session_.mouseMove(cursor_);
 }
 
@@ -181,7 +235,7 @@ void DesktopInput::button(int button, int action, int mods) {
     dragging_ = false;
     return;
   }
-  if (panelWantsMouse() || overPanel()) return;
+  if (forPanel() || overPanel()) return;
   // Ctrl+click: the pick tool, not a drag; with Shift the picked point is the next vertex of a measurement.
   if (which == MouseButton::Left && (mods & GLFW_MOD_CONTROL)) {
     toolPress_ = {cursor_, (mods & GLFW_MOD_SHIFT) != 0};
@@ -204,8 +258,10 @@ void DesktopInput::button(int button, int action, int mods) {
 
 void DesktopInput::scroll(double y) {
   arrived_ = true;
-  ImGui::GetIO().MouseWheel += float(y);
-  if (!panelWantsMouse()) wheel_ += y;
+  if (forPanel())
+    ImGui::GetIO().MouseWheel += float(y);
+  else
+    wheel_ += y;
 }
 
 std::optional<WheelInput> DesktopInput::takeWheel() {
@@ -215,12 +271,29 @@ std::optional<WheelInput> DesktopInput::takeWheel() {
 
 void DesktopInput::key(int key, int action, int mods) {
   arrived_ = true;
+  // X11 reports the modifiers as they were before the event: a modifier's own release still holds it.
+  if (action == GLFW_RELEASE) {
+    if (key == GLFW_KEY_LEFT_CONTROL || key == GLFW_KEY_RIGHT_CONTROL) mods &= ~GLFW_MOD_CONTROL;
+    if (key == GLFW_KEY_LEFT_SHIFT || key == GLFW_KEY_RIGHT_SHIFT) mods &= ~GLFW_MOD_SHIFT;
+    if (key == GLFW_KEY_LEFT_ALT || key == GLFW_KEY_RIGHT_ALT) mods &= ~GLFW_MOD_ALT;
+    if (key == GLFW_KEY_LEFT_SUPER || key == GLFW_KEY_RIGHT_SUPER) mods &= ~GLFW_MOD_SUPER;
+  }
+  // As with the mouse buttons: a key released in the frame of its press (a quick tap, Ctrl+A typed by a
+  // script) stays down, with its modifiers, until ImGui has seen it once.
   ImGuiIO& io = ImGui::GetIO();
-  if (key >= 0 && key < int(IM_ARRAYSIZE(io.KeysDown))) io.KeysDown[key] = action != GLFW_RELEASE;
-  io.KeyCtrl = mods & GLFW_MOD_CONTROL;
-  io.KeyShift = mods & GLFW_MOD_SHIFT;
-  io.KeyAlt = mods & GLFW_MOD_ALT;
-  io.KeySuper = mods & GLFW_MOD_SUPER;
+  if (key >= 0 && size_t(key) < keyPressedThisFrame_.size()) {
+    if (action == GLFW_PRESS) keyPressedThisFrame_[size_t(key)] = true;
+    if (action == GLFW_RELEASE && keyPressedThisFrame_[size_t(key)] && panelVisible_)
+      keyReleasePending_[size_t(key)] = true;
+    else
+      io.KeysDown[key] = action != GLFW_RELEASE;
+  }
+  if (keyReleasePending_.any() && panelVisible_) {
+    modsPending_ = mods;
+  } else {
+    modsDue_.reset();
+    applyMods(mods);
+  }
   // Ctrl+S saves the measurements (not the S of flying).
   if (key == GLFW_KEY_S && (mods & GLFW_MOD_CONTROL)) {
     if (action == GLFW_PRESS && !panelWantsKeyboard()) saveMeasurements_ = true;

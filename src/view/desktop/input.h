@@ -3,8 +3,10 @@
 #pragma once
 
 #include <array>
+#include <bitset>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -33,11 +35,14 @@ public:
   DesktopInput(GLFWwindow* window, Session& session);
 
   void setPanelVisible(bool visible) { panelVisible_ = visible; }
-  // The panel window's rectangle (x, y, width, height) in the last frame: a press inside it belongs to the
-  // panel, whatever ImGui's capture flag said in that frame (the cursor may just have arrived).
-  void setPanelRect(const std::array<float, 4>& rect) { panelRect_ = rect; }
-  // After ImGui::NewFrame: releases that came in the same frame as their press are handed over now, so
-  // that ImGui 1.86, which polls the button state once a frame, sees a quick click as a click.
+  // The panel's windows' rectangles (x, y, width, height) in the last frame: a press inside one belongs to
+  // the panel, whatever ImGui's capture flag said in that frame (the cursor may just have arrived).
+  void setPanelRects(std::vector<std::array<float, 4>> rects) { panelRects_ = std::move(rects); }
+  // After ImGui::NewFrame: releases of buttons and keys that came in the same frame as their press are
+  // handed over now, so that ImGui 1.86, which polls the input state once a frame, sees a quick click or
+  // key tap; panelFrameStart, before the next NewFrame, hands over what came after them (the cursor's
+  // moves, the modifiers).
+  void panelFrameStart();
   void panelFrameDone();
   // Whether any event arrived since the last call (the panel must be redrawn).
   bool takeArrived() { return std::exchange(arrived_, false); }
@@ -52,18 +57,28 @@ private:
   glm::dvec2 toPixels(double x, double y) const;
   bool panelWantsMouse() const;
   bool overPanel() const;
+  bool forPanel() const;
   bool panelWantsKeyboard() const;
   void cursor(double x, double y);
   void button(int button, int action, int mods);
   void scroll(double y);
   void key(int key, int action, int mods);
+  void character(unsigned int c);
 
   GLFWwindow* window_;
   Session& session_;
   bool panelVisible_ = true;
-  std::array<float, 4> panelRect_{0, 0, 0, 0};
+  std::vector<std::array<float, 4>> panelRects_;
+  bool movedSinceFrame_ = false;
+  void applyMods(int mods);
+
   bool pressedThisFrame_[3] = {false, false, false};
   bool releasePending_[3] = {false, false, false};
+  std::bitset<512> keyPressedThisFrame_, keyReleasePending_; // by GLFW key code, as io.KeysDown
+  // Modifiers that came after a held release, the cursor's place after a held press; due: for the next frame.
+  std::optional<int> modsPending_, modsDue_;
+  std::optional<glm::dvec2> cursorPending_, cursorDue_;
+  std::vector<unsigned int> charsPending_, charsDue_; // characters typed after held modifiers
   bool arrived_ = true;
   bool dragging_ = false;
   glm::dvec2 cursor_{0};

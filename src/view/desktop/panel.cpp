@@ -10,6 +10,7 @@
 #include "base/progress.h"
 #include "cloud/attribute_colors.h"
 #include "shared.h"
+#include "view/desktop/panel_renderer.h"
 
 namespace pointrast::view {
 
@@ -25,6 +26,67 @@ constexpr Preset kBackgrounds[] = {{"Black", 0xFF000000u}, {"White", 0xFFFFFFFFu
 void remember(PanelItems& items, const std::string& label) {
   ImVec2 min = ImGui::GetItemRectMin(), max = ImGui::GetItemRectMax();
   items[label] = {min.x, min.y, max.x - min.x, max.y - min.y};
+}
+
+// Profile: the line typed or taken from the latest measurement (its vertices' x and y), the strip's width,
+// Cut to show the side view in a window of its own, and the exports to the typed file, whose extension the
+// button sets (.las, .csv, .png).
+void profileControls(Session& session, PanelInfo& info, PanelActions& actions, PanelItems& items) {
+  char* text = info.profileLineText.data();
+  if (ImGui::Button("From measurement")) {
+    const Annotations& all = session.measurements().all();
+    for (size_t i = all.items.size(); i-- > 0;) {
+      const Annotation& a = all.items[i];
+      if (a.points.size() < 2 || (a.kind != AnnotationKind::Distance && a.kind != AnnotationKind::Area))
+        continue;
+      std::string line;
+      char number[64];
+      for (const glm::dvec3& p : a.points) {
+        std::snprintf(number, sizeof number, "%s%.3f,%.3f", line.empty() ? "" : ",", p.x, p.y);
+        line += number;
+      }
+      if (line.size() < info.profileLineText.size())
+        std::snprintf(text, info.profileLineText.size(), "%s", line.c_str());
+      break;
+    }
+  }
+  remember(items, "From measurement");
+  ImGui::InputText("line", text, info.profileLineText.size());
+  remember(items, "line");
+  ImGui::InputDouble("width", &info.profileWidth, 0, 0, "%.3f");
+  remember(items, "width");
+  ImGui::InputTextWithHint("file##profile", "pointrast-profile beside the screenshots",
+                           info.profileFileText.data(), info.profileFileText.size());
+  remember(items, "profile file");
+  if (ImGui::Button("Cut")) actions.profile = true;
+  remember(items, "Cut");
+  ImGui::BeginDisabled(info.profileImageWidth == 0);
+  ImGui::SameLine();
+  if (ImGui::Button("Profile LAS")) actions.profileLas = true;
+  remember(items, "Profile LAS");
+  ImGui::SameLine();
+  if (ImGui::Button("Profile CSV")) actions.profileCsv = true;
+  remember(items, "Profile CSV");
+  ImGui::SameLine();
+  if (ImGui::Button("Profile PNG")) actions.profilePng = true;
+  remember(items, "Profile PNG");
+  ImGui::EndDisabled();
+  if (!info.profileStatus.empty()) ImGui::TextWrapped("%s", info.profileStatus.c_str());
+}
+
+// The last cut profile in a window of its own, at the picture's size, first shown in the bottom right
+// corner of the view, clear of the panel at the top left.
+void profileWindow(const PanelInfo& info, PanelItems& items) {
+  if (info.profileImageWidth == 0) return;
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(display.x - 8, display.y - 8), ImGuiCond_Appearing, ImVec2(1, 1));
+  ImGui::Begin("Profile", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::Image(reinterpret_cast<ImTextureID>(PanelRenderer::kImageId),
+               ImVec2(float(info.profileImageWidth), float(info.profileImageHeight)));
+  remember(items, "profile image");
+  const ImVec2 position = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  items["profile window"] = {position.x, position.y, size.x, size.y};
+  ImGui::End();
 }
 
 void methodCombo(const PanelInfo& info, ViewSettings& settings, PanelItems& items) {
@@ -186,8 +248,8 @@ struct Budget {
   const char* label;
   uint64_t points;
 };
-constexpr Budget kBudgets[] = {{"none", 0}, {"1M", 1'000'000}, {"3M", 3'000'000}, {"10M", 10'000'000},
-                               {"30M", 30'000'000}};
+constexpr Budget kBudgets[] = {
+    {"none", 0}, {"1M", 1'000'000}, {"3M", 3'000'000}, {"10M", 10'000'000}, {"30M", 30'000'000}};
 
 void lodControls(ViewSettings& settings, PanelItems& items) {
   float minPx = float(settings.minNodePx);
@@ -337,8 +399,9 @@ void toolControls(Session& session, const PanelInfo& info, PanelActions& actions
   ImGui::TextUnformatted("Ctrl+drag a vertex: move it");
   if (!info.picked.empty()) ImGui::TextUnformatted(info.picked.c_str());
   MeasureTool& tool = session.measurements();
-  const std::pair<AnnotationKind, const char*> kinds[] = {
-      {AnnotationKind::Distance, "distance"}, {AnnotationKind::Height, "height"}, {AnnotationKind::Area, "area"}};
+  const std::pair<AnnotationKind, const char*> kinds[] = {{AnnotationKind::Distance, "distance"},
+                                                          {AnnotationKind::Height, "height"},
+                                                          {AnnotationKind::Area, "area"}};
   for (const auto& [kind, name] : kinds) {
     ImGui::SameLine();
     if (ImGui::RadioButton(name, tool.measureKind == kind)) {
@@ -432,7 +495,9 @@ PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& setting
   methodCombo(info, settings, items);
   depthControls(settings, items);
   backgroundControls(settings, items);
-  if (ImGui::CollapsingHeader("Look", ImGuiTreeNodeFlags_DefaultOpen)) {
+  const bool lookOpen = ImGui::CollapsingHeader("Look", ImGuiTreeNodeFlags_DefaultOpen);
+  remember(items, "Look");
+  if (lookOpen) {
     colorControls(session, settings, items);
     ImGui::BeginDisabled(!takesPost(settings.method));
     pointControls(settings, items);
@@ -446,8 +511,9 @@ PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& setting
     lodControls(settings, items);
     ImGui::EndDisabled();
   }
-  if (ImGui::CollapsingHeader("Stereo and foveation", ImGuiTreeNodeFlags_DefaultOpen))
-    stereoControls(settings, items);
+  const bool stereoOpen = ImGui::CollapsingHeader("Stereo and foveation", ImGuiTreeNodeFlags_DefaultOpen);
+  remember(items, "Stereo and foveation");
+  if (stereoOpen) stereoControls(settings, items);
   // A value render would refuse (a slider typed past its end with Ctrl+click) keeps the last good settings.
   try {
     validateSettings(settings);
@@ -463,6 +529,9 @@ PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& setting
   const bool clipOpen = ImGui::CollapsingHeader("Clip and export");
   remember(items, "Clip and export");
   if (clipOpen) clipControls(session, info, settings, actions, items);
+  const bool profileOpen = ImGui::CollapsingHeader("Profile");
+  remember(items, "Profile");
+  if (profileOpen) profileControls(session, info, actions, items);
   ImGui::TextDisabled("drag: orbit  right/middle drag: pan  wheel: zoom\n"
                       "double-click: pivot  WASD QE: fly (Shift: fast)\n"
                       "8 2 5 0 4 6: views  F: frame all  K: keyframe\n"
@@ -470,6 +539,7 @@ PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& setting
   ImVec2 position = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   items["panel"] = {position.x, position.y, size.x, size.y};
   ImGui::End();
+  profileWindow(info, items);
   return actions;
 }
 

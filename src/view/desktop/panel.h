@@ -25,6 +25,14 @@ struct PanelInfo {
   std::string exported;        // the last export's file and points, or why it failed
   // The clip box as typed (min then max corner, six numbers), kept between frames.
   std::array<char, 256> clipBoxText{};
+  // The profile: its line as typed (x1,y1,x2,y2,...), the strip's width, the last cut's message, and the
+  // size of the picture shown in the Profile window (0: none yet).
+  std::array<char, 2048> profileLineText{};
+  std::array<char, 1024> profileFileText{}; // where the exports go (the button sets the extension); empty:
+                                            // beside the screenshots
+  double profileWidth = 1;
+  std::string profileStatus;
+  uint32_t profileImageWidth = 0, profileImageHeight = 0;
 };
 
 struct PanelActions {
@@ -36,6 +44,8 @@ struct PanelActions {
   bool saveMeasurements = false;
   std::optional<size_t> deleteMeasurement;
   bool exportLas = false; // write the points the clip box keeps (with the clip mode) as LAS
+  bool profile = false;   // cut the profile of the typed line and width, and show it
+  bool profileLas = false, profileCsv = false, profilePng = false; // write the profile's points or picture
 };
 
 // Screen rectangles (x, y, width, height in pixels) of the panel's controls by label, for --events.

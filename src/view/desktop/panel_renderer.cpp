@@ -1,6 +1,7 @@
 #include "view/desktop/panel_renderer.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 #include <imgui.h>
@@ -51,6 +52,15 @@ PanelRenderer::PanelRenderer(gpu::Context& context, VkFormat colorFormat)
   io.Fonts->SetTexID(reinterpret_cast<ImTextureID>(intptr_t(1)));
 }
 
+void PanelRenderer::setImage(uint32_t width, uint32_t height, const uint32_t* rgba) {
+  const uint64_t bytes = uint64_t(width) * height * 4;
+  image_ = gpu::Buffer(context_, std::max<uint64_t>(bytes, 4), gpu::kBufferUsage, gpu::MemoryKind::Upload,
+                       "panel image");
+  std::memcpy(image_.mapped(), rgba, bytes);
+  imageWidth_ = width;
+  imageHeight_ = height;
+}
+
 void PanelRenderer::upload(const ImDrawData& data) {
   uint64_t vertexBytes = uint64_t(data.TotalVtxCount) * sizeof(ImDrawVert);
   // Indices are read two to a uint: round up so the last half-read stays inside the buffer.
@@ -90,6 +100,11 @@ void PanelRenderer::record(VkCommandBuffer cmd, const ImDrawData& data, uint32_t
       if (x1 <= x0 || y1 <= y0) continue;
       VkRect2D scissor{{int32_t(x0), int32_t(y0)}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
       gpu::vkCmdSetScissor(cmd, 0, 1, &scissor);
+      const bool image = draw.TextureId == reinterpret_cast<ImTextureID>(kImageId) && image_;
+      push.image = image ? 1 : 0;
+      push.font = image ? image_.address() : font_.address();
+      push.fontWidth = image ? imageWidth_ : fontWidth_;
+      push.fontHeight = image ? imageHeight_ : fontHeight_;
       push.firstIndex = indexBase + draw.IdxOffset;
       push.vertexOffset = vertexBase + draw.VtxOffset;
       program_.draw(cmd, draw.ElemCount, push);

@@ -19,6 +19,11 @@ public:
   // Builds the current ImGui context's font atlas into a buffer. colorFormat: the target's format.
   PanelRenderer(gpu::Context& context, VkFormat colorFormat);
 
+  // The picture ImGui::Image(kImageId, ...) shows: width x height RGBA8 pixels, row 0 at the top, copied.
+  // Call between frames (present() waits for its pass, so the previous picture is no longer read).
+  static constexpr intptr_t kImageId = 2;
+  void setImage(uint32_t width, uint32_t height, const uint32_t* rgba);
+
   // Uploads the draw lists (before the command buffer is recorded).
   void upload(const ImDrawData& data);
   // Records the draws, inside vkCmdBeginRendering on a width x height target, after upload().
@@ -29,6 +34,8 @@ private:
   gpu::GraphicsProgram program_;
   gpu::Buffer font_, vertices_, indices_;
   uint32_t fontWidth_ = 0, fontHeight_ = 0;
+  gpu::Buffer image_;
+  uint32_t imageWidth_ = 0, imageHeight_ = 0;
 };
 
 } // namespace pointrast::view

@@ -31,6 +31,10 @@ public:
   };
   // panel: the panel's draw data, or null when the panel is hidden.
   Result present(const ShownImage& image, const ImDrawData* panel);
+  // The picture the panel shows with ImGui::Image(PanelRenderer::kImageId, ...).
+  void setPanelImage(uint32_t width, uint32_t height, const uint32_t* rgba) {
+    panel_.setImage(width, height, rgba);
+  }
 
 private:
   gpu::Context& context_;

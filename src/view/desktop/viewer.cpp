@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -24,6 +25,7 @@
 #include "view/desktop/panel.h"
 #include "view/desktop/presenter.h"
 #include "view/flight.h"
+#include "view/profile_tool.h"
 #include "view/scene_view.h"
 
 namespace pointrast::view {
@@ -118,6 +120,7 @@ private:
   void saveKeyframes();
   void saveMeasurements();
   void exportClipped();
+  void cutProfile(const PanelActions& actions);
   ImDrawData* buildPanelFrame(double seconds);
 
   const ViewerOptions& options_;
@@ -184,6 +187,9 @@ Viewer::Viewer(SceneInput& input, const ViewerOptions& options, gpu::Context& co
   if (!options.annotationsFile.empty() && std::filesystem::exists(options.annotationsFile, error))
     session_.measurements().load(io::loadAnnotations(options.annotationsFile));
   info_.methods = methodsFor(*source_, context);
+  // A strip a hundredth of the cloud's larger horizontal extent wide.
+  const glm::dvec3 extent = input.bounds.max - input.bounds.min;
+  info_.profileWidth = std::max(extent.x, extent.y) > 0 ? std::max(extent.x, extent.y) / 100 : 1;
 }
 
 ImDrawData* Viewer::buildPanelFrame(double seconds) {
@@ -192,12 +198,15 @@ ImDrawData* Viewer::buildPanelFrame(double seconds) {
   ImGuiIO& io = ImGui::GetIO();
   io.DisplaySize = ImVec2(float(swapchain_.width()), float(swapchain_.height()));
   io.DeltaTime = float(std::max(seconds, 1e-4));
+  input_.panelFrameStart();
   ImGui::NewFrame();
   input_.panelFrameDone();
   ViewSettings edited = session_.settings();
   PanelActions actions = buildPanel(session_, info_, edited, items_);
   ImGui::Render();
-  input_.setPanelRect(items_["panel"]);
+  std::vector<std::array<float, 4>> rects = {items_["panel"]};
+  if (items_.count("profile window")) rects.push_back(items_["profile window"]);
+  input_.setPanelRects(std::move(rects));
   session_.setSettings(edited);
   handlePanel(actions);
   return ImGui::GetDrawData();
@@ -216,9 +225,69 @@ void Viewer::handlePanel(const PanelActions& actions) {
     saveKeyframes();
   }
   if (actions.screenshot) takeScreenshot();
-  if (actions.deleteMeasurement && session_.measurements().remove(*actions.deleteMeasurement)) session_.invalidate();
+  if (actions.deleteMeasurement && session_.measurements().remove(*actions.deleteMeasurement))
+    session_.invalidate();
   if (actions.saveMeasurements) saveMeasurements();
   if (actions.exportLas) exportClipped();
+  if (actions.profile || actions.profileLas || actions.profileCsv || actions.profilePng) cutProfile(actions);
+}
+
+// The profile of the panel's line and width through `pointrast profile`'s code (view/profile_tool.h), read
+// from the input file: Cut shows its picture; an export writes the panel's file (temporary name, renamed).
+void Viewer::cutProfile(const PanelActions& actions) {
+  constexpr uint32_t kProfileWidth = 720, kProfileHeight = 300;
+  nlohmann::json event = {{"event", "profile"}};
+  try {
+    ProfileRequest request;
+    request.input = options_.inputFile.string();
+    std::error_code error;
+    if (request.input.empty() || !std::filesystem::exists(options_.inputFile, error))
+      throw InputError("a profile is cut from a file or octree, not " + info_.input);
+    request.line.vertices = parseProfileVertices(info_.profileLineText.data(), "the profile's line", 1000);
+    request.line.width = info_.profileWidth;
+    if (!(request.line.width > 0) || !std::isfinite(request.line.width))
+      throw InputError("the profile's width must be a positive length");
+    if (!(profileLength(request.line) > 0)) throw InputError("the profile's line has no length");
+    request.filter = session_.settings().filter;
+    std::filesystem::path file;
+    const bool exporting = actions.profileLas || actions.profileCsv || actions.profilePng;
+    if (exporting) {
+      file = info_.profileFileText.data();
+      if (file.empty()) file = options_.screenshotDir / "pointrast-profile";
+      if (!file.has_filename()) throw InputError("type the file to export the profile to");
+      file.replace_extension(actions.profileLas ? ".las" : actions.profileCsv ? ".csv" : ".png");
+    }
+    if (actions.profile || actions.profilePng) {
+      request.imageWidth = kProfileWidth;
+      request.imageHeight = kProfileHeight;
+    }
+    if (actions.profileLas) request.las = file.string();
+    if (actions.profileCsv) request.csv = file.string();
+    const ProfileResult result = view::cutProfile(request);
+    if (!result.pixels.empty()) {
+      presenter_.setPanelImage(request.imageWidth, request.imageHeight, result.pixels.data());
+      info_.profileImageWidth = request.imageWidth;
+      info_.profileImageHeight = request.imageHeight;
+    }
+    if (actions.profilePng) io::writePng(file, request.imageWidth, request.imageHeight, result.pixels.data());
+    info_.profileStatus =
+        std::to_string(result.points) + " points" + (file.empty() ? "" : " in " + file.string());
+    event["points"] = result.points;
+    event["line"] = info_.profileLineText.data();
+    event["strip_width"] = request.line.width;
+    event["width"] = request.imageWidth;
+    event["height"] = request.imageHeight;
+    if (!file.empty()) event["file"] = file.string();
+  } catch (const InputError& e) {
+    info_.profileStatus = e.what();
+    event["error"] = e.what();
+    if (!options_.events) std::fprintf(stderr, "%s\n", e.what());
+  }
+  if (options_.events)
+    emit(event);
+  else if (!event.contains("error"))
+    std::printf("profile: %s\n", info_.profileStatus.c_str());
+  std::fflush(stdout);
 }
 
 // The input's points that the applied clip box keeps, as LAS beside the screenshots, through convert's
@@ -261,9 +330,12 @@ void Viewer::saveMeasurements() {
   const Annotations annotations = session_.measurements().complete();
   io::saveAnnotations(options_.annotationsFile, annotations);
   if (options_.events)
-    emit({{"event", "annotations"}, {"count", annotations.items.size()}, {"file", options_.annotationsFile.string()}});
+    emit({{"event", "annotations"},
+          {"count", annotations.items.size()},
+          {"file", options_.annotationsFile.string()}});
   else
-    std::printf("measurements: %s (%zu)\n", options_.annotationsFile.string().c_str(), annotations.items.size());
+    std::printf("measurements: %s (%zu)\n", options_.annotationsFile.string().c_str(),
+                annotations.items.size());
   std::fflush(stdout);
 }
 
