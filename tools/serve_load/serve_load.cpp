@@ -13,6 +13,7 @@
 //   serve_load --port 8080 [--host 127.0.0.1] [--token T] [--width 1920] [--height 1080] [--seconds 10]
 //              [--rate 120] [--isolated 30] [--flight] [--no-decode] [-o result.json] [--markdown result.md]
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -103,11 +104,14 @@ private:
   std::map<uint32_t, double> pointsByFrame_;                      // frame id -> its state's lod.pointsDrawn
   std::map<uint32_t, std::pair<double, double>> serverMsByFrame_; // frame id -> inputWaitMs, frameWallMs
   std::vector<double> receivedLatencies_; // ms, as latencies_ but to the frame's message before decoding
+  std::vector<std::pair<uint32_t, double>>
+      sentLog_; // every input's seq and send time, since the flight began
 };
 
 uint32_t Load::send(Json message) {
   message["seq"] = ++seq_;
   sentAt_[seq_] = clockSeconds();
+  sentLog_.emplace_back(seq_, sentAt_[seq_]);
   ws_.sendText(message.dump());
   return seq_;
 }
@@ -328,6 +332,54 @@ bool writeFile(const std::string& path, const std::string& text) {
 // `--flight` plays the same) carry it sideways at that height, across the cloud and back, for --seconds, a
 // pointer move every 1/rate s. Every node the flight needs is streamed while it flies; a frame never waits
 // for one.
+// The machine's own scheduling delays while the flight runs, apart from pointrast: a thread of this process
+// that sleeps 1 ms at a time and records how late it wakes, and the share of CPU time the hypervisor took
+// (the steal column of /proc/stat).
+class Canary {
+public:
+  Canary()
+      : stealFrom_(steal()), thread_([this] {
+          while (!stop_) {
+            const double t = clockSeconds();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            late_.push_back(std::max(0.0, (clockSeconds() - t) * 1e3 - 1.0));
+          }
+        }) {}
+  Json finish() {
+    stop_ = true;
+    thread_.join();
+    const auto to = steal();
+    Json j = {{"late_ms",
+               {{"p50", percentile(late_, 0.5)},
+                {"p95", percentile(late_, 0.95)},
+                {"p99", percentile(late_, 0.99)},
+                {"max", late_.empty() ? 0.0 : *std::max_element(late_.begin(), late_.end())},
+                {"wakes", late_.size()}}}};
+    if (to.second > stealFrom_.second)
+      j["steal_percent"] =
+          100.0 * double(to.first - stealFrom_.first) / double(to.second - stealFrom_.second);
+    return j;
+  }
+
+private:
+  // Steal and total jiffies of all CPUs.
+  static std::pair<uint64_t, uint64_t> steal() {
+    std::ifstream in("/proc/stat");
+    std::string cpu;
+    uint64_t v[8] = {}, total = 0;
+    in >> cpu;
+    for (uint64_t& x : v) {
+      in >> x;
+      total += x;
+    }
+    return {v[7], total};
+  }
+  std::pair<uint64_t, uint64_t> stealFrom_;
+  std::atomic<bool> stop_{false};
+  std::vector<double> late_;
+  std::thread thread_;
+};
+
 Json Load::flightPhase() {
   send({{"t", "stream"}, {"motionScale", 0.5}});
   for (int i = 0; i < 6; ++i) {
@@ -339,6 +391,8 @@ Json Load::flightPhase() {
   latencies_.clear();
   receivedLatencies_.clear();
   sentAt_.clear();
+  Canary canary;
+  sentLog_.clear();
   double start = clockSeconds(), next = start;
   const double stroke = 1.5; // seconds a stroke
   bool down = false;
@@ -371,6 +425,7 @@ Json Load::flightPhase() {
   }
   if (down) send(pointer("up", view::flightStroke(strokes, 1.0)));
   double elapsed = clockSeconds() - start;
+  Json machine = canary.finish();
   std::vector<Frame> flown = frames_;
   std::vector<double> latencies = latencies_;
   const std::vector<double> receivedLatencies = receivedLatencies_;
@@ -408,7 +463,23 @@ Json Load::flightPhase() {
               {"input_to_frame_received_ms", summary(receivedLatencies)},
               {"frame_decode_ms", spread(decodeMs)},
               {"server_input_wait_ms", spread(waitMs)},
-              {"server_frame_wall_ms", spread(wallMs)}};
+              {"server_frame_wall_ms", spread(wallMs)},
+              {"machine", machine}};
+  // Frame by frame (ms from the flight's start): when each arrived and was decoded, its input sequence
+  // number, and the server's figures, to see where a late input's time went.
+  Json trace = Json::array();
+  for (const Frame& f : flown)
+    trace.push_back({(f.received - start) * 1e3, (f.arrived - start) * 1e3, f.header.seq, f.header.frame,
+                     f.header.renderMs, f.header.encodeMs, f.serverInputWaitMs.value_or(-1),
+                     f.serverFrameWallMs.value_or(-1)});
+  out["trace_columns"] = {
+      "received_ms",          "decoded_ms",          "seq", "frame", "render_ms", "encode_ms",
+      "server_input_wait_ms", "server_frame_wall_ms"};
+  out["trace"] = trace;
+  Json sends = Json::array();
+  for (const auto& [seq, at] : sentLog_)
+    sends.push_back({seq, (at - start) * 1e3});
+  out["sent"] = sends;
   if (!points.empty()) {
     std::sort(points.begin(), points.end());
     out["points_drawn"] = {
@@ -528,6 +599,18 @@ int Load::runFlight(const Frame& first, Json result) {
     md += row("server: JPEG encode", flight["frame_encode_ms"]);
     md += row("here: JPEG decode", flight["frame_decode_ms"]);
     md += row("between frames arriving", flight["frame_gap_ms"]);
+    if (flight.contains("machine")) {
+      const Json& m = flight["machine"];
+      md +=
+          "\nThe machine while flying, apart from pointrast: a thread sleeping 1 ms at a time woke late by " +
+          format("p50 %.2f, p95 %.2f, p99 %.2f, max %.1f ms", m["late_ms"]["p50"].get<double>(),
+                 m["late_ms"]["p95"].get<double>(), m["late_ms"]["p99"].get<double>(),
+                 m["late_ms"]["max"].get<double>()) +
+          (m.contains("steal_percent")
+               ? format("; the hypervisor took %.2f %% of CPU time (steal)", m["steal_percent"].get<double>())
+               : std::string()) +
+          ".\n";
+    }
     md += "\n| jump | converged | frames to converge | ms |\n| --- | --- | ---: | ---: |\n";
     for (const Json& j : jumped)
       md += "| " + j["jump"].get<std::string>() + " | " + (j["converged"].get<bool>() ? "yes" : "no") +
