@@ -603,9 +603,9 @@ int Load::runFlight(const Frame& first, Json result) {
       const Json& m = flight["machine"];
       md +=
           "\nThe machine while flying, apart from pointrast: a thread sleeping 1 ms at a time woke late by " +
-          format("p50 %.2f, p95 %.2f, p99 %.2f, max %.1f ms", m["late_ms"]["p50"].get<double>(),
-                 m["late_ms"]["p95"].get<double>(), m["late_ms"]["p99"].get<double>(),
-                 m["late_ms"]["max"].get<double>()) +
+          format("p50 %.2f, p95 %.2f, p99 %.2f", m["late_ms"]["p50"].get<double>(),
+                 m["late_ms"]["p95"].get<double>(), m["late_ms"]["p99"].get<double>()) +
+          format(", max %.1f ms", m["late_ms"]["max"].get<double>()) +
           (m.contains("steal_percent")
                ? format("; the hypervisor took %.2f %% of CPU time (steal)", m["steal_percent"].get<double>())
                : std::string()) +
