@@ -18,9 +18,13 @@ void MotionQuality::input(double time) {
 }
 
 FrameQuality MotionQuality::next(const Camera& camera, double now) const {
-  if (!last_ || !changed(camera)) return FrameQuality::Full;
-  bool framesMove = now - lastChange_ < kRestSeconds;
-  bool inputsMove = inputsContinue_ && now - lastInput_ < kRestSeconds;
+  if (!last_) return FrameQuality::Full;
+  const bool inputsMove = inputsContinue_ && now - lastInput_ < kRestSeconds;
+  // The same camera: a settings change at rest shows at full quality at once. While the user's inputs
+  // still move the camera, a frame drawn because the content changed under it (level-of-detail nodes
+  // arrived) stays a motion frame: a full frame's encoding and decoding would hold up the inputs behind it.
+  if (!changed(camera)) return inputsMove ? FrameQuality::Motion : FrameQuality::Full;
+  const bool framesMove = now - lastChange_ < kRestSeconds;
   return framesMove || inputsMove ? FrameQuality::Motion : FrameQuality::Full;
 }
 

@@ -29,7 +29,8 @@ public:
   void input(double time);
   // The quality of the frame about to be rendered at `now` with `camera`: Motion when the camera differs
   // from the last frame's and either the previous change was less than kRestSeconds ago, or the latest
-  // input followed the one before within kRestSeconds and is itself less than kRestSeconds old.
+  // input followed the one before within kRestSeconds and is itself less than kRestSeconds old; with the
+  // camera of the last frame (new content, other settings), Motion only while such inputs continue.
   FrameQuality next(const Camera& camera, double now) const;
   // Records a rendered frame.
   void rendered(const Camera& camera, FrameQuality quality, double now);

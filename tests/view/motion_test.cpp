@@ -68,6 +68,26 @@ TEST(MotionQuality, ADragStaysMotionWhenFramesAreSlowerThanTheRest) {
   EXPECT_EQ(q.next(at(3), 20.1), FrameQuality::Full);
 }
 
+// A drag over an octree: between two moves, nodes arrive and a frame is drawn with the camera of the last
+// one. While the moves continue it is a motion frame (a full frame's JPEG held up the inputs behind it);
+// once they stop, the refinement is full.
+TEST(MotionQuality, NewContentDuringADragIsMotionAndAtRestFull) {
+  MotionQuality q;
+  q.rendered(at(0), FrameQuality::Full, 0.0);
+  double t = 1.0;
+  for (int i = 1; i <= 10; ++i, t += 0.008) {
+    q.input(t);
+    EXPECT_EQ(q.next(at(i), t), i == 1 ? FrameQuality::Full : FrameQuality::Motion) << i;
+    q.rendered(at(i), q.next(at(i), t), t);
+  }
+  // Nodes arrived 4 ms after the last move: the same camera, drawn again.
+  EXPECT_EQ(q.next(at(10), t + 0.004), FrameQuality::Motion);
+  q.rendered(at(10), FrameQuality::Motion, t + 0.004);
+  // The drag ended: after kRestSeconds the full frame is due, and new content at rest is full at once.
+  EXPECT_TRUE(q.refineDue(t + kRestSeconds));
+  EXPECT_EQ(q.next(at(10), t + kRestSeconds), FrameQuality::Full);
+}
+
 TEST(MotionQuality, SameCameraComparesEveryField) {
   Camera a = at(1), b = at(1);
   EXPECT_TRUE(sameCamera(a, b));
