@@ -11,6 +11,7 @@
 
 #include "cloud/annotations.h"
 #include "io/annotations_file.h"
+#include "las_records.h"
 #include "viewer_harness.h"
 
 namespace pointrast::test {
@@ -304,29 +305,8 @@ TEST_F(ViewerTools, CtrlDragMovesAMeasurementsVertexToThePointUnderTheRelease) {
   finish(*viewer);
 }
 
-// The point records of a LAS file, each as its bytes, sorted: the file's multiset of points.
 std::vector<std::string> sortedRecords(const std::filesystem::path& file) {
-  const std::string bytes = shellOutput("cat '" + file.string() + "'");
-  std::vector<std::string> records;
-  if (bytes.size() < 227 || bytes.compare(0, 4, "LASF") != 0) {
-    ADD_FAILURE() << file << " is not a LAS file";
-    return records;
-  }
-  uint32_t start = 0, count32 = 0;
-  uint16_t length = 0;
-  std::memcpy(&start, bytes.data() + 96, 4);
-  std::memcpy(&length, bytes.data() + 105, 2);
-  std::memcpy(&count32, bytes.data() + 107, 4);
-  uint64_t count = count32;
-  if (count == 0 && bytes.size() >= 255) std::memcpy(&count, bytes.data() + 247, 8);
-  if (uint64_t(start) + count * length > bytes.size()) {
-    ADD_FAILURE() << file << " is shorter than its header says";
-    return records;
-  }
-  for (uint64_t i = 0; i < count; ++i)
-    records.push_back(bytes.substr(start + i * length, length));
-  std::sort(records.begin(), records.end());
-  return records;
+  return sortedLasRecords(file.string());
 }
 
 std::optional<nlohmann::json> panelFrame(Viewer& viewer, size_t from, const std::string& item) {

@@ -1,7 +1,8 @@
 // The point records of a LAS file read by the test itself, not by the library: what the browser tests
-// compare a download with.
+// compare a download or an export with.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -55,6 +56,13 @@ inline LasRecords readLasRecords(const std::string& path) {
   for (uint64_t i = 0; i < count; ++i)
     r.records.push_back(bytes.substr(start + i * length, length));
   return r;
+}
+
+// The point records of a LAS file, sorted: the file's multiset of points.
+inline std::vector<std::string> sortedLasRecords(const std::string& path) {
+  std::vector<std::string> records = readLasRecords(path).records;
+  std::sort(records.begin(), records.end());
+  return records;
 }
 
 } // namespace pointrast::test
