@@ -121,18 +121,27 @@ ExportSource exportSource(const std::string& input) {
   return s;
 }
 
-PointFilter parseExportQuery(std::string_view query) {
-  PointFilter f;
-  bool mode = false;
+namespace {
+// Calls each(key, value) for the query's parameters, their values %-decoded, leaving out the token (the
+// access rules read it). `what` starts the error for a broken escape.
+void forEachParameter(std::string_view query, const char* what,
+                      const std::function<void(std::string_view, std::string_view)>& each) {
   for (std::string_view pair : split(query, '&')) {
     if (pair.empty()) continue;
     const size_t eq = pair.find('=');
     const std::string_view key = pair.substr(0, eq);
     const std::optional<std::string> decoded =
         decodeQueryValue(eq == std::string_view::npos ? std::string_view() : pair.substr(eq + 1));
-    if (!decoded) throw InputError("export: a broken %-escape in the query");
-    const std::string_view value = *decoded;
-    if (key == "token") continue; // the access rules read it
+    if (!decoded) throw InputError(std::string(what) + ": a broken %-escape in the query");
+    if (key != "token") each(key, *decoded);
+  }
+}
+} // namespace
+
+PointFilter parseExportQuery(std::string_view query) {
+  PointFilter f;
+  bool mode = false;
+  forEachParameter(query, "export", [&](std::string_view key, std::string_view value) {
     if (key == "box") {
       std::vector<std::string_view> items = split(value, ',');
       if (items.size() != 6 || !f.boxes.empty()) throw InputError("export: box takes x0,y0,z0,x1,y1,z1 once");
@@ -163,7 +172,7 @@ PointFilter parseExportQuery(std::string_view query) {
     } else {
       throw InputError("export: unknown parameter '" + std::string(key.substr(0, 32)) + "'");
     }
-  }
+  });
   if (mode && f.boxes.empty()) throw InputError("export: mode needs a box");
   return f;
 }
@@ -182,15 +191,7 @@ uint64_t exportLas(const std::filesystem::path& source, const PointFilter& filte
 ProfileQuery parseProfileQuery(std::string_view query, ProfileOutput output) {
   ProfileQuery q;
   bool line = false, width = false, size = false;
-  for (std::string_view pair : split(query, '&')) {
-    if (pair.empty()) continue;
-    const size_t eq = pair.find('=');
-    const std::string_view key = pair.substr(0, eq);
-    const std::optional<std::string> decoded =
-        decodeQueryValue(eq == std::string_view::npos ? std::string_view() : pair.substr(eq + 1));
-    if (!decoded) throw InputError("profile: a broken %-escape in the query");
-    const std::string_view value = *decoded;
-    if (key == "token") continue; // the access rules read it
+  forEachParameter(query, "profile", [&](std::string_view key, std::string_view value) {
     if (key == "line") {
       if (line) throw InputError("profile: line given twice");
       q.line.vertices = parseProfileVertices(std::string(value), "profile: line", kMaxProfileVertices);
@@ -212,7 +213,7 @@ ProfileQuery parseProfileQuery(std::string_view query, ProfileOutput output) {
     } else {
       throw InputError("profile: unknown parameter '" + std::string(key.substr(0, 32)) + "'");
     }
-  }
+  });
   if (!line) throw InputError("profile: the line is missing (line=x1,y1,x2,y2[,...])");
   if (!width) throw InputError("profile: the width is missing (width=W)");
   if (output == ProfileOutput::Png && !size)
