@@ -18,19 +18,6 @@
 namespace pointrast::test {
 namespace {
 
-// Runs a scenario of browser.mjs; its last line is the JSON result.
-Json browser(const std::string& scenario, const std::string& url, const std::filesystem::path& outdir,
-             const Json& args) {
-  const std::string dir = std::string(POINTRAST_SOURCE_DIR) + "/tests/web";
-  const std::string out = commandOutput("cd '" + dir + "' && node browser.mjs " + scenario + " '" + url +
-                                        "' '" + outdir.string() + "' '" + args.dump() + "' 2>&1");
-  const size_t last = out.rfind('\n', out.size() >= 2 ? out.size() - 2 : 0);
-  Json result = Json::parse(last == std::string::npos ? out : out.substr(last + 1), nullptr, false);
-  if (!result.is_object()) ADD_FAILURE() << "browser.mjs " << scenario << " printed:\n" << out;
-  if (result.is_object() && result.contains("failure")) ADD_FAILURE() << result["failure"].get<std::string>();
-  return result.is_object() ? result : Json::object();
-}
-
 std::string fileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

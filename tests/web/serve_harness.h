@@ -170,4 +170,18 @@ private:
   uint16_t port_ = 0;
 };
 
+// Runs a scenario of browser.mjs (chromium through playwright-core) against url, its files in outdir; its
+// last line is the JSON result, a failure it reports fails the test.
+inline Json browser(const std::string& scenario, const std::string& url, const std::filesystem::path& outdir,
+                    const Json& args) {
+  const std::string dir = std::string(POINTRAST_SOURCE_DIR) + "/tests/web";
+  const std::string out = commandOutput("cd '" + dir + "' && node browser.mjs " + scenario + " '" + url +
+                                        "' '" + outdir.string() + "' '" + args.dump() + "' 2>&1");
+  const size_t last = out.rfind('\n', out.size() >= 2 ? out.size() - 2 : 0);
+  Json result = Json::parse(last == std::string::npos ? out : out.substr(last + 1), nullptr, false);
+  if (!result.is_object()) ADD_FAILURE() << "browser.mjs " << scenario << " printed:\n" << out;
+  if (result.is_object() && result.contains("failure")) ADD_FAILURE() << result["failure"].get<std::string>();
+  return result.is_object() ? result : Json::object();
+}
+
 } // namespace pointrast::test
