@@ -394,9 +394,11 @@ TEST(Serve, TenThousandHostileMessagesLeaveItAnswering) {
       break; // unmasked
     }
     hostile++;
-    // Wait for the server's close, so that each message reaches a server that is reading.
+    // Wait for the server's close, so that each message reaches a server that is reading. The bound only
+    // fails a hung server: under load (lavapipe compiling a pipeline for a renderer on every core) a close
+    // can take seconds.
     bool closed = !ok;
-    for (int waited = 0; waited < 20 && !closed;) {
+    for (int waited = 0; waited < 600 && !closed;) {
       auto m = ws.receive(0.1);
       if (m) {
         closed = m->opcode == 8;
@@ -477,9 +479,9 @@ TEST(Serve, MaxClientsTellsTheNextOneAndFreesSlots) {
   ASSERT_TRUE(m);
   EXPECT_NE(m->text().find("--max-clients"), std::string::npos) << m->text();
   first.ws.close();
-  // The slot frees once the server saw the close.
+  // The slot frees once the server saw the close (the bound only fails a server that never frees it).
   bool served = false;
-  for (int i = 0; i < 50 && !served; ++i) {
+  for (int i = 0; i < 600 && !served; ++i) {
     Viewer third;
     served = third.open(server.port(), 64, 48);
     if (!served) std::this_thread::sleep_for(std::chrono::milliseconds(100));

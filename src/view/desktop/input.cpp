@@ -157,11 +157,69 @@ void DesktopInput::panelFrameDone() {
   keyReleasePending_.reset();
   keyPressedThisFrame_.reset();
   movedSinceFrame_ = false;
+  if (panelPressFrames_ > 0 && --panelPressFrames_ > 0) arrived_ = true;
+  releaseHeld();
+  if (!held_.empty()) arrived_ = true;
+}
+
+void DesktopInput::setPanelVisible(bool visible) {
+  panelVisible_ = visible;
+  if (!visible) { // no panel frame will come to release what is held
+    panelPressFrames_ = 0;
+    releaseHeld();
+  }
+}
+
+// Input is held, in the order it came, from the first event that must wait for a frame: keys and characters
+// after a press on the panel (until ImGui's capture flag knows whether the press focused a text field), a
+// press after text ImGui has not yet seen (the click would end the field's editing before the text reached
+// it). The events after a held one wait behind it.
+bool DesktopInput::hold(const HeldInput& e) {
+  if (!panelVisible_) return false;
+  bool wait = !held_.empty();
+  if (e.kind == HeldInput::Key || e.kind == HeldInput::Character) wait = wait || panelPressFrames_ > 0;
+  if (e.kind == HeldInput::Button && e.action == GLFW_PRESS)
+    wait = wait || !charsPending_.empty() || !charsDue_.empty() || keyReleasePending_.any() || modsPending_ ||
+           modsDue_ || !ImGui::GetIO().InputQueueCharacters.empty();
+  if (wait) {
+    held_.push_back(e);
+    arrived_ = true;
+  }
+  return wait;
+}
+
+void DesktopInput::releaseHeld() {
+  std::vector<HeldInput> events = std::exchange(held_, {});
+  for (size_t i = 0; i < events.size(); ++i) {
+    if (!held_.empty()) { // one had to wait again: it and those after it stay in order
+      held_.insert(held_.end(), events.begin() + std::ptrdiff_t(i), events.end());
+      return;
+    }
+    const HeldInput& e = events[i];
+    switch (e.kind) {
+    case HeldInput::Cursor:
+      cursor(e.x, e.y);
+      break;
+    case HeldInput::Button:
+      button(e.key, e.action, e.mods);
+      break;
+    case HeldInput::Key:
+      key(e.key, e.action, e.mods);
+      break;
+    case HeldInput::Character:
+      character(e.codepoint);
+      break;
+    case HeldInput::Scroll:
+      scroll(e.y);
+      break;
+    }
+  }
 }
 
 // ImGui drops characters typed while Ctrl is down: those that follow a held Ctrl+key wait for its modifiers.
 void DesktopInput::character(unsigned int c) {
   arrived_ = true;
+  if (hold({HeldInput::Character, 0, 0, 0, c, 0, 0})) return;
   if (modsPending_)
     charsPending_.push_back(c);
   else if (modsDue_ || !charsDue_.empty())
@@ -193,6 +251,7 @@ bool DesktopInput::panelWantsKeyboard() const {
 
 void DesktopInput::cursor(double x, double y) {
   arrived_ = true;
+  if (hold({HeldInput::Cursor, 0, 0, 0, 0, x, y})) return;
   cursor_ = toPixels(x, y);
   movedSinceFrame_ = true;
   // A button pressed since the last frame is seen by ImGui where it was pressed (a click, then a move
@@ -209,6 +268,7 @@ void DesktopInput::cursor(double x, double y) {
 
 void DesktopInput::button(int button, int action, int mods) {
   arrived_ = true;
+  if (hold({HeldInput::Button, button, action, mods, 0, 0, 0})) return;
   if (button >= 0 && button < 3) {
     bool pressed = action == GLFW_PRESS;
     if (pressed) pressedThisFrame_[button] = true;
@@ -235,7 +295,10 @@ void DesktopInput::button(int button, int action, int mods) {
     dragging_ = false;
     return;
   }
-  if (forPanel() || overPanel()) return;
+  if (forPanel() || overPanel()) {
+    panelPressFrames_ = 2; // the frame that sees the press, then the one whose capture flag knows of it
+    return;
+  }
   // Ctrl+click: the pick tool, not a drag; with Shift the picked point is the next vertex of a measurement.
   if (which == MouseButton::Left && (mods & GLFW_MOD_CONTROL)) {
     toolPress_ = {cursor_, (mods & GLFW_MOD_SHIFT) != 0};
@@ -258,6 +321,7 @@ void DesktopInput::button(int button, int action, int mods) {
 
 void DesktopInput::scroll(double y) {
   arrived_ = true;
+  if (hold({HeldInput::Scroll, 0, 0, 0, 0, 0, y})) return;
   if (forPanel())
     ImGui::GetIO().MouseWheel += float(y);
   else
@@ -271,6 +335,7 @@ std::optional<WheelInput> DesktopInput::takeWheel() {
 
 void DesktopInput::key(int key, int action, int mods) {
   arrived_ = true;
+  if (hold({HeldInput::Key, key, action, mods, 0, 0, 0})) return;
   // X11 reports the modifiers as they were before the event: a modifier's own release still holds it.
   if (action == GLFW_RELEASE) {
     if (key == GLFW_KEY_LEFT_CONTROL || key == GLFW_KEY_RIGHT_CONTROL) mods &= ~GLFW_MOD_CONTROL;

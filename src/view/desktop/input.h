@@ -34,7 +34,7 @@ public:
   // Installs the callbacks on the window (and its user pointer).
   DesktopInput(GLFWwindow* window, Session& session);
 
-  void setPanelVisible(bool visible) { panelVisible_ = visible; }
+  void setPanelVisible(bool visible);
   // The panel's windows' rectangles (x, y, width, height) in the last frame: a press inside one belongs to
   // the panel, whatever ImGui's capture flag said in that frame (the cursor may just have arrived).
   void setPanelRects(std::vector<std::array<float, 4>> rects) { panelRects_ = std::move(rects); }
@@ -86,6 +86,17 @@ private:
   glm::dvec2 lastClick_{0};
   double wheel_ = 0;
   bool saveMeasurements_ = false;
+  // Input that waits for a frame (see hold in input.cpp), in the order it came.
+  struct HeldInput {
+    enum Kind { Cursor, Button, Key, Character, Scroll } kind;
+    int key, action, mods; // Button: key is the button
+    unsigned int codepoint;
+    double x, y; // Cursor: window coordinates; Scroll: y is the steps
+  };
+  bool hold(const HeldInput& e);
+  void releaseHeld();
+  std::vector<HeldInput> held_;
+  int panelPressFrames_ = 0; // frames to build before keyboard input after a panel press is routed
   std::optional<std::pair<glm::dvec2, bool>> toolPress_; // a Ctrl+press: where, and whether Shift was held
 };
 
