@@ -32,9 +32,15 @@ public:
     held_ = on;
     changed_.notify_all();
   }
-  bool waitFor(size_t frames, std::chrono::milliseconds timeout = 5s) {
+  // The bounds only fail a sender that hangs.
+  bool waitFor(size_t frames, std::chrono::milliseconds timeout = 60s) {
     std::unique_lock lock(mutex_);
     return changed_.wait_for(lock, timeout, [&] { return frameIds.size() >= frames; });
+  }
+  // Until `writes` messages have reached the sink (a held one waits in it).
+  bool waitForWrites(size_t writes, std::chrono::milliseconds timeout = 60s) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, timeout, [&] { return writes_ >= writes; });
   }
   std::mutex mutex_;
   std::condition_variable changed_;
@@ -44,8 +50,11 @@ public:
   int closeCode = 0;
 
 private:
+  size_t writes_ = 0;
   bool record(std::string data, bool binary) {
     std::unique_lock lock(mutex_);
+    ++writes_;
+    changed_.notify_all();
     changed_.wait(lock, [&] { return !held_; });
     if (fail) return false;
     if (binary)
@@ -73,7 +82,7 @@ TEST(FrameStream, TheNewestFrameWinsAndTwoAreInFlightAtMost) {
   EXPECT_TRUE(stream.wantsFrame());
   sink.hold(true); // the network stalls while frame 1 is being written
   stream.submitFrame(frame(1));
-  std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(sink.waitForWrites(1)); // frame 1 is being written
   stream.submitFrame(frame(2));
   EXPECT_FALSE(stream.wantsFrame()); // 1 in flight, 2 pending
   stream.submitFrame(frame(3));      // replaces 2: a stalled client never queues frames

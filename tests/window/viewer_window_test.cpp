@@ -226,10 +226,10 @@ TEST_F(ViewerWindow, DoubleClickSetsThePivotOnTheClickedPoint) {
 
 // render --pick at a pixel of a kWidth x kHeight image with a frame event's camera: its "pick" object.
 nlohmann::json renderPick(const nlohmann::json& camera, int x, int y) {
-  const std::string command = "POINTRAST_VALIDATION=1 '" + pointrastBinary() + "' render '" + autzen() + "' " +
-                              cameraArgs(camera) + " --width " + std::to_string(kWidth) + " --height " +
-                              std::to_string(kHeight) + " -q --json --pick " + std::to_string(x) + "," +
-                              std::to_string(y) + " -o '" + (tempDir() / "pick.png").string() + "'";
+  const std::string command =
+      "POINTRAST_VALIDATION=1 '" + pointrastBinary() + "' render '" + autzen() + "' " + cameraArgs(camera) +
+      " --width " + std::to_string(kWidth) + " --height " + std::to_string(kHeight) + " -q --json --pick " +
+      std::to_string(x) + "," + std::to_string(y) + " -o '" + (tempDir() / "pick.png").string() + "'";
   std::string out;
   if (FILE* pipe = popen(command.c_str(), "r")) {
     char buffer[4096];
@@ -316,13 +316,20 @@ TEST_F(ViewerWindow, PanelControlChangesTheImage) {
       from, 30);
   ASSERT_TRUE(changed) << viewer->errors();
   // The background outside the panel turned white: the sky above the cloud and the gaps between points.
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  Capture after = captureWindow(display(), viewer->window());
+  // (The X server shows a presented image a moment after the viewer reports it: captured until it shows.)
+  Capture after;
+  size_t whiteNow = 0;
+  const auto deadline = Clock::now() + std::chrono::seconds(20);
+  do {
+    after = captureWindow(display(), viewer->window());
+    whiteNow = 0;
+    for (uint32_t p : after.rgba)
+      whiteNow += p == 0xFFFFFFFFu;
+    if (whiteNow > after.rgba.size() / 20) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  } while (Clock::now() < deadline);
   ASSERT_EQ(after.rgba.size(), before.rgba.size());
   EXPECT_LT(equalFraction(before.rgba, after.rgba), 0.9);
-  size_t whiteNow = 0;
-  for (uint32_t p : after.rgba)
-    whiteNow += p == 0xFFFFFFFFu;
   EXPECT_GT(whiteNow, after.rgba.size() / 20);
   finish(*viewer);
 }
