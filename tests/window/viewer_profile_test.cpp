@@ -263,5 +263,17 @@ TEST_F(ViewerProfile, LineTypedOnAFileGivesTheProfileCommandsPictureAndExports) 
   checkPanelProfile(xvfb_->display(), (dataDir() / "las" / "autzen_trim.las").string(), "typed", kLine);
 }
 
+TEST_F(ViewerProfile, LineTypedOnAnOctreeGivesTheProfileCommandsPictureAndExports) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const std::filesystem::path octree = profileTempDir() / "autzen_octree";
+  std::filesystem::remove_all(octree);
+  const std::string build = "'" + pointrastBinary() + "' lod '" +
+                            (dataDir() / "las" / "autzen_trim.las").string() + "' -o '" + octree.string() +
+                            "' -q";
+  ASSERT_EQ(std::system(build.c_str()), 0) << build;
+  checkPanelProfile(xvfb_->display(), octree.string(), "octree", kLine);
+  if (!HasFailure()) std::filesystem::remove_all(octree);
+}
+
 } // namespace
 } // namespace pointrast::test

@@ -490,7 +490,10 @@ PanelActions buildPanel(Session& session, PanelInfo& info, ViewSettings& setting
   PanelActions actions;
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
-  ImGui::Begin("pointrast", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  // The panel stays behind the windows it opens (the Profile picture): a click on its buttons, or a long
+  // input path that widens it, must not hide the picture they overlap.
+  ImGui::Begin("pointrast", nullptr,
+               ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoBringToFrontOnFocus);
   const ViewSettings before = settings;
   methodCombo(info, settings, items);
   depthControls(settings, items);
