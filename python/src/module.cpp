@@ -371,6 +371,8 @@ private:
     steps["stage"] = lastUpload_.stageCpu;
     steps["threads"] = lastUpload_.threads;
     steps["allocate_wall"] = lastUpload_.allocate;
+    steps["reused_bytes"] = lastUpload_.reusedBytes;
+    steps["allocated_bytes"] = lastUpload_.allocatedBytes;
     r["upload_steps_cpu_s"] = steps;
     return r;
   }
@@ -423,12 +425,18 @@ private:
       const bool same = scene_ && sceneCloud_.lock() == identity && sceneLayout_ == layout &&
                         sameColors(sceneColors_, colors) && sceneHighlight_ == highlight;
       if (!same) {
+        // The new cloud goes into the GPU memory of the one drawn before where it fits (the same size or
+        // smaller): no second allocation, and never both scenes' memory at once.
+        SceneBuffers previous;
+        if (scene_) previous = scene_->takeBuffers();
         scene_.reset();
         UploadOptions upload;
         upload.layout = layout;
         upload.progress = false;
         upload.colors = colors;
         upload.filter = highlight;
+        upload.recycle = &previous;
+        upload.keepStaging = true;
         const auto start = std::chrono::steady_clock::now();
         scene_ = arrays ? std::make_unique<GpuScene>(*context_, *arrays, upload)
                         : std::make_unique<GpuScene>(*context_, cloud, upload);

@@ -37,6 +37,26 @@ uint64_t roundUp4(uint64_t n) {
   return (n + 3) & ~uint64_t(3);
 }
 
+static_assert(kStagingBatches * kBatchBytes <= kStagingBytes);
+
+// The smallest buffer of `pool` that holds `bytes` and is at most twice as large, moved out of it; an
+// empty buffer when none is.
+gpu::Buffer takeFitting(std::vector<gpu::Buffer>& pool, uint64_t bytes) {
+  auto best = pool.end();
+  for (auto it = pool.begin(); it != pool.end(); ++it)
+    if (it->size() >= bytes && it->size() / 2 <= bytes && (best == pool.end() || it->size() < best->size()))
+      best = it;
+  if (best == pool.end()) return {};
+  gpu::Buffer taken = std::move(*best);
+  *best = std::move(pool.back());
+  pool.pop_back();
+  return taken;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 } // namespace
 
 const char* sceneLayoutName(SceneLayout layout) {
@@ -82,8 +102,11 @@ GpuScene::GpuScene(gpu::Context& context, const PointCloud& cloud, const UploadO
   const auto start = std::chrono::steady_clock::now();
   uint64_t first = std::min(options.first, cloud.size());
   uint64_t count = std::min(options.count, cloud.size() - first);
-  makeParts(context, first, count, options.maxPartPoints);
-  if (count == 0) return;
+  makeParts(context, first, count, options);
+  if (count == 0) {
+    endStaging({});
+    return;
+  }
   const DisplayColorMode colors = options.colors ? *options.colors : displayColorMode(cloud); // once
   if (options.filter && options.filter->hasClip() && options.filter->clipMode == ClipMode::Highlight)
     highlight_ = options.filter;
@@ -108,8 +131,11 @@ GpuScene::GpuScene(gpu::Context& context, const PointBlocks& blocks, const Uploa
   if (!options.colors) throw InternalError("an upload from blocks needs its color mode");
   const uint64_t first = std::min(options.first, blocks.size());
   const uint64_t count = std::min(options.count, blocks.size() - first);
-  makeParts(context, first, count, options.maxPartPoints);
-  if (count == 0) return;
+  makeParts(context, first, count, options);
+  if (count == 0) {
+    endStaging({});
+    return;
+  }
   if (options.filter && options.filter->hasClip() && options.filter->clipMode == ClipMode::Highlight)
     highlight_ = options.filter;
   const PointCloud& shape = blocks.shape();
@@ -127,16 +153,26 @@ GpuScene::GpuScene(gpu::Context& context, const PointBlocks& blocks, const Uploa
   times_.total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void GpuScene::makeParts(gpu::Context& context, uint64_t first, uint64_t count, uint64_t maxPartPoints) {
+void GpuScene::makeParts(gpu::Context& context, uint64_t first, uint64_t count,
+                         const UploadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   struct Timed {
     double& seconds;
     std::chrono::steady_clock::time_point start;
-    ~Timed() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+    ~Timed() { seconds += secondsSince(start); }
   } timed{times_.allocate, start};
+  // Buffers of a replaced scene: the device ones are matched below, the rest freed on return.
+  std::vector<gpu::Buffer> spare;
+  keepStaging_ = options.keepStaging;
+  if (options.recycle) {
+    spare = std::move(options.recycle->device);
+    options.recycle->device.clear();
+    staging_ = std::move(options.recycle->staging);
+    options.recycle->staging.clear();
+  }
   pointCount_ = count;
   uint64_t limit = std::min(context.maxAllocationSize(), context.maxBufferSize());
-  uint64_t partPoints = partCapacity(layout_, maxPartPoints, limit);
+  uint64_t partPoints = partCapacity(layout_, options.maxPartPoints, limit);
   if (partPoints == 0)
     throw UnsupportedError("device buffers are too small to hold even one batch of points");
 
@@ -147,27 +183,87 @@ void GpuScene::makeParts(gpu::Context& context, uint64_t first, uint64_t count, 
     ScenePart part;
     part.first = first + at;
     part.count = std::min(partPoints, count - at);
-    std::string index = std::to_string(parts_.size());
-    auto buffer = [&](uint64_t bytes, const std::string& name) {
-      return gpu::Buffer(context, bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, name + " " + index);
-    };
-    if (layout_ == SceneLayout::Float) {
-      part.positions = buffer(part.count * 12, "positions");
-    } else {
-      part.high = buffer(roundUp4(part.count) * 4, "high words");
-      part.medium = buffer(roundUp4(part.count) * 4, "medium words");
-      part.low = buffer(roundUp4(part.count) * 4, "low words");
-      part.batches = buffer(part.batchCount() * sizeof(shared::BatchBounds), "batch bounds");
-    }
-    part.colors = buffer(part.count * 4, "colors");
     parts_.push_back(std::move(part));
   }
+  struct Need {
+    gpu::Buffer* buffer;
+    uint64_t bytes;
+    std::string name;
+  };
+  std::vector<Need> needs;
+  for (size_t i = 0; i < parts_.size(); ++i) {
+    ScenePart& part = parts_[i];
+    const std::string index = " " + std::to_string(i);
+    if (layout_ == SceneLayout::Float) {
+      needs.push_back({&part.positions, part.count * 12, "positions" + index});
+    } else {
+      needs.push_back({&part.high, roundUp4(part.count) * 4, "high words" + index});
+      needs.push_back({&part.medium, roundUp4(part.count) * 4, "medium words" + index});
+      needs.push_back({&part.low, roundUp4(part.count) * 4, "low words" + index});
+      needs.push_back(
+          {&part.batches, part.batchCount() * sizeof(shared::BatchBounds), "batch bounds" + index});
+    }
+    needs.push_back({&part.colors, part.count * 4, "colors" + index});
+  }
+  // The largest first, so that a small buffer does not take the spare one a larger buffer needed.
+  std::stable_sort(needs.begin(), needs.end(),
+                   [](const Need& a, const Need& b) { return a.bytes > b.bytes; });
+  for (Need& need : needs) {
+    *need.buffer = takeFitting(spare, need.bytes);
+    if (!*need.buffer) continue;
+    times_.reusedBytes += need.buffer->size();
+    context.setName(VK_OBJECT_TYPE_BUFFER, uint64_t(need.buffer->handle()), need.name);
+  }
+  spare.clear(); // freed before the new buffers are allocated
+  for (Need& need : needs) {
+    if (*need.buffer) continue;
+    *need.buffer = gpu::Buffer(context, need.bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, need.name);
+    times_.allocatedBytes += need.bytes;
+  }
+}
+
+gpu::Buffer GpuScene::takeStaging(gpu::Context& context, uint64_t bytes, const std::string& name) {
+  const auto start = std::chrono::steady_clock::now();
+  auto it =
+      std::find_if(staging_.begin(), staging_.end(), [&](const gpu::Buffer& b) { return b.size() >= bytes; });
+  gpu::Buffer buffer;
+  if (it != staging_.end()) {
+    buffer = std::move(*it);
+    staging_.erase(it);
+    times_.reusedBytes += buffer.size();
+  } else {
+    buffer = gpu::Buffer(context, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload, name);
+    times_.allocatedBytes += bytes;
+  }
+  times_.allocate += secondsSince(start);
+  return buffer;
+}
+
+void GpuScene::endStaging(std::vector<gpu::Buffer> used) {
+  if (!keepStaging_) {
+    staging_.clear();
+    return;
+  }
+  for (gpu::Buffer& buffer : used)
+    staging_.push_back(std::move(buffer));
+}
+
+SceneBuffers GpuScene::takeBuffers() {
+  SceneBuffers out;
+  for (ScenePart& part : parts_)
+    for (gpu::Buffer* buffer :
+         {&part.positions, &part.colors, &part.high, &part.medium, &part.low, &part.batches})
+      if (*buffer) out.device.push_back(std::move(*buffer));
+  out.staging = std::move(staging_);
+  staging_.clear();
+  parts_.clear();
+  pointCount_ = 0;
+  return out;
 }
 
 void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
                            bool progressShown) {
-  gpu::Buffer staging(context, kStagingBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload,
-                      "upload staging");
+  gpu::Buffer staging = takeStaging(context, kStagingBytes, "upload staging");
   auto* stagingFloats = static_cast<float*>(staging.mapped());
   auto* stagingColors =
       reinterpret_cast<uint32_t*>(static_cast<char*>(staging.mapped()) + kStagingPoints * 12);
@@ -187,6 +283,9 @@ void GpuScene::uploadFloat(gpu::Context& context, const PointCloud& cloud, const
       progress.advance(n);
     }
   }
+  std::vector<gpu::Buffer> used;
+  used.push_back(std::move(staging));
+  endStaging(std::move(used));
 }
 
 // Encodes whole batches on all cores (bounds, three words, colors per batch, as cloud/batch_words.h
@@ -207,13 +306,9 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
       chunks.push_back({&part, at, std::min(kStagingBatchPoints, part.count - at)});
   if (chunks.empty()) return;
   std::atomic<int64_t> stepNs[5] = {}; // the encoding's steps, as UploadTimes counts them
-  const auto allocating = std::chrono::steady_clock::now();
-  gpu::Buffer staging[2] = {
-      gpu::Buffer(context, kStagingBatches * kBatchBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                  gpu::MemoryKind::Upload, "upload staging 0"),
-      gpu::Buffer(context, chunks.size() > 1 ? kStagingBatches * kBatchBytes : 16,
-                  VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryKind::Upload, "upload staging 1")};
-  times_.allocate += std::chrono::duration<double>(std::chrono::steady_clock::now() - allocating).count();
+  // Whole staging buffers (64 MiB, as the float upload's), so that either upload can reuse the other's.
+  gpu::Buffer staging[2] = {takeStaging(context, kStagingBytes, "upload staging 0"),
+                            takeStaging(context, chunks.size() > 1 ? kStagingBytes : 16, "upload staging 1")};
   // Staging sections: high, medium, low words, colors (kStagingBatchPoints each), then the bounds.
   auto section = [&](int s, int k) {
     return static_cast<uint32_t*>(staging[s].mapped()) + k * kStagingBatchPoints;
@@ -331,6 +426,10 @@ void GpuScene::uploadBatched(gpu::Context& context, const PointsView& points,
                     &times_.stageCpu};
   for (int step = 0; step < 5; ++step)
     *cpu[step] += double(stepNs[step].load()) * 1e-9;
+  std::vector<gpu::Buffer> used;
+  for (gpu::Buffer& buffer : staging)
+    used.push_back(std::move(buffer));
+  endStaging(std::move(used));
 }
 
 uint32_t highlightColor(uint32_t rgba) {

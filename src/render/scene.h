@@ -45,6 +45,13 @@ struct ScenePart {
   uint64_t batchCount() const;
 };
 
+// The buffers of a scene no longer drawn, for the upload that replaces it (GpuScene::takeBuffers(),
+// UploadOptions::recycle): a new cloud reuses GPU memory instead of allocating it again.
+struct SceneBuffers {
+  std::vector<gpu::Buffer> device;  // the parts' buffers, of either layout
+  std::vector<gpu::Buffer> staging; // upload staging buffers the scene kept (UploadOptions::keepStaging)
+};
+
 struct UploadOptions {
   uint64_t first = 0;          // upload points [first, first + count) of the cloud
   uint64_t count = UINT64_MAX; // clamped to the cloud's size
@@ -61,6 +68,15 @@ struct UploadOptions {
   // ClipMode::Highlight: the points inside the clip volumes are tinted (highlightColor) in the uploaded
   // colors, as a color mode is folded in; other modes change nothing here (the renderer clips, per frame).
   std::optional<PointFilter> filter;
+  // Buffers of a scene this upload replaces: each buffer the new scene needs takes the smallest of them
+  // that holds it and is at most twice its size (so a much smaller cloud does not keep a large cloud's
+  // memory); the rest are freed before anything is allocated, so the old and the new scene never hold
+  // memory at once. The upload writes every byte the renderer reads, so nothing of the old scene shows.
+  // Left empty by the upload.
+  SceneBuffers* recycle = nullptr;
+  // Keep the staging buffers after the upload (up to 128 MiB of host-visible memory while the scene
+  // lives), for an upload that recycles this scene.
+  bool keepStaging = false;
 };
 
 // The tint of a highlighted point: each channel halfway to the highlight color (255, 200, 0), alpha kept.
@@ -98,7 +114,8 @@ public:
 // copies to the GPU that the encoding did not hide.
 struct UploadTimes {
   double total = 0, encode = 0, copyWait = 0;
-  double allocate = 0; // the device buffers and the staging buffers
+  double allocate = 0; // the device buffers and the staging buffers (~0 where recycled ones sufficed)
+  uint64_t reusedBytes = 0, allocatedBytes = 0; // of those buffers, taken from a recycled scene / new
   // The encoding's steps, in seconds of all its threads together (a batched upload): reading the points
   // (positions and colors from the input), cutting batches (their bounds), the position words, the
   // display colors, and copying each thread's words into the staging buffer.
@@ -132,6 +149,10 @@ public:
   void recolor(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& mode,
                const std::optional<PointFilter>& filter = std::nullopt);
 
+  // Gives up the scene's buffers for an upload that replaces it (UploadOptions::recycle). The scene is
+  // left empty: no points, no parts; it draws nothing.
+  SceneBuffers takeBuffers();
+
 private:
   void uploadFloat(gpu::Context& context, const PointCloud& cloud, const DisplayColorMode& colors,
                    bool progress);
@@ -139,10 +160,16 @@ private:
   // the input cloud itself, or `scratch` filled from blocks.
   using PointsView = std::function<std::pair<const PointCloud*, uint64_t>(uint64_t first, uint64_t count,
                                                                           PointCloud& scratch)>;
-  void makeParts(gpu::Context& context, uint64_t first, uint64_t count, uint64_t maxPartPoints);
+  void makeParts(gpu::Context& context, uint64_t first, uint64_t count, const UploadOptions& options);
+  // A staging buffer of at least `bytes`: a kept one (staging_) or a new one; given back with
+  // endStaging(), which keeps it where UploadOptions::keepStaging asked.
+  gpu::Buffer takeStaging(gpu::Context& context, uint64_t bytes, const std::string& name);
+  void endStaging(std::vector<gpu::Buffer> used);
   void uploadBatched(gpu::Context& context, const PointsView& points, const DisplayColorMode& colors,
                      bool progress);
   std::optional<PointFilter> highlight_; // the filter whose inside points are tinted, if any
+  std::vector<gpu::Buffer> staging_;     // staging buffers kept for a later upload (keepStaging)
+  bool keepStaging_ = false;
   std::vector<ScenePart> parts_;
   SceneLayout layout_ = SceneLayout::Float;
   uint64_t pointCount_ = 0;
