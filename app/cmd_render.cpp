@@ -434,8 +434,17 @@ nlohmann::json octreeJson(const gpu::Context& context, const RenderSettings& set
   return j;
 }
 
+// Draws the annotations over the frame the renderer drew last with `camera`.
+void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds, const Annotations& annotations,
+                 std::vector<uint32_t>& pixels) {
+  const std::vector<uint64_t> words = renderer.framebufferWords();
+  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(bounds);
+  drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
+}
+
 // The LOD methods (--method lod, lod-hqs): an octree streamed through the node cache.
-int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
+int runRenderOctree(const RenderArgs& a, RenderSettings settings,
+                    const std::optional<Annotations>& annotations) {
   if (!a.path.path.empty())
     throw InputError("--path renders the methods that draw a loaded cloud, not " + a.method + " (an octree)");
   if (a.order != "original" || a.parts != 1 || a.depth != "float")
@@ -492,6 +501,7 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings) {
     }
   } else {
     pixels = renderer.image();
+    if (annotations) drawOverlay(renderer, camera, scene.bounds(), *annotations, pixels);
   }
   finishImage(
       a, context, pixels,
@@ -722,13 +732,14 @@ int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
 std::optional<Annotations> overlayAnnotations(const RenderArgs& a, RenderSettings& settings) {
   if (a.annotations.empty()) return std::nullopt;
   const MethodInfo& info = settings.method.info();
-  if (info.layout == SceneLayout::Octree)
-    throw InputError("--annotations draws over the methods that draw a loaded cloud, not " + a.method);
+  const bool octree = info.layout == SceneLayout::Octree;
   if (a.eyes.stereo) throw InputError("--annotations draws over a mono image, not --stereo");
-  const bool resolved = settings.post.enabled(); // the resolve stage leaves float-depth words for any method
+  // The resolve stage leaves float-depth words for any method (an octree's settings get it later).
+  const bool resolved = (octree ? postSettings(a.look) : settings.post).enabled();
   if (!resolved && !hasCanonicalWords(info))
     throw InputError("--annotations needs the depth of each pixel, which " + a.method +
-                     " does not keep; use a closest-point method (atomicmin) or add --point-size 1.5");
+                     " does not keep; use a closest-point method (" + (octree ? "lod" : "atomicmin") +
+                     ") or add --point-size 1.5");
   if (!resolved && settings.depth == DepthMode::Int40)
     throw InputError("--annotations reads float depths: leave --depth at float");
   settings.captureWords = true;
@@ -757,14 +768,6 @@ nlohmann::json pickAt(Renderer& renderer, const PointCloud& cloud, const std::op
   return pickJson(cloud, pixel, word == shared::kEmptyPixel, pickPoint(request, pixel.x, pixel.y, word));
 }
 
-// Draws the annotations over the frame the renderer drew last with `camera`.
-void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds, const Annotations& annotations,
-                 std::vector<uint32_t>& pixels) {
-  const std::vector<uint64_t> words = renderer.framebufferWords();
-  const double nearW = camera.nearW > 0 ? camera.nearW : defaultNear(bounds);
-  drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
-}
-
 int runRender(const RenderArgs& a) {
   Progress::setEnabled(!a.quiet); // progress goes to stderr, so it does not disturb --json on stdout
   checkCommonArgs(a);
@@ -772,9 +775,9 @@ int runRender(const RenderArgs& a) {
   if (isSphereMethodName(a.method)) return runRenderSpheres(a);
   RenderSettings settings = pointSettings(a);
   const std::optional<Annotations> annotations = overlayAnnotations(a, settings);
-  if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings);
   if (distributedRun() && annotations)
     throw InputError("--annotations draws over the frame of one process; under mpirun render draws without it");
+  if (settings.method.info().layout == SceneLayout::Octree) return runRenderOctree(a, settings, annotations);
   if (distributedRun()) return runRenderDistributed(a, settings);
   view::CameraPath cameraPath;
   if (!a.path.path.empty()) cameraPath = loadPathForRender(a.path, a.width, a.height);
