@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include <imgui.h>
 
@@ -320,7 +321,13 @@ std::string mib(uint64_t bytes) {
 void statistics(const Session& session, const PanelInfo& info) {
   const Statistics& s = session.statistics();
   ImGui::Text("%s", info.device.c_str());
-  ImGui::Text("%s: %s points", info.input.c_str(), humanCount(double(info.points)).c_str());
+  // The file or folder name keeps the panel narrow; the full path is in the window title and the tooltip.
+  const std::filesystem::path input = std::filesystem::path(info.input).lexically_normal();
+  const std::string name =
+      (input.has_filename() ? input.filename() : input.parent_path().filename()).string();
+  ImGui::Text("%s: %s points", name.empty() ? info.input.c_str() : name.c_str(),
+              humanCount(double(info.points)).c_str());
+  if (ImGui::IsItemHovered() && name != info.input) ImGui::SetTooltip("%s", info.input.c_str());
   ImGui::Text("GPU render  %8.3f ms  (clear + draw + resolve)", s.renderMs);
   if (s.post)
     ImGui::Text("  resolve stage: splat %.3f, dilate %.3f, compose %.3f ms", s.post->splatMs,
