@@ -127,6 +127,20 @@ TEST(AnnotationsCli, OnAnOctreeMarkersAndLinesLandOnTheProjectedPixelsAndHideBeh
   const fs::path octree = buildOctree(wallCloud(), "wall_octree");
   ASSERT_FALSE(testing::Test::HasFailure());
   expectMarkersAndLinesOnTheProjectedPixels(octree);
+  // lod-hqs keeps no depth per pixel without the resolve stage; the overlay draws over one mono image.
+  const fs::path annotations = writeText("empty.json", R"({"version": 1, "annotations": []})");
+  const fs::path png = pointrast::test::cliTempDir() / "octree_refused.png";
+  for (const std::string& args : {std::string("--method lod-hqs"), std::string("--method lod --stereo")}) {
+    fs::remove(png);
+    const auto r = runPointrast("render " + octree.string() + " " + args + " --frames 1 -q --annotations " +
+                                annotations.string() + " -o " + png.string());
+    EXPECT_EQ(r.exitCode, 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(args == "--method lod-hqs" ? "needs the depth of each pixel" : "not --stereo"),
+              std::string::npos)
+        << args << "\n"
+        << r.err;
+    EXPECT_FALSE(fs::exists(png)) << args;
+  }
 }
 
 // On an octree of a real survey, with the default camera: the annotated image equals the plain one except

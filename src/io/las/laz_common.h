@@ -45,59 +45,27 @@ inline uint8_t* recordSlot(std::vector<uint8_t>& out, uint64_t i, uint64_t& capa
 }
 
 // Median of the last five values, maintained in a sorted window without sorting: LASzip's
-// "StreamingMedian5", which alternates which end of the window a new value pushes out.
+// "StreamingMedian5", which alternates which end of the window a new value pushes out. Both of its
+// cases drop one end of the window (the largest value while high_, else the smallest) and insert the
+// new value in order among the four others, so the window is computed here without branches: slot i
+// of the result is the new value clamped between the kept values i - 1 and i. LASzip's nested
+// comparisons mispredicted on about half of the coordinates (the differences are noise).
 class Median5 {
 public:
   void reset() { *this = Median5{}; }
   int32_t get() const { return v_[2]; }
   void add(int32_t v) {
-    if (high_) {
-      if (v < v_[2]) {
-        v_[4] = v_[3];
-        v_[3] = v_[2];
-        if (v < v_[0]) {
-          v_[2] = v_[1];
-          v_[1] = v_[0];
-          v_[0] = v;
-        } else if (v < v_[1]) {
-          v_[2] = v_[1];
-          v_[1] = v;
-        } else {
-          v_[2] = v;
-        }
-      } else {
-        if (v < v_[3]) {
-          v_[4] = v_[3];
-          v_[3] = v;
-        } else {
-          v_[4] = v;
-        }
-        high_ = false;
-      }
-    } else {
-      if (v_[2] < v) {
-        v_[0] = v_[1];
-        v_[1] = v_[2];
-        if (v_[4] < v) {
-          v_[2] = v_[3];
-          v_[3] = v_[4];
-          v_[4] = v;
-        } else if (v_[3] < v) {
-          v_[2] = v_[3];
-          v_[3] = v;
-        } else {
-          v_[2] = v;
-        }
-      } else {
-        if (v_[1] < v) {
-          v_[0] = v_[1];
-          v_[1] = v;
-        } else {
-          v_[0] = v;
-        }
-        high_ = true;
-      }
-    }
+    const int32_t* w = v_ + (high_ ^ 1); // the four values kept, in order
+    const int32_t w0 = w[0], w1 = w[1], w2 = w[2], w3 = w[3];
+    // The end moves when the value lands on its side of the median (ties go the way LASzip's do);
+    // bitwise operators, as a short-circuit would be a branch again.
+    const bool high = (v < v_[2]) | ((high_ ^ 1) & (v == v_[2]));
+    v_[0] = std::min(w0, v);
+    v_[1] = std::max(w0, std::min(w1, v));
+    v_[2] = std::max(w1, std::min(w2, v));
+    v_[3] = std::max(w2, std::min(w3, v));
+    v_[4] = std::max(w3, v);
+    high_ = high;
   }
 
 private:
