@@ -174,6 +174,7 @@ template <class R, class Measure, class Record>
 void measureGuarded(R& result, Measure&& measure, Record&& record) {
   try {
     measure();
+    gpu::noteMeasuredResult();
   } catch (const UnsupportedError& e) {
     result.status = "unsupported";
     result.reason = e.what();

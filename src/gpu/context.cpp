@@ -1,9 +1,12 @@
 #include "gpu/context.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "base/error.h"
@@ -26,19 +29,37 @@ double submitTimeoutSeconds() {
 
 // Test hook: POINTRAST_INJECT_DEVICE_LOST=N makes the Nth submission of the process (counting from 1) and
 // every later one fail with VK_ERROR_DEVICE_LOST instead of reaching the driver, so tests can show what a
-// lost device leaves behind (a benchmark's reports, one line from the CLI).
-uint64_t injectedLossFrom() {
-  static const uint64_t from = [] {
+// lost device leaves behind (a benchmark's reports, one line from the CLI). With result+N the count starts
+// at the first measured result a benchmark keeps (noteMeasuredResult): where reader threads also submit
+// (node uploads), a count from the start lands at a point that depends on their timing.
+struct InjectedLoss {
+  uint64_t from = 0;
+  bool afterResult = false;
+};
+
+InjectedLoss injectedLoss() {
+  static const InjectedLoss loss = [] {
+    InjectedLoss l;
     const char* env = std::getenv("POINTRAST_INJECT_DEVICE_LOST");
-    return env && *env ? std::strtoull(env, nullptr, 10) : 0ull;
+    if (!env || !*env) return l;
+    std::string_view v(env);
+    if (v.starts_with("result+")) {
+      l.afterResult = true;
+      v.remove_prefix(7);
+    }
+    l.from = std::strtoull(std::string(v).c_str(), nullptr, 10);
+    return l;
   }();
-  return from;
+  return loss;
 }
+
+std::atomic<bool> measuredResultNoted{false};
 
 bool injectedDeviceLoss() {
   static std::atomic<uint64_t> submissions{0};
-  const uint64_t from = injectedLossFrom();
-  return from > 0 && ++submissions >= from;
+  const InjectedLoss loss = injectedLoss();
+  if (loss.from == 0 || (loss.afterResult && !measuredResultNoted)) return false;
+  return ++submissions >= loss.from;
 }
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
@@ -152,7 +173,11 @@ std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
 } // namespace
 
 bool deviceLossInjected() {
-  return injectedLossFrom() > 0;
+  return injectedLoss().from > 0;
+}
+
+void noteMeasuredResult() {
+  measuredResultNoted = true;
 }
 
 std::vector<DeviceInfo> listDevices() {

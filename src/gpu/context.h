@@ -61,6 +61,9 @@ struct DeviceFeatures {
 // Whether the test hook POINTRAST_INJECT_DEVICE_LOST is set: the process's submissions, counted, are to fail
 // from a given one on. Work whose number of submissions depends on the device (clock settling) stays out.
 bool deviceLossInjected();
+// For POINTRAST_INJECT_DEVICE_LOST=result+N: a benchmark kept a measured result; the count of submissions
+// to fail starts at the first call.
+void noteMeasuredResult();
 
 class Context {
 public:

@@ -197,38 +197,32 @@ TEST(BenchCli, ALostDeviceKeepsWhatWasMeasuredAndIsOneErrorLine) {
 }
 
 TEST(BenchCli, ALostDeviceInTheLodSuiteKeepsWhatWasMeasuredAndIsOneErrorLine) {
-  // The 25th submission fails: usually after the copy bandwidth and the sweeps. Node uploads are
-  // submissions too and depend on the reader threads' timing, so the fault can land earlier, before any
-  // result (about one run in eight on lavapipe). Every run must end as a lost device does; the property
-  // "what was measured is kept" needs a run whose fault came after a result, so up to four runs are made.
-  bool keptWhatWasMeasured = false;
-  for (int attempt = 0; attempt < 4 && !keptWhatWasMeasured; ++attempt) {
-    SCOPED_TRACE("attempt " + std::to_string(attempt + 1));
-    fs::path dir = tempDir() / "lost-lod";
-    fs::remove_all(dir);
-    setenv("POINTRAST_INJECT_DEVICE_LOST", "25", 1);
-    Result r = run("bench --suite lod --views overview --flight-frames 6 --jumps 2 --scale 0.0001 --frames 1 "
-                   "--width 160 --height 100 --copy-size 16M --budget 0 -q --octree-cache " +
-                   (dir / "octrees").string() + " --out " + (dir / "out").string());
-    unsetenv("POINTRAST_INJECT_DEVICE_LOST");
-    EXPECT_FALSE(r.signaled) << r.err;
-    EXPECT_EQ(r.exitCode, 1) << r.err;
-    EXPECT_EQ(errorLines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find("device was lost"), std::string::npos) << r.err;
-    const fs::path json = dir / "out" / "lod-scale0.0001.json";
-    ASSERT_TRUE(fs::exists(json)) << r.err;
-    nlohmann::json report = nlohmann::json::parse(slurp(json));
-    EXPECT_NE(report["stopped"].get<std::string>().find("device was lost"), std::string::npos);
-    int ok = 0, faulted = 0;
-    for (const char* part : {"sweeps", "streams"})
-      for (const auto& result : report[part]) {
-        ok += result["status"] == "ok";
-        faulted += result["status"] == "device-fault";
-      }
-    EXPECT_LE(faulted, 1) << "nothing runs after the fault";
-    keptWhatWasMeasured = ok >= 1 && faulted == 1;
-  }
-  EXPECT_TRUE(keptWhatWasMeasured) << "no run kept a measured result before its fault";
+  // The first submission after the first measured result fails (result+1): node uploads are submissions
+  // too and come from reader threads, so a count from the process's start would land at a point that
+  // depends on their timing.
+  fs::path dir = tempDir() / "lost-lod";
+  fs::remove_all(dir);
+  setenv("POINTRAST_INJECT_DEVICE_LOST", "result+1", 1);
+  Result r = run("bench --suite lod --views overview --flight-frames 6 --jumps 2 --scale 0.0001 --frames 1 "
+                 "--width 160 --height 100 --copy-size 16M --budget 0 -q --octree-cache " +
+                 (dir / "octrees").string() + " --out " + (dir / "out").string());
+  unsetenv("POINTRAST_INJECT_DEVICE_LOST");
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("device was lost"), std::string::npos) << r.err;
+  const fs::path json = dir / "out" / "lod-scale0.0001.json";
+  ASSERT_TRUE(fs::exists(json)) << r.err;
+  nlohmann::json report = nlohmann::json::parse(slurp(json));
+  EXPECT_NE(report["stopped"].get<std::string>().find("device was lost"), std::string::npos);
+  int ok = 0, faulted = 0;
+  for (const char* part : {"sweeps", "streams"})
+    for (const auto& result : report[part]) {
+      ok += result["status"] == "ok";
+      faulted += result["status"] == "device-fault";
+    }
+  EXPECT_GE(ok, 1) << "what was measured before the fault is kept";
+  EXPECT_EQ(faulted, 1) << "nothing runs after the fault";
 }
 
 TEST(BenchCli, ALostDeviceInRenderIsOneLineAndNoImage) {

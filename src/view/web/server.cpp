@@ -100,6 +100,9 @@ struct Connection : MessageSink {
   Viewport canvas{0, 0}; // civetweb's thread only: the frame size its last resize asked for, clamped
   uint32_t supersample = 1;
   std::atomic<bool> ready{false}, closed{false};
+  // The server has sent its close (a refused message, the closing handshake): the connection no longer
+  // holds one of --max-clients' slots, though civetweb has yet to tear it down.
+  std::atomic<bool> ending{false};
 
   bool sendText(std::string_view text) override {
     return cw::mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_TEXT, text.data(), text.size()) > 0;
@@ -459,7 +462,7 @@ int Server::wsConnect(const mg_connection* conn, void* selfPointer) {
   std::lock_guard lock(self.connectionsMutex_);
   size_t open = 0;
   for (const auto& [id, other] : self.connections_)
-    open += other->closed || other->refused ? 0 : 1; // a refused one is on its way out
+    open += other->closed || other->refused || other->ending ? 0 : 1; // those on their way out are not
   c->refused = open >= self.options_.maxClients;
   c->id = self.nextId_++;
   cw::mg_set_user_connection_data(conn, c.get());
@@ -530,6 +533,7 @@ bool Server::boundSamples(Connection& c, ClientMessage& m) {
 int Server::refuseMessage(Connection& c, uint16_t code, const std::string& why) {
   log_.line("client " + std::to_string(c.id) + " cut off: " + why);
   emit({{"event", "refused"}, {"id", c.id}, {"why", why}, {"websocket", true}});
+  c.ending = true;
   sendClose(c.conn, code, why.substr(0, 100));
   return 0; // civetweb closes the connection
 }
@@ -549,6 +553,7 @@ int Server::receive(Connection& c, int bits, const char* data, size_t length) {
   if (frame.action == FrameAction::Close) {
     // The closing handshake's answer, after the last frame the sender was writing; none when this server
     // closed first (the client's frame is then the answer).
+    c.ending = true;
     if (!c.refused && !stopping_) {
       if (c.stream) c.stream->stop();
       sendClose(c.conn, kCloseNormal, "");
