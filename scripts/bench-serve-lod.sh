@@ -55,5 +55,37 @@ trap - EXIT
 kill -TERM "$server"
 wait "$server" || { echo "bench-serve-lod: the server exited with $?" >&2; status=1; }
 cat "$out/serve-lod-server.log"
+
+# Beside it, the same flight over the same points drawn by brute force (the generated terrain of the same
+# seed, uploaded whole, the device's default method): serve-lod-brute.{json,md}, appended to serve-lod.md.
+if [ "${SERVE_BRUTE:-1}" = 1 ]; then
+  brute_events="$out/serve-lod-brute-events.jsonl"
+  "$pr" serve terrain --points "$points" --port 0 --events -q >"$brute_events" 2>"$out/serve-lod-brute-server.log" &
+  server=$!
+  trap stop_server EXIT
+  port=""
+  for ((i = 0; i < 600; ++i)); do
+    port=$(sed -n 's/.*"event":"listening".*"port":\([0-9]*\).*/\1/p' "$brute_events" | head -1)
+    [ -n "$port" ] && break
+    kill -0 "$server" 2>/dev/null || break
+    sleep 0.5
+  done
+  if [ -z "$port" ]; then
+    echo "bench-serve-lod: the brute-force server did not listen" >&2
+    cat "$out/serve-lod-brute-server.log" >&2
+    status=1
+  else
+    "$load" --port "$port" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" \
+      --rate "${SERVE_RATE:-120}" --flight \
+      -o "$out/serve-lod-brute.json" --markdown "$out/serve-lod-brute.md" || status=1
+  fi
+  trap - EXIT
+  kill -TERM "$server" 2>/dev/null || true
+  wait "$server" || { echo "bench-serve-lod: the brute-force server exited with $?" >&2; status=1; }
+  if [ -f "$out/serve-lod-brute.md" ] && [ -f "$out/serve-lod.md" ]; then
+    { echo; echo "## Beside it: the same flight over the same $points points drawn by brute force"; echo
+      sed '1s/^# /### /' "$out/serve-lod-brute.md"; } >> "$out/serve-lod.md"
+  fi
+fi
 [ -f "$out/serve-lod.md" ] && cat "$out/serve-lod.md"
 exit $status

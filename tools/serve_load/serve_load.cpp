@@ -100,7 +100,10 @@ private:
   std::vector<double> latencies_;     // ms, of the inputs shown since the last reset
   std::vector<Frame> frames_;         // received since the last reset
   std::vector<uint32_t> rgba_;
-  std::map<uint32_t, bool> convergedByFrame_;                     // frame id -> its state's lod.converged
+  // frame id -> its state's lod.converged; none for a source without level of detail, whose full frame
+  // (the one drawn at rest) is its final image.
+  std::map<uint32_t, std::optional<bool>> convergedByFrame_;
+  bool sawLod_ = false; // some state carried level-of-detail statistics
   std::map<uint32_t, double> pointsByFrame_;                      // frame id -> its state's lod.pointsDrawn
   std::map<uint32_t, std::pair<double, double>> serverMsByFrame_; // frame id -> inputWaitMs, frameWallMs
   std::vector<double> receivedLatencies_; // ms, as latencies_ but to the frame's message before decoding
@@ -140,7 +143,9 @@ void Load::pump(double until) {
         state_ = j;
         const Json& lod = j.value("stats", Json::object()).value("lod", Json::object());
         if (j.contains("frame") && j["frame"].is_number_unsigned()) {
-          convergedByFrame_[j["frame"].get<uint32_t>()] = lod.value("converged", false);
+          std::optional<bool> converged;
+          if (!lod.empty()) converged = lod.value("converged", false), sawLod_ = true;
+          convergedByFrame_[j["frame"].get<uint32_t>()] = converged;
           if (lod.contains("pointsDrawn") && lod["pointsDrawn"].is_number())
             pointsByFrame_[j["frame"].get<uint32_t>()] = lod["pointsDrawn"].get<double>();
           const Json& stats = j.value("stats", Json::object());
@@ -166,7 +171,7 @@ void Load::pump(double until) {
     }
     f.arrived = clockSeconds();
     if (auto it = convergedByFrame_.find(f.header.frame); it != convergedByFrame_.end()) {
-      f.converged = it->second;
+      f.converged = it->second.value_or((f.header.flags & view::web::kFrameFull) != 0);
       convergedByFrame_.erase(convergedByFrame_.begin(), std::next(it));
     }
     if (auto it = pointsByFrame_.find(f.header.frame); it != pointsByFrame_.end()) {
@@ -568,7 +573,8 @@ int Load::runFlight(const Frame& first, Json result) {
                          "went under its ground, so the figures time empty frames\n");
   if (!args_.output.empty() && !writeFile(args_.output, text + "\n")) return 1;
   if (!args_.markdown.empty()) {
-    std::string md = "# pointrast serve: a flight with level of detail, one client at " +
+    std::string md = std::string("# pointrast serve: a flight") +
+                     (sawLod_ ? " with level of detail" : ", the cloud drawn whole") + ", one client at " +
                      std::to_string(args_.width) + "x" + std::to_string(args_.height) + "\n\n";
     md += "Device " + result["device"].get<std::string>() + ", " + result["input"].get<std::string>() +
           ", method " + result["method"].get<std::string>() +
