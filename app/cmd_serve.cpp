@@ -9,10 +9,13 @@
 #include "base/progress.h"
 #include "cli_util.h"
 #include "commands.h"
+#include "distributed.h"
+#include "distributed_serve.h"
 #include "input.h"
-#include "options.h"
 #include "io/annotations_file.h"
 #include "io/format_table.h"
+#include "mpi/mpi_job.h"
+#include "options.h"
 #include "view/web/server.h"
 
 namespace pointrast::app {
@@ -39,6 +42,44 @@ view::Viewport parseSize(const std::string& text) {
   if (std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X'))
     throw InputError("--max-size " + text + ": give WIDTHxHEIGHT, e.g. 1920x1080");
   return {w, h};
+}
+
+// `mpirun -np N pointrast serve` (docs/mpi.md): every rank opens its share of the input on its own device;
+// rank 0 serves the page and draws every frame with all ranks (distributed_serve.h), the others follow its
+// draws until it stops, and every rank exits with rank 0's status.
+int serveRanks(const ServeArgs& a, view::web::ServerOptions& o, const InputSpec& spec,
+               const SceneOptions& scene) {
+  mpi::Job& job = mpi::Job::get();
+  if (o.method)
+    if (std::optional<std::string> why = viewRefusal(*o.method)) throw InputError(*why);
+  gpu::ContextOptions device;
+  device.deviceIndex = o.device;
+  device.announce = !a.quiet;
+  chooseRankDevice(device);
+  o.device = device.deviceIndex;
+  if (!a.quiet) Progress::setEnabled(job.root());
+  view::SceneInput input = openSceneShare(spec, scene);
+  const view::DrawShare share{job.rank(), job.size()};
+  if (!job.root()) {
+    gpu::Context context(device);
+    announceRanks(context, a.quiet);
+    std::unique_ptr<view::SceneSource> source =
+        view::makeSceneSource(context, input, o.settings, false, share);
+    job.check(); // every rank has its input on its device before rank 0 listens
+    return followDraws(context, *source);
+  }
+  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center())) o.camera = camera;
+  o.announceDevice = false; // one line per rank instead
+  const uint64_t points = input.points;
+  o.makeSource = [&](gpu::Context& context, view::SceneInput& in, const view::ViewSettings& settings) {
+    announceRanks(context, a.quiet);
+    auto mine = view::makeSceneSource(context, in, settings, !a.quiet, share);
+    job.check();
+    return compositedSource(context, std::move(mine), points);
+  };
+  const int status = view::web::runServer(input, o);
+  stopFollowers(status);
+  return status;
 }
 
 int runServe(const ServeArgs& a) {
@@ -73,6 +114,7 @@ int runServe(const ServeArgs& a) {
   scene.method = o.method;
   scene.gpuBudget = o.settings.gpuMemory;
   scene.onNote = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  if (distributedRun()) return serveRanks(a, o, spec, scene);
   view::SceneInput input = openScene(spec, scene);
   if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center())) o.camera = camera;
   return view::web::runServer(input, o);
@@ -94,12 +136,18 @@ Command addServe(CLI::App& app) {
       "on touch screens one finger orbits, two pan and pinch zooms. Ctrl-C (SIGINT) or SIGTERM stops it.\n"
       "Limits: a client's frame is at most 3840x2160 samples (width x height x supersample^2: 4K at 1,\n"
       "1080p at 2, 960x540 at 4); a connection that sends no request within 3 s is closed, and up to 128\n"
-      "such connections delay no page load.\n\n"
+      "such connections delay no page load.\n"
+      "Under mpirun (one rank per GPU, docs/mpi.md) rank 0 serves the page and every rank draws its\n"
+      "share of each frame (a cloud's points, an octree's nodes), composited on rank 0: the closest-point\n"
+      "methods only, and the pick tool and measuring run on one process. The other ranks open no socket\n"
+      "and exit with rank 0's status: stop the job by signalling rank 0 (the pid of --events' listening\n"
+      "line); mpirun, signalled itself, ends the job with its own status.\n\n"
       "Examples:\n"
       "  pointrast serve autzen.las                                   # http://127.0.0.1:8080/\n"
       "  pointrast serve lone-star.copc.laz                           # an octree, streamed (lod)\n"
       "  pointrast serve terrain --points 1G --method batch-prefetch --port 9000\n"
-      "  pointrast serve cloud.las --bind 0.0.0.0 --max-clients 8     # prints http://HOST:8080/?token=...");
+      "  pointrast serve cloud.las --bind 0.0.0.0 --max-clients 8     # prints http://HOST:8080/?token=...\n"
+      "  mpirun -np 2 pointrast serve big_octree/                     # two GPUs draw each frame");
   cmd->add_option("FILE", a->input,
                   "A cloud file (" + io::formatList(io::FormatUse::Cloud) + "), an octree (" +
                       io::formatList(io::FormatUse::Octree) +
@@ -141,7 +189,8 @@ Command addServe(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "Seed for generated scenes and shuffled orders")->capture_default_str();
   cmd->add_flag(
       "--events", a->events,
-      "Print one JSON object a line on stdout: listening (with the URL), clients, refusals, the exit");
+      "Print one JSON object a line on stdout: listening (with the URL and the process id), clients, "
+      "refusals, the exit");
   cmd->add_option("--device", a->device, "Vulkan device index (see `pointrast info --devices`)");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines");
   return [a] { return runServe(*a); };

@@ -174,26 +174,32 @@ static void gatherRankStats(const FrameStats& stats, CompositeStats& out) {
     out.rankPoints.push_back(uint64_t(points));
 }
 
-std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, const Camera& camera,
-                                     const RenderSettings& settings, double int40Scale,
-                                     const FrameStats& stats, CompositeStats& out) {
+std::vector<uint32_t> compositeWords(CompositeResolver& resolver, std::vector<uint64_t>& words,
+                                     const Camera& camera, const RenderSettings& settings, double int40Scale,
+                                     CompositeStats& out, std::vector<uint64_t>* ended) {
   mpi::Job& job = mpi::Job::get();
-  auto start = std::chrono::steady_clock::now();
-  std::vector<uint64_t> words = renderer.framebufferWords();
-  out.readbackMs = msSince(start);
-  gatherRankStats(stats, out);
   job.check(); // all ranks are here: the composite's time is its own, not a wait for the slowest rank
-  start = std::chrono::steady_clock::now();
+  auto start = std::chrono::steady_clock::now();
   job.minToRoot(words);
   out.compositeMs = msSince(start);
   out.bytesMoved = uint64_t(job.size() - 1) * words.size() * 8;
   if (!job.root()) return {};
   dumpWords(words);
   start = std::chrono::steady_clock::now();
-  CompositeResolver resolver(context, renderer.width() / renderer.eyes(), renderer.height(), renderer.eyes());
-  std::vector<uint32_t> image = resolver.resolve(words, camera, settings, int40Scale, &out.post);
+  std::vector<uint32_t> image = resolver.resolve(words, camera, settings, int40Scale, &out.post, ended);
   out.resolveMs = msSince(start);
   return image;
+}
+
+std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, const Camera& camera,
+                                     const RenderSettings& settings, double int40Scale,
+                                     const FrameStats& stats, CompositeStats& out) {
+  auto start = std::chrono::steady_clock::now();
+  std::vector<uint64_t> words = renderer.framebufferWords();
+  out.readbackMs = msSince(start);
+  gatherRankStats(stats, out);
+  CompositeResolver resolver(context, renderer.width() / renderer.eyes(), renderer.height(), renderer.eyes());
+  return compositeWords(resolver, words, camera, settings, int40Scale, out);
 }
 
 std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuScene* const> scenes,

@@ -14,6 +14,7 @@
 #include "cloud/cloud.h"
 #include "gpu/context.h"
 #include "input.h"
+#include "render/composite.h"
 #include "render/renderer.h"
 
 namespace pointrast::app {
@@ -58,6 +59,15 @@ struct CompositeStats {
   std::optional<PostStats> post;    // the resolve stage on rank 0
   std::vector<std::string> devices; // "host: device" per rank
 };
+
+// The words of every rank (one a pixel, as Renderer::framebufferWords() returns them for `settings`
+// rendered without the resolve stage) composited on rank 0 by their MIN and resolved there with `settings`
+// (render/composite.h). Returns the image on rank 0, nothing elsewhere; *ended receives the words the
+// composited frame ended with (CompositeResolver::resolve). Fills out's compositeMs, bytesMoved, post and
+// resolveMs. A collective; the render and serve commands' one composite.
+std::vector<uint32_t> compositeWords(CompositeResolver& resolver, std::vector<uint64_t>& words,
+                                     const Camera& camera, const RenderSettings& settings, double int40Scale,
+                                     CompositeStats& out, std::vector<uint64_t>* ended = nullptr);
 
 // After this rank's timed frames (stats): composites the last frame on rank 0 and resolves it there.
 // Returns the image on rank 0, nothing elsewhere. `int40Scale` is the int40 steps per unit the frames used.

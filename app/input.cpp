@@ -11,9 +11,11 @@
 #include "cloud/generate.h"
 #include "cloud/octree.h"
 #include "cloud/particles_generate.h"
+#include "distributed.h"
 #include "io/format_table.h"
 #include "io/particles/particles_io.h"
 #include "io/reader.h"
+#include "mpi/mpi_job.h"
 
 namespace pointrast::app {
 
@@ -126,6 +128,25 @@ view::SceneInput openScene(const InputSpec& spec, const SceneOptions& options) {
     break;
   }
   return view::SceneInput::fromCloud(loadInput(spec));
+}
+
+view::SceneInput openSceneShare(const InputSpec& spec, const SceneOptions& options) {
+  checkSceneMethod(spec, options.method);
+  switch (howOpens(spec, options)) {
+  case Opens::Octree:
+    return view::SceneInput::fromOctree(io::openNodeSource(spec.source));
+  case Opens::BuiltOctree:
+    throw InputError(spec.source +
+                     ": under mpirun serve draws a cloud's shares or an octree's, and builds "
+                     "no octree; build one with `pointrast lod " +
+                     spec.source + " -o DIR` and serve that");
+  case Opens::Cloud:
+    break;
+  }
+  // Each rank's points; the bounds, and the count the page shows, are the whole input's.
+  view::SceneInput input = view::SceneInput::fromCloud(loadShare(spec));
+  input.points = mpi::Job::get().sumOf(input.points);
+  return input;
 }
 
 std::optional<uint64_t> statedPoints(const InputSpec& spec) {

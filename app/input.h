@@ -61,6 +61,10 @@ struct SceneOptions {
   std::function<void(const std::string&)> onNote;
 };
 view::SceneInput openScene(const InputSpec& spec, const SceneOptions& options = {});
+// A rank's part of the input under mpirun (docs/mpi.md): an octree opened whole (each frame draws the
+// rank's share of its selection), a cloud's share (loadShare) with the whole input's bounds and point
+// count. Refuses an input openScene would build an octree of. A collective.
+view::SceneInput openSceneShare(const InputSpec& spec, const SceneOptions& options = {});
 // The refusals of openScene that need no reading, said before a device starts or a file is read.
 void checkSceneMethod(const InputSpec& spec, std::optional<Method> method);
 // The octree cache's key of a file: its name and a hash of its absolute path, size and modification time.

@@ -80,12 +80,13 @@ int runCommand(int argc, char** argv) {
 
   try {
     for (CLI::App* sub : app.get_subcommands()) {
-      // Under mpirun with several ranks only render draws a share per rank; the others would each do the
-      // whole work (and write the same files).
-      if (mpi::Job::get().distributed() && sub->get_name() != "render")
-        throw InputError("`pointrast " + sub->get_name() +
-                         "` runs as one process; under mpirun only render divides its work among ranks "
-                         "(docs/mpi.md)");
+      // Under mpirun with several ranks only render and serve draw a share per rank; the others would each
+      // do the whole work (and write the same files).
+      const std::string name = sub->get_name();
+      if (mpi::Job::get().distributed() && name != "render" && name != "serve")
+        throw InputError("`pointrast " + name +
+                         "` runs as one process; under mpirun only render and serve divide their work among "
+                         "ranks (docs/mpi.md)");
       for (const app::RegisteredCommand& command : commands)
         if (command.subcommand == sub) return command.run();
     }

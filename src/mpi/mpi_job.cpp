@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cassert>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <thread>
 
 #include "base/parallel.h"
 #include "base/text.h"
@@ -56,12 +58,29 @@ bool startedByLauncher() {
 // MPI counts are int: large arrays go in slices of 2^28 elements.
 constexpr uint64_t kSlice = uint64_t(1) << 28;
 
+// Waits for a request without holding a core: MPI implementations wait by polling, and the ranks of a
+// browser viewer wait between frames for as long as nobody moves the camera. The first millisecond polls
+// (a collective between frames of a render answers within it); after that a test every millisecond.
+void waitSparingly(MPI_Request& request) {
+  const auto start = std::chrono::steady_clock::now();
+  int done = 0;
+  for (;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    if (std::chrono::steady_clock::now() - start > std::chrono::milliseconds(1))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
 } // namespace
 
 void Job::start(int& argc, char**& argv) {
   Job& job = get();
   if (job.started_ || !startedByLauncher()) return;
-  MPI_Init(&argc, &argv);
+  // The browser viewer's rank 0 calls MPI from its render thread and, once that thread ended, from the
+  // main thread: never two threads at once.
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
   job.started_ = job.launched_ = true;
   int rank = 0, size = 1, localRank = 0, localSize = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -93,7 +112,9 @@ void Job::agree(const std::string* failure) {
   }
   const int mine = failure ? 1 : 0;
   int failed = 0;
-  MPI_Allreduce(&mine, &failed, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Request request;
+  MPI_Iallreduce(&mine, &failed, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD, &request);
+  waitSparingly(request);
   if (failed == 0) return;
   // The lowest failing rank's message goes to rank 0, which prints it once for the job.
   const int candidate = failure ? int(rank_) : int(size_);

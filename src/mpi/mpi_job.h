@@ -9,7 +9,9 @@
 // whose work throws calls fail() instead of its next collective: the others learn it there, rank 0 prints
 // the one line (naming the rank when not every rank failed), and every rank returns exit code 1 through
 // JobFailed; nobody waits on a rank that is gone. Only a rank that fails where this agreement cannot reach
-// (inside MPI itself) ends the job with MPI_Abort.
+// (inside MPI itself) ends the job with MPI_Abort. The agreement waits without holding a core (it tests for
+// the others every millisecond once a first millisecond has passed): the ranks of a browser viewer wait in
+// it between frames for as long as nobody moves the camera.
 #pragma once
 
 #include <cstdint>

@@ -27,7 +27,8 @@ double int40ScaleOf(std::span<const GpuScene* const> scenes, const Camera& camer
 
 std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words, const Camera& camera,
                                                  const RenderSettings& settings, double int40Scale,
-                                                 std::optional<PostStats>* post) {
+                                                 std::optional<PostStats>* post,
+                                                 std::vector<uint64_t>* ended) {
   const uint64_t pixels = uint64_t(width_) * eyes_ * height_;
   if (words.size() != pixels) throw InputError("composited words do not match the image size");
   const bool int40 = settings.depth == DepthMode::Int40;
@@ -41,6 +42,7 @@ std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words
     for (uint64_t i = 0; i < pixels; ++i)
       image[i] = words[i] == shared::kEmptyPixel ? settings.background : colorOf(words[i]);
     if (post) post->reset();
+    if (ended) ended->assign(words.begin(), words.end());
     return image;
   }
   validatePostSettings(settings.post);
@@ -64,7 +66,7 @@ std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words
   for (uint32_t e = 0; e < eyes_; ++e)
     views.push_back({device.address() + uint64_t(e) * width_ * 8, target.address() + uint64_t(e) * width_ * 4,
                      width_, height_, pitch, float(glm::length(camera.target - camera.eye)),
-                     settings.background, false});
+                     settings.background, ended != nullptr});
   gpu::TimestampPool timestamps(context_, kPostPasses);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
@@ -75,6 +77,10 @@ std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words
   });
   if (post) *post = PostStage::stats(timestamps.milliseconds(), 1);
   gpu::readBuffer(context_, target, 0, image.data(), pixels * 4);
+  if (ended) {
+    ended->resize(pixels);
+    gpu::readBuffer(context_, device, 0, ended->data(), pixels * 8);
+  }
   return image;
 }
 

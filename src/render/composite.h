@@ -27,10 +27,13 @@ public:
   // `words`: one canonical word per pixel of the whole image, as Renderer::framebufferWords() returns them
   // for `settings` rendered without the resolve stage (int40 words for DepthMode::Int40, whose steps per
   // unit are `int40Scale`). Returns the image, row 0 at the top; *post receives the stage's GPU times
-  // when it ran. Throws InputError for resolve-stage settings out of range.
+  // when it ran; *ended the words the frame ended with, as Renderer::framebufferWords() returns them after
+  // such a frame (`words` themselves without the resolve stage, its float-depth words with it). Throws
+  // InputError for resolve-stage settings out of range.
   std::vector<uint32_t> resolve(std::span<const uint64_t> words, const Camera& camera,
                                 const RenderSettings& settings, double int40Scale,
-                                std::optional<PostStats>* post = nullptr);
+                                std::optional<PostStats>* post = nullptr,
+                                std::vector<uint64_t>* ended = nullptr);
 
 private:
   gpu::Context& context_;

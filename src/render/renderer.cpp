@@ -400,6 +400,18 @@ std::vector<uint32_t> Renderer::image() {
   return pixels;
 }
 
+void Renderer::showComposite(std::span<const uint32_t> image, std::span<const uint64_t> words) {
+  Targets& t = *targets_;
+  assert(image.size() == t.pixels() && words.size() == t.pixels() && "a composited frame of this size");
+  allocateWords();
+  gpu::writeBuffer(context_, t.image, 0, image.data(), image.size_bytes());
+  gpu::writeBuffer(context_, t.words, 0, words.data(), words.size_bytes());
+  wordsCaptured_ = true;
+  last_ = nullptr;
+  pickableOctree_ = nullptr;
+  lodWhy_ = "the last frame was composited from several processes' frames";
+}
+
 std::vector<uint64_t> Renderer::framebufferWords() {
   if (!wordsCaptured_)
     throw InputError("no canonical framebuffer words: the last frame was not rendered with captureWords by a "

@@ -153,6 +153,12 @@ public:
   // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
   // reads to pick the point under the cursor.
   std::vector<uint64_t> framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h);
+  // Makes a frame composited elsewhere (render/composite.h) this renderer's last frame: `image` (width() x
+  // height() pixels) is what image() returns, `words` (one a pixel) what framebufferWords() returns. A
+  // viewer whose frames are composited across processes reads them as it reads its own frames' (picking,
+  // the overlay's depth test). The octree visibility buffer and the HQS buffers are not the composite's:
+  // lodPointAt and hqsDepths refuse after it.
+  void showComposite(std::span<const uint32_t> image, std::span<const uint64_t> words);
   // Device address of the RGBA8 image of the last frame (width() x height() words, row 0 at the top), for
   // front ends that show it without a copy to the host. Valid until the Renderer is destroyed.
   uint64_t imageAddress() const;

@@ -46,7 +46,8 @@ SceneInput SceneInput::fromOctree(std::unique_ptr<lod::NodeSource> source) {
 std::vector<Method> methodsFor(const SceneSource& source, const gpu::Context& context) {
   std::vector<Method> methods;
   for (Method m : allMethods())
-    if (source.draws(m) && Renderer::supports(const_cast<gpu::Context&>(context), m)) methods.push_back(m);
+    if (source.draws(m) && !source.refuses(m) && Renderer::supports(const_cast<gpu::Context&>(context), m))
+      methods.push_back(m);
   return methods;
 }
 
@@ -78,8 +79,8 @@ GpuOctree::Options GpuOctree::optionsOf(const ViewSettings& settings) {
 }
 
 GpuOctree::GpuOctree(gpu::Context& context, lod::NodeSource& source, const std::string& name,
-                     const Bounds& bounds, uint64_t points, const ViewSettings& settings)
-    : context_(context), source_(source), name_(name), bounds_(bounds), points_(points) {
+                     const Bounds& bounds, uint64_t points, const ViewSettings& settings, DrawShare share)
+    : context_(context), source_(source), name_(name), bounds_(bounds), points_(points), share_(share) {
   make(optionsOf(settings));
 }
 
@@ -96,6 +97,8 @@ void GpuOctree::make(const Options& options) {
   // refines over a few more frames.
   o.uploadBytesPerFrame = kInteractiveUploadBytes;
   o.readerNiceness = kInteractiveReaderNiceness;
+  o.shareIndex = share_.index;
+  o.shares = share_.count;
   scene_.reset(); // its node cache goes before the new one is allocated
   scene_ = std::make_unique<lod::LodScene>(context_, source_, o);
   options_ = options;
@@ -144,10 +147,10 @@ FrameStats GpuOctree::draw(Renderer& renderer, const Camera& camera, const Rende
 }
 
 std::unique_ptr<SceneSource> makeSceneSource(gpu::Context& context, SceneInput& input,
-                                             const ViewSettings& settings, bool progress) {
+                                             const ViewSettings& settings, bool progress, DrawShare share) {
   if (input.octree)
     return std::make_unique<GpuOctree>(context, *input.octree, input.name, input.bounds, input.points,
-                                       settings);
+                                       settings, share);
   assert(input.cloud && "an input holds a cloud or an octree");
   return std::make_unique<GpuCloud>(context, *input.cloud, progress);
 }

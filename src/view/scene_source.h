@@ -73,6 +73,18 @@ public:
                           const ViewSettings& settings, std::string& status) = 0;
   // Whether a frame drawn now would differ from the last one without any input: nodes still arriving.
   virtual bool changed() const { return false; }
+  // Why the points a frame shows cannot be read on this host (a rank of a distributed viewer holds only
+  // its share of them), for the tools that read them (the pick tool and its measurements); empty when they
+  // can.
+  virtual std::string pointsElsewhere() const { return {}; }
+  // Why this source does not draw a method it would draw by its layout (a distributed viewer's frames must
+  // composite), or nothing. methodsFor() leaves such methods out.
+  virtual std::optional<std::string> refuses(Method) const { return std::nullopt; }
+};
+
+// The part of an input one process draws: share `index` of `count` (docs/mpi.md); {0, 1} is the whole.
+struct DrawShare {
+  uint32_t index = 0, count = 1;
 };
 
 // The method a viewer starts with on this device: lod for an octree; for a cloud the fastest the device
@@ -92,7 +104,7 @@ public:
   // The node source must outlive this. Throws InputError for a source whose root is unusable,
   // UnsupportedError when the budget holds no page.
   GpuOctree(gpu::Context& context, lod::NodeSource& source, const std::string& name, const Bounds& bounds,
-            uint64_t points, const ViewSettings& settings = {});
+            uint64_t points, const ViewSettings& settings = {}, DrawShare share = {});
   ~GpuOctree() override;
   const std::string& name() const override { return name_; }
   const Bounds& bounds() const override { return bounds_; }
@@ -119,6 +131,7 @@ private:
   std::string name_;
   Bounds bounds_;
   uint64_t points_;
+  DrawShare share_;
   Options options_;
   std::unique_ptr<lod::LodScene> scene_;
   std::string error_; // why the last change of options was refused, said with every frame until the next
@@ -127,8 +140,10 @@ private:
 };
 
 // The GPU side of an opened input: a GpuOctree for an octree, a GpuCloud for a cloud (uploaded on first
-// use, with progress lines unless quiet).
+// use, with progress lines unless quiet). An octree's frames draw `share` of each selection; a cloud is
+// already only its share.
 std::unique_ptr<SceneSource> makeSceneSource(gpu::Context& context, SceneInput& input,
-                                             const ViewSettings& settings, bool progress);
+                                             const ViewSettings& settings, bool progress,
+                                             DrawShare share = {});
 
 } // namespace pointrast::view

@@ -116,6 +116,18 @@ std::optional<std::string> GpuCloud::setColors(std::optional<DisplayColorMode::S
   return std::nullopt;
 }
 
+void GpuCloud::setColors(std::optional<DisplayColorMode::Source> source, std::optional<ColorRange> range,
+                         const DisplayColorMode& mode) {
+  const bool same =
+      colors_ && colors_->source == mode.source && colors_->lo == mode.lo && colors_->hi == mode.hi;
+  colorSource_ = source;
+  colorRange_ = range;
+  colors_ = mode;
+  if (same) return;
+  for (auto& scene : scenes_)
+    if (scene) scene->recolor(context_, cloud_, mode);
+}
+
 const std::string& GpuCloud::name() const {
   return cloud_.source;
 }
@@ -232,6 +244,7 @@ nlohmann::json SceneView::pickAttributes(const Camera& camera, const ViewSetting
     return nlohmann::json{{"pixel", {px, py}}, {"point", "unavailable: " + why}};
   };
   if (applicable(settings).stereo) return unavailable("a stereo frame shows two cameras; turn stereo off to pick");
+  if (const std::string why = source_.pointsElsewhere(); !why.empty()) return unavailable(why);
   auto* cloud = dynamic_cast<GpuCloud*>(&source_);
   auto* octree = dynamic_cast<GpuOctree*>(&source_);
   if (!cloud && !octree) return unavailable("this input keeps no points to pick from");

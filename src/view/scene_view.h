@@ -55,6 +55,10 @@ public:
   // the sentence why not when the cloud lacks the attribute; the colors then stay as they were.
   std::optional<std::string> setColors(std::optional<DisplayColorMode::Source> source,
                                        std::optional<ColorRange> range);
+  // The same with the colors decided elsewhere: a rank of a distributed viewer colors its share as rank 0
+  // colored its own (percentile ramps from rank 0's share), so that the composite is one process's frame.
+  void setColors(std::optional<DisplayColorMode::Source> source, std::optional<ColorRange> range,
+                 const DisplayColorMode& mode);
   const std::string& name() const override;
   const Bounds& bounds() const override;
   uint64_t pointCount() const override;

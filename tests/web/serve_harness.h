@@ -58,7 +58,8 @@ inline std::filesystem::path scratchDir(const std::string& name) {
 
 class ServeProcess {
 public:
-  explicit ServeProcess(const std::string& args) {
+  // `launcher`: a command the server is started under (mpirun and its options), before the binary.
+  explicit ServeProcess(const std::string& args, const std::string& launcher = "") {
     int fds[2];
     if (pipe(fds) != 0) return;
     errFile_ = scratchDir("server") / ("stderr_" + std::to_string(counter()++) + ".txt");
@@ -70,7 +71,8 @@ public:
       dup2(err, STDERR_FILENO);
       setenv("XDG_RUNTIME_DIR", "/tmp", 1);
       if (!getenv("POINTRAST_VALIDATION")) setenv("POINTRAST_VALIDATION", "1", 1);
-      std::string command = "exec '" + pointrastBinary() + "' serve " + args + " --port 0 --events -q";
+      std::string command =
+          "exec " + launcher + " '" + pointrastBinary() + "' serve " + args + " --port 0 --events -q";
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }

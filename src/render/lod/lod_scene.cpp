@@ -247,20 +247,25 @@ bool LodScene::update(std::span<const Camera> views, uint32_t width, uint32_t he
   limits.foveation = view.foveation;
   limits.pointBudget = std::min(view.pointBudget ? view.pointBudget : kMaxPassPoints, kMaxPassPoints);
   limits.pageBudget = pool_->capacity(); // a frame draws one pass: its selection fits the cache
-  const Selection sel = selectNodes(*hierarchy_, views, width, height, origin_, nearW(views[0]), limits);
-  stats_.nodesSelected = sel.nodes.size();
-  stats_.pointsSelected = sel.points;
-  stats_.budgetReached = sel.limited;
+  const Selection whole = selectNodes(*hierarchy_, views, width, height, origin_, nearW(views[0]), limits);
+  stats_.nodesSelected = whole.nodes.size();
+  stats_.pointsSelected = whole.points;
+  stats_.budgetReached = whole.limited;
+  // A rank of a distributed viewer reads and draws its share of the selection; every rank reads the
+  // hierarchy the whole selection reaches, so that all select alike.
+  const bool shared = options_.shares > 1;
+  const Selection sel = shared ? shareOf(whole, *hierarchy_, options_.shareIndex, options_.shares) : whole;
   for (uint32_t id : sel.nodes)
     touch(id);
   uploadArrived(sel.nodes, options_.uploadBytesPerFrame);
-  request(sel.nodes, sel.unexpanded);
-  // The resident part of the selection, a node only under a drawn parent (parents come first in sel.nodes).
+  request(sel.nodes, whole.unexpanded);
+  // The resident part of the selection, a node only under a drawn parent (parents come first in sel.nodes);
+  // a share's parents are often another rank's, so a share draws every resident node of its own.
   std::unordered_set<uint32_t> drawn;
   std::vector<uint32_t> draw;
   for (uint32_t id : sel.nodes) {
     const uint32_t parent = hierarchy_->node(id).parent;
-    if (!residentOrEmpty(id) || (parent != kNoNode && !drawn.count(parent))) continue;
+    if (!residentOrEmpty(id) || (!shared && parent != kNoNode && !drawn.count(parent))) continue;
     drawn.insert(id);
     if (hierarchy_->node(id).info.pointCount > 0) draw.push_back(id);
   }
@@ -270,7 +275,7 @@ bool LodScene::update(std::span<const Camera> views, uint32_t width, uint32_t he
   const bool changed = draw != drawn_ || !sameViews(views, lastViews_) || frame_ == 1;
   buildDrawList(draw, 0);
   lastViews_.assign(views.begin(), views.end());
-  converged_ = drawn.size() == sel.nodes.size() && sel.unexpanded.empty();
+  converged_ = drawn.size() == sel.nodes.size() && whole.unexpanded.empty();
   return changed;
 }
 

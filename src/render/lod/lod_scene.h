@@ -60,8 +60,9 @@ struct LodOptions {
   // choice (node_encoding.h). Colors are computed as nodes are encoded, so every LOD method draws them.
   std::optional<DisplayColorMode::Source> colorSource;
   std::optional<ColorRange> colorRange; // intensity and elevation: the values at the ramp's ends
-  // A distributed render (docs/mpi.md): selectAll() returns share `shareIndex` of `shares` of the whole
-  // selection (selection.h, shareOf), so that each rank draws its part of every frame.
+  // A distributed render or viewer (docs/mpi.md): selectAll() returns, and update() draws, share
+  // `shareIndex` of `shares` of the whole selection (selection.h, shareOf), so that each rank draws its part
+  // of every frame.
   uint32_t shareIndex = 0;
   uint32_t shares = 1;
 };

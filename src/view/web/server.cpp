@@ -210,13 +210,19 @@ private:
 gpu::Context makeContext(const ServerOptions& options) {
   gpu::ContextOptions o;
   o.deviceIndex = options.device;
-  o.announce = !options.quiet;
+  o.announce = !options.quiet && options.announceDevice;
   return gpu::Context(o);
+}
+
+std::unique_ptr<SceneSource> makeSource(gpu::Context& context, SceneInput& input,
+                                        const ServerOptions& options) {
+  if (options.makeSource) return options.makeSource(context, input, options.settings);
+  return makeSceneSource(context, input, options.settings, !options.quiet);
 }
 
 Server::Server(SceneInput& input, const ServerOptions& options)
     : input_(input), options_(options), context_(makeContext(options)),
-      source_(makeSceneSource(context_, input, options.settings, !options.quiet)) {
+      source_(makeSource(context_, input, options)) {
   access_.token = options.token;
   pageHeaders_ = pageHeaders(options.frameAncestors);
   // A client's page offers the methods that draw what was opened (an uploaded cloud, or an octree).
@@ -224,6 +230,7 @@ Server::Server(SceneInput& input, const ServerOptions& options)
   ViewSettings settings = options.settings;
   settings.method = options.method ? *options.method : defaultMethod(*source_, context_);
   if (!source_->draws(settings.method)) throw InputError(notDrawn(*source_, settings.method));
+  if (std::optional<std::string> why = source_->refuses(settings.method)) throw InputError(*why);
   if (std::find(methods_.begin(), methods_.end(), settings.method) == methods_.end())
     throw UnsupportedError(std::string("this device cannot run ") + methodName(settings.method));
   // The first client should not wait for the upload of the starting method's scene.
@@ -244,7 +251,7 @@ Server::Server(SceneInput& input, const ServerOptions& options)
   info_ = Json{{"t", "info"},
                {"device", context_.info().name},
                {"input", input.name},
-               {"points", input.points},
+               {"points", source_->pointCount()},
                {"methods", methods},
                {"maxSize", {options.maxSize.width, options.maxSize.height}},
                {"maxClients", options.maxClients},
@@ -764,7 +771,7 @@ int Server::run() {
   start();
   renderThread_ = std::thread([this] { renderLoop(); });
   std::string link = url();
-  emit({{"event", "listening"}, {"url", link}, {"port", port_}, {"bind", options_.bind}});
+  emit({{"event", "listening"}, {"url", link}, {"port", port_}, {"bind", options_.bind}, {"pid", getpid()}});
   if (!options_.events && !options_.quiet)
     std::printf("pointrast serve: %s  (%s, %s points; Ctrl-C stops)\n", link.c_str(), input_.name.c_str(),
                 humanCount(double(input_.points)).c_str());

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -40,6 +42,10 @@ struct ServerOptions {
   std::string frameAncestors; // pages that may show the viewer in a frame (CSP sources); empty: none
   bool events = false; // one JSON object a line on stdout: listening, clients, refusals, the exit
   bool quiet = false;
+  bool announceDevice = true; // the device's line on stderr (unless quiet)
+  // How the input goes on the device (default: makeSceneSource); a distributed viewer's rank 0 draws
+  // every rank's share through it (docs/mpi.md).
+  std::function<std::unique_ptr<SceneSource>(gpu::Context&, SceneInput&, const ViewSettings&)> makeSource;
 };
 
 // InputError with one sentence for options that cannot work; runServer checks them too. Callers check before

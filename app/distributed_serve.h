@@ -1,0 +1,36 @@
+// `mpirun -np N pointrast serve ...` (docs/mpi.md): rank 0 runs the browser viewer as one process does;
+// every frame it draws (a client's frame, a pick's or the overlay's depth frame, a screenshot) is drawn by
+// every rank, each its share of the input, and composited on rank 0 as render composites its frame. The
+// other ranks open no socket: they follow rank 0's draws until it tells them to stop.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "render/renderer.h"
+#include "view/scene_source.h"
+
+namespace pointrast::gpu {
+class Context;
+}
+
+namespace pointrast::app {
+
+// Why a viewer under mpirun does not offer `method` (its frames cannot be composited), or nothing.
+std::optional<std::string> viewRefusal(Method method);
+
+// Rank 0's source: its own share drawn and every rank's composited into each frame. `points` counts the
+// points of every rank. Its draws are collectives: every other rank runs followDraws().
+std::unique_ptr<view::SceneSource>
+compositedSource(gpu::Context& context, std::unique_ptr<view::SceneSource> share, uint64_t points);
+
+// The other ranks: draws `share` for every draw of rank 0 until stopFollowers(); returns rank 0's status.
+// Throws mpi::JobFailed when a rank failed.
+int followDraws(gpu::Context& context, view::SceneSource& share);
+
+// Rank 0, after its viewer stopped: the other ranks end with `status`. A collective.
+void stopFollowers(int status);
+
+} // namespace pointrast::app

@@ -1,0 +1,272 @@
+// The browser viewer on several ranks as a user starts it: `mpirun -np N pointrast serve ...` on lavapipe,
+// reached by the load tool's WebSocket client. Rank 0's frames are every rank's shares composited: its
+// lossless screenshot must be the one-process server's (bit for bit for atomicmin; for lod, the words of the
+// composite may differ from one rank's only at depth ties, as in the render tests).
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <csignal>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include "cli/cli_harness.h"
+#include "mpi/mpi_job.h"
+#include "view/web/protocol.h"
+#include "web/serve_harness.h"
+#include "ws_client.h"
+
+namespace fs = std::filesystem;
+using pointrast::test::cliTempDir;
+using pointrast::test::Json;
+using pointrast::test::pointrastBinary;
+using pointrast::test::runPointrast;
+using pointrast::test::ServeProcess;
+using pointrast::test::slurp;
+
+namespace {
+
+constexpr uint64_t kEmpty = ~uint64_t(0);
+
+#define REQUIRE_MPI()                                                                                        \
+  do {                                                                                                       \
+    if (!pointrast::mpi::Job::built() || std::string(POINTRAST_MPIRUN).empty())                              \
+      GTEST_SKIP() << "this build has no MPI (CMake option POINTRAST_MPI off, or no mpirun found)";          \
+  } while (0)
+
+// mpirun with `ranks` ranks before the binary; the composited words of rank 0's last frame go to `words`.
+std::string mpirun(uint32_t ranks, const fs::path& words) {
+  return "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
+         "POINTRAST_MPI_WORDS='" +
+         words.string() + "' " + POINTRAST_MPIRUN + " --oversubscribe -np " + std::to_string(ranks);
+}
+
+std::vector<uint64_t> readWords(const fs::path& path) {
+  std::vector<uint64_t> words;
+  if (!fs::exists(path)) return words;
+  std::ifstream in(path, std::ios::binary);
+  words.resize(fs::file_size(path) / 8);
+  in.read(reinterpret_cast<char*>(words.data()), std::streamsize(words.size() * 8));
+  return words;
+}
+
+// What a client of the server saw: the screenshot (PNG) of its view once a full frame at rest was shown
+// (for an octree: once its level of detail converged), and what the pick tool answered.
+struct Seen {
+  std::string png;
+  Json state, picked;
+};
+
+Seen look(uint16_t port, uint32_t w, uint32_t h, bool octree, double seconds = 180) {
+  using namespace pointrast::view::web;
+  Seen seen;
+  pointrast::wsclient::Client ws;
+  if (!ws.connect("127.0.0.1", port, "/ws")) return seen;
+  ws.sendText(Json{{"t", "resize"}, {"w", w}, {"h", h}}.dump());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  bool ready = false, asked = false, picking = false;
+  while (std::chrono::steady_clock::now() < deadline) {
+    auto m = ws.receive(std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count());
+    if (!m) break;
+    if (m->opcode == 1) {
+      const Json j = Json::parse(m->text(), nullptr, false);
+      if (!j.is_object()) continue;
+      const std::string type = j.value("t", "");
+      if (type == "state") {
+        seen.state = j;
+        ready = !octree || (j.contains("stats") && j["stats"].contains("lod") &&
+                            j["stats"]["lod"].value("converged", false));
+      }
+      if (type == "picked") {
+        seen.picked = j;
+        if (!seen.png.empty()) break;
+      }
+      continue;
+    }
+    if (m->opcode != 2 || m->data.size() < kFrameHeaderBytes) continue;
+    const FrameHeader header = readFrameHeader(m->data.data());
+    if (header.magic == kScreenshotMagic) {
+      seen.png.assign(m->data.begin() + kFrameHeaderBytes, m->data.end());
+      if (!seen.picked.is_null()) break;
+      continue;
+    }
+    if (header.magic != kFrameMagic) continue;
+    ws.sendText(Json{{"t", "ack"}, {"frame", header.frame}}.dump());
+    // A frame's state comes before its image: a full frame drawn at rest shows the view to compare.
+    if (ready && (header.flags & kFrameFull) && !asked) {
+      asked = true;
+      ws.sendText(Json{{"t", "key"}, {"key", "Screenshot"}, {"down", true}}.dump());
+      ws.sendText(Json{{"t", "key"}, {"key", "Screenshot"}, {"down", false}}.dump());
+    }
+    if (asked && !picking) {
+      picking = true;
+      ws.sendText(Json{{"t", "pickpoint"}, {"x", 0.5}, {"y", 0.5}}.dump());
+    }
+  }
+  return seen;
+}
+
+struct Served {
+  Seen seen;
+  std::vector<uint64_t> words; // the composite's words (under mpirun)
+  int exitCode = -1;
+  std::string err;
+};
+
+// `pointrast serve ARGS` on `ranks` ranks (0: without mpirun), looked at by one client, then stopped.
+Served serveOn(uint32_t ranks, const std::string& args, uint32_t w, uint32_t h, bool octree) {
+  const fs::path words = cliTempDir() / ("serve_words_" + std::to_string(ranks) + ".bin");
+  fs::remove(words);
+  Served s;
+  ServeProcess server(args, ranks == 0 ? "" : mpirun(ranks, words));
+  EXPECT_TRUE(server.listening()) << server.stderrText();
+  if (!server.listening()) return s;
+  s.seen = look(server.port(), w, h, octree);
+  if (ranks == 0) {
+    s.exitCode = server.stop();
+  } else {
+    // Rank 0 stops the job: mpirun, signalled itself, would end every rank with its own status.
+    const auto listening =
+        server.waitFor([](const Json& j) { return j.value("event", "") == "listening"; }, 1);
+    EXPECT_TRUE(listening && listening->contains("pid"));
+    if (listening && listening->contains("pid")) kill(pid_t((*listening)["pid"].get<int>()), SIGTERM);
+    s.exitCode = server.stop(0); // waits for the job's end
+  }
+  s.err = server.stderrText();
+  s.words = readWords(words);
+  return s;
+}
+
+const std::string kTerrain = "terrain --points 40000 --eye 500022.37,3999984.26,217.29 "
+                             "--target 500022.37,4000018.99,192.97";
+
+// Every rank generates its share of the terrain; the composite of two is the one-process frame exactly,
+// and the pick tool, which reads points on the host, says in the page why it does not run.
+TEST(MpiServe, TwoRanksServeTheOneProcessFrameExactly) {
+  REQUIRE_MPI();
+  const std::string args = kTerrain + " --method atomicmin --point-size 2";
+  const Served one = serveOn(0, args, 240, 160, false);
+  const Served two = serveOn(2, args, 240, 160, false);
+  ASSERT_FALSE(one.seen.png.empty()) << one.err;
+  ASSERT_FALSE(two.seen.png.empty()) << two.err;
+  EXPECT_TRUE(two.seen.png == one.seen.png) << "the 2-rank screenshot differs from one process's";
+  EXPECT_EQ(two.exitCode, 0) << two.err;
+  EXPECT_EQ(one.exitCode, 0) << one.err;
+  // The page's statistics count every rank's points.
+  EXPECT_EQ(two.seen.state["stats"]["points"], 40000) << two.seen.state.dump();
+  ASSERT_EQ(two.words.size(), 240u * 160u);
+  uint64_t covered = 0;
+  for (uint64_t w : two.words)
+    covered += w != kEmpty;
+  EXPECT_GT(covered, two.words.size() / 4) << "the frame must show the scene";
+  const std::string point = two.seen.picked["pick"].value("point", std::string());
+  EXPECT_NE(point.find("unavailable: under mpirun each rank holds only its share"), std::string::npos)
+      << two.seen.picked.dump();
+  EXPECT_EQ(one.seen.picked.dump().find("unavailable"), std::string::npos) << one.seen.picked.dump();
+  EXPECT_FALSE(one.seen.picked.is_null());
+}
+
+// An octree: each rank reads and draws its share of every frame's nodes. The converged frame of two ranks
+// equals one rank's up to depth ties, and one rank under mpirun is the one-process server.
+TEST(MpiServe, TwoRanksServeAnOctreesConvergedFrame) {
+  REQUIRE_MPI();
+  const fs::path las = cliTempDir() / "serve_terrain.las", octree = cliTempDir() / "serve_terrain";
+  fs::remove_all(octree);
+  ASSERT_EQ(runPointrast("generate terrain --points 60000 -o " + las.string() + " -q").exitCode, 0);
+  const pointrast::test::CliResult built =
+      runPointrast("lod " + las.string() + " -o " + octree.string() + " -q");
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  const std::string args = "'" + octree.string() + "' --method lod --min-node-px 0";
+  const Served plain = serveOn(0, args, 240, 160, true);
+  const Served one = serveOn(1, args, 240, 160, true);
+  const Served two = serveOn(2, args, 240, 160, true);
+  ASSERT_FALSE(plain.seen.png.empty()) << plain.err;
+  ASSERT_FALSE(one.seen.png.empty()) << one.err;
+  ASSERT_FALSE(two.seen.png.empty()) << two.err;
+  EXPECT_TRUE(one.seen.png == plain.seen.png) << "one rank under mpirun differs from one process";
+  ASSERT_EQ(one.words.size(), 240u * 160u);
+  ASSERT_EQ(two.words.size(), one.words.size());
+  uint64_t covered = 0, differ = 0, ties = 0;
+  for (size_t i = 0; i < one.words.size(); ++i) {
+    covered += one.words[i] != kEmpty;
+    if (one.words[i] == two.words[i]) continue;
+    ++differ;
+    if (one.words[i] != kEmpty && two.words[i] != kEmpty && one.words[i] >> 32 == two.words[i] >> 32) ++ties;
+  }
+  EXPECT_GT(covered, one.words.size() / 4);
+  EXPECT_EQ(differ, ties) << differ - ties << " pixels differ in depth";
+  if (differ == 0) EXPECT_TRUE(two.seen.png == one.seen.png);
+  EXPECT_EQ(two.seen.state["stats"]["points"], plain.seen.state["stats"]["points"]) << two.seen.state.dump();
+  EXPECT_EQ(two.exitCode, 0) << two.err;
+}
+
+struct MpiRun {
+  int exitCode = -1;
+  bool signaled = false;
+  double seconds = 0;
+  std::string out, err;
+};
+
+MpiRun runMpi(const std::string& launch, int timeout = 90) {
+  const fs::path out = cliTempDir() / "serve_mpi_out.txt", err = cliTempDir() / "serve_mpi_err.txt";
+  const std::string command = "timeout -k 5 " + std::to_string(timeout) +
+                              " env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+                              "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
+                              std::string(POINTRAST_MPIRUN) + " --oversubscribe " + launch + " >" +
+                              out.string() + " 2>" + err.string() + " </dev/null";
+  const auto start = std::chrono::steady_clock::now();
+  const int status = std::system(command.c_str());
+  MpiRun r;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) > 128);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+int errorLines(const std::string& err) {
+  int lines = 0;
+  for (size_t at = err.find("pointrast:"); at != std::string::npos; at = err.find("pointrast:", at + 1))
+    ++lines;
+  return lines;
+}
+
+// A rank given a damaged file ends the whole job, rank 0's server included, with one line naming it.
+TEST(MpiServe, ARankWithADamagedFileEndsTheServerWithOneLine) {
+  REQUIRE_MPI();
+  const fs::path good = cliTempDir() / "serve_good.las", bad = cliTempDir() / "serve_damaged.las";
+  ASSERT_EQ(runPointrast("generate terrain --points 20000 -o " + good.string() + " -q").exitCode, 0);
+  fs::copy_file(good, bad, fs::copy_options::overwrite_existing);
+  fs::resize_file(bad, fs::file_size(good) / 2); // the header promises twice the records present
+  const std::string tail = " --port 0 -q";
+  const MpiRun r = runMpi("-np 1 " + pointrastBinary() + " serve " + good.string() + tail + " : -np 1 " +
+                          pointrastBinary() + " serve " + bad.string() + tail);
+  EXPECT_FALSE(r.signaled) << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_LT(r.seconds, 60);
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("pointrast: rank 1: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("serve_damaged.las: header claims"), std::string::npos) << r.err;
+}
+
+// Methods whose frames cannot be composited are refused before anything is read, on every rank alike.
+TEST(MpiServe, MethodsThatBlendAreRefusedWithOneLine) {
+  REQUIRE_MPI();
+  const MpiRun r =
+      runMpi("-np 2 " + pointrastBinary() + " serve terrain --points 20000 --method hqs --port 0 -q");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(errorLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("pointrast: hqs blends points, so ranks' frames cannot be composited"),
+            std::string::npos)
+      << r.err;
+}
+
+} // namespace
