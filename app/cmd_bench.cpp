@@ -29,9 +29,11 @@
 #include "cli_util.h"
 #include "cloud/generate.h"
 #include "commands.h"
+#include "distributed.h"
 #include "gpu/context.h"
 #include "input.h"
 #include "io/format_table.h"
+#include "mpi/mpi_job.h"
 #include "render/spheres/sphere_renderer.h"
 
 namespace pointrast::app {
@@ -437,8 +439,89 @@ int runVrSuite(const BenchArgs& a) {
   return 0;
 }
 
+// `mpirun -np N pointrast bench FILE|SCENE` (docs/mpi.md): every rank loads its share of each data set and
+// times its frames; after each combination the last frame is composited on rank 0, whose result carries
+// every rank's time (the slowest is the job's) and the composite's cost. Closest-point methods that draw a
+// loaded cloud only, no suites, no time limit: every rank measures the same combinations.
+bench::BenchRanks benchRanks(gpu::Context& context, const std::vector<std::string>& devices) {
+  bench::BenchRanks ranks;
+  ranks.loadShare = [](const bench::Dataset& d, bool progress) {
+    InputSpec spec;
+    spec.source = d.source;
+    spec.points = d.points;
+    spec.seed = d.seed;
+    spec.progress = progress;
+    PointCloud cloud = loadShare(spec);
+    // As loadDataset: the display colors decided once (rank 0's choice for every rank), attributes dropped.
+    const DisplayColorMode mode = agreeColors(displayColorMode(cloud));
+    std::vector<uint32_t> colors(cloud.size());
+    displayColors(colors.data(), cloud, 0, cloud.size(), mode);
+    cloud.colors = std::move(colors);
+    cloud.intensity = {};
+    cloud.classification = {};
+    cloud.returnNumber = {};
+    cloud.pointSourceId = {};
+    return cloud;
+  };
+  ranks.any = [](bool mine) { return mpi::Job::get().sumOf(mine ? 1 : 0) > 0; };
+  ranks.sum = [](uint64_t mine) { return mpi::Job::get().sumOf(mine); };
+  ranks.composite = [&context, devices](Renderer& renderer, const Camera& camera, bench::Result& r) {
+    mpi::Job& job = mpi::Job::get();
+    // A combination some rank could not measure is not measured: rank 0 says which rank and why.
+    if (job.sumOf(r.ok() ? 0 : 1) > 0) {
+      const std::vector<std::string> reasons = job.gatherText(r.ok() ? "" : r.reason);
+      for (size_t rank = 1; rank < reasons.size() && r.ok(); ++rank)
+        if (!reasons[rank].empty()) {
+          r.status = "unsupported";
+          r.reason = "rank " + std::to_string(rank) + ": " + reasons[rank];
+        }
+      return;
+    }
+    CompositeStats composite;
+    composite.devices = devices;
+    RenderSettings settings;
+    settings.method = r.method;
+    compositeFrame(context, renderer, camera, settings, 0, r.stats, composite);
+    if (!job.root()) return;
+    r.stats.medianMs = composite.renderMs; // the job's frame is done when the slowest rank's is
+    r.stats.points = composite.points;
+    r.points = composite.points;
+    r.stats.batch.reset(); // counted per rank
+    r.ranks = compositeJson(composite);
+  };
+  return ranks;
+}
+
+// Refusals of a bench under mpirun, before anything is read; methods left at "all" become those that
+// composite.
+void checkBenchRanks(const BenchArgs& a, std::vector<Method>& methods) {
+  std::vector<Method> kept;
+  for (Method m : methods) {
+    const MethodInfo& info = methodInfo(m);
+    std::string why;
+    if (info.layout == SceneLayout::Octree)
+      why = std::string(info.name) + " draws an octree, which bench measures on one process";
+    else if (!hasCanonicalWords(info))
+      why = std::string(info.name) + " keeps no closest point per pixel, so ranks' frames cannot be "
+                                     "composited";
+    if (why.empty()) {
+      kept.push_back(m);
+    } else if (a.methodsGiven) {
+      throw InputError(why + "; under mpirun bench measures the closest-point methods that draw a loaded "
+                             "cloud (atomicmin, the batch methods)");
+    }
+  }
+  methods = kept;
+}
+
 int runBench(const BenchArgs& a) {
-  Progress::setEnabled(!a.quiet);
+  Progress::setEnabled(!a.quiet && mpi::Job::get().root());
+  if (distributedRun() && !a.suite.empty())
+    throw InputError(
+        "--suite runs on one process; under mpirun bench measures the files and scenes it is given");
+  if (distributedRun() && a.timeLimit > 0)
+    throw InputError(
+        "--time-limit applies to one process; under mpirun every rank measures every combination");
   if (a.frames == 0) throw InputError("--frames must be at least 1");
   if (a.width == 0 || a.height == 0) throw InputError("--width and --height must be at least 1");
   if (!(a.fov > 0 && a.fov < 180)) throw InputError("--fov must be between 0 and 180 degrees");
@@ -499,8 +582,17 @@ int runBench(const BenchArgs& a) {
   info.commandLine = commandLine("pointrast bench");
   info.date = bench::utcNow();
 
-  gpu::Context context(contextOptions(a));
-  ProgressLines lines(a.quiet);
+  const bool distributed = distributedRun();
+  if (distributed) checkBenchRanks(a, config.methods);
+  gpu::ContextOptions device = contextOptions(a);
+  if (distributed) chooseRankDevice(device);
+  gpu::Context context(device);
+  const bool root = mpi::Job::get().root();
+  if (distributed) {
+    config.ranks = benchRanks(context, announceRanks(context, a.quiet));
+    config.progress = config.progress && root;
+  }
+  ProgressLines lines(a.quiet || !root);
   // The cache folder is only looked at when a method draws octrees.
   if (std::any_of(config.methods.begin(), config.methods.end(),
                   [](Method m) { return methodInfo(m).layout == SceneLayout::Octree; }))
@@ -508,6 +600,7 @@ int runBench(const BenchArgs& a) {
   bench::BenchCallbacks callbacks;
   callbacks.onNote = [&](const std::string& line) { lines.note(line); };
   callbacks.onResult = [&](const bench::BenchRun& run, const bench::Result& r, size_t done, size_t total) {
+    if (!root) return;
     if (a.json) printJsonLine(bench::resultJson(run, r), context);
     lines.result(done, total,
                  r.dataset + " / " + orderName(r.order) + " / " + bench::viewName(r.view) + " / " +
@@ -516,9 +609,20 @@ int runBench(const BenchArgs& a) {
   };
   bench::BenchRun run = bench::runBench(context, config, callbacks);
   lines.end();
-  checkRun(context, run.datasets);
+  if (distributed) {
+    // Every rank's validation errors count, and only rank 0 writes the reports.
+    if (const uint64_t errors = mpi::Job::get().sumOf(context.validationErrors()); errors > 0)
+      throw InternalError("the Vulkan validation layer reported " + std::to_string(errors) +
+                          " error(s) on the ranks, above; no report was written");
+  }
+  checkRun(context, run.datasets); // alike on every rank: the data sets skipped are agreed
+  if (distributed && !root) {
+    mpi::Job::get().close();
+    return 0;
+  }
   bench::WrittenFiles files = bench::writeReports(run, info, reportDir(a, context));
   printWritten(a, run, run.results.size(), files);
+  if (distributed) mpi::Job::get().close();
   return 0;
 }
 
@@ -595,8 +699,14 @@ std::string benchFooter() {
       "(default 5 here); a result is the median over the orbit's cameras of each camera's median. Its\n"
       "report adds sphere-compute against the fastest other method. --methods, --layouts, --billboards,\n"
       "--conservative off,on and --orbits short,long pick parts of the matrix.\n\n"
+      "Under mpirun (one rank per GPU, docs/mpi.md) every rank times its share of each data set, the last\n"
+      "frame of each combination is composited on rank 0, and each result reports every rank's time and\n"
+      "points and the composite's cost (the \"mpi\" object of --json, a table of ranks in NAME.md); the\n"
+      "slowest rank's time is the result's. The closest-point methods that draw a loaded cloud only; no\n"
+      "--suite, no --time-limit.\n\n"
       "Examples:\n"
       "  pointrast bench terrain --points 10M --methods atomicmin,earlyz --orders original,morton\n"
+      "  mpirun -np 2 pointrast bench terrain --points 2G --methods atomicmin,batch-prefetch --json\n"
       "  pointrast bench autzen.las --views overview --frames 100 --json\n"
       "  pointrast bench --suite paper2021\n"
       "  pointrast bench --suite paper2021 --scale 0.001 --frames 5 --out /tmp/smoke\n"

@@ -15,6 +15,7 @@
 
 #include "base/build_info.h"
 #include "base/error.h"
+#include "base/progress.h"
 #include "bench/lod_report.h"
 #include "bench/report_parts.h"
 #include "bench/suites.h"
@@ -76,6 +77,7 @@ nlohmann::json resultJson(const BenchRun& run, const Result& r) {
   if (r.stats.batch) j["batch_stats"] = batchStatsJson(*r.stats.batch);
   if (r.stats.lod) j["lod_stats"] = lodStatsJson(*r.stats.lod);
   j["camera"] = r.camera;
+  if (!r.ranks.is_null()) j["mpi"] = r.ranks;
   return j;
 }
 
@@ -248,6 +250,34 @@ void markdownBatchStatistics(std::ostringstream& md, const PointTables& t) {
 
 } // namespace
 
+// A run on several processes (BenchRanks): each combination's frame time on every rank and the composite's
+// cost; the tables above show the slowest rank's time, when the job's frame is done.
+static void markdownRanks(std::ostringstream& md, const BenchRun& run) {
+  bool any = false;
+  for (const Result& r : run.results)
+    any = any || !r.ranks.is_null();
+  if (!any) return;
+  md << "## Ranks: median GPU time per frame of each rank, and the composite on rank 0\n\n"
+     << "| data set | order | view | method | ranks | each rank, ms | points per rank | readback, ms | "
+        "composite (MIN), ms | resolve, ms | MB moved |\n"
+     << "|---|---|---|---|---:|---|---|---:|---:|---:|---:|\n";
+  for (const Result& r : run.results) {
+    if (r.ranks.is_null()) continue;
+    const nlohmann::json& m = r.ranks;
+    std::string each, points;
+    for (const nlohmann::json& ms : m["rank_render_ms"])
+      each += (each.empty() ? "" : ", ") + formatMs(ms.get<double>());
+    for (const nlohmann::json& p : m["rank_points"])
+      points += (points.empty() ? "" : ", ") + humanCount(p.get<double>());
+    md << "| " << r.dataset << " | " << orderName(r.order) << " | " << viewName(r.view) << " | "
+       << methodName(r.method) << " | " << m["ranks"].get<uint32_t>() << " | " << each << " | " << points
+       << " | " << formatMs(m["readback_ms"].get<double>()) << " | "
+       << formatMs(m["composite_ms"].get<double>()) << " | " << formatMs(m["resolve_ms"].get<double>())
+       << " | " << printf1("%.1f", m["bytes_moved"].get<double>() / 1e6) << " |\n";
+  }
+  md << "\n";
+}
+
 std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
   const PointTables tables{run, ResultIndex(run), measuredDatasets(run.datasets)};
   std::ostringstream md;
@@ -259,6 +289,7 @@ std::string markdownReport(const BenchRun& run, const ReportInfo& info) {
     methodTable(md, tables, v, [](const Result& r) { return formatMs(r.stats.medianMs); });
   }
   markdownBandwidth(md, tables);
+  markdownRanks(md, run);
   markdownBatchStatistics(md, tables);
   markdownLodStatistics(md, run);
   markdownDatasets(md, run.datasets);

@@ -240,6 +240,7 @@ FrameStats timeFrames(Method method, const BenchRun& run, const RenderFrames& re
   const BenchConfig& config = run.config;
   RenderSettings settings;
   settings.method = method;
+  settings.captureWords = config.ranks.has_value(); // the last frame's words go to the composite
   settings.frames = config.frames;
   settings.warmup = run.warmup;
   if (config.secondsPerCombination > 0) {
@@ -262,6 +263,9 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
   run.config = config;
   run.warmup = warmupFrames(config.frames);
   const size_t total = sizeDatasets(context, config, run, note);
+  if (config.ranks) // a data set one process cannot hold is skipped by every process
+    for (DatasetOutcome& outcome : run.datasets)
+      outcome.skipped = config.ranks->any(outcome.skipped);
   runRecorded(context, run, config.copyBytes, config.copyRepeats, start, note, [&] {
     Renderer renderer(context, config.width, config.height);
     const double aspect = double(config.width) / double(config.height);
@@ -277,8 +281,9 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
       const Dataset& d = outcome.dataset;
       // Host-side preparation can take minutes at the paper's sizes; a line each keeps a log readable.
       auto since = std::chrono::steady_clock::now();
-      const PointCloud cloud = loadDataset(d, config.progress);
-      outcome.points = cloud.size();
+      const PointCloud cloud =
+          config.ranks ? config.ranks->loadShare(d, config.progress) : loadDataset(d, config.progress);
+      outcome.points = config.ranks ? config.ranks->sum(cloud.size()) : cloud.size();
       outcome.description = cloud.source;
       note(d.label + ": " + cloud.source + " ready in " + printf1("%.1f s", secondsSince(since)));
       for (Order order : ordersOf(d, config)) {
@@ -325,6 +330,7 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
                   },
                   record);
             }
+            if (config.ranks) config.ranks->composite(renderer, camera, r);
             completeRates(r, run.copy);
             record(r);
           }

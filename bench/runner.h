@@ -12,10 +12,13 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "base/error.h"
 #include "base/text.h" // bytesText
@@ -42,6 +45,24 @@ struct Dataset {
   std::vector<View> views;
 };
 
+struct Result;
+
+// A run on several processes (`mpirun -np N pointrast bench`, docs/mpi.md), as the command line wires it:
+// each process loads its share of a data set and times its frames of it; after every combination each
+// process composites its last frame (a collective: every process measures the same combinations).
+struct BenchRanks {
+  // This process's share of a data set, ready to upload (loadDataset's whole cloud on one process).
+  std::function<PointCloud(const Dataset& dataset, bool progress)> loadShare;
+  // After a combination's frames on this process (its status says whether it drew): the last frame of
+  // `renderer` composited on rank 0, and the result made the job's there (every process's points, the
+  // slowest process's time, the figures of each in Result::ranks).
+  std::function<void(Renderer& renderer, const Camera& camera, Result& result)> composite;
+  // Whether any process says true (a data set another process cannot hold is skipped by all).
+  std::function<bool(bool)> any;
+  // The sum over every process.
+  std::function<uint64_t(uint64_t)> sum;
+};
+
 struct BenchConfig {
   std::vector<Dataset> datasets;
   std::vector<Method> methods;
@@ -60,6 +81,7 @@ struct BenchConfig {
   uint64_t orderSeed = 1; // for the shuffled orders
   uint64_t copyBytes = uint64_t(1) << 30;
   int copyRepeats = 10;
+  std::optional<BenchRanks> ranks; // a run on several processes; no octree methods, no time limit
   bool progress = true; // generation, reading and upload progress (drawn only on a terminal)
   // The octrees the LOD methods draw (bench/lod_runner.h); without one, their results say so.
   OctreeProvider octrees;
@@ -125,6 +147,9 @@ struct Result {
                                       // the frame read (FrameStats::batch) / median time
   double copyFraction = 0;            // effectiveBytesPerSecond / copy bandwidth (read + write)
   std::string camera;                 // describeCamera(), to reproduce the view with `pointrast render`
+  // A run on several processes (BenchRanks): render --json's "mpi" object (each process's time and points,
+  // the composite's); null on one process.
+  nlohmann::json ranks;
   bool ok() const { return status == "ok"; }
 };
 

@@ -269,4 +269,64 @@ TEST(MpiServe, MethodsThatBlendAreRefusedWithOneLine) {
       << r.err;
 }
 
+// bench on two ranks: each rank times its share; every result carries each rank's time and the composite's
+// cost (JSON and the Markdown table), its points are the whole scene's and its time the slowest rank's.
+TEST(MpiBench, TwoRanksReportEachRanksTimeAndTheComposite) {
+  REQUIRE_MPI();
+  const fs::path out = cliTempDir() / "bench_ranks";
+  fs::remove_all(out);
+  const MpiRun r = runMpi("-np 2 " + pointrastBinary() +
+                          " bench terrain --points 40000 --methods atomicmin,batch --orders original "
+                          "--views overview --frames 3 --width 240 --height 160 --copy-size 16M --json -q "
+                          "--name ranks --out " +
+                          out.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  int results = 0;
+  while (std::getline(lines, line)) {
+    const Json j = Json::parse(line, nullptr, false);
+    ASSERT_TRUE(j.is_object()) << line;
+    ++results;
+    EXPECT_EQ(j["status"], "ok") << line;
+    EXPECT_EQ(j["points"], 40000) << line;
+    const Json& mpi = j["mpi"];
+    ASSERT_TRUE(mpi.is_object()) << line;
+    EXPECT_EQ(mpi["ranks"], 2);
+    ASSERT_EQ(mpi["rank_render_ms"].size(), 2u);
+    ASSERT_EQ(mpi["rank_points"].size(), 2u);
+    EXPECT_EQ(mpi["rank_points"][0].get<double>() + mpi["rank_points"][1].get<double>(), 40000.0);
+    EXPECT_EQ(mpi["rank_points"][0].get<double>(), double(pointrast::mpi::rangeOf(40000, 10240, 0, 2).count));
+    const double slowest =
+        std::max(mpi["rank_render_ms"][0].get<double>(), mpi["rank_render_ms"][1].get<double>());
+    EXPECT_EQ(j["median_ms"].get<double>(), slowest);
+    EXPECT_GT(slowest, 0.0);
+    EXPECT_EQ(mpi["bytes_moved"], 240u * 160u * 8u);
+    EXPECT_GE(mpi["composite_ms"].get<double>(), 0.0);
+    EXPECT_EQ(mpi["devices"].size(), 2u);
+  }
+  EXPECT_EQ(results, 2);
+  const std::string md = slurp(out / "ranks.md");
+  EXPECT_NE(md.find("## Ranks: median GPU time per frame of each rank"), std::string::npos) << md;
+  EXPECT_NE(md.find("| terrain-40k | original | overview | batch | 2 | "), std::string::npos) << md;
+  const Json report = Json::parse(slurp(out / "ranks.json"), nullptr, false);
+  ASSERT_TRUE(report.is_object());
+  EXPECT_EQ(report["results"][0]["mpi"]["ranks"], 2);
+}
+
+TEST(MpiBench, WhatCannotBeCompositedIsRefusedWithOneLine) {
+  REQUIRE_MPI();
+  const std::string bench = "-np 2 " + pointrastBinary() + " bench terrain --points 20000 --frames 2 -q ";
+  const struct {
+    std::string args, line;
+  } cases[] = {{"--methods hqs", "pointrast: hqs keeps no closest point per pixel"},
+               {"--suite paper2021", "pointrast: --suite runs on one process"}};
+  for (const auto& c : cases) {
+    const MpiRun r = runMpi(bench + c.args + " --out " + (cliTempDir() / "refused").string());
+    EXPECT_EQ(r.exitCode, 1) << c.args << "\n" << r.err;
+    EXPECT_EQ(errorLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.line), std::string::npos) << r.err;
+  }
+}
+
 } // namespace
