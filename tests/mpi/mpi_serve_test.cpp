@@ -20,6 +20,7 @@
 #include "cli/cli_harness.h"
 #include "mpi/mpi_job.h"
 #include "view/web/protocol.h"
+#include "web/image_compare.h"
 #include "web/serve_harness.h"
 #include "ws_client.h"
 
@@ -267,6 +268,37 @@ TEST(MpiServe, MethodsThatBlendAreRefusedWithOneLine) {
   EXPECT_NE(r.err.find("pointrast: hqs blends points, so ranks' frames cannot be composited"),
             std::string::npos)
       << r.err;
+}
+
+// The page in Debian's chromium (tests/web/browser.mjs) shows a 2-rank server's frame: the canvas holds the
+// frame `render` draws of the same camera on one process, within the JPEG tolerance of the browser tests.
+TEST(MpiServe, ThePageShowsATwoRankFrame) {
+  REQUIRE_MPI();
+  const std::string web = std::string(POINTRAST_SOURCE_DIR) + "/tests/web";
+  if (!fs::exists(web + "/node_modules/playwright-core"))
+    FAIL() << "playwright-core is not installed: run scripts/web-test-setup.sh (npm ci in tests/web)";
+  if (!fs::exists("/usr/bin/chromium")) FAIL() << "chromium is missing: run scripts/install-deps.sh";
+  const fs::path words = cliTempDir() / "serve_words_browser.bin";
+  ServeProcess server(kTerrain + " --method atomicmin --point-size 2", mpirun(2, words));
+  ASSERT_TRUE(server.listening()) << server.stderrText();
+  const fs::path dir = pointrast::test::scratchDir("mpi_browser_frame");
+  const Json r = pointrast::test::browser("frame", server.url(), dir, Json::object());
+  ASSERT_TRUE(r.contains("frame")) << r.dump();
+  EXPECT_EQ(r["errors"], Json::array());
+  EXPECT_EQ(r["frame"]["full"], true);
+  EXPECT_EQ(r["frame"]["width"], 640);
+  const std::string ref = (dir / "ref.png").string();
+  ASSERT_EQ(
+      runPointrast("render " + kTerrain + " --point-size 2 --width 640 --height 480 -q -o " + ref).exitCode,
+      0);
+  const pointrast::test::ImageDifference d = pointrast::test::comparePngs((dir / "canvas.png").string(), ref);
+  ASSERT_TRUE(d.sameSize);
+  EXPECT_GE(d.psnr, pointrast::test::kJpegPsnr) << "mean abs " << d.meanAbs;
+  EXPECT_LE(d.meanAbs, pointrast::test::kJpegMeanAbs);
+  const auto listening = server.waitFor([](const Json& j) { return j.value("event", "") == "listening"; }, 1);
+  ASSERT_TRUE(listening && listening->contains("pid"));
+  kill(pid_t((*listening)["pid"].get<int>()), SIGTERM);
+  EXPECT_EQ(server.stop(0), 0) << server.stderrText();
 }
 
 // bench on two ranks: each rank times its share; every result carries each rank's time and the composite's
