@@ -59,6 +59,7 @@ void warnUnsettled(bool settled, double medianMs, double minMs) {
 struct RenderArgs {
   std::string input, output, eye, target, up = "0,0,1", background = "0,0,0", order = "original";
   std::string method = "atomicmin", points = "1M", depth = "float";
+  bool methodGiven = false; // --method was on the command line (the default is atomicmin)
   std::string precision = "adaptive"; // batch methods
   LodArgs lod;                        // LOD methods
   std::string layout = "auto";        // sphere methods
@@ -442,6 +443,8 @@ void drawOverlay(Renderer& renderer, const Camera& camera, const Bounds& bounds,
   drawAnnotations({pixels, renderer.width(), renderer.height(), words}, camera, nearW, annotations);
 }
 
+InputSpec renderInputSpec(const RenderArgs& a, const RenderSettings& settings);
+
 // The LOD methods (--method lod, lod-hqs): an octree streamed through the node cache.
 int runRenderOctree(const RenderArgs& a, RenderSettings settings,
                     const std::optional<Annotations>& annotations) {
@@ -473,7 +476,17 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings,
   options.colorRange = colors.range;
   options.shareIndex = mpi::Job::get().rank();
   options.shares = mpi::Job::get().size();
-  std::unique_ptr<lod::NodeSource> source = io::openNodeSource(a.input);
+  // The input opens as the viewers open it (app/input.h): an octree as it is; a cloud file is built into
+  // the octree cache once and streamed from there.
+  SceneOptions sceneOptions;
+  sceneOptions.method = settings.method;
+  sceneOptions.onNote = [&a](const std::string& line) {
+    if (!a.quiet) std::fprintf(stderr, "%s\n", line.c_str());
+  };
+  const InputSpec spec = renderInputSpec(a, settings);
+  view::SceneInput input = distributed ? openSceneShare(spec, sceneOptions) : openScene(spec, sceneOptions);
+  std::unique_ptr<lod::NodeSource> source = std::move(input.octree);
+  if (!source) throw InternalError(a.input + " opened without an octree for " + a.method);
   const lod::OctreeMetadata& octree = source->metadata();
   const Camera camera = renderCamera(a, octree.bounds.empty() ? octree.cube : octree.bounds, octree.source,
                                      framingSample(*source));
@@ -552,7 +565,9 @@ RenderSettings pointSettings(const RenderArgs& a) {
   if (a.eyes.stereo && layout != SceneLayout::Batched && layout != SceneLayout::Octree)
     throw InputError("--stereo draws both eyes in one pass with the batch and LOD methods (" +
                      methodNamesReading(SceneLayout::Batched) + ", " +
-                     methodNamesReading(SceneLayout::Octree) + "), not " + a.method);
+                     methodNamesReading(SceneLayout::Octree) + ")" +
+                     (a.methodGiven ? ", not " + a.method
+                                    : ": name one with --method (batch-prefetch for a cloud, lod for an octree)"));
   if (a.eyes.stereo && !a.path.path.empty())
     throw InputError("--stereo renders one frame with -o, not a camera path");
   settings.background = parseRgb(a.background, "--background");
@@ -911,7 +926,8 @@ void addMethodOptions(CLI::App& cmd, RenderArgs& a) {
          "--method", a.method,
          "Rasterization method, e.g. atomicmin (compute) or hw-points (the hardware GL_POINTS baseline); "
          "an unknown name lists them all")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([&a](const std::string&) { a.methodGiven = true; });
   cmd.add_option("--depth", a.depth,
                  "Depth encoding of the atomic methods: float (32-bit linear depth) or int40 (40-bit integer "
                  "computed in double precision)")

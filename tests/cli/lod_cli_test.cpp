@@ -2,6 +2,9 @@
 // nodes included) draws every point with --min-node-px 0, the same image with a node cache far smaller than
 // the octree (drawn in passes), reports its statistics in --json; wrong inputs and options, and an octree
 // damaged where only streaming finds it, fail with one line and exit 1.
+#include <sys/wait.h>
+
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -94,7 +97,6 @@ TEST(LodCli, WrongInputsAndOptionsFailWithOneLine) {
   const std::string las = (pointrast::test::dataDir() / "las" / "autzen_trim.las").string();
   const std::pair<std::string, std::string> cases[] = {
       {"render terrain --method lod" + out, "is a generated scene; lod draws octrees"},
-      {"render " + las + " --method lod" + out, "is no level-of-detail octree"},
       {"render " + octree + " --method lod --gpu-memory 12x" + out, "--gpu-memory expects a size"},
       {"render " + octree + " --method lod --min-node-px -1" + out, "--min-node-px must be 0 or more"},
       {"render " + octree + " --method lod --order morton" + out, "do not apply to lod"},
@@ -106,6 +108,50 @@ TEST(LodCli, WrongInputsAndOptionsFailWithOneLine) {
     expectOneErrorLine(runPointrast(args), args, says);
     EXPECT_FALSE(fs::exists(png)) << args;
   }
+}
+
+// A cloud file drawn with lod opens as the viewers open it: built into the octree cache once, then
+// streamed; the frame is the one of the octree `pointrast lod` builds from the same file.
+TEST(LodCli, ACloudFileDrawnWithLodIsBuiltIntoTheCacheOnceAndEqualsItsOctree) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const fs::path cache = pointrast::test::cliTempDir() / "lod-cache";
+  const fs::path tree = pointrast::test::cliTempDir() / "lod-cache-tree";
+  fs::remove_all(cache);
+  fs::remove_all(tree);
+  const std::string las = (pointrast::test::dataDir() / "las" / "autzen_trim.las").string();
+  const std::string png = (pointrast::test::cliTempDir() / "lod-cache.png").string();
+  const std::string env = "env XDG_CACHE_HOME=" + cache.string() + " ";
+  const std::string draw = " --method lod --min-node-px 20 --width 160 --height 120 --json -o " + png;
+  auto run = [&](const std::string& args) {
+    const std::string command = env + "'" + pointrast::test::pointrastBinary() + "' " + args + " 2>&1";
+    std::string output;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return std::pair<int, std::string>{-1, ""};
+    char buffer[4096];
+    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+      output.append(buffer, n);
+    const int status = pclose(pipe);
+    return std::pair<int, std::string>{WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  };
+  auto hashOf = [](const std::string& output) {
+    const size_t at = output.find("\"image_hash\":\"");
+    return at == std::string::npos ? std::string() : output.substr(at + 14, 16);
+  };
+  const auto first = run("render '" + las + "'" + draw);
+  ASSERT_EQ(first.first, 0) << first.second;
+  EXPECT_NE(first.second.find("octree cache: building"), std::string::npos) << first.second;
+  const auto second = run("render '" + las + "'" + draw);
+  ASSERT_EQ(second.first, 0) << second.second;
+  EXPECT_EQ(second.second.find("octree cache: building"), std::string::npos) << "reused: " << second.second;
+  const auto built = run("lod '" + las + "' -o '" + tree.string() + "' -q");
+  ASSERT_EQ(built.first, 0) << built.second;
+  const auto direct = run("render '" + tree.string() + "'" + draw);
+  ASSERT_EQ(direct.first, 0) << direct.second;
+  ASSERT_FALSE(hashOf(first.second).empty()) << first.second;
+  EXPECT_EQ(hashOf(first.second), hashOf(direct.second));
+  EXPECT_EQ(hashOf(second.second), hashOf(direct.second));
+  fs::remove_all(cache);
+  fs::remove_all(tree);
 }
 
 TEST(LodCli, AnOctreeDamagedWhereStreamingFindsItFailsWithOneLine) {

@@ -95,6 +95,9 @@ TEST(StereoCli, WrongCombinationsFailWithOneLine) {
   const std::string tree = octree().string();
   const std::pair<std::string, std::string> cases[] = {
       {"render terrain --points 1k --stereo" + out, "--stereo draws both eyes in one pass with the batch"},
+      // Without --method the message names what to add, not the default the user never chose.
+      {"render " + tree + " --stereo" + out, "name one with --method (batch-prefetch for a cloud, lod for"},
+      {"render terrain --points 1k --method atomicmin --stereo" + out, "lod and lod-hqs), not atomicmin"},
       {"render terrain --points 1k --method batch --ipd 1" + out, "need --stereo"},
       {"render terrain --points 1k --method batch --stereo --ipd -1" + out, "--ipd must be a distance > 0"},
       {"render terrain --points 1k --method batch --stereo --convergence near" + out, "--convergence takes"},
