@@ -716,7 +716,7 @@ int runRenderDistributed(const RenderArgs& a, const RenderSettings& settings) {
     throw InternalError("the Vulkan validation layer reported " + std::to_string(context.validationErrors()) +
                         " error(s), above");
   const std::vector<uint32_t> pixels =
-      settings.method.info().family == MethodFamily::Hqs
+      compositesInSteps(settings.method.info())
           ? compositeHqsFrame(renderer, drawn, camera, settings, stats, composite)
           : compositeFrame(context, renderer, camera, settings, rank.depthScale, stats, composite);
   if (job.root()) {

@@ -58,6 +58,10 @@ void dumpWords(const std::vector<uint64_t>& words) {
 
 } // namespace
 
+bool compositesInSteps(const MethodInfo& info) {
+  return info.output == MethodOutput::Blend && info.layout != SceneLayout::Octree;
+}
+
 bool distributedRun() {
   return mpi::Job::get().launched();
 }
@@ -99,11 +103,11 @@ void checkDistributed(const RenderSettings& settings, bool cameraPath, bool sphe
     throw InputError(std::string(info.name) +
                      " keeps no depth per pixel, so ranks' frames cannot be composited; under mpirun use a "
                      "closest-point method (atomicmin, the batch methods, lod)");
-  if (!hasCanonicalWords(info) && info.family != MethodFamily::Hqs)
-    throw InputError(std::string(info.name) +
-                     " blends points in batches or octree nodes, which is not composited across ranks yet; "
-                     "under mpirun use hqs, hqs1r or a closest-point method (atomicmin, the batch methods, "
-                     "lod)");
+  if (!hasCanonicalWords(info) && !compositesInSteps(info))
+    throw InputError(
+        std::string(info.name) +
+        " blends points in octree nodes, which is not composited across ranks yet; under mpirun "
+        "use hqs, hqs1r, batch-hqs or a closest-point method (atomicmin, the batch methods, lod)");
 }
 
 PointCloud loadShare(const InputSpec& spec) {

@@ -22,6 +22,9 @@ namespace pointrast::app {
 // Whether this process is a rank of a job mpirun started (of any size).
 bool distributedRun();
 
+// The blending methods whose frames composite in HQS steps (compositeHqsFrame): hqs, hqs1r, batch-hqs.
+bool compositesInSteps(const MethodInfo& info);
+
 // The device of this rank: --device or POINTRAST_DEVICE when given, else local rank mod the number of
 // devices of the best type on the host (discrete GPUs, else integrated, ...). The device line is not
 // printed by each rank: announceRanks() prints them all on rank 0.
@@ -76,10 +79,10 @@ std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, 
                                      const RenderSettings& settings, double int40Scale,
                                      const FrameStats& stats, CompositeStats& out);
 
-// The same for the HQS methods (hqs, hqs1r), after this rank's timed frames: the depth pass again, the
-// closest depths of all ranks to every rank (MIN), the blend pass against them, the blend sums of all ranks
-// to rank 0 (SUM), where the method's resolve and the resolve stage run once: the frame of one process.
-// Returns the image on rank 0, nothing elsewhere. A collective.
+// The same for the HQS methods (compositesInSteps: hqs, hqs1r, batch-hqs), after this rank's timed frames:
+// the depth pass again, the closest depths of all ranks to every rank (MIN), the blend pass against them, the
+// blend sums of all ranks to rank 0 (SUM), where the method's resolve and the resolve stage run once: the
+// frame of one process. Returns the image on rank 0, nothing elsewhere. A collective.
 std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuScene* const> scenes,
                                         const Camera& camera, const RenderSettings& settings,
                                         const FrameStats& stats, CompositeStats& out);

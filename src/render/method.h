@@ -66,6 +66,15 @@ public:
   virtual void writeSums(std::span<const uint64_t>) {}
 };
 
+// The blend sums of an HQS accumulator buffer as PointMethod::readSums() returns them (two words a pixel,
+// r << 32 | g, b << 32 | count), read from and written into its layout: two words a pixel (hqs), or one
+// packed word a pixel before two fallback words a pixel (hqs1r's single atomic, oneRound; also batch-hqs's),
+// whose packed 16-bit fields are added into the fallback sums as the resolve adds them.
+std::vector<uint64_t> readHqsSums(gpu::Context& context, const gpu::Buffer& accumulators, uint64_t pixels,
+                                  bool oneRound);
+void writeHqsSums(gpu::Context& context, const gpu::Buffer& accumulators, uint64_t pixels, bool oneRound,
+                  std::span<const uint64_t> sums);
+
 // Points per thread of the raster_closest and raster_hqs shaders (POINTS_PER_THREAD): a thread loads 4
 // positions before projecting any, four loads in flight instead of one (docs/performance.md has the measurements).
 constexpr uint32_t kPointsPerThread = 4;

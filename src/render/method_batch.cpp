@@ -65,7 +65,8 @@ uint64_t frameBatches(const Frame& frame) {
 class BatchMethod : public PointMethod {
 public:
   BatchMethod(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height, uint32_t eyes)
-      : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
+      : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes),
+        pixels_(uint64_t(width) * height) {
     // The row's constants: PREFETCH (one 128-bit load of 4 consecutive points) and, for the blending
     // rows, DEPTH_ONLY (the depth pass before the accumulation); STEREO for two eyes.
     // COUNT (batch.inc.glsl): the pipelines of counted frames gather the statistics, the others do not.
@@ -107,13 +108,20 @@ public:
     // The frame's constants, written here (before the submission) and copied into device memory at the
     // start of the frame: sizeof(shared::BatchFrame) bytes, which every workgroup reads from the GPU's
     // caches.
+    // batch-hqs in steps (HqsPass, frames composited across processes): the depth pass, the accumulation
+    // against depths set from outside, the resolve of sums set from outside. The steps draw without the
+    // dense path, which blends dense batches against this frame's own depths during its depth pass; a
+    // whole frame with it is the same image (RenderSettings::batchHqsDense).
+    const HqsPass pass = hqs_ ? frame.settings.hqsPass : HqsPass::Whole;
+    const bool whole = pass == HqsPass::Whole, depthPass = whole || pass == HqsPass::Depth;
+    const bool blendPass = hqs_ && (whole || pass == HqsPass::Blend);
     shared::BatchFrame f{};
     f.framebuffer = targets.framebuffer.address();
     f.stats = stats_.address();
     f.accumulators = hqs_ ? accumulators_.address() : 0;
     f.denseDepths = hqs_ ? accumulators_.address() + pixels * 24 : 0;
     f.denseTiles = hqs_ ? accumulators_.address() + pixels * 28 : 0;
-    f.dense = hqs_ && eyes_ == 1 && frame.settings.batchHqsDense ? 1 : 0;
+    f.dense = hqs_ && eyes_ == 1 && frame.settings.batchHqsDense && whole ? 1 : 0;
     f.tilesX = tilesAcross(targets.width);
     f.denseHistory = f.dense != 0 ? historyBuffer(frame, cmd).address() : 0;
     f.width = targets.eyeWidth();
@@ -137,18 +145,23 @@ public:
     std::memcpy(frameUpload_.mapped(), &f, sizeof f);
     VkBufferCopy copy{0, 0, sizeof f};
     gpu::vkCmdCopyBuffer(cmd, frameUpload_.handle(), frame_.handle(), 1, &copy);
-    gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 8, 0xFFFFFFFFu); // kEmptyPixel
+    if (depthPass) // kEmptyPixel
+      gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, pixels * 8, 0xFFFFFFFFu);
     gpu::vkCmdFillBuffer(cmd, stats_.handle(), 0, VK_WHOLE_SIZE, 0);
-    if (hqs_) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
+    if (blendPass) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
     gpu::fullBarrier(cmd);
-    forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
-      views_.dispatch(cmd, (batches + views_.groupSize() - 1) / views_.groupSize(), 1, push);
-    });
-    gpu::fullBarrier(cmd);
+    if (depthPass || blendPass) {
+      forEachBatchPart(
+          frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
+            views_.dispatch(cmd, (batches + views_.groupSize() - 1) / views_.groupSize(), 1, push);
+          });
+      gpu::fullBarrier(cmd);
+    }
     const gpu::ComputeProgram& raster = frame.counted ? raster_ : rasterUncounted_;
-    forEachBatchPart(frame, targets, frame_.address(), [&](const shared::BatchPush& push, uint32_t batches) {
-      raster.dispatch(cmd, batches, 1, push);
-    });
+    if (depthPass)
+      forEachBatchPart(
+          frame, targets, frame_.address(),
+          [&](const shared::BatchPush& push, uint32_t batches) { raster.dispatch(cmd, batches, 1, push); });
     if (f.dense != 0) {
       // Beside the depth pass (both only take minima and add): dense batches in one pass, then the check.
       const gpu::ComputeProgram& dense = frame.counted ? dense_ : denseUncounted_;
@@ -165,18 +178,25 @@ public:
     gpu::fullBarrier(cmd);
     shared::ResolvePush resolve =
         resolvePush(frame, targets, targets.framebuffer.address(), resolve_.groupSize());
-    if (hqs_) {
+    if (blendPass) {
       forEachBatchPart(frame, targets, frame_.address(),
                        [&](const shared::BatchPush& push, uint32_t batches) {
                          (frame.counted ? accumulate_ : accumulateUncounted_).dispatch(cmd, batches, 1, push);
                        });
       gpu::fullBarrier(cmd);
-      resolve.aux = accumulators_.address();
-    } else {
-      resolve.aux = frame_.address(); // the table of color buffers
     }
-    resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
-    gpu::fullBarrier(cmd);
+    resolve.aux = hqs_ ? accumulators_.address() : frame_.address(); // or the table of color buffers
+    if (whole || pass == HqsPass::Resolve) {
+      resolve_.dispatch(cmd, resolve.groupsX, gpu::gridFor(pixels, resolve_.groupSize()).y, resolve);
+      gpu::fullBarrier(cmd);
+    }
+  }
+
+  bool blends() const override { return hqs_; }
+  // hqs1r's accumulator layout (the first 24 bytes a pixel).
+  std::vector<uint64_t> readSums() override { return readHqsSums(context_, accumulators_, pixels_, true); }
+  void writeSums(std::span<const uint64_t> sums) override {
+    writeHqsSums(context_, accumulators_, pixels_, true, sums);
   }
 
   std::optional<BatchStats> readStats() override {
@@ -212,6 +232,7 @@ private:
   gpu::Context& context_;
   bool hqs_;
   uint32_t eyes_;
+  uint64_t pixels_;                       // of the whole image (both eyes)
   static constexpr uint32_t kCountId = 5; // COUNT
   gpu::ComputeProgram raster_;     // batch / batch-prefetch, or batch-hqs's depth pass
   gpu::ComputeProgram rasterUncounted_;

@@ -86,34 +86,12 @@ public:
 
   bool blends() const override { return true; }
 
-  // hqs keeps the two words a pixel as they are; hqs1r's packed 16-bit fields are added into its fallback
-  // sums, as its resolve adds them.
   std::vector<uint64_t> readSums() override {
-    std::vector<uint64_t> sums(2 * pixels_);
-    if (!oneRound_) {
-      gpu::readBuffer(context_, accumulators_, 0, sums.data(), sums.size() * 8);
-      return sums;
-    }
-    std::vector<uint64_t> packed(pixels_);
-    gpu::readBuffer(context_, accumulators_, 0, packed.data(), pixels_ * 8);
-    gpu::readBuffer(context_, accumulators_, pixels_ * 8, sums.data(), sums.size() * 8);
-    for (uint64_t i = 0; i < pixels_; ++i) {
-      const uint64_t p = packed[i];
-      sums[2 * i] += ((p & 0xFFFFu) << 32) + ((p >> 16) & 0xFFFFu);
-      sums[2 * i + 1] += (((p >> 32) & 0xFFFFu) << 32) + (p >> 48);
-    }
-    return sums;
+    return readHqsSums(context_, accumulators_, pixels_, oneRound_);
   }
 
   void writeSums(std::span<const uint64_t> sums) override {
-    if (sums.size() != 2 * pixels_) throw InternalError("internal error: HQS sums of another image size");
-    if (!oneRound_) {
-      gpu::writeBuffer(context_, accumulators_, 0, sums.data(), sums.size() * 8);
-      return;
-    }
-    std::vector<uint64_t> all(3 * pixels_, 0); // packed words empty, everything in the fallback sums
-    std::copy(sums.begin(), sums.end(), all.begin() + static_cast<ptrdiff_t>(pixels_));
-    gpu::writeBuffer(context_, accumulators_, 0, all.data(), all.size() * 8);
+    writeHqsSums(context_, accumulators_, pixels_, oneRound_, sums);
   }
 
 private:
@@ -145,6 +123,38 @@ private:
 };
 
 } // namespace
+
+// hqs keeps the two words a pixel as they are; hqs1r's packed 16-bit fields are added into its fallback
+// sums, as its resolve adds them.
+std::vector<uint64_t> readHqsSums(gpu::Context& context, const gpu::Buffer& accumulators, uint64_t pixels,
+                                  bool oneRound) {
+  std::vector<uint64_t> sums(2 * pixels);
+  if (!oneRound) {
+    gpu::readBuffer(context, accumulators, 0, sums.data(), sums.size() * 8);
+    return sums;
+  }
+  std::vector<uint64_t> packed(pixels);
+  gpu::readBuffer(context, accumulators, 0, packed.data(), pixels * 8);
+  gpu::readBuffer(context, accumulators, pixels * 8, sums.data(), sums.size() * 8);
+  for (uint64_t i = 0; i < pixels; ++i) {
+    const uint64_t p = packed[i];
+    sums[2 * i] += ((p & 0xFFFFu) << 32) + ((p >> 16) & 0xFFFFu);
+    sums[2 * i + 1] += (((p >> 32) & 0xFFFFu) << 32) + (p >> 48);
+  }
+  return sums;
+}
+
+void writeHqsSums(gpu::Context& context, const gpu::Buffer& accumulators, uint64_t pixels, bool oneRound,
+                  std::span<const uint64_t> sums) {
+  if (sums.size() != 2 * pixels) throw InternalError("internal error: HQS sums of another image size");
+  if (!oneRound) {
+    gpu::writeBuffer(context, accumulators, 0, sums.data(), sums.size() * 8);
+    return;
+  }
+  std::vector<uint64_t> all(3 * pixels, 0); // packed words empty, everything in the fallback sums
+  std::copy(sums.begin(), sums.end(), all.begin() + static_cast<ptrdiff_t>(pixels));
+  gpu::writeBuffer(context, accumulators, 0, all.data(), all.size() * 8);
+}
 
 std::unique_ptr<PointMethod> createHqsMethod(gpu::Context& context, const MethodInfo& method, uint32_t width,
                                              uint32_t height) {

@@ -194,7 +194,8 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   const bool post = preparePost(settings);
   PointMethod& m = method(settings);
   if (settings.hqsPass != HqsPass::Whole && !m.blends())
-    throw InputError(std::string(info.name) + " records whole frames; HQS steps are for hqs and hqs1r");
+    throw InputError(std::string(info.name) +
+                     " records whole frames; HQS steps are for hqs, hqs1r and batch-hqs");
   last_ = &m;
   Targets& t = *targets_;
   if (settings.captureWords) allocateWords();

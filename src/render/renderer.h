@@ -35,10 +35,11 @@ enum class DepthMode {
 DepthMode parseDepthMode(std::string_view name);
 const char* depthModeName(DepthMode mode);
 
-// The steps of an HQS frame (hqs, hqs1r) a frame records: all of them, or one, for frames composited across
-// processes (docs/mpi.md): each draws its depths (Depth), the closest of all is set (Renderer::setHqsDepths),
-// each blends its points against it (Blend), the sums of all are set (setHqsSums) and one resolves them
-// (Resolve, with the resolve stage of the settings). Other methods record whole frames only.
+// The steps of an HQS frame (hqs, hqs1r, batch-hqs) a frame records: all of them, or one, for frames
+// composited across processes (docs/mpi.md): each draws its depths (Depth), the closest of all is set
+// (Renderer::setHqsDepths), each blends its points against it (Blend), the sums of all are set (setHqsSums)
+// and one resolves them (Resolve, with the resolve stage of the settings). Other methods record whole frames
+// only.
 enum class HqsPass { Whole, Depth, Blend, Resolve };
 
 struct RenderSettings {

@@ -212,15 +212,47 @@ TEST(MpiRender, HqsComposesTheOneRankFrameExactly) {
   EXPECT_TRUE(edl.json.contains("post"));
 }
 
-TEST(MpiRender, BlendingInBatchesIsRefusedWithOneLine) {
+// batch-hqs in the same two steps, drawn without its dense-batch path (which blends a dense batch against
+// the rank's own depths): the frame of one process drawing it whole, dense path included, bit for bit. From
+// far away at 60x40 one of the four Morton-ordered batches is dense.
+TEST(MpiRender, BatchHqsComposesTheOneProcessFrameExactly) {
+  REQUIRE_MPI();
+  const std::string scene = "terrain --points 40000 --order morton --width 60 --height 40 --frames 1 --fov 3 "
+                            "--eye 500022.35,3999419.41,620.0 --target 500022.35,4000022.37,197.80";
+  const std::string args = scene + " --method batch-hqs";
+  auto plain = [&](const std::string& extra) {
+    const pointrast::test::CliResult r = runPointrast("render " + args + extra + " --json -q -o " +
+                                                      (cliTempDir() / "bhqs_plain.png").string());
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return r.exitCode == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
+  };
+  const nlohmann::json whole = plain("");
+  ASSERT_TRUE(whole.contains("batch_stats"));
+  EXPECT_GT(whole["batch_stats"]["batches_dense"].get<int>(), 0)
+      << "the dense path must be part of the frame";
+  const Image two = imageOn(2, args, cliTempDir() / "bhqs2.png");
+  ASSERT_FALSE(two.png.empty());
+  EXPECT_EQ(two.json["image_hash"], whole["image_hash"]);
+  EXPECT_EQ(two.json["points"], 40000);
+  EXPECT_EQ(two.json["mpi"]["bytes_moved"], 60u * 40u * 32);
+  // The resolve stage once on the composite of three ranks, as on one process.
+  const Image three = imageOn(3, args + " --point-size 2", cliTempDir() / "bhqs3.png");
+  EXPECT_EQ(three.json["image_hash"], plain(" --point-size 2")["image_hash"]);
+  // The frame blends: it is not the closest-point frame of the batches.
+  const pointrast::test::CliResult closest = runPointrast(
+      "render " + scene + " --method batch --json -q -o " + (cliTempDir() / "bclosest.png").string());
+  ASSERT_EQ(closest.exitCode, 0) << closest.err;
+  EXPECT_NE(nlohmann::json::parse(closest.out)["image_hash"], whole["image_hash"]);
+}
+
+TEST(MpiRender, BlendingInOctreeNodesIsRefusedWithOneLine) {
   REQUIRE_MPI();
   const MpiRun r =
-      runMpi("-np 2 " + pointrastBinary() + " render terrain --points 20000 --method batch-hqs -o " +
+      runMpi("-np 2 " + pointrastBinary() + " render terrain --points 20000 --method lod-hqs -o " +
                  (cliTempDir() / "refused.png").string() + kImage + " -q",
              "", 60);
   EXPECT_EQ(r.exitCode, 1) << r.err;
-  EXPECT_NE(r.err.find("pointrast: batch-hqs blends points in batches or octree nodes"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("pointrast: lod-hqs blends points in octree nodes"), std::string::npos) << r.err;
 }
 
 // A LAS file: each rank reads only its records (whole batches, as the whole file would be cut), and the
