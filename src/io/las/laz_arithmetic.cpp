@@ -22,12 +22,13 @@ POINTRAST_LAZ_NO_COVERAGE void BitModel::update() {
   bitsUntilUpdate = updateCycle;
 }
 
-POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols) {
+POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols, ModelUse use) {
   assert(symbols >= 2 && symbols <= 2048);
   symbols_ = symbols;
   lastSymbol_ = symbols - 1;
   size_t words = 2 * size_t(symbols);
-  if (symbols > 16) {
+  const bool table = symbols > 16 && use == ModelUse::Decode;
+  if (table) {
     // A table of at least one entry per symbol: FastAC sizes it for four symbols per entry, but the
     // bisection within an entry mispredicts, and a finer table costs nothing in exactness (it only
     // narrows the search; the distribution decides).
@@ -43,7 +44,7 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols) {
   storage_ = std::make_unique<uint32_t[]>(words);
   distribution_ = storage_.get();
   symbolCount_ = distribution_ + symbols;
-  decoderTable_ = symbols > 16 ? symbolCount_ + symbols : nullptr;
+  decoderTable_ = table ? symbolCount_ + symbols : nullptr;
   ready_ = false;
 }
 
@@ -51,11 +52,13 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::reset() {
   assert(symbols_ != 0);
   // Every reset of an alphabet of a given size ends in the same tables (counts of 1, their
   // distribution and decoder table): the first on a thread computes them, later ones copy them. A
-  // chunk resets a model per context it meets, often hundreds of 256-symbol models.
+  // chunk resets a model per context it meets, often hundreds of 256-symbol models. An encoder's model
+  // copies the distribution and counts only (the words before the decoder table); a decoder's model
+  // after an encoder's computes them again, with its table.
   thread_local std::vector<std::vector<uint32_t>> uniform(2049);
   std::vector<uint32_t>& tables = uniform[symbols_];
   const size_t words = 2 * size_t(symbols_) + (decoderTable_ ? tableSize_ + 2 : 0);
-  if (tables.empty()) {
+  if (tables.size() < words) {
     totalCount_ = 0;
     updateCycle_ = symbols_;
     std::fill(symbolCount_, symbolCount_ + symbols_, 1u);
@@ -108,10 +111,11 @@ void ArithmeticEncoder::writeBits(uint32_t bits, uint32_t value) {
     value >>= 16;
     bits -= 16;
   }
-  const uint32_t initBase = base_;
-  base_ += value * (length_ >>= bits);
-  if (initBase > base_) propagateCarry();
-  normalize();
+  const uint32_t length = length_ >> bits;
+  const uint32_t x = value * length;
+  const uint32_t base = base_ + x;
+  if (base < x) propagateCarry();
+  normalize(base, length);
 }
 
 std::span<const uint8_t> ArithmeticEncoder::flush() {
@@ -126,9 +130,9 @@ std::span<const uint8_t> ArithmeticEncoder::flush() {
     anotherByte = false;
   }
   if (initBase > base_) propagateCarry();
-  normalize(); // length is below 2^24 here: at least one byte, as FastAC's final renormalization
+  normalize(base_, length_); // length is below 2^24: at least one byte, as FastAC's final renormalization
   // Zero bytes so the decoder's reads ahead stay inside the stream.
-  if (end_ - ptr_ < 4) grow();
+  if (ptr_ >= limit_) grow();
   const size_t zeros = anotherByte ? 3 : 2;
   std::memset(ptr_, 0, zeros);
   ptr_ += zeros;
@@ -144,14 +148,15 @@ std::vector<uint8_t> ArithmeticEncoder::finish() {
   return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
-void ArithmeticEncoder::grow() {
+uint8_t* ArithmeticEncoder::grow() {
   const size_t used = buffer_ ? size_t(ptr_ - buffer_.get()) : 0;
-  const size_t capacity = std::max<size_t>(4096, 2 * size_t(end_ - buffer_.get()));
+  const size_t capacity = std::max<size_t>(4096, buffer_ ? 2 * size_t(limit_ + 3 - buffer_.get()) : 0);
   auto bigger = std::make_unique<uint8_t[]>(capacity);
   if (used) std::memcpy(bigger.get(), buffer_.get(), used);
   buffer_ = std::move(bigger);
   ptr_ = buffer_.get() + used;
-  end_ = buffer_.get() + capacity;
+  limit_ = buffer_.get() + capacity - 3;
+  return ptr_;
 }
 
 void ArithmeticEncoder::propagateCarry() {

@@ -51,17 +51,23 @@ struct BitModel {
   POINTRAST_LAZ_NO_COVERAGE void update();
 };
 
-// An adaptive model of `symbols` symbols (2..2048). Alphabets above 16 symbols get a lookup table that
-// maps the top bits of value / length to a first guess, refined by bisection (FastAC's table decoding).
+// Who uses a model: a decoder's models above 16 symbols keep FastAC's decoder table, which every update
+// rebuilds; an encoder's never read it, so theirs have none (their distributions, and so their bytes,
+// are the same).
+enum class ModelUse : uint8_t { Decode, Encode };
+
+// An adaptive model of `symbols` symbols (2..2048). Alphabets above 16 symbols get (for a decoder) a
+// lookup table that maps the top bits of value / length to a first guess, refined by bisection (FastAC's
+// table decoding).
 class SymbolModel {
 public:
   SymbolModel() = default;
-  explicit SymbolModel(uint32_t symbols) { create(symbols); }
+  explicit SymbolModel(uint32_t symbols, ModelUse use = ModelUse::Decode) { create(symbols, use); }
   SymbolModel(SymbolModel&&) = default;
   SymbolModel& operator=(SymbolModel&&) = default;
 
   // Allocates the tables for an alphabet of `symbols` (2..2048) and leaves the model not ready.
-  POINTRAST_LAZ_NO_COVERAGE void create(uint32_t symbols);
+  POINTRAST_LAZ_NO_COVERAGE void create(uint32_t symbols, ModelUse use = ModelUse::Decode);
   // Back to the uniform start state (every count 1), as LASzip's initSymbolModel.
   POINTRAST_LAZ_NO_COVERAGE void reset();
   // Marks the model for a reset before its next use: models that a chunk never touches are not reset.
@@ -79,7 +85,7 @@ private:
 
   uint32_t* distribution_ = nullptr; // symbols_ entries: cumulative probability, 15-bit scale
   uint32_t* symbolCount_ = nullptr;  // symbols_ entries
-  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries, or null for small alphabets
+  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries, or null (small alphabets, encoders)
   uint32_t symbols_ = 0, lastSymbol_ = 0, tableSize_ = 0, tableShift_ = 0;
   uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
   bool ready_ = false;
@@ -230,6 +236,11 @@ private:
 // bring length back to 2^24 or more (clz(length) / 8 of them, 0 to 3) without a branch on length,
 // which mispredicts about every third symbol: the top four bytes of base are stored and the pointer
 // advances by that count (the same bytes FastAC's loop writes one at a time).
+//
+// A symbol works on local copies of base and length and updates its model before it stores bytes:
+// a byte store may alias anything, so state read after it would be loaded again, and the state stored
+// as separate words and read back as one (GCC paired base and length in a vector register) stalled
+// store forwarding on every symbol.
 class ArithmeticEncoder {
 public:
   ArithmeticEncoder() = default;
@@ -238,37 +249,34 @@ public:
 
   [[gnu::always_inline]] void encodeBit(BitModel& m, uint32_t bit) {
     const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
-    const uint32_t initBase = base_;
-    if (bit == 0) {
-      length_ = x;
-      ++m.bit0Count;
-    } else {
-      base_ += x;
-      length_ -= x;
-    }
-    if (initBase > base_) [[unlikely]]
-      propagateCarry();
-    normalize();
+    const uint32_t add = bit ? x : 0;
+    const uint32_t base = base_ + add;
+    const uint32_t length = bit ? length_ - x : x;
+    m.bit0Count += bit == 0;
     if (--m.bitsUntilUpdate == 0) m.update();
+    if (base < add) [[unlikely]]
+      propagateCarry();
+    normalize(base, length);
   }
 
   [[gnu::always_inline]] void encodeSymbol(SymbolModel& m, uint32_t sym) {
     assert(sym < m.symbols_);
-    const uint32_t initBase = base_;
-    if (sym == m.lastSymbol_) {
-      const uint32_t x = m.distribution_[sym] * (length_ >> kLengthShift);
-      base_ += x;
-      length_ -= x;
-    } else {
-      const uint32_t x = m.distribution_[sym] * (length_ >>= kLengthShift);
-      base_ += x;
-      length_ = m.distribution_[sym + 1] * length_ - x;
-    }
-    if (initBase > base_) [[unlikely]]
-      propagateCarry();
-    normalize();
+    const uint32_t* distribution = m.distribution_;
+    const uint32_t l = length_ >> kLengthShift;
+    const uint32_t x = distribution[sym] * l;
+    // The last symbol's interval ends at length itself. Its entry sym + 1 is the first count (the
+    // model's storage continues), read and dropped by a conditional move: the last symbol of a
+    // corrector's model is as frequent as any other, and a branch on it mispredicted. GCC made a branch
+    // of the ?: by moving the product into one arm; the empty asm, which takes the product, keeps it.
+    uint32_t next = distribution[sym + 1] * l;
+    asm("" : "+r"(next));
+    const uint32_t length = (sym == m.lastSymbol_ ? length_ : next) - x;
+    const uint32_t base = base_ + x;
     ++m.symbolCount_[sym];
     if (--m.symbolsUntilUpdate_ == 0) m.update();
+    if (base < x) [[unlikely]]
+      propagateCarry();
+    normalize(base, length);
   }
 
   void writeBits(uint32_t bits, uint32_t value);
@@ -279,21 +287,23 @@ public:
   std::vector<uint8_t> finish();
 
 private:
-  [[gnu::always_inline]] void normalize() {
-    if (end_ - ptr_ < 4) [[unlikely]]
-      grow();
-    const uint32_t n = uint32_t(__builtin_clz(length_ | 1)) >> 3;
-    const uint32_t bytes = __builtin_bswap32(base_);
-    std::memcpy(ptr_, &bytes, 4);
-    ptr_ += n;
-    base_ <<= 8 * n;
-    length_ <<= 8 * n;
+  // Stores the interval (base, length) after shifting out its settled bytes.
+  [[gnu::always_inline]] void normalize(uint32_t base, uint32_t length) {
+    uint8_t* p = ptr_;
+    if (p >= limit_) [[unlikely]]
+      p = grow();
+    const uint32_t n = uint32_t(__builtin_clz(length | 1)) >> 3;
+    const uint32_t bytes = __builtin_bswap32(base);
+    std::memcpy(p, &bytes, 4);
+    ptr_ = p + n;
+    base_ = base << (8 * n);
+    length_ = length << (8 * n);
   }
-  void grow();
+  uint8_t* grow(); // returns the new ptr_
   void propagateCarry();
   std::unique_ptr<uint8_t[]> buffer_;
-  uint8_t* ptr_ = nullptr; // the next byte in buffer_
-  uint8_t* end_ = nullptr;
+  uint8_t* ptr_ = nullptr;   // the next byte in buffer_
+  uint8_t* limit_ = nullptr; // buffer_'s end - 3: a four-byte store fits at ptr_ while ptr_ < limit_
   uint32_t base_ = 0, length_ = kMaxLength;
 };
 

@@ -44,6 +44,15 @@ inline uint8_t* recordSlot(std::vector<uint8_t>& out, uint64_t i, uint64_t& capa
   return out.data() + i * recordLength;
 }
 
+// min and max without a branch. GCC compiles std::min and std::max of ints into branches where it
+// judges them cheaper, which it did in some of the places Median5::add is inlined into.
+inline int32_t minNoBranch(int32_t a, int32_t b) {
+  return b ^ ((a ^ b) & -int32_t(a < b));
+}
+inline int32_t maxNoBranch(int32_t a, int32_t b) {
+  return b ^ ((a ^ b) & -int32_t(a > b));
+}
+
 // Median of the last five values, maintained in a sorted window without sorting: LASzip's
 // "StreamingMedian5", which alternates which end of the window a new value pushes out. Both of its
 // cases drop one end of the window (the largest value while high_, else the smallest) and insert the
@@ -60,11 +69,11 @@ public:
     // The end moves when the value lands on its side of the median (ties go the way LASzip's do);
     // bitwise operators, as a short-circuit would be a branch again.
     const bool high = (v < v_[2]) | ((high_ ^ 1) & (v == v_[2]));
-    v_[0] = std::min(w0, v);
-    v_[1] = std::max(w0, std::min(w1, v));
-    v_[2] = std::max(w1, std::min(w2, v));
-    v_[3] = std::max(w2, std::min(w3, v));
-    v_[4] = std::max(w3, v);
+    v_[0] = minNoBranch(w0, v);
+    v_[1] = maxNoBranch(w0, minNoBranch(w1, v));
+    v_[2] = maxNoBranch(w1, minNoBranch(w2, v));
+    v_[3] = maxNoBranch(w2, minNoBranch(w3, v));
+    v_[4] = maxNoBranch(w3, v);
     high_ = high;
   }
 

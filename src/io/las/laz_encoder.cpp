@@ -22,6 +22,9 @@ using detail::storeLE;
 
 namespace {
 
+// The encoders' models keep no decoder tables (laz_arithmetic.h).
+constexpr ModelUse kEncode = ModelUse::Encode;
+
 bool fitsInt32(int64_t v) {
   return v >= INT32_MIN && v <= INT32_MAX;
 }
@@ -224,12 +227,12 @@ public:
   }
 
 private:
-  SymbolModel changedValues_{64};
-  IntegerCodec intensity_{16, 4};
-  SymbolModel scanAngleRank_[2] = {SymbolModel(256), SymbolModel(256)};
-  IntegerCodec pointSourceId_{16, 1};
-  ContextModels bitByte_{256, 256}, classification_{256, 256}, userData_{256, 256};
-  IntegerCodec dx_{32, 2}, dy_{32, 22}, z_{32, 20};
+  SymbolModel changedValues_{64, kEncode};
+  IntegerCodec intensity_{16, 4, kEncode};
+  SymbolModel scanAngleRank_[2] = {SymbolModel(256, kEncode), SymbolModel(256, kEncode)};
+  IntegerCodec pointSourceId_{16, 1, kEncode};
+  ContextModels bitByte_{256, 256, kEncode}, classification_{256, 256, kEncode}, userData_{256, 256, kEncode};
+  IntegerCodec dx_{32, 2, kEncode}, dy_{32, 22, kEncode}, z_{32, 20, kEncode};
   uint8_t last_[20] = {};
   uint16_t lastIntensity_[16] = {};
   Median5 lastXDiff_[16], lastYDiff_[16];
@@ -249,9 +252,9 @@ public:
   }
 
 private:
-  SymbolModel multi_{516};
+  SymbolModel multi_{516, kEncode};
   SymbolModel zeroDiff_{6};
-  IntegerCodec gpsTime_{32, 9};
+  IntegerCodec gpsTime_{32, 9, kEncode};
   GpsSequences seq_;
 };
 
@@ -273,15 +276,15 @@ public:
   }
 
 private:
-  SymbolModel byteUsed_{128};
-  SymbolModel diff_[6] = {SymbolModel(256), SymbolModel(256), SymbolModel(256),
-                          SymbolModel(256), SymbolModel(256), SymbolModel(256)};
+  SymbolModel byteUsed_{128, kEncode};
+  SymbolModel diff_[6] = {SymbolModel(256, kEncode), SymbolModel(256, kEncode), SymbolModel(256, kEncode),
+                          SymbolModel(256, kEncode), SymbolModel(256, kEncode), SymbolModel(256, kEncode)};
   uint16_t last_[3] = {};
 };
 
 class Byte2Encoder {
 public:
-  explicit Byte2Encoder(uint32_t count) : models_(count, 256), last_(count) {}
+  explicit Byte2Encoder(uint32_t count) : models_(count, 256, kEncode), last_(count) {}
   void init(const uint8_t* item) {
     models_.invalidate();
     std::memcpy(last_.data(), item, last_.size());
@@ -489,17 +492,17 @@ private:
     int32_t lastZ[8] = {};
     SymbolModel changedValues[8];
     SymbolModel scannerChannel{3};
-    ContextModels numberOfReturns{16, 16}, returnNumber{16, 16};
+    ContextModels numberOfReturns{16, 16, kEncode}, returnNumber{16, 16, kEncode};
     SymbolModel returnNumberGpsSame{13};
-    IntegerCodec dx{32, 2}, dy{32, 22}, z{32, 20};
-    ContextModels classification{64, 256}, flags{64, 64}, userData{64, 256};
-    IntegerCodec intensity{16, 4}, scanAngle{16, 2}, pointSourceId{16, 1};
-    SymbolModel gpsMulti{515}, gpsZeroDiff{5};
-    IntegerCodec gpsTime{32, 9};
+    IntegerCodec dx{32, 2, kEncode}, dy{32, 22, kEncode}, z{32, 20, kEncode};
+    ContextModels classification{64, 256, kEncode}, flags{64, 64, kEncode}, userData{64, 256, kEncode};
+    IntegerCodec intensity{16, 4, kEncode}, scanAngle{16, 2, kEncode}, pointSourceId{16, 1, kEncode};
+    SymbolModel gpsMulti{515, kEncode}, gpsZeroDiff{5};
+    IntegerCodec gpsTime{32, 9, kEncode};
     GpsSequences gps;
     Context() {
       for (SymbolModel& m : changedValues)
-        m.create(128);
+        m.create(128, kEncode);
     }
   };
 
@@ -593,11 +596,11 @@ private:
   struct Context {
     bool unused = true;
     uint16_t last[4] = {};
-    SymbolModel byteUsed{128};
-    SymbolModel diff[6] = {SymbolModel(256), SymbolModel(256), SymbolModel(256),
-                           SymbolModel(256), SymbolModel(256), SymbolModel(256)};
+    SymbolModel byteUsed{128, kEncode};
+    SymbolModel diff[6] = {SymbolModel(256, kEncode), SymbolModel(256, kEncode), SymbolModel(256, kEncode),
+                           SymbolModel(256, kEncode), SymbolModel(256, kEncode), SymbolModel(256, kEncode)};
     SymbolModel nirUsed{4};
-    SymbolModel nirDiff[2] = {SymbolModel(256), SymbolModel(256)};
+    SymbolModel nirDiff[2] = {SymbolModel(256, kEncode), SymbolModel(256, kEncode)};
   };
 
   void createContext(uint32_t channel, const uint16_t* seed) {
@@ -661,7 +664,7 @@ private:
     bool unused = true;
     std::vector<uint8_t> last;
     ContextModels models;
-    explicit Context(uint32_t count) : last(count), models(count, 256) {}
+    explicit Context(uint32_t count) : last(count), models(count, 256, kEncode) {}
   };
 
   void createContext(uint32_t channel, const uint8_t* seed) {

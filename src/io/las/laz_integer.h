@@ -16,7 +16,10 @@ class IntegerCodec {
 public:
   IntegerCodec() = default;
   // bits: width of the values (32 for coordinates, 16 for intensity); contexts: caller contexts.
-  IntegerCodec(uint32_t bits, uint32_t contexts, uint32_t bitsHigh = 8, uint32_t range = 0);
+  IntegerCodec(uint32_t bits, uint32_t contexts, uint32_t bitsHigh = 8, uint32_t range = 0,
+               ModelUse use = ModelUse::Decode);
+  // An encoder's codec (its models without decoder tables).
+  IntegerCodec(uint32_t bits, uint32_t contexts, ModelUse use) : IntegerCodec(bits, contexts, 8, 0, use) {}
   IntegerCodec(IntegerCodec&&) = default;
   IntegerCodec& operator=(IntegerCodec&&) = default;
 
@@ -31,7 +34,37 @@ public:
       real -= corrRange_;
     return int32_t(real);
   }
-  void compress(ArithmeticEncoder& enc, int32_t pred, int32_t real, uint32_t context = 0);
+  [[gnu::always_inline]] void compress(ArithmeticEncoder& enc, int32_t pred, int32_t real,
+                                       uint32_t context = 0) {
+    // The corrector folded into [corrMin, corrMax]; for 32-bit values that is the wrapping difference.
+    // Everything up to the symbols is without branches: the size and the sign of a corrector are noise,
+    // and branches on them mispredict.
+    const int64_t d = int64_t(real) - int64_t(pred);
+    const int64_t c = d + (foldRange_ & -int64_t(d < corrMin_)) - (foldRange_ & -int64_t(d > corrMax_));
+    // k: the smallest interval [-(2^k - 1), 2^k] that holds c, the bit width of c1 (0 for c1 = 0).
+    const uint64_t c1 = c <= 0 ? uint64_t(-c) : uint64_t(c - 1);
+    const uint32_t k = 63 - uint32_t(__builtin_clzll(2 * c1 + 1));
+    SymbolModel& bitsModel = bitsModels_[context];
+    bitsModel.ensureReady();
+    enc.encodeSymbol(bitsModel, k);
+    k_ = k;
+    if (k == 0) {
+      enc.encodeBit(corrector0_, uint32_t(c));
+      return;
+    }
+    if (k >= 32) return; // only corrMin needs 32 bits, and k alone says so
+    // c in [-(2^k - 1), -2^(k-1)] as [0, 2^(k-1)), c in [2^(k-1) + 1, 2^k] as [2^(k-1), 2^k).
+    const uint32_t u = uint32_t(c) - 1 + (uint32_t(c < 0) << k);
+    SymbolModel& model = correctors_[k];
+    model.ensureReady();
+    if (k <= bitsHigh_) {
+      enc.encodeSymbol(model, u);
+    } else {
+      const uint32_t k1 = k - bitsHigh_;
+      enc.encodeSymbol(model, u >> k1);
+      enc.writeBits(k1, u & ((1u << k1) - 1));
+    }
+  }
 
   uint32_t getK() const { return k_; }
 
@@ -64,6 +97,7 @@ private:
   uint32_t corrBits_ = 32;
   uint32_t corrRange_ = 0;
   int32_t corrMin_ = INT32_MIN;
+  int64_t corrMax_ = INT32_MAX, foldRange_ = int64_t(1) << 32; // compress()'s fold
   uint32_t k_ = 0;
   std::vector<SymbolModel> bitsModels_; // one per context, corrBits + 1 symbols
   BitModel corrector0_;

@@ -20,10 +20,11 @@ namespace pointrast::io::laz {
 // A model per possible previous byte value, created on first use (most files use a handful).
 class ContextModels {
 public:
-  ContextModels(size_t contexts, uint32_t symbols) : models_(contexts), symbols_(symbols) {}
+  ContextModels(size_t contexts, uint32_t symbols, ModelUse use = ModelUse::Decode)
+      : models_(contexts), symbols_(symbols), use_(use) {}
   SymbolModel& operator[](size_t context) {
     SymbolModel& m = models_[context];
-    if (!m.created()) m.create(symbols_);
+    if (!m.created()) m.create(symbols_, use_);
     m.ensureReady();
     return m;
   }
@@ -35,6 +36,7 @@ public:
 private:
   std::vector<SymbolModel> models_;
   uint32_t symbols_;
+  ModelUse use_;
 };
 
 // X, Y, Z, intensity, return bits, classification, scan angle rank, user data, point source id (20 B).
