@@ -504,7 +504,11 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings,
     if (context.validationErrors() > 0)
       throw InternalError("the Vulkan validation layer reported " +
                           std::to_string(context.validationErrors()) + " error(s), above");
-    pixels = compositeFrame(context, renderer, camera, settings, 0, stats, composite);
+    pixels = compositesInSteps(settings.method.info())
+                 ? compositeHqsFrame(
+                       renderer, [&](const RenderSettings& s) { return renderer.render(scene, camera, s); },
+                       settings, stats, composite)
+                 : compositeFrame(context, renderer, camera, settings, 0, stats, composite);
     stats.medianMs = composite.renderMs; // the frame is done when the slowest rank is
     stats.points = composite.points;
     stats.post = composite.post;

@@ -59,7 +59,7 @@ void dumpWords(const std::vector<uint64_t>& words) {
 } // namespace
 
 bool compositesInSteps(const MethodInfo& info) {
-  return info.output == MethodOutput::Blend && info.layout != SceneLayout::Octree;
+  return info.output == MethodOutput::Blend;
 }
 
 bool distributedRun() {
@@ -103,11 +103,6 @@ void checkDistributed(const RenderSettings& settings, bool cameraPath, bool sphe
     throw InputError(std::string(info.name) +
                      " keeps no depth per pixel, so ranks' frames cannot be composited; under mpirun use a "
                      "closest-point method (atomicmin, the batch methods, lod)");
-  if (!hasCanonicalWords(info) && !compositesInSteps(info))
-    throw InputError(
-        std::string(info.name) +
-        " blends points in octree nodes, which is not composited across ranks yet; under mpirun "
-        "use hqs, hqs1r, batch-hqs or a closest-point method (atomicmin, the batch methods, lod)");
 }
 
 PointCloud loadShare(const InputSpec& spec) {
@@ -209,6 +204,15 @@ std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, 
 std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuScene* const> scenes,
                                         const Camera& camera, const RenderSettings& settings,
                                         const FrameStats& stats, CompositeStats& out) {
+  return compositeHqsFrame(
+      renderer, [&](const RenderSettings& s) { return renderer.render(scenes, camera, s); }, settings, stats,
+      out);
+}
+
+std::vector<uint32_t> compositeHqsFrame(Renderer& renderer,
+                                        const std::function<FrameStats(const RenderSettings&)>& draw,
+                                        const RenderSettings& settings, const FrameStats& stats,
+                                        CompositeStats& out) {
   mpi::Job& job = mpi::Job::get();
   gatherRankStats(stats, out);
   RenderSettings step = rankSettings(settings);
@@ -216,7 +220,7 @@ std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuS
   step.frames = 1;
   step.warmup = 0;
   step.hqsPass = HqsPass::Depth;
-  renderer.render(scenes, camera, step);
+  draw(step);
   auto start = std::chrono::steady_clock::now();
   std::vector<uint64_t> depths = renderer.hqsDepths();
   out.readbackMs = msSince(start);
@@ -226,7 +230,7 @@ std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuS
   out.compositeMs = msSince(start);
   renderer.setHqsDepths(depths);
   step.hqsPass = HqsPass::Blend;
-  renderer.render(scenes, camera, step);
+  draw(step);
   start = std::chrono::steady_clock::now();
   std::vector<uint64_t> sums = renderer.hqsSums();
   out.readbackMs += msSince(start);
@@ -243,7 +247,7 @@ std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuS
   step.frames = 1;
   step.warmup = 0;
   step.hqsPass = HqsPass::Resolve;
-  const FrameStats resolved = renderer.render(scenes, camera, step);
+  const FrameStats resolved = draw(step);
   out.post = resolved.post;
   std::vector<uint32_t> image = renderer.image();
   out.resolveMs = msSince(start);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -22,7 +23,8 @@ namespace pointrast::app {
 // Whether this process is a rank of a job mpirun started (of any size).
 bool distributedRun();
 
-// The blending methods whose frames composite in HQS steps (compositeHqsFrame): hqs, hqs1r, batch-hqs.
+// The blending methods, whose frames composite in HQS steps (compositeHqsFrame): hqs, hqs1r, batch-hqs,
+// lod-hqs.
 bool compositesInSteps(const MethodInfo& info);
 
 // The device of this rank: --device or POINTRAST_DEVICE when given, else local rank mod the number of
@@ -79,13 +81,18 @@ std::vector<uint32_t> compositeFrame(gpu::Context& context, Renderer& renderer, 
                                      const RenderSettings& settings, double int40Scale,
                                      const FrameStats& stats, CompositeStats& out);
 
-// The same for the HQS methods (compositesInSteps: hqs, hqs1r, batch-hqs), after this rank's timed frames:
+// The same for the blending methods (compositesInSteps), after this rank's timed frames:
 // the depth pass again, the closest depths of all ranks to every rank (MIN), the blend pass against them, the
 // blend sums of all ranks to rank 0 (SUM), where the method's resolve and the resolve stage run once: the
 // frame of one process. Returns the image on rank 0, nothing elsewhere. A collective.
 std::vector<uint32_t> compositeHqsFrame(Renderer& renderer, std::span<const GpuScene* const> scenes,
                                         const Camera& camera, const RenderSettings& settings,
                                         const FrameStats& stats, CompositeStats& out);
+// The same with each step drawn by `draw` (lod-hqs: the rank's share of an octree).
+std::vector<uint32_t> compositeHqsFrame(Renderer& renderer,
+                                        const std::function<FrameStats(const RenderSettings&)>& draw,
+                                        const RenderSettings& settings, const FrameStats& stats,
+                                        CompositeStats& out);
 
 // The "mpi" object of render --json.
 nlohmann::json compositeJson(const CompositeStats& stats);

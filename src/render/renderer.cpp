@@ -195,8 +195,9 @@ FrameStats Renderer::render(std::span<const GpuScene* const> scenes, const Camer
   PointMethod& m = method(settings);
   if (settings.hqsPass != HqsPass::Whole && !m.blends())
     throw InputError(std::string(info.name) +
-                     " records whole frames; HQS steps are for hqs, hqs1r and batch-hqs");
+                     " records whole frames; HQS steps are for hqs, hqs1r, batch-hqs and lod-hqs");
   last_ = &m;
+  lodHqs_ = nullptr;
   Targets& t = *targets_;
   if (settings.captureWords) allocateWords();
   // Each scene's record: its clip volumes and the double-precision copy of its matrix (the int40 path).
@@ -326,6 +327,9 @@ FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, cons
                                bool resident) {
   validateCamera(camera);
   lod::LodPasses& passes = lodPasses(settings);
+  if (settings.hqsPass != HqsPass::Whole && !passes.hqs())
+    throw InputError(std::string(methodName(settings.method)) +
+                     " records whole frames; HQS steps are for hqs, hqs1r, batch-hqs and lod-hqs");
   const bool post = preparePost(settings);
   Targets& t = *targets_;
   if (settings.captureWords) allocateWords();
@@ -355,6 +359,8 @@ FrameStats Renderer::renderLod(lod::LodScene& octree, const Camera& camera, cons
                          : lod::renderOctree(context_, octree, passes, t, eyes, settings, epilogue);
   if (post) stats.post = PostStage::stats(postTimestamps->milliseconds(), postFrames);
   wordsCaptured_ = settings.captureWords && (hasCanonicalWords(methodInfo(settings.method)) || post);
+  last_ = nullptr;
+  lodHqs_ = passes.hqs() ? &passes : nullptr;
   pickableOctree_ = nullptr;
   if (t.eyes != 1)
     lodWhy_ = "a stereo frame shows two cameras";
@@ -409,6 +415,7 @@ void Renderer::showComposite(std::span<const uint32_t> image, std::span<const ui
   gpu::writeBuffer(context_, t.words, 0, words.data(), words.size_bytes());
   wordsCaptured_ = true;
   last_ = nullptr;
+  lodHqs_ = nullptr;
   pickableOctree_ = nullptr;
   lodWhy_ = "the last frame was composited from several processes' frames";
 }
@@ -437,30 +444,33 @@ std::vector<uint64_t> Renderer::framebufferWords(uint32_t x, uint32_t y, uint32_
 namespace {
 PointMethod& blending(PointMethod* last) {
   if (!last || !last->blends())
-    throw InputError("no HQS buffers: the last frame was not rendered with hqs or hqs1r");
+    throw InputError("no HQS buffers: the last frame was not rendered with an HQS method");
   return *last;
 }
 } // namespace
 
 std::vector<uint64_t> Renderer::hqsDepths() {
-  blending(last_);
+  if (!lodHqs_) blending(last_);
   std::vector<uint64_t> words(targets_->pixels());
   gpu::readBuffer(context_, targets_->framebuffer, 0, words.data(), words.size() * 8);
   return words;
 }
 
 void Renderer::setHqsDepths(std::span<const uint64_t> words) {
-  blending(last_);
+  if (!lodHqs_) blending(last_);
   if (words.size() != targets_->pixels()) throw InternalError("internal error: depths of another image size");
   gpu::writeBuffer(context_, targets_->framebuffer, 0, words.data(), words.size() * 8);
 }
 
 std::vector<uint64_t> Renderer::hqsSums() {
-  return blending(last_).readSums();
+  return lodHqs_ ? lodHqs_->readSums() : blending(last_).readSums();
 }
 
 void Renderer::setHqsSums(std::span<const uint64_t> sums) {
-  blending(last_).writeSums(sums);
+  if (lodHqs_)
+    lodHqs_->writeSums(sums);
+  else
+    blending(last_).writeSums(sums);
 }
 
 uint64_t Renderer::imageAddress() const {

@@ -35,8 +35,8 @@ enum class DepthMode {
 DepthMode parseDepthMode(std::string_view name);
 const char* depthModeName(DepthMode mode);
 
-// The steps of an HQS frame (hqs, hqs1r, batch-hqs) a frame records: all of them, or one, for frames
-// composited across processes (docs/mpi.md): each draws its depths (Depth), the closest of all is set
+// The steps of an HQS frame (hqs, hqs1r, batch-hqs, lod-hqs) a frame records: all of them, or one, for
+// frames composited across processes (docs/mpi.md): each draws its depths (Depth), the closest of all is set
 // (Renderer::setHqsDepths), each blends its points against it (Blend), the sums of all are set (setHqsSums)
 // and one resolves them (Resolve, with the resolve stage of the settings). Other methods record whole frames
 // only.
@@ -173,10 +173,10 @@ public:
   };
   std::optional<LodPixel> lodPointAt(uint32_t x, uint32_t y);
 
-  // The buffers between the steps of an HQS frame (HqsPass), after a frame of an HQS method: the depth
-  // words of the depth pass (depth << 32, all ones where empty), and the blend sums, two words a pixel
-  // (r << 32 | g, b << 32 | count) in every method's accumulator layout. Sums of several frames' blends add
-  // word by word. Throws InputError when the last frame was not an HQS method's.
+  // The buffers between the steps of an HQS frame (HqsPass), after a frame of an HQS method (lod-hqs too):
+  // the depth words of the depth pass (depth << 32, all ones where empty), and the blend sums, two words a
+  // pixel (r << 32 | g, b << 32 | count) in every method's accumulator layout. Sums of several frames' blends
+  // add word by word. Throws InputError when the last frame was not an HQS method's.
   std::vector<uint64_t> hqsDepths();
   void setHqsDepths(std::span<const uint64_t> words);
   std::vector<uint64_t> hqsSums();
@@ -209,6 +209,7 @@ private:
   std::map<Method, std::unique_ptr<lod::LodPasses>> lodPasses_;
   bool wordsCaptured_ = false; // the last frame wrote canonical words
   PointMethod* last_ = nullptr; // the method of the last render() frame
+  lod::LodPasses* lodHqs_ = nullptr; // the passes of the last frame when it was lod-hqs's
   // The octree of the last frame when lodPointAt can read it (mono, the lod method, one pass), else null;
   // lodWhy_ says why not.
   lod::LodScene* pickableOctree_ = nullptr;

@@ -245,14 +245,42 @@ TEST(MpiRender, BatchHqsComposesTheOneProcessFrameExactly) {
   EXPECT_NE(nlohmann::json::parse(closest.out)["image_hash"], whole["image_hash"]);
 }
 
-TEST(MpiRender, BlendingInOctreeNodesIsRefusedWithOneLine) {
+// lod-hqs in the same two steps, each rank blending its share of the octree's nodes (in several passes
+// where its node cache is small): the frame of one process drawing the whole selection, bit for bit.
+TEST(MpiRender, LodHqsComposesTheOneProcessFrameExactly) {
+  REQUIRE_MPI();
+  const fs::path las = cliTempDir() / "lodhqs_terrain.las", octree = cliTempDir() / "lodhqs_terrain";
+  fs::remove_all(octree);
+  ASSERT_EQ(runPointrast("generate terrain --points 60000 -o " + las.string() + " -q").exitCode, 0);
+  const pointrast::test::CliResult built =
+      runPointrast("lod " + las.string() + " -o " + octree.string() + " -q");
+  ASSERT_EQ(built.exitCode, 0) << built.err;
+  const std::string args = octree.string() + " --method lod-hqs --min-node-px 0" + kImage;
+  const pointrast::test::CliResult plain =
+      runPointrast("render " + args + " --json -q -o " + (cliTempDir() / "lodhqs_plain.png").string());
+  ASSERT_EQ(plain.exitCode, 0) << plain.err;
+  const nlohmann::json whole = nlohmann::json::parse(plain.out);
+  const Image two = imageOn(2, args + " --gpu-memory 384k", cliTempDir() / "lodhqs2.png");
+  ASSERT_FALSE(two.png.empty());
+  EXPECT_EQ(two.json["image_hash"], whole["image_hash"]);
+  EXPECT_EQ(two.json["points"], 60000);
+  EXPECT_GT(two.json["lod_stats"]["passes"].get<int>(), 1);
+  // The frame blends: it is not lod's closest-point frame.
+  const pointrast::test::CliResult closest =
+      runPointrast("render " + octree.string() + " --method lod --min-node-px 0" + kImage + " --json -q -o " +
+                   (cliTempDir() / "lod_closest.png").string());
+  ASSERT_EQ(closest.exitCode, 0) << closest.err;
+  EXPECT_NE(nlohmann::json::parse(closest.out)["image_hash"], whole["image_hash"]);
+}
+
+TEST(MpiRender, AMethodWithoutDepthsIsRefusedWithOneLine) {
   REQUIRE_MPI();
   const MpiRun r =
-      runMpi("-np 2 " + pointrastBinary() + " render terrain --points 20000 --method lod-hqs -o " +
+      runMpi("-np 2 " + pointrastBinary() + " render terrain --points 20000 --method hw-points -o " +
                  (cliTempDir() / "refused.png").string() + kImage + " -q",
              "", 60);
   EXPECT_EQ(r.exitCode, 1) << r.err;
-  EXPECT_NE(r.err.find("pointrast: lod-hqs blends points in octree nodes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pointrast: hw-points keeps no depth per pixel"), std::string::npos) << r.err;
 }
 
 // A LAS file: each rank reads only its records (whole batches, as the whole file would be cut), and the

@@ -1,7 +1,10 @@
 #include "render/lod/lod_passes.h"
 
 #include <cstring>
+#include <span>
+#include <vector>
 
+#include "base/error.h"
 #include "gpu/context.h"
 #include "render/batch_stats.h"
 
@@ -38,7 +41,8 @@ TableLayout layoutOf(uint64_t nodes, uint64_t pages, uint32_t eyes) {
 
 LodPasses::LodPasses(gpu::Context& context, const MethodInfo& method, uint32_t width, uint32_t height,
                      uint32_t eyes)
-    : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes) {
+    : context_(context), hqs_(method.output == MethodOutput::Blend), eyes_(eyes),
+      pixels_(uint64_t(width) * height) {
   const gpu::SpecConstant stereo{/* STEREO= */ 2, eyes == 2 ? 1u : 0u};
   nodes_ = gpu::ComputeProgram(context, "lod_nodes.comp", {stereo});
   // The row's constants: PREFETCH and, for lod-hqs, DEPTH_ONLY (the depth pass before the accumulation).
@@ -161,33 +165,46 @@ void LodPasses::recordResolve(VkCommandBuffer cmd, const gpu::ComputeProgram& pr
 
 void LodPasses::recordFrame(VkCommandBuffer cmd, const LodCamera& camera, Targets& targets,
                             const RenderSettings& settings) {
+  const HqsPass step = hqs_ ? settings.hqsPass : HqsPass::Whole;
+  const bool whole = step == HqsPass::Whole, depth = whole || step == HqsPass::Depth;
+  const bool blend = hqs_ && (whole || step == HqsPass::Blend);
   writeFrame(targets, camera, settings, true);
   recordTables(cmd);
-  gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, targets.pixels() * 8,
-                       0xFFFFFFFFu); // kEmptyPixel
+  if (depth)
+    gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, targets.pixels() * 8,
+                         0xFFFFFFFFu); // kEmptyPixel
   gpu::vkCmdFillBuffer(cmd, stats_.handle(), 0, VK_WHOLE_SIZE, 0);
-  if (hqs_) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
+  if (blend) gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
   gpu::fullBarrier(cmd);
-  recordNodes(cmd, camera);
-  gpu::fullBarrier(cmd);
-  recordPages(cmd, raster_, camera);
-  gpu::fullBarrier(cmd);
-  if (hqs_) {
+  if (depth || blend) {
+    recordNodes(cmd, camera);
+    gpu::fullBarrier(cmd);
+  }
+  if (depth) {
+    recordPages(cmd, raster_, camera);
+    gpu::fullBarrier(cmd);
+  }
+  if (blend) {
     recordPages(cmd, accumulate_, camera);
     gpu::fullBarrier(cmd);
-    recordResolve(cmd, resolve_, targets, settings, accumulators_.address(), false);
-  } else {
-    recordResolve(cmd, resolve_, targets, settings, tables_.address(), true);
   }
-  gpu::fullBarrier(cmd);
+  if (whole || step == HqsPass::Resolve) {
+    if (hqs_)
+      recordResolve(cmd, resolve_, targets, settings, accumulators_.address(), false);
+    else
+      recordResolve(cmd, resolve_, targets, settings, tables_.address(), true);
+    gpu::fullBarrier(cmd);
+  }
   recordStatsCopy(cmd);
 }
 
-void LodPasses::recordBegin(VkCommandBuffer cmd, Targets& targets) {
+void LodPasses::recordBegin(VkCommandBuffer cmd, Targets& targets, HqsPass step) {
   gpu::vkCmdFillBuffer(cmd, stats_.handle(), 0, VK_WHOLE_SIZE, 0);
   if (hqs_) {
-    gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, targets.pixels() * 8, 0xFFFFFFFFu);
-    gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
+    if (step == HqsPass::Whole || step == HqsPass::Depth)
+      gpu::vkCmdFillBuffer(cmd, targets.framebuffer.handle(), 0, targets.pixels() * 8, 0xFFFFFFFFu);
+    if (step == HqsPass::Whole || step == HqsPass::Blend)
+      gpu::vkCmdFillBuffer(cmd, accumulators_.handle(), 0, VK_WHOLE_SIZE, 0);
   } else {
     if (!composite_ || composite_.size() < targets.pixels() * shared::kLodCompositeBytes)
       composite_ = gpu::Buffer(context_, targets.pixels() * shared::kLodCompositeBytes, gpu::kBufferUsage,
@@ -221,6 +238,16 @@ void LodPasses::recordFinish(VkCommandBuffer cmd, Targets& targets, const Render
     recordResolve(cmd, finish_, targets, settings, tables_.address(), true);
   gpu::fullBarrier(cmd);
   recordStatsCopy(cmd);
+}
+
+std::vector<uint64_t> LodPasses::readSums() {
+  if (!hqs_) throw InternalError("internal error: lod keeps no blend sums");
+  return readHqsSums(context_, accumulators_, pixels_, true);
+}
+
+void LodPasses::writeSums(std::span<const uint64_t> sums) {
+  if (!hqs_) throw InternalError("internal error: lod keeps no blend sums");
+  writeHqsSums(context_, accumulators_, pixels_, true, sums);
 }
 
 BatchStats LodPasses::readStats() const {

@@ -46,10 +46,13 @@ public:
   // per submission: call between submissions only.
   void setList(const LodDrawList& list);
 
+  // A frame in one pass; lod-hqs records the step of it settings.hqsPass names (renderer.h, HqsPass).
   void recordFrame(VkCommandBuffer cmd, const LodCamera& camera, Targets& targets,
                    const RenderSettings& settings);
 
-  void recordBegin(VkCommandBuffer cmd, Targets& targets);
+  // A frame in several passes: the begin clears what the step `step` of lod-hqs fills (the whole frame's
+  // steps for lod).
+  void recordBegin(VkCommandBuffer cmd, Targets& targets, HqsPass step = HqsPass::Whole);
   void recordPass(VkCommandBuffer cmd, const LodCamera& camera, Targets& targets,
                   const RenderSettings& settings, LodPhase phase);
   void recordFinish(VkCommandBuffer cmd, Targets& targets, const RenderSettings& settings);
@@ -57,6 +60,10 @@ public:
   // Counts since the last recordFrame or recordBegin (nodes in the batch fields), after the submission of
   // recordFrame or recordFinish (which copy them where the host reads them: no submission of its own).
   BatchStats readStats() const;
+
+  // lod-hqs: the blend sums of the last frame (PointMethod::readSums' layout), and sums set for its resolve.
+  std::vector<uint64_t> readSums();
+  void writeSums(std::span<const uint64_t> sums);
 
 private:
   void writeFrame(const Targets& targets, const LodCamera& camera, const RenderSettings& settings,
@@ -78,6 +85,7 @@ private:
   gpu::ComputeProgram compose_;    // lod, several passes: into the composite
   gpu::ComputeProgram finish_;     // lod, several passes: the composite into the image
   gpu::Buffer accumulators_;       // lod-hqs
+  uint64_t pixels_ = 0;            // of the whole framebuffer
   gpu::Buffer composite_;          // lod, several passes
   gpu::Buffer stats_;
   gpu::Buffer statsReadback_;

@@ -54,8 +54,27 @@ void timeOnePass(gpu::Context& context, LodScene& scene, LodPasses& passes, Targ
 void timePasses(gpu::Context& context, LodScene& scene, LodPasses& passes, Targets& targets,
                 const LodCamera& cam, const RenderSettings& settings, const FrameEpilogue& epilogue,
                 const std::vector<std::vector<uint32_t>>& split, FrameStats& result, double& streamSeconds) {
-  std::vector<LodPhase> phases = passes.hqs() ? std::vector<LodPhase>{LodPhase::Depth, LodPhase::Blend}
-                                              : std::vector<LodPhase>{LodPhase::Closest};
+  // lod-hqs in steps (HqsPass): the depth round, the blend round, or the resolve alone.
+  const HqsPass step = passes.hqs() ? settings.hqsPass : HqsPass::Whole;
+  std::vector<LodPhase> phases;
+  if (!passes.hqs()) phases.push_back(LodPhase::Closest);
+  if (passes.hqs() && (step == HqsPass::Whole || step == HqsPass::Depth)) phases.push_back(LodPhase::Depth);
+  if (passes.hqs() && (step == HqsPass::Whole || step == HqsPass::Blend)) phases.push_back(LodPhase::Blend);
+  const bool finish = step == HqsPass::Whole || step == HqsPass::Resolve;
+  if (phases.empty()) { // the resolve of sums set from outside
+    gpu::TimestampPool timestamps(context, 1);
+    context.submitAndWait([&](VkCommandBuffer cmd) {
+      timestamps.reset(cmd);
+      beginEpilogue(epilogue, cmd, 1);
+      timestamps.begin(cmd, 0);
+      passes.recordFinish(cmd, targets, settings);
+      recordEpilogue(epilogue, cmd, 0);
+      timestamps.end(cmd, 0);
+    });
+    result.frames = 1;
+    result.medianMs = result.minMs = result.maxMs = timestamps.milliseconds()[0];
+    return;
+  }
   const uint32_t spans = uint32_t(split.size() * phases.size());
   gpu::TimestampPool timestamps(context, spans);
   uint32_t span = 0;
@@ -72,9 +91,9 @@ void timePasses(gpu::Context& context, LodScene& scene, LodPasses& passes, Targe
         if (first) timestamps.reset(cmd);
         if (last) beginEpilogue(epilogue, cmd, 1);
         timestamps.begin(cmd, span);
-        if (first) passes.recordBegin(cmd, targets);
+        if (first) passes.recordBegin(cmd, targets, step);
         passes.recordPass(cmd, cam, targets, settings, phase);
-        if (last) {
+        if (last && finish) {
           passes.recordFinish(cmd, targets, settings);
           recordEpilogue(epilogue, cmd, 0);
         }
