@@ -203,7 +203,9 @@ TEST(MpiServe, TwoRanksServeAnOctreesConvergedFrame) {
   }
   EXPECT_GT(covered, one.words.size() / 4);
   EXPECT_EQ(differ, ties) << differ - ties << " pixels differ in depth";
-  if (differ == 0) EXPECT_TRUE(two.seen.png == one.seen.png);
+  if (differ == 0) {
+    EXPECT_TRUE(two.seen.png == one.seen.png);
+  }
   EXPECT_EQ(two.seen.state["stats"]["points"], plain.seen.state["stats"]["points"]) << two.seen.state.dump();
   EXPECT_EQ(two.exitCode, 0) << two.err;
 }
