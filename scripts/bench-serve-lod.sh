@@ -34,13 +34,24 @@ events="$out/serve-lod-events.jsonl"
 server=$!
 stop_server() { kill -TERM "$server" 2>/dev/null || true; }
 trap stop_server EXIT
-port=""
-for ((i = 0; i < 240; ++i)); do
-  port=$(sed -n 's/.*"event":"listening".*"port":\([0-9]*\).*/\1/p' "$events" | head -1)
-  [ -n "$port" ] && break
-  kill -0 "$server" 2>/dev/null || break
-  sleep 0.5
-done
+# The port a server started with --events says it listens on, within TRIES half-seconds; empty if it
+# exits or never says.
+listening_port() { # EVENTS TRIES
+  local i found=""
+  for ((i = 0; i < $2; ++i)); do
+    found=$(sed -n 's/.*"event":"listening".*"port":\([0-9]*\).*/\1/p' "$1" | head -1)
+    [ -n "$found" ] && break
+    kill -0 "$server" 2>/dev/null || break
+    sleep 0.5
+  done
+  echo "$found"
+}
+# serve_load's flight against PORT, its reports at $out/NAME.{json,md}.
+fly() { # PORT NAME
+  "$load" --port "$1" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" \
+    --rate "${SERVE_RATE:-120}" --flight -o "$out/$2.json" --markdown "$out/$2.md"
+}
+port=$(listening_port "$events" 240)
 if [ -z "$port" ]; then
   echo "bench-serve-lod: the server did not listen" >&2
   cat "$out/serve-lod-server.log" >&2
@@ -48,9 +59,7 @@ if [ -z "$port" ]; then
 fi
 status=0
 # SERVE_RATE: pointer moves a second, the page's display refresh rate (one move per animation frame).
-"$load" --port "$port" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" \
-  --rate "${SERVE_RATE:-120}" --flight \
-  -o "$out/serve-lod.json" --markdown "$out/serve-lod.md" || status=1
+fly "$port" serve-lod || status=1
 trap - EXIT
 kill -TERM "$server"
 wait "$server" || { echo "bench-serve-lod: the server exited with $?" >&2; status=1; }
@@ -63,21 +72,13 @@ if [ "${SERVE_BRUTE:-1}" = 1 ]; then
   "$pr" serve terrain --points "$points" --port 0 --events -q >"$brute_events" 2>"$out/serve-lod-brute-server.log" &
   server=$!
   trap stop_server EXIT
-  port=""
-  for ((i = 0; i < 600; ++i)); do
-    port=$(sed -n 's/.*"event":"listening".*"port":\([0-9]*\).*/\1/p' "$brute_events" | head -1)
-    [ -n "$port" ] && break
-    kill -0 "$server" 2>/dev/null || break
-    sleep 0.5
-  done
+  port=$(listening_port "$brute_events" 600)
   if [ -z "$port" ]; then
     echo "bench-serve-lod: the brute-force server did not listen" >&2
     cat "$out/serve-lod-brute-server.log" >&2
     status=1
   else
-    "$load" --port "$port" --width "${size%x*}" --height "${size#*x}" --seconds "${SERVE_SECONDS:-15}" \
-      --rate "${SERVE_RATE:-120}" --flight \
-      -o "$out/serve-lod-brute.json" --markdown "$out/serve-lod-brute.md" || status=1
+    fly "$port" serve-lod-brute || status=1
   fi
   trap - EXIT
   kill -TERM "$server" 2>/dev/null || true
