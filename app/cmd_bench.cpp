@@ -453,14 +453,7 @@ bench::BenchRanks benchRanks(gpu::Context& context, const std::vector<std::strin
     spec.progress = progress;
     PointCloud cloud = loadShare(spec);
     // As loadDataset: the display colors decided once (rank 0's choice for every rank), attributes dropped.
-    const DisplayColorMode mode = agreeColors(displayColorMode(cloud));
-    std::vector<uint32_t> colors(cloud.size());
-    displayColors(colors.data(), cloud, 0, cloud.size(), mode);
-    cloud.colors = std::move(colors);
-    cloud.intensity = {};
-    cloud.classification = {};
-    cloud.returnNumber = {};
-    cloud.pointSourceId = {};
+    bench::keepDisplayColorsOnly(cloud, agreeColors(displayColorMode(cloud)));
     return cloud;
   };
   ranks.any = [](bool mine) { return mpi::Job::get().sumOf(mine ? 1 : 0) > 0; };

@@ -125,7 +125,11 @@ PointCloud loadDataset(const Dataset& dataset, bool progress) {
   PointCloud cloud = io::readCloud(dataset.source, options);
   // Decide the display colors once, from the whole cloud, and drop what rendering never reads: every
   // order then uploads the same colors from 16 B/point, and the reordered copy needs no attributes.
-  DisplayColorMode mode = displayColorMode(cloud);
+  keepDisplayColorsOnly(cloud, displayColorMode(cloud));
+  return cloud;
+}
+
+void keepDisplayColorsOnly(PointCloud& cloud, const DisplayColorMode& mode) {
   std::vector<uint32_t> colors(cloud.size());
   displayColors(colors.data(), cloud, 0, cloud.size(), mode);
   cloud.colors = std::move(colors);
@@ -133,7 +137,6 @@ PointCloud loadDataset(const Dataset& dataset, bool progress) {
   cloud.classification = {};
   cloud.returnNumber = {};
   cloud.pointSourceId = {};
-  return cloud;
 }
 
 namespace {

@@ -263,6 +263,9 @@ BenchRun runBench(gpu::Context& context, const BenchConfig& config, const BenchC
 
 // The cloud of a data set, ready to upload: positions and display colors only.
 PointCloud loadDataset(const Dataset& dataset, bool progress);
+// What a loaded data set keeps for the benchmarks: its colors replaced by the display colors of `mode`,
+// and the attributes rendering never reads dropped.
+void keepDisplayColorsOnly(PointCloud& cloud, const DisplayColorMode& mode);
 
 template <class Combinations>
 void runRecorded(gpu::Context& context, RunRecord& run, uint64_t copyBytes, int copyRepeats,
