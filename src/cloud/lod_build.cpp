@@ -4,9 +4,11 @@
 #include <cassert>
 #include <chrono>
 #include <condition_variable>
+#include <cstdlib>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string_view>
 #include <thread>
 
 #include "base/cpu_time.h"
@@ -62,6 +64,14 @@ LodPhase PhaseClock::done(std::string name, uint64_t points, uint64_t bytes) con
 
 void checkCancel(const LodRunOptions& options) {
   if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw Interrupted();
+}
+
+void holdForTest(const char* point, const LodRunOptions& options) {
+  const char* held = std::getenv("POINTRAST_TEST_HOLD");
+  if (!held || std::string_view(held) != point || !options.cancel) return;
+  while (!options.cancel->load(std::memory_order_relaxed))
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  throw Interrupted();
 }
 
 detail::QuantBox quantBoxOf(const Pieces& pieces, const LodRunOptions& options) {

@@ -50,6 +50,11 @@ private:
 // Throws Interrupted when options.cancel is set.
 void checkCancel(const LodRunOptions& options);
 
+// A named point in a build where it can be held for tests: when the environment's POINTRAST_TEST_HOLD
+// names `point` and the build can be cancelled, it waits there until cancelled and throws Interrupted, so
+// that a test's signal lands at that point whatever the machine's load. Otherwise it returns at once.
+void holdForTest(const char* point, const LodRunOptions& options);
+
 // The quantized extremes of all records.
 detail::QuantBox quantBoxOf(const Pieces& pieces, const LodRunOptions& options);
 

@@ -166,12 +166,14 @@ TEST(LodBuildCli, InterruptLeavesNothingBehind) {
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
+    // Held once its chunk files are written (until interrupted), so that the signal lands mid-build
+    // whatever the machine's load.
+    setenv("POINTRAST_TEST_HOLD", "chunks-written", 1);
     execl("/bin/sh", "sh", "-c", ("exec " + command + " 2>/dev/null").c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
-  // Interrupted once the build has written something beside the input (its temporary folder), which it does
-  // within its first chunk: long before a one-thread out-of-core build of 3 M points ends, whatever the load.
-  // The bound only fails a build that never starts writing.
+  // Interrupted once the build has written something beside the input (its temporary folder); held at its
+  // chunk files, it cannot end before the signal. The bound only fails a build that never starts writing.
   int status = 0;
   bool exited = false, writing = false;
   for (int polls = 0; polls < 60'000 && !writing && !exited; ++polls) {

@@ -358,6 +358,7 @@ LodBuildReport OctreeBuilder::build(lod::NodeSink& sink, const std::filesystem::
         w->flush();
     }
     s.phases.push_back(clock.done("distribute", n, s.inputs.fileBytes() + spill.bytesWritten()));
+    lod::holdForTest("chunks-written", s.run);
 
     const size_t window = std::clamp<size_t>(
         s.memory / std::max<uint64_t>(1, largest * s.indexBytesPerPoint()), 1, 2 * size_t(s.threads));
