@@ -151,6 +151,26 @@ TEST(LazHostile, CountsThatLie) {
   expectRefused(b, "holds 50000 points in 1 chunks, the header says 4000000000");
 }
 
+// A run of records decodes only the chunks that hold it: with the second chunk's own count damaged, the
+// first chunk's records read, and any run that reaches into the second chunk is refused.
+TEST(LazHostile, ARangeDecodesOnlyTheChunksThatHoldIt) {
+  POINTRAST_REQUIRE_DATA();
+  const LazBytes f = smallLayered(); // chunks of 212 and 318 points, 1438 and 1733 bytes
+  std::vector<uint8_t> b = f.bytes;
+  uint16_t recordLength;
+  std::memcpy(&recordLength, b.data() + 105, 2);
+  const size_t second = f.pointOffset + 8 + 1438;
+  put<uint32_t>(b, second + recordLength, 999); // the second chunk's own count
+  iotest::TempDir dir;
+  const auto path = dir / "second-damaged.laz";
+  iotest::writeBytes(path, b);
+  EXPECT_EQ(readLazRange(path, quiet(), 0, 212, nullptr).size(), 212u);
+  EXPECT_EQ(readLazRange(path, quiet(), 100, 112, nullptr).size(), 112u);
+  EXPECT_THROW(readLazRange(path, quiet(), 200, 13, nullptr), InputError);
+  EXPECT_THROW(readLazRange(path, quiet(), 212, 1, nullptr), InputError);
+  EXPECT_THROW(readCloud(path, quiet()), InputError);
+}
+
 TEST(LazHostile, CorruptCodedBytesReadOrRefuse) {
   POINTRAST_REQUIRE_DATA();
   iotest::TempDir dir;

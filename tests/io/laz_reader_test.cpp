@@ -93,6 +93,50 @@ TEST(LazReader, ReadCloudEqualsTheLasTwin) {
   }
 }
 
+void append(PointCloud& to, const PointCloud& part) {
+  to.scale = part.scale;
+  to.offset = part.offset;
+  to.positions.insert(to.positions.end(), part.positions.begin(), part.positions.end());
+  to.colors.insert(to.colors.end(), part.colors.begin(), part.colors.end());
+  to.intensity.insert(to.intensity.end(), part.intensity.begin(), part.intensity.end());
+  to.classification.insert(to.classification.end(), part.classification.begin(), part.classification.end());
+  to.returnNumber.insert(to.returnNumber.end(), part.returnNumber.begin(), part.returnNumber.end());
+  to.pointSourceId.insert(to.pointSourceId.end(), part.pointSourceId.begin(), part.pointSourceId.end());
+}
+
+// Runs of records cut anywhere (inside chunks, on their edges, one point, past the end) read by
+// readLazRange() join to the whole file, fixed and variable chunks alike.
+TEST(LazReader, RangesJoinToTheWholeFile) {
+  POINTRAST_REQUIRE_DATA();
+  for (const char* file :
+       {"laz/autzen_trim.laz", "laz/lone-star.copc.laz", "laz/las_with_several_extra_byte_bloc.laz"}) {
+    SCOPED_TRACE(file);
+    const PointCloud whole = readCloud(data(file), quiet());
+    const uint64_t n = whole.size();
+    const std::vector<uint64_t> cuts = {0, 1, 10240, 49999, 50000, 50001, n / 2, n - 1, n};
+    PointCloud joined;
+    for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+      const PointCloud part = readLazRange(data(file), quiet(), cuts[i], cuts[i + 1] - cuts[i], nullptr);
+      ASSERT_EQ(part.size(), cuts[i + 1] - cuts[i]) << cuts[i];
+      for (uint64_t p = 0; p < part.size(); ++p)
+        for (int a = 0; a < 3; ++a) {
+          ASSERT_GE(part.world(p)[a], part.bounds.min[a] - 1e-6);
+          ASSERT_LE(part.world(p)[a], part.bounds.max[a] + 1e-6);
+        }
+      append(joined, part);
+    }
+    ASSERT_EQ(joined.size(), n);
+    expectSamePoints(whole, joined, n);
+    EXPECT_EQ(readLazRange(data(file), quiet(), n, 5, nullptr).size(), 0u);
+    EXPECT_EQ(readLazRange(data(file), quiet(), n - 1, 100, nullptr).size(), 1u);
+    // The whole file read with its color depths reported: nothing converted as 8-bit where it is 16-bit.
+    LazColorDepths depths;
+    PointCloud reported = readLazRange(data(file), quiet(), 0, UINT64_MAX, &depths);
+    if (depths.any16) blackenEightBit(reported, depths);
+    expectSamePoints(whole, reported, n);
+  }
+}
+
 TEST(LazReader, SameOutputOnOneAndManyThreads) {
   POINTRAST_REQUIRE_DATA();
   for (const char* file : {"laz/autzen_trim.laz", "laz/las_with_several_extra_byte_bloc.laz"}) {

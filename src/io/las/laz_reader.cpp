@@ -2,6 +2,7 @@
 // the shared LAS record parser maps the raw records into the cloud, exactly as for an uncompressed file.
 #include "io/las/laz_reader.h"
 
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <optional>
@@ -40,16 +41,16 @@ unsigned lazThreads() {
 }
 
 void decodeLazInWindows(const InputFile& file, const laz::LazFile& laz, unsigned threads,
-                        const ChunkWindowFn& deliver) {
-  const size_t chunks = laz.chunks.size();
-  if (chunks == 0) return;
-  threads = static_cast<unsigned>(std::min<size_t>(resolveThreads(threads), chunks));
+                        const ChunkWindowFn& deliver, size_t beginChunk, size_t endChunk) {
+  const size_t chunks = std::min(endChunk, laz.chunks.size());
+  if (beginChunk >= chunks) return;
+  threads = static_cast<unsigned>(std::min<size_t>(resolveThreads(threads), chunks - beginChunk));
   const size_t window = threads * kChunksPerThread;
-  std::vector<std::vector<uint8_t>> records(std::min(window, chunks));
+  std::vector<std::vector<uint8_t>> records(std::min(window, chunks - beginChunk));
   // One decoder per thread for the whole file: its models are allocated once.
   std::vector<std::unique_ptr<laz::ChunkDecoder>> decoders(threads);
   std::vector<std::vector<uint8_t>> scratch(threads);
-  for (size_t first = 0; first < chunks; first += window) {
+  for (size_t first = beginChunk; first < chunks; first += window) {
     const size_t last = std::min(chunks, first + window);
     std::atomic<size_t> next{first};
     std::exception_ptr error;
@@ -143,7 +144,8 @@ uint16_t colorMax(const uint8_t* records, uint64_t count, size_t recordLength, i
 
 } // namespace
 
-PointCloud readLaz(const std::filesystem::path& path, const ReadOptions& options) {
+PointCloud readLazRange(const std::filesystem::path& path, const ReadOptions& options, uint64_t firstRecord,
+                        uint64_t recordCount, LazColorDepths* depths) {
   InputFile file(path);
   const laz::LazFile laz = laz::openLaz(file);
   const LasHeader& hd = laz.header;
@@ -152,13 +154,36 @@ PointCloud readLaz(const std::filesystem::path& path, const ReadOptions& options
   const int rgbOffset = hd.rgbOffset();
   const bool keep = options.keepAttributes;
 
+  // The chunks that hold the records asked for (chunk i holds [firstPoint, firstPoint + pointCount));
+  // the whole file decodes every chunk and keeps every record decoded.
+  const uint64_t filePoints =
+      laz.chunks.empty() ? 0 : laz.chunks.back().firstPoint + laz.chunks.back().pointCount;
+  const bool whole = firstRecord == 0 && recordCount >= filePoints;
+  firstRecord = std::min(firstRecord, filePoints);
+  const uint64_t endRecord =
+      whole ? UINT64_MAX : firstRecord + std::min(recordCount, filePoints - firstRecord);
+  const uint64_t wanted = whole ? filePoints : endRecord - firstRecord;
+  size_t beginChunk = 0, endChunk = laz.chunks.size();
+  if (!whole && wanted == 0) {
+    endChunk = 0;
+  } else if (!whole) {
+    const auto first = laz.chunks.begin();
+    beginChunk = size_t(std::partition_point(
+                            first, laz.chunks.end(),
+                            [&](const laz::Chunk& c) { return c.firstPoint + c.pointCount <= firstRecord; }) -
+                        first);
+    endChunk = size_t(std::partition_point(first, laz.chunks.end(),
+                                           [&](const laz::Chunk& c) { return c.firstPoint < endRecord; }) -
+                      first);
+  }
+
   PointCloud cloud;
   cloud.source = path.filename().string();
   cloud.scale = hd.scale;
   cloud.offset = hd.offset;
   // The header's count is only a claim until the chunks decode; reserving at most one point per file
   // byte keeps a lying count from allocating (real LAZ files hold 3-10 bytes per point).
-  const uint64_t reserve = std::min<uint64_t>(hd.pointCount, file.size());
+  const uint64_t reserve = std::min<uint64_t>(wanted, file.size());
   cloud.positions.reserve(3 * reserve);
   if (hd.hasColor()) cloud.colors.reserve(reserve);
   if (keep) {
@@ -168,49 +193,62 @@ PointCloud readLaz(const std::filesystem::path& path, const ReadOptions& options
   }
 
   std::optional<Progress> progress;
-  if (options.progress) progress.emplace("reading " + path.filename().string(), hd.pointCount);
+  if (options.progress) progress.emplace("reading " + path.filename().string(), wanted);
   RecordStats total;
-  // Colors: each chunk is converted by its own depth (8-bit unless a value exceeds 255); if any chunk
-  // was 16-bit, the chunks converted as 8-bit hold only values <= 255, which are black in 16-bit terms
-  // (the LAS reader's rule, decided for the whole file).
-  bool colors16 = false;
-  std::vector<std::pair<uint64_t, uint64_t>> converted8; // [first, count) ranges converted as 8-bit
+  // Colors: each chunk is converted by its own depth (8-bit unless a value of the whole chunk exceeds 255);
+  // if any chunk was 16-bit, the chunks converted as 8-bit hold only values <= 255, which are black in
+  // 16-bit terms (the LAS reader's rule, decided for the whole file).
+  LazColorDepths local;
+  LazColorDepths& d = depths ? *depths : local;
+  d = LazColorDepths{};
   std::vector<RecordStats> stats;
-  std::vector<uint64_t> starts;
-  decodeLazInWindows(file, laz, lazThreads(), [&](size_t, std::vector<std::vector<uint8_t>>& records) {
-    const size_t n = records.size();
-    starts.assign(n + 1, cloud.size());
-    for (size_t i = 0; i < n; ++i)
-      starts[i + 1] = starts[i] + records[i].size() / recordLength;
-    resizeCloud(cloud, starts[n], hd.hasColor(), keep);
-    stats.assign(n, RecordStats{});
-    std::vector<int> shifts(n, 0);
-    parallelBlocks(n, 1, [&](uint64_t i, uint64_t, uint64_t) {
-      const uint8_t* src = records[i].data();
-      const uint64_t count = starts[i + 1] - starts[i];
-      if (rgbOffset >= 0 && colorMax(src, count, recordLength, rgbOffset) > 255) shifts[i] = 8;
-      const RecordDestination d = destinationAt(cloud, starts[i], keep);
-      if (extended)
-        parseRecords<true>(src, recordLength, count, rgbOffset, shifts[i], d, stats[i]);
-      else
-        parseRecords<false>(src, recordLength, count, rgbOffset, shifts[i], d, stats[i]);
-    });
-    for (size_t i = 0; i < n; ++i) {
-      for (int a = 0; a < 3; ++a) {
-        total.qmin[a] = std::min(total.qmin[a], stats[i].qmin[a]);
-        total.qmax[a] = std::max(total.qmax[a], stats[i].qmax[a]);
-      }
-      if (shifts[i] == 8)
-        colors16 = true;
-      else
-        converted8.emplace_back(starts[i], starts[i + 1] - starts[i]);
-    }
-    if (progress) progress->advance(starts[n] - starts[0]);
-  });
+  std::vector<uint64_t> starts, skip;
+  decodeLazInWindows(
+      file, laz, lazThreads(),
+      [&](size_t firstChunk, std::vector<std::vector<uint8_t>>& records) {
+        const size_t n = records.size();
+        starts.assign(n + 1, cloud.size());
+        skip.assign(n, 0);
+        for (size_t i = 0; i < n; ++i) {
+          const uint64_t first = laz.chunks[firstChunk + i].firstPoint;
+          const uint64_t count = records[i].size() / recordLength;
+          const uint64_t lo = std::clamp(firstRecord, first, first + count);
+          const uint64_t hi = std::clamp(endRecord, first, first + count);
+          skip[i] = lo - first;
+          starts[i + 1] = starts[i] + (hi - lo);
+        }
+        resizeCloud(cloud, starts[n], hd.hasColor(), keep);
+        stats.assign(n, RecordStats{});
+        std::vector<int> shifts(n, 0);
+        parallelBlocks(n, 1, [&](uint64_t i, uint64_t, uint64_t) {
+          const uint8_t* chunk = records[i].data();
+          const uint64_t count = starts[i + 1] - starts[i];
+          if (rgbOffset >= 0 &&
+              colorMax(chunk, records[i].size() / recordLength, recordLength, rgbOffset) > 255)
+            shifts[i] = 8;
+          const RecordDestination dest = destinationAt(cloud, starts[i], keep);
+          const uint8_t* src = chunk + skip[i] * recordLength;
+          if (extended)
+            parseRecords<true>(src, recordLength, count, rgbOffset, shifts[i], dest, stats[i]);
+          else
+            parseRecords<false>(src, recordLength, count, rgbOffset, shifts[i], dest, stats[i]);
+        });
+        for (size_t i = 0; i < n; ++i) {
+          if (starts[i + 1] == starts[i]) continue;
+          for (int a = 0; a < 3; ++a) {
+            total.qmin[a] = std::min(total.qmin[a], stats[i].qmin[a]);
+            total.qmax[a] = std::max(total.qmax[a], stats[i].qmax[a]);
+          }
+          if (shifts[i] == 8)
+            d.any16 = true;
+          else
+            d.eightBit.emplace_back(starts[i], starts[i + 1] - starts[i]);
+        }
+        if (progress) progress->advance(starts[n] - starts[0]);
+      },
+      beginChunk, endChunk);
   if (progress) progress->finish();
-  if (colors16 && !cloud.colors.empty())
-    for (const auto& [first, count] : converted8)
-      std::fill_n(cloud.colors.begin() + static_cast<ptrdiff_t>(first), count, packRgba(0, 0, 0));
+  if (!depths && d.any16) blackenEightBit(cloud, d);
 
   if (cloud.size() > 0) {
     cloud.bounds = boundsFromQuantized(total.qmin, total.qmax, cloud.scale, cloud.offset);
@@ -219,6 +257,16 @@ PointCloud readLaz(const std::filesystem::path& path, const ReadOptions& options
         fail(path, "coordinates overflow after applying the header's scale and offset");
   }
   return cloud;
+}
+
+void blackenEightBit(PointCloud& cloud, const LazColorDepths& depths) {
+  if (cloud.colors.empty()) return;
+  for (const auto& [first, count] : depths.eightBit)
+    std::fill_n(cloud.colors.begin() + static_cast<ptrdiff_t>(first), count, packRgba(0, 0, 0));
+}
+
+PointCloud readLaz(const std::filesystem::path& path, const ReadOptions& options) {
+  return readLazRange(path, options, 0, UINT64_MAX, nullptr);
 }
 
 std::vector<uint8_t> readLazRecords(const std::filesystem::path& path, unsigned threads) {
