@@ -14,7 +14,6 @@
 #include "input.h"
 #include "io/annotations_file.h"
 #include "io/format_table.h"
-#include "mpi/mpi_job.h"
 #include "options.h"
 #include "view/web/server.h"
 
@@ -44,42 +43,18 @@ view::Viewport parseSize(const std::string& text) {
   return {w, h};
 }
 
-// `mpirun -np N pointrast serve` (docs/mpi.md): every rank opens its share of the input on its own device;
-// rank 0 serves the page and draws every frame with all ranks (distributed_serve.h), the others follow its
-// draws until it stops, and every rank exits with rank 0's status.
+// `mpirun -np N pointrast serve` (docs/mpi.md): rank 0 serves the page and draws every frame with all
+// ranks (distributed_serve.h), the others follow its draws until it stops.
 int serveRanks(const ServeArgs& a, view::web::ServerOptions& o, const InputSpec& spec,
                const SceneOptions& scene) {
-  mpi::Job& job = mpi::Job::get();
-  if (o.method)
-    if (std::optional<std::string> why = viewRefusal(*o.method)) throw InputError(*why);
-  gpu::ContextOptions device;
-  device.deviceIndex = o.device;
-  device.announce = !a.quiet;
-  chooseRankDevice(device);
-  o.device = device.deviceIndex;
-  if (!a.quiet) Progress::setEnabled(job.root());
-  view::SceneInput input = openSceneShare(spec, scene);
-  const view::DrawShare share{job.rank(), job.size()};
-  if (!job.root()) {
-    gpu::Context context(device);
-    announceRanks(context, a.quiet);
-    std::unique_ptr<view::SceneSource> source =
-        view::makeSceneSource(context, input, o.settings, false, share);
-    job.check(); // every rank has its input on its device before rank 0 listens
-    return followDraws(context, *source);
-  }
-  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center())) o.camera = camera;
-  o.announceDevice = false; // one line per rank instead
-  const uint64_t points = input.points;
-  o.makeSource = [&](gpu::Context& context, view::SceneInput& in, const view::ViewSettings& settings) {
-    announceRanks(context, a.quiet);
-    auto mine = view::makeSceneSource(context, in, settings, !a.quiet, share);
-    job.check();
-    return compositedSource(context, std::move(mine), points);
-  };
-  const int status = view::web::runServer(input, o);
-  stopFollowers(status);
-  return status;
+  return runViewerRanks(
+      o.method, o.device, a.quiet, o.settings, spec, scene, [&](view::SceneInput& input, SourceMaker make) {
+        if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center()))
+          o.camera = camera;
+        o.announceDevice = false; // one line per rank instead
+        o.makeSource = std::move(make);
+        return view::web::runServer(input, o);
+      });
 }
 
 int runServe(const ServeArgs& a) {

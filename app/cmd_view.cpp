@@ -13,10 +13,13 @@
 #include "view/stats_report.h"
 #include "cli_util.h"
 #include "commands.h"
+#include "distributed.h"
+#include "distributed_serve.h"
 #include "input.h"
 #include "options.h"
 #include "io/annotations_file.h"
 #include "io/format_table.h"
+#include "mpi/mpi_job.h"
 #include "view/desktop/viewer.h"
 #include "view/flight.h"
 
@@ -67,8 +70,8 @@ void writeStats(const ViewArgs& a, const view::SceneInput& input, const view::Fr
 }
 
 int runView(const ViewArgs& a) {
-  // Said before anything is loaded: there is no window to show it in.
-  if (!view::hasDisplay())
+  // Said before anything is loaded: there is no window to show it in (under mpirun only rank 0 opens one).
+  if ((!distributedRun() || mpi::Job::get().root()) && !view::hasDisplay())
     throw InputError("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset): view in a "
                      "browser with `pointrast serve`, or render images with `pointrast render`");
   Progress::setEnabled(!a.quiet);
@@ -105,20 +108,30 @@ int runView(const ViewArgs& a) {
   scene.method = options.method;
   scene.gpuBudget = options.settings.gpuMemory;
   scene.onNote = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
-  view::SceneInput input = openScene(spec, scene);
-  if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center()))
-    options.camera = camera;
-  options.title = "pointrast - " + input.name;
-  const int status = view::runViewer(input, options);
-  if (!a.stats.empty()) writeStats(a, input, log, options, flight ? &*flight : nullptr);
-  if (flight) {
-    std::fprintf(stderr, "%s\n", flight->summary().c_str());
-    if (const std::string why = flight->emptyStrokes(); !why.empty() && status == 0) {
-      std::fprintf(stderr, "pointrast: %s\n", why.c_str());
-      return 1;
+  auto show = [&](view::SceneInput& input) {
+    if (auto camera = cameraFromOptions(a.eye, a.target, a.up, a.fov, input.bounds.center()))
+      options.camera = camera;
+    options.title = "pointrast - " + input.name;
+    const int status = view::runViewer(input, options);
+    if (!a.stats.empty()) writeStats(a, input, log, options, flight ? &*flight : nullptr);
+    if (flight) {
+      std::fprintf(stderr, "%s\n", flight->summary().c_str());
+      if (const std::string why = flight->emptyStrokes(); !why.empty() && status == 0) {
+        std::fprintf(stderr, "pointrast: %s\n", why.c_str());
+        return 1;
+      }
     }
-  }
-  return status;
+    return status;
+  };
+  // Under mpirun (docs/mpi.md): rank 0 opens the window and every rank draws its share of each frame.
+  if (distributedRun())
+    return runViewerRanks(options.method, options.device, a.quiet, options.settings, spec, scene,
+                          [&](view::SceneInput& input, SourceMaker make) {
+                            options.makeSource = std::move(make);
+                            return show(input);
+                          });
+  view::SceneInput input = openScene(spec, scene);
+  return show(input);
 }
 
 } // namespace
@@ -140,7 +153,10 @@ Command addView(CLI::App& app) {
       "--stats writes, as the window closes, the median and 95th percentile GPU time of each pass\n"
       "(render: clear + draw + resolve; present: the image into the window, and the panel) and of the\n"
       "frame over every frame rendered, the host's frame time, the device and the commit (JSON).\n"
-      "Without a display, use `pointrast serve` (a browser) or `pointrast render` (images).\n\n"
+      "Without a display, use `pointrast serve` (a browser) or `pointrast render` (images).\n"
+      "Under mpirun (one rank per GPU, docs/mpi.md) rank 0 opens the window and every rank draws its share\n"
+      "of each frame (its share of a file's points, or of each frame's octree nodes), composited on rank 0;\n"
+      "methods whose frames cannot be composited are left out of the panel, and the pick tool is off.\n\n"
       "Examples:\n"
       "  pointrast view autzen.las\n"
       "  pointrast view autzen_octree/              # an octree: streamed with level of detail (lod)\n"
@@ -148,7 +164,8 @@ Command addView(CLI::App& app) {
       "  pointrast view terrain --points 10M --method batch-prefetch\n"
       "  pointrast view autzen.las --eye 636000,848900,700 --target 636600,849200,450 --no-panel\n"
       "  pointrast view terrain --points 10M --no-vsync --stats view.json  # then drag, and Escape\n"
-      "  pointrast view octree/ --no-vsync --flight 15 --stats flight.json # flies, measures, closes");
+      "  pointrast view octree/ --no-vsync --flight 15 --stats flight.json # flies, measures, closes\n"
+      "  mpirun -np 2 pointrast view big_octree/                    # two GPUs draw each frame");
   cmd->add_option("FILE", a->input,
                   "A cloud file (" + io::formatList(io::FormatUse::Cloud) + "), an octree (" +
                       io::formatList(io::FormatUse::Octree) +

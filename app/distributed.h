@@ -59,6 +59,7 @@ struct CompositeStats {
   std::vector<uint64_t> rankPoints; // points drawn by each rank, rank 0 first
   double readbackMs = 0;            // rank 0: its words read back from the device
   double compositeMs = 0;           // rank 0: the MIN over all ranks' words (wall clock)
+  std::string compositePath;        // how: in shared memory (one host) or by MPI_Reduce
   double resolveMs = 0;             // rank 0: the composited words to the image (wall clock)
   uint64_t bytesMoved = 0;          // sent to the composite: 8 B a pixel from every rank but 0 (HQS: 32)
   std::optional<PostStats> post;    // the resolve stage on rank 0
@@ -69,10 +70,12 @@ struct CompositeStats {
 // rendered without the resolve stage) composited on rank 0 by their MIN and resolved there with `settings`
 // (render/composite.h). Returns the image on rank 0, nothing elsewhere; *ended receives the words the
 // composited frame ended with (CompositeResolver::resolve). Fills out's compositeMs, bytesMoved, post and
-// resolveMs. A collective; the render and serve commands' one composite.
-std::vector<uint32_t> compositeWords(CompositeResolver& resolver, std::vector<uint64_t>& words,
+// resolveMs; with `composited`, the words were composited already (minToRoot) and only resolved here. A
+// collective; the render and serve commands' one composite.
+std::vector<uint32_t> compositeWords(CompositeResolver& resolver, std::span<uint64_t> words,
                                      const Camera& camera, const RenderSettings& settings, double int40Scale,
-                                     CompositeStats& out, std::vector<uint64_t>* ended = nullptr);
+                                     CompositeStats& out, std::vector<uint64_t>* ended = nullptr,
+                                     bool composited = false);
 
 // After this rank's timed frames (stats): composites the last frame on rank 0 and resolves it there.
 // Returns the image on rank 0, nothing elsewhere. `int40Scale` is the int40 steps per unit the frames used.

@@ -1,12 +1,15 @@
 #include "distributed_serve.h"
 
+#include <algorithm>
 #include <cstring>
 #include <list>
 #include <type_traits>
 #include <vector>
 
 #include "base/error.h"
+#include "base/progress.h"
 #include "distributed.h"
+#include "gpu/context.h"
 #include "gpu/shared_types.h"
 #include "mpi/mpi_job.h"
 #include "render/composite.h"
@@ -192,13 +195,15 @@ DrawResult drawShare(view::SceneSource& share, const DrawOrder& order, Make&& ma
   Renderer* renderer = nullptr;
   FrameStats stats;
   std::string error;
-  std::vector<uint64_t> words;
+  // Where the composite reads this rank's words (a collective before any rank can fail its draw).
+  const std::span<uint64_t> words = job.compositeBuffer(uint64_t(order.width) * order.eyes * order.height);
   try {
     renderer = &make();
     stats = share.draw(*renderer, order.camera, mine, applied, status);
-    words = stats.frames > 0 ? renderer->framebufferWords()
-                             : std::vector<uint64_t>(uint64_t(renderer->width()) * renderer->height(),
-                                                     shared::kEmptyPixel);
+    if (stats.frames > 0)
+      renderer->framebufferWords(words);
+    else
+      std::fill(words.begin(), words.end(), shared::kEmptyPixel);
   } catch (const InputError& e) {
     error = e.what();
   } catch (const UnsupportedError& e) {
@@ -365,6 +370,39 @@ void stopFollowers(int status) {
   order.stop = true;
   order.status = status;
   exchangeOrder(&order);
+}
+
+int runViewerRanks(std::optional<Method> method, std::optional<uint32_t>& device, bool quiet,
+                   const view::ViewSettings& settings, const InputSpec& spec, const SceneOptions& scene,
+                   const std::function<int(view::SceneInput&, SourceMaker)>& viewer) {
+  mpi::Job& job = mpi::Job::get();
+  if (method)
+    if (std::optional<std::string> why = viewRefusal(*method)) throw InputError(*why);
+  gpu::ContextOptions options;
+  options.deviceIndex = device;
+  options.announce = !quiet;
+  chooseRankDevice(options);
+  device = options.deviceIndex;
+  if (!quiet) Progress::setEnabled(job.root());
+  view::SceneInput input = openSceneShare(spec, scene);
+  const view::DrawShare share{job.rank(), job.size()};
+  if (!job.root()) {
+    gpu::Context context(options);
+    announceRanks(context, quiet);
+    std::unique_ptr<view::SceneSource> source = view::makeSceneSource(context, input, settings, false, share);
+    job.check(); // every rank has its input on its device before rank 0 starts
+    return followDraws(context, *source);
+  }
+  const uint64_t points = input.points;
+  const int status = viewer(input, [&job, quiet, share, points](gpu::Context& context, view::SceneInput& in,
+                                                                const view::ViewSettings& rootSettings) {
+    announceRanks(context, quiet);
+    auto mine = view::makeSceneSource(context, in, rootSettings, !quiet, share);
+    job.check();
+    return compositedSource(context, std::move(mine), points);
+  });
+  stopFollowers(status);
+  return status;
 }
 
 } // namespace pointrast::app

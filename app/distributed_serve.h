@@ -1,14 +1,16 @@
-// `mpirun -np N pointrast serve ...` (docs/mpi.md): rank 0 runs the browser viewer as one process does;
+// `mpirun -np N pointrast serve|view ...` (docs/mpi.md): rank 0 runs the viewer as one process does;
 // every frame it draws (a client's frame, a pick's or the overlay's depth frame, a screenshot) is drawn by
 // every rank, each its share of the input, and composited on rank 0 as render composites its frame. The
 // other ranks open no socket: they follow rank 0's draws until it tells them to stop.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "input.h"
 #include "render/renderer.h"
 #include "view/scene_source.h"
 
@@ -32,5 +34,18 @@ int followDraws(gpu::Context& context, view::SceneSource& share);
 
 // Rank 0, after its viewer stopped: the other ranks end with `status`. A collective.
 void stopFollowers(int status);
+
+// How a viewer puts its input on the device (view::web::ServerOptions::makeSource,
+// view::ViewerOptions::makeSource).
+using SourceMaker = std::function<std::unique_ptr<view::SceneSource>(gpu::Context&, view::SceneInput&,
+                                                                     const view::ViewSettings&)>;
+
+// `mpirun -np N pointrast serve|view`: every rank opens its share of the input on its own device (the local
+// rank's unless `device` names one; `device` receives the choice); rank 0 runs `viewer` with a SourceMaker
+// that draws its share and composites every rank's, the other ranks follow its draws; every rank returns
+// rank 0's status. `method` refused under several ranks is an InputError; `settings` are the viewer's.
+int runViewerRanks(std::optional<Method> method, std::optional<uint32_t>& device, bool quiet,
+                   const view::ViewSettings& settings, const InputSpec& spec, const SceneOptions& scene,
+                   const std::function<int(view::SceneInput&, SourceMaker)>& viewer);
 
 } // namespace pointrast::app

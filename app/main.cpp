@@ -80,13 +80,15 @@ int runCommand(int argc, char** argv) {
 
   try {
     for (CLI::App* sub : app.get_subcommands()) {
-      // Under mpirun with several ranks only render, serve and bench draw a share per rank; the others would
-      // each do the whole work (and write the same files).
+      // Under mpirun with several ranks only render, view, serve and bench draw a share per rank; the others
+      // would each do the whole work (and write the same files).
       const std::string name = sub->get_name();
-      if (mpi::Job::get().distributed() && name != "render" && name != "serve" && name != "bench")
-        throw InputError("`pointrast " + name +
-                         "` runs as one process; under mpirun only render, serve and bench divide their work "
-                         "among ranks (docs/mpi.md)");
+      if (mpi::Job::get().distributed() && name != "render" && name != "view" && name != "serve" &&
+          name != "bench")
+        throw InputError(
+            "`pointrast " + name +
+            "` runs as one process; under mpirun only render, view, serve and bench divide their "
+            "work among ranks (docs/mpi.md)");
       for (const app::RegisteredCommand& command : commands)
         if (command.subcommand == sub) return command.run();
     }

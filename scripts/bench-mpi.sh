@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Scaling of distributed rendering (docs/mpi.md) on one host: 1 rank against 2 ranks (one GPU each) at
-# 2560x1140, the slowest rank's GPU time and rank 0's composite separately. Brute force on a generated
-# terrain of POINTS points (default 1G), and, when OCTREE is given, lod on it at full detail.
+# Scaling of distributed rendering (docs/mpi.md) on one host: 1 rank against 2 ranks (one GPU each, or
+# both on the one GPU of a single-GPU host) at 2560x1140, the slowest rank's GPU time and rank 0's
+# composite separately; 2 ranks composite in shared memory (one host) and again by MPI_Reduce (what
+# several hosts use), side by side. Brute force on a generated terrain of POINTS points (default 1G), and,
+# when OCTREE is given, lod on it at full detail.
 #   scripts/bench-mpi.sh PointrastBinary OutDir [POINTS] [OCTREE]
 # Writes OutDir/mpi-scaling.jsonl (one `render --json` object per run) and OutDir/mpi-scaling.md.
 set -uo pipefail
@@ -13,25 +15,37 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 view=(--width 2560 --height 1140 --frames "${MPI_FRAMES:-20}" --json -q)
 field() { grep -o "\"$1\":[^,}]*" <<<"$2" | head -1 | cut -d: -f2; }
 {
-  echo "| input | method | ranks | points | render ms (slowest rank) | composite ms | readback ms | resolve ms | MB moved |"
-  echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+  gpus=$(nvidia-smi -L 2>/dev/null | grep -c GPU || true)
+  echo "Host: $(nproc) cores, ${gpus:-?} GPU(s) ($(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null |
+    sort -u | paste -sd, -)); $(mpirun --version 2>/dev/null | head -1); 2560x1140, ${MPI_FRAMES:-20} frames," \
+    "medians. With one GPU, both ranks draw on it: their render times share it, the read-back and composite" \
+    "are what one host pays for any number of GPUs."
+  echo
+  echo "| input | method | ranks | points | render ms (slowest rank) | readback ms | composite ms | composite | resolve ms | MB moved |"
+  echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 } >"$md"
 status=0
-run() { # name method ranks args...
-  local name=$1 method=$2 ranks=$3
-  shift 3
-  echo "== $name, $method, $ranks rank(s)"
+run() { # composite name method ranks args...  (composite: shared or reduce)
+  local composite=$1 name=$2 method=$3 ranks=$4
+  shift 4
+  echo "== $name, $method, $ranks rank(s), composite $composite"
   local line
-  line=$(POINTRAST_VALIDATION=0 timeout 580 mpirun --oversubscribe --bind-to none -np "$ranks" "$pr" render "$@" \
+  line=$(POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 timeout 580 \
+    mpirun --oversubscribe --bind-to none -np "$ranks" "$pr" render "$@" \
     --method "$method" -o "/tmp/mpi-$ranks.png" "${view[@]}") || { status=1; return; }
   echo "$line" | tee -a "$jsonl"
-  local mb
+  local mb path
   mb=$(awk -v b="$(field bytes_moved "$line")" 'BEGIN { printf "%.1f", b / 1e6 }')
-  echo "| $name | $method | $ranks | $(field points "$line") | $(field render_ms "$line") | $(field composite_ms "$line") | $(field readback_ms "$line") | $(field resolve_ms "$line") | $mb |" >>"$md"
+  path=$(grep -o '"composite_path":"[^"]*"' <<<"$line" | head -1 | cut -d'"' -f4)
+  echo "| $name | $method | $ranks | $(field points "$line") | $(field render_ms "$line") | $(field readback_ms "$line") | $(field composite_ms "$line") | ${path:--} | $(field resolve_ms "$line") | $mb |" >>"$md"
 }
-for ranks in 1 2; do run "terrain $points" batch-prefetch "$ranks" terrain --points "$points"; done
+for input in "terrain $points"; do
+  run shared "$input" batch-prefetch 1 terrain --points "$points"
+  run shared "$input" batch-prefetch 2 terrain --points "$points"
+  run reduce "$input" batch-prefetch 2 terrain --points "$points"
+done
 if [ -n "$octree" ]; then
-  for ranks in 1 2; do run "$(basename "$octree")" lod "$ranks" "$octree" --min-node-px 0; done
+  for ranks in 1 2; do run shared "$(basename "$octree")" lod "$ranks" "$octree" --min-node-px 0; done
 fi
 cat "$md"
 exit $status

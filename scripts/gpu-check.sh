@@ -234,7 +234,14 @@ for what in "$@"; do
   mpi)
     # Distributed rendering (docs/mpi.md): 1 rank against 2 ranks at 2560x1140, render and composite ms
     # apart; brute force on MPI_POINTS (default 1G) generated points, lod on MPI_OCTREE when given. Writes
-    # mpi-scaling.{jsonl,md}.
+    # mpi-scaling.{jsonl,md}. A machine without mpirun takes Debian's Open MPI from .mpirt/ (its .deb files,
+    # carried beside .vkrt/; the binary is built against Debian's libmpi.so.40).
+    if ! command -v mpirun >/dev/null && ls .mpirt/*.deb >/dev/null 2>&1; then
+      for f in .mpirt/*.deb; do dpkg -x "$f" /; done
+      ldconfig
+    fi
+    mpirun --version | head -1
+    nvidia-smi --query-gpu=index,name --format=csv,noheader
     timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" "${MPI_POINTS:-1G}" "${MPI_OCTREE:-}" || status=1
     ;;
   *)

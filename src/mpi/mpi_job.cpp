@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <string_view>
 #include <thread>
 
 #include "base/parallel.h"
@@ -101,6 +102,7 @@ void Job::start(int& argc, char**& argv) {
 void Job::finish() {
   Job& job = get();
   if (!job.started_) return;
+  job.shared_.reset(); // its window goes before MPI does
   job.started_ = false;
   MPI_Finalize();
 }
@@ -217,9 +219,73 @@ void Job::broadcast(void* data, uint64_t bytes) {
     MPI_Bcast(static_cast<char*>(data) + at, int(std::min(kSlice, bytes - at)), MPI_BYTE, 0, MPI_COMM_WORLD);
 }
 
+// One window of memory the ranks of one host share: a segment of `count` words per rank, rank order.
+struct Job::SharedWords {
+  MPI_Win window = MPI_WIN_NULL;
+  uint64_t count = 0;
+  std::vector<uint64_t*> segments; // every rank's, mapped into this process
+  ~SharedWords() {
+    if (window != MPI_WIN_NULL) MPI_Win_free(&window);
+  }
+};
+
+namespace {
+
+bool compositeInSharedMemory(uint32_t size, uint32_t localSize) {
+  const char* forced = std::getenv("POINTRAST_MPI_COMPOSITE");
+  if (forced && std::string_view(forced) == "reduce") return false;
+  return size > 1 && localSize == size;
+}
+
+} // namespace
+
+std::span<uint64_t> Job::compositeBuffer(uint64_t count) {
+  check();
+  if (!started_ || !compositeInSharedMemory(size_, localSize_)) {
+    ownWords_.resize(count);
+    return ownWords_;
+  }
+  if (!shared_ || shared_->count != count) {
+    shared_.reset(); // every rank frees the old window before the new one (collectives, in one order)
+    auto words = std::make_shared<SharedWords>();
+    words->count = count;
+    void* base = nullptr;
+    MPI_Win_allocate_shared(MPI_Aint(count * 8), 8, MPI_INFO_NULL, MPI_COMM_WORLD, &base, &words->window);
+    for (uint32_t r = 0; r < size_; ++r) {
+      MPI_Aint bytes = 0;
+      int unit = 0;
+      void* segment = nullptr;
+      MPI_Win_shared_query(words->window, int(r), &bytes, &unit, &segment);
+      words->segments.push_back(static_cast<uint64_t*>(segment));
+    }
+    shared_ = std::move(words);
+  }
+  return {shared_->segments[rank_], count};
+}
+
+const char* Job::compositePath() const {
+  return started_ && compositeInSharedMemory(size_, localSize_) ? "shared memory" : "MPI_Reduce";
+}
+
 void Job::minToRoot(std::span<uint64_t> words) {
   check();
   if (!started_) return;
+  if (shared_ && words.data() == shared_->segments[rank_] && words.size() == shared_->count) {
+    // Every rank's words are in; each reduces its stripe of the pixels over every segment into rank 0's.
+    MPI_Win_fence(0, shared_->window);
+    const Range stripe = rangeOf(words.size(), 1, rank_, size_);
+    const std::vector<uint64_t*>& segments = shared_->segments;
+    parallelBlocks(stripe.count, uint64_t(1) << 16, [&](uint64_t, uint64_t begin, uint64_t end) {
+      uint64_t* out = segments[0] + stripe.first;
+      for (uint32_t r = 1; r < segments.size(); ++r) {
+        const uint64_t* in = segments[r] + stripe.first;
+        for (uint64_t i = begin; i < end; ++i)
+          out[i] = std::min(out[i], in[i]);
+      }
+    });
+    MPI_Win_fence(0, shared_->window); // rank 0 reads every stripe after this
+    return;
+  }
   for (uint64_t at = 0; at < words.size(); at += kSlice) {
     const int n = int(std::min<uint64_t>(kSlice, words.size() - at));
     if (rank_ == 0)
@@ -279,6 +345,13 @@ Bounds Job::unionOf(const Bounds& bounds) {
   return bounds;
 }
 void Job::broadcast(void*, uint64_t) {}
+std::span<uint64_t> Job::compositeBuffer(uint64_t count) {
+  ownWords_.resize(count);
+  return ownWords_;
+}
+const char* Job::compositePath() const {
+  return "none";
+}
 void Job::minToRoot(std::span<uint64_t>) {}
 void Job::minToAll(std::span<uint64_t>) {}
 void Job::sumToRoot(std::span<uint64_t>) {}

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -77,8 +78,17 @@ public:
   std::vector<std::string> gatherText(const std::string& text); // the same for text
   Bounds unionOf(const Bounds& bounds);              // union of every rank's bounds (empty ones ignored)
   void broadcast(void* data, uint64_t bytes);        // rank 0's bytes to every rank
-  // Element-wise MIN of every rank's words into rank 0's (the others' are left as they were).
+  // The words this rank composites with minToRoot(), `count` of them: when every rank runs on one host,
+  // this rank's segment of memory the ranks share (the MIN then runs in place, each rank reducing a stripe
+  // of every segment on its threads, and nothing is copied); otherwise a buffer of this process. Kept for
+  // the next call of the same count; the contents are this rank's to fill. A collective.
+  std::span<uint64_t> compositeBuffer(uint64_t count);
+  // Element-wise MIN of every rank's words into rank 0's (the others' are left as they were). Words from
+  // compositeBuffer() composite in shared memory on one host; any other words by MPI_Reduce.
   void minToRoot(std::span<uint64_t> words);
+  // How minToRoot() composites compositeBuffer()'s words: "shared memory" (one host) or "MPI_Reduce".
+  // POINTRAST_MPI_COMPOSITE=reduce forces MPI_Reduce (what several hosts use).
+  const char* compositePath() const;
   // Element-wise MIN of every rank's words into every rank's.
   void minToAll(std::span<uint64_t> words);
   // Element-wise SUM of every rank's values into rank 0's.
@@ -91,6 +101,9 @@ private:
   bool started_ = false; // MPI_Init was called
   bool closed_ = false;  // close() was called
   uint32_t rank_ = 0, size_ = 1, localRank_ = 0, localSize_ = 1;
+  struct SharedWords; // the shared-memory window of compositeBuffer() (mpi_job.cpp)
+  std::shared_ptr<SharedWords> shared_;
+  std::vector<uint64_t> ownWords_; // compositeBuffer() without shared memory
 };
 
 } // namespace pointrast::mpi

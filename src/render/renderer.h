@@ -24,8 +24,9 @@
 namespace pointrast {
 
 namespace gpu {
+class Buffer;
 class Context;
-}
+} // namespace gpu
 
 enum class DepthMode {
   Float, // IEEE bits of the linear depth, 32 bits, color in the low 32 bits
@@ -151,6 +152,9 @@ public:
   // captureWords; for closest-point methods only, or for any method when the resolve stage ran (then the
   // words it ended with, float depth also for int40).
   std::vector<uint64_t> framebufferWords();
+  // The same into `into` (width() x height() words), through a read-back buffer the renderer keeps, on all
+  // threads: what a process of a distributed job reads every frame to composite.
+  void framebufferWords(std::span<uint64_t> into);
   // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
   // reads to pick the point under the cursor.
   std::vector<uint64_t> framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h);
@@ -205,7 +209,8 @@ private:
   gpu::Context& context_;
   std::unique_ptr<Targets> targets_;
   std::map<std::pair<Method, DepthMode>, std::unique_ptr<PointMethod>> methods_;
-  std::unique_ptr<PostStage> post_; // made on the first frame that uses it
+  std::unique_ptr<PostStage> post_;            // made on the first frame that uses it
+  std::unique_ptr<gpu::Buffer> wordsReadback_; // framebufferWords(into)'s, kept for the next frame
   std::map<Method, std::unique_ptr<lod::LodPasses>> lodPasses_;
   bool wordsCaptured_ = false; // the last frame wrote canonical words
   PointMethod* last_ = nullptr; // the method of the last render() frame

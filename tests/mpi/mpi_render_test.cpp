@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 
 #include "cli/cli_harness.h"
+#include "mpi/mpi_harness.h"
 #include "mpi/mpi_job.h"
 #include "test_data.h"
 
@@ -26,62 +27,20 @@ using pointrast::test::slurp;
 
 namespace {
 
-constexpr uint64_t kEmpty = ~uint64_t(0);
-
-struct MpiRun {
-  int exitCode = -1;
-  bool signaled = false;
-  std::string out, err;
-  double seconds = 0;
-};
-
-// Skips the test in a build without MPI (there is nothing distributed to test).
-#define REQUIRE_MPI()                                                                                       \
-  do {                                                                                                      \
-    if (!pointrast::mpi::Job::built() || std::string(POINTRAST_MPIRUN).empty())                              \
-      GTEST_SKIP() << "this build has no MPI (CMake option POINTRAST_MPI off, or no mpirun found)";        \
-  } while (0)
-
-// Runs `mpirun --oversubscribe LAUNCH` (LAUNCH names the binary, e.g. "-np 2 " + bin() + " render ..."),
-// stopped after `timeout` seconds so that a hang fails the test.
-MpiRun runMpi(const std::string& launch, const std::string& env = "", int timeout = 120) {
-  const fs::path out = cliTempDir() / "mpi_stdout.txt", err = cliTempDir() / "mpi_stderr.txt";
-  fs::remove(out);
-  const std::string command = "timeout -k 5 " + std::to_string(timeout) +
-                              " env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
-                              "OMPI_MCA_rmaps_base_oversubscribe=1 "
-                              "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
-                              env + " " + POINTRAST_MPIRUN + " --oversubscribe " + launch + " >" +
-                              out.string() + " 2>" + err.string();
-  const auto start = std::chrono::steady_clock::now();
-  const int status = std::system(command.c_str());
-  MpiRun r;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) > 128);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-std::vector<uint64_t> readWords(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::vector<uint64_t> words(fs::file_size(path) / 8);
-  in.read(reinterpret_cast<char*>(words.data()), std::streamsize(words.size() * 8));
-  return words;
-}
+using namespace pointrast::test::mpi;
 
 // One render of `args` on `ranks` ranks (extra mpirun options first); the composited words and the JSON.
 struct Frame {
   std::vector<uint64_t> words;
   nlohmann::json json;
 };
-Frame renderOn(uint32_t ranks, const std::string& args, const std::string& mpirunOptions = "") {
+Frame renderOn(uint32_t ranks, const std::string& args, const std::string& mpirunOptions = "",
+               const std::string& env = "") {
   const fs::path words = cliTempDir() / ("words_" + std::to_string(ranks) + ".bin");
   fs::remove(words);
   const MpiRun r = runMpi(mpirunOptions + " -np " + std::to_string(ranks) + " " + pointrastBinary() +
                               " render " + args + " --json -q",
-                          "POINTRAST_MPI_WORDS=" + words.string());
+                          "POINTRAST_MPI_WORDS=" + words.string() + " " + env);
   EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.err;
   Frame f;
   if (r.exitCode != 0) return f;
@@ -311,13 +270,47 @@ TEST(MpiRender, LasSharesAreReadPerRankAndComposeTheOneRankFrame) {
   EXPECT_EQ(nlohmann::json::parse(plain.out)["image_hash"], one.json["image_hash"]);
 }
 
+// A LAZ file: each rank decodes only the chunks that hold its records (the file's chunks of 50,000 points
+// cut across the ranks' batches), and the composite is the frame of the LAS twin drawn by one process.
+TEST(MpiRender, LazSharesAreDecodedPerRankAndComposeTheOneRankFrame) {
+  REQUIRE_MPI();
+  POINTRAST_REQUIRE_DATA("laz/autzen_trim.laz");
+  const std::string view = kImage + " --eye 636590,848500,1400 --target 636590,849216,463";
+  const std::string args = (pointrast::test::dataDir() / "laz/autzen_trim.laz").string() + " -o " +
+                           (cliTempDir() / "autzen-laz.png").string() + view;
+  const Frame one = renderOn(1, args);
+  const Frame three = renderOn(3, args);
+  ASSERT_FALSE(one.words.empty());
+  ASSERT_FALSE(three.words.empty());
+  const Difference d = compare(one.words, three.words);
+  EXPECT_GT(d.covered, d.pixels / 10) << "the frame must show the file";
+  EXPECT_EQ(d.differ, 0u);
+  EXPECT_EQ(three.json["image_hash"], one.json["image_hash"]);
+  const nlohmann::json& points = three.json["mpi"]["rank_points"];
+  ASSERT_EQ(points.size(), 3u);
+  for (uint32_t r = 0; r < 3; ++r)
+    EXPECT_EQ(points[r].get<double>(), double(pointrast::mpi::rangeOf(110000, 10240, r, 3).count)) << r;
+  const pointrast::test::CliResult twin =
+      runPointrast("render " + (pointrast::test::dataDir() / "las/autzen_trim.las").string() + " -o " +
+                   (cliTempDir() / "autzen-twin.png").string() + view + " --json -q");
+  ASSERT_EQ(twin.exitCode, 0) << twin.err;
+  EXPECT_EQ(nlohmann::json::parse(twin.out)["image_hash"], three.json["image_hash"]);
+}
+
+// Standing in for several hosts: the tcp transport, and the composite by MPI_Reduce (ranks on several
+// hosts share no memory); on one host the composite runs in shared memory, with the same frame.
 TEST(MpiRender, TcpTransportGivesTheSameFrame) {
   REQUIRE_MPI();
   const Frame one = renderOn(1, terrain("tcp1.png"));
-  const Frame two = renderOn(2, terrain("tcp2.png"), "--mca btl tcp,self");
+  const Frame two = renderOn(2, terrain("tcp2.png"), "--mca btl tcp,self", "POINTRAST_MPI_COMPOSITE=reduce");
   ASSERT_FALSE(two.words.empty());
   EXPECT_EQ(compare(one.words, two.words).differ, 0u);
   EXPECT_EQ(two.json["image_hash"], one.json["image_hash"]);
+  EXPECT_EQ(two.json["mpi"]["composite_path"], "MPI_Reduce");
+  const Frame shared = renderOn(2, terrain("tcp3.png"));
+  EXPECT_EQ(shared.json["mpi"]["composite_path"], "shared memory");
+  EXPECT_EQ(shared.json["image_hash"], one.json["image_hash"]);
+  EXPECT_EQ(compare(one.words, shared.words).differ, 0u);
 }
 
 TEST(MpiRender, LodSharesWithASmallNodeCacheGiveTheOneRankFrame) {

@@ -18,6 +18,7 @@
 #include <sys/wait.h>
 
 #include "cli/cli_harness.h"
+#include "mpi/mpi_harness.h"
 #include "mpi/mpi_job.h"
 #include "view/web/protocol.h"
 #include "web/image_compare.h"
@@ -34,29 +35,7 @@ using pointrast::test::slurp;
 
 namespace {
 
-constexpr uint64_t kEmpty = ~uint64_t(0);
-
-#define REQUIRE_MPI()                                                                                        \
-  do {                                                                                                       \
-    if (!pointrast::mpi::Job::built() || std::string(POINTRAST_MPIRUN).empty())                              \
-      GTEST_SKIP() << "this build has no MPI (CMake option POINTRAST_MPI off, or no mpirun found)";          \
-  } while (0)
-
-// mpirun with `ranks` ranks before the binary; the composited words of rank 0's last frame go to `words`.
-std::string mpirun(uint32_t ranks, const fs::path& words) {
-  return "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
-         "POINTRAST_MPI_WORDS='" +
-         words.string() + "' " + POINTRAST_MPIRUN + " --oversubscribe -np " + std::to_string(ranks);
-}
-
-std::vector<uint64_t> readWords(const fs::path& path) {
-  std::vector<uint64_t> words;
-  if (!fs::exists(path)) return words;
-  std::ifstream in(path, std::ios::binary);
-  words.resize(fs::file_size(path) / 8);
-  in.read(reinterpret_cast<char*>(words.data()), std::streamsize(words.size() * 8));
-  return words;
-}
+using namespace pointrast::test::mpi;
 
 // What a client of the server saw: the screenshot (PNG) of its view once a full frame at rest was shown
 // (for an octree: once its level of detail converged), and what the pick tool answered.
@@ -208,31 +187,6 @@ TEST(MpiServe, TwoRanksServeAnOctreesConvergedFrame) {
   }
   EXPECT_EQ(two.seen.state["stats"]["points"], plain.seen.state["stats"]["points"]) << two.seen.state.dump();
   EXPECT_EQ(two.exitCode, 0) << two.err;
-}
-
-struct MpiRun {
-  int exitCode = -1;
-  bool signaled = false;
-  double seconds = 0;
-  std::string out, err;
-};
-
-MpiRun runMpi(const std::string& launch, int timeout = 90) {
-  const fs::path out = cliTempDir() / "serve_mpi_out.txt", err = cliTempDir() / "serve_mpi_err.txt";
-  const std::string command = "timeout -k 5 " + std::to_string(timeout) +
-                              " env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
-                              "POINTRAST_VALIDATION=${POINTRAST_VALIDATION:-1} XDG_RUNTIME_DIR=/tmp " +
-                              std::string(POINTRAST_MPIRUN) + " --oversubscribe " + launch + " >" +
-                              out.string() + " 2>" + err.string() + " </dev/null";
-  const auto start = std::chrono::steady_clock::now();
-  const int status = std::system(command.c_str());
-  MpiRun r;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) > 128);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
 }
 
 int errorLines(const std::string& err) {

@@ -79,10 +79,12 @@ private:
   std::string display_;
 };
 
-// A running `pointrast view ... --events`; its events are collected by a reader thread.
+// A running `pointrast view ... --events`; its events are collected by a reader thread. `launcher` goes
+// before the binary (e.g. mpirun and its options).
 class Viewer {
 public:
-  Viewer(const std::string& display, const std::string& args) : display_(display) {
+  Viewer(const std::string& display, const std::string& args, const std::string& launcher = "")
+      : display_(display) {
     int fds[2];
     if (pipe(fds) != 0) return;
     errFile_ =
@@ -96,7 +98,7 @@ public:
       setenv("DISPLAY", display.c_str(), 1);
       setenv("XDG_RUNTIME_DIR", "/tmp", 1);
       if (!getenv("POINTRAST_VALIDATION")) setenv("POINTRAST_VALIDATION", "1", 1);
-      std::string command = "exec '" + pointrastBinary() + "' view " + args + " --events -q";
+      std::string command = "exec " + launcher + " '" + pointrastBinary() + "' view " + args + " --events -q";
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }

@@ -167,7 +167,9 @@ Viewport framebufferViewport(GLFWwindow* window) {
 Viewer::Viewer(SceneInput& input, const ViewerOptions& options, gpu::Context& context, GLFWwindow* window,
                gpu::Swapchain& swapchain)
     : options_(options), context_(context), window_(window), swapchain_(swapchain),
-      source_(makeSceneSource(context, input, options.settings, true)), scene_(context, *source_),
+      source_(options.makeSource ? options.makeSource(context, input, options.settings)
+                                 : makeSceneSource(context, input, options.settings, true)),
+      scene_(context, *source_),
       session_(input.bounds, startCamera(input, options, {swapchain.width(), swapchain.height()}),
                {swapchain.width(), swapchain.height()}, startSettings(*source_, options, context)),
       input_(window, session_), presenter_(context, swapchain) {

@@ -4,16 +4,18 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "render/camera.h"
 #include "view/frame_log.h"
+#include "view/scene_source.h"
 #include "view/session.h"
 
 namespace pointrast::view {
 
-struct SceneInput;
 class Flight;
 
 struct ViewerOptions {
@@ -41,6 +43,9 @@ struct ViewerOptions {
   // When set, the viewer plays this flight (flight.h) from its first frame, reports each frame shown to
   // it, and closes when the flight is done.
   Flight* flight = nullptr;
+  // How the input goes on the device (default: makeSceneSource); a distributed viewer's rank 0 draws
+  // its share and composites every rank's (docs/mpi.md).
+  std::function<std::unique_ptr<SceneSource>(gpu::Context&, SceneInput&, const ViewSettings&)> makeSource;
 };
 
 // Whether a display is there to open a window on: X11 (DISPLAY) or Wayland (WAYLAND_DISPLAY).
