@@ -163,13 +163,15 @@ TEST(LodBuildCli, InterruptLeavesNothingBehind) {
   // Out of core on one thread: long enough to be interrupted while temporary chunk files exist.
   const std::string command = pointrast::test::pointrastBinary() + " lod " + input.string() + " -o " +
                               (dir / "o").string() + " --threads 1 --memory 4M -q";
+  const fs::path errors = pointrast::test::cliTempDir() / "lod_interrupt_stderr.txt";
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     // Held once its chunk files are written (until interrupted), so that the signal lands mid-build
     // whatever the machine's load.
     setenv("POINTRAST_TEST_HOLD", "chunks-written", 1);
-    execl("/bin/sh", "sh", "-c", ("exec " + command + " 2>/dev/null").c_str(), static_cast<char*>(nullptr));
+    execl("/bin/sh", "sh", "-c", ("exec " + command + " 2>" + errors.string()).c_str(),
+          static_cast<char*>(nullptr));
     _exit(127);
   }
   // Interrupted once the build has written something beside the input (its temporary folder); held at its
@@ -187,7 +189,8 @@ TEST(LodBuildCli, InterruptLeavesNothingBehind) {
     waitpid(pid, &status, 0);
   }
   ASSERT_TRUE(writing) << "the build wrote nothing before it ended";
-  ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << WTERMSIG(status) << ": "
+                                 << pointrast::test::slurp(errors);
   EXPECT_EQ(WEXITSTATUS(status), 130) << "the build was not interrupted";
   fs::remove(input);
   for (const auto& e : fs::directory_iterator(dir))
