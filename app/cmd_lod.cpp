@@ -167,13 +167,14 @@ int runLod(LodArgs a) {
     throw InputError("--format expects potree or copc, got '" + a.format + "'");
   if (a.format == "copc" && a.encoding != "default")
     throw InputError("--encoding applies to Potree output; COPC nodes are LAZ");
+  // From here on a signal asks the build to stop: the check below already writes (a probe file it removes).
+  gInterrupted = false;
+  options.cancel = &gInterrupted;
+  InterruptGuard guard;
   // Refused before any point is read: a mistake in the output's name should not cost a read of the input.
   checkOutputFolder(a.output);
 
   std::vector<std::filesystem::path> inputs(a.inputs.begin(), a.inputs.end());
-  gInterrupted = false;
-  options.cancel = &gInterrupted;
-  InterruptGuard guard;
   io::PotreeBuildReport report;
   try {
     if (a.format == "copc") {
