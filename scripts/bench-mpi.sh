@@ -32,19 +32,22 @@ run() { # composite name method ranks args...  (composite: shared or reduce)
   local line
   line=$(POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 timeout 580 \
     mpirun --oversubscribe --bind-to none -np "$ranks" "$pr" render "$@" \
-    --method "$method" -o "/tmp/mpi-$ranks.png" "${view[@]}") || { status=1; return; }
+    --method "$method" -o "/tmp/mpi-$ranks.png" "${view[@]}" ${camera[@]+"${camera[@]}"}) || { status=1; return; }
   echo "$line" | tee -a "$jsonl"
+  # Every later run of this input uses the first run's camera (the overview of 2 ranks is framed from rank
+  # 0's share), so that the images and times compare.
+  [ ${#camera[@]} -gt 0 ] || read -r -a camera <<<"$(grep -o '"camera":"[^"]*"' <<<"$line" | head -1 | cut -d'"' -f4)"
   local mb path
   mb=$(awk -v b="$(field bytes_moved "$line")" 'BEGIN { printf "%.1f", b / 1e6 }')
   path=$(grep -o '"composite_path":"[^"]*"' <<<"$line" | head -1 | cut -d'"' -f4)
   echo "| $name | $method | $ranks | $(field points "$line") | $(field render_ms "$line") | $(field readback_ms "$line") | $(field composite_ms "$line") | ${path:--} | $(field resolve_ms "$line") | $mb |" >>"$md"
 }
-for input in "terrain $points"; do
-  run shared "$input" batch-prefetch 1 terrain --points "$points"
-  run shared "$input" batch-prefetch 2 terrain --points "$points"
-  run reduce "$input" batch-prefetch 2 terrain --points "$points"
-done
+camera=()
+run shared "terrain $points" batch-prefetch 1 terrain --points "$points"
+run shared "terrain $points" batch-prefetch 2 terrain --points "$points"
+run reduce "terrain $points" batch-prefetch 2 terrain --points "$points"
 if [ -n "$octree" ]; then
+  camera=()
   for ranks in 1 2; do run shared "$(basename "$octree")" lod "$ranks" "$octree" --min-node-px 0; done
 fi
 cat "$md"

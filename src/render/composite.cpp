@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "gpu/buffer.h"
 #include "gpu/context.h"
 #include "gpu/shared_types.h"
@@ -37,50 +38,73 @@ std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words
   auto colorOf = [&](uint64_t word) {
     return int40 ? (uint32_t(word) & 0xFFFFFFu) | 0xFF000000u : uint32_t(word);
   };
+  // Per-pixel loops on all threads: a 2560x1140 frame is 3 M pixels, resolved every frame a viewer shows.
+  auto eachPixel = [&](auto&& body) {
+    parallelBlocks(pixels, uint64_t(1) << 16, [&](uint64_t, uint64_t begin, uint64_t end) {
+      for (uint64_t i = begin; i < end; ++i)
+        body(i);
+    });
+  };
   std::vector<uint32_t> image(pixels);
   if (!settings.post.enabled()) {
-    for (uint64_t i = 0; i < pixels; ++i)
+    eachPixel([&](uint64_t i) {
       image[i] = words[i] == shared::kEmptyPixel ? settings.background : colorOf(words[i]);
+    });
     if (post) post->reset();
     if (ended) ended->assign(words.begin(), words.end());
     return image;
   }
   validatePostSettings(settings.post);
   if (!post_) post_ = std::make_unique<PostStage>(context_);
+  if (!upload_) {
+    upload_ = std::make_unique<gpu::Buffer>(context_, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Upload,
+                                            "composited words");
+    words_ = std::make_unique<gpu::Buffer>(context_, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Device,
+                                           "composited words");
+    image_ = std::make_unique<gpu::Buffer>(context_, pixels * 4, gpu::kBufferUsage, gpu::MemoryKind::Device,
+                                           "composited image");
+    readback_ = std::make_unique<gpu::Buffer>(context_, pixels * 12, gpu::kBufferUsage,
+                                              gpu::MemoryKind::Readback, "composited image read back");
+  }
   // The stage reads float-depth words: int40 steps are converted as the methods' resolve converts them.
-  gpu::Buffer staging(context_, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Upload, "composited words");
-  uint64_t* mapped = static_cast<uint64_t*>(staging.mapped());
-  for (uint64_t i = 0; i < pixels; ++i) {
+  uint64_t* mapped = static_cast<uint64_t*>(upload_->mapped());
+  eachPixel([&](uint64_t i) {
     const uint64_t w = words[i];
     if (!int40 || w == shared::kEmptyPixel) {
       mapped[i] = w;
-      continue;
+      return;
     }
     const float depth = float(double(w >> shared::kInt40ColorBits) / int40Scale);
     mapped[i] = uint64_t(std::bit_cast<uint32_t>(depth)) << 32 | colorOf(w);
-  }
-  gpu::Buffer device(context_, pixels * 8, gpu::kBufferUsage, gpu::MemoryKind::Device, "composited words");
-  gpu::Buffer target(context_, pixels * 4, gpu::kBufferUsage, gpu::MemoryKind::Device, "composited image");
+  });
   const uint32_t pitch = width_ * eyes_;
   std::vector<PostView> views;
   for (uint32_t e = 0; e < eyes_; ++e)
-    views.push_back({device.address() + uint64_t(e) * width_ * 8, target.address() + uint64_t(e) * width_ * 4,
+    views.push_back({words_->address() + uint64_t(e) * width_ * 8, image_->address() + uint64_t(e) * width_ * 4,
                      width_, height_, pitch, float(glm::length(camera.target - camera.eye)),
                      settings.background, ended != nullptr});
   gpu::TimestampPool timestamps(context_, kPostPasses);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
     VkBufferCopy region{0, 0, pixels * 8};
-    gpu::vkCmdCopyBuffer(cmd, staging.handle(), device.handle(), 1, &region);
+    gpu::vkCmdCopyBuffer(cmd, upload_->handle(), words_->handle(), 1, &region);
     gpu::fullBarrier(cmd);
     post_->record(cmd, views, settings.post, &timestamps, 0);
+    gpu::fullBarrier(cmd);
+    // The image, then (for a caller that reads the frame's words) the words the stage ended with.
+    VkBufferCopy out[2] = {{0, 0, pixels * 4}, {0, pixels * 4, pixels * 8}};
+    gpu::vkCmdCopyBuffer(cmd, image_->handle(), readback_->handle(), 1, &out[0]);
+    if (ended) gpu::vkCmdCopyBuffer(cmd, words_->handle(), readback_->handle(), 1, &out[1]);
+    gpu::fullBarrier(cmd);
   });
   if (post) *post = PostStage::stats(timestamps.milliseconds(), 1);
-  gpu::readBuffer(context_, target, 0, image.data(), pixels * 4);
-  if (ended) {
-    ended->resize(pixels);
-    gpu::readBuffer(context_, device, 0, ended->data(), pixels * 8);
-  }
+  readback_->invalidate();
+  const auto* from = static_cast<const uint8_t*>(readback_->mapped());
+  if (ended) ended->resize(pixels);
+  parallelBlocks(pixels, uint64_t(1) << 16, [&](uint64_t, uint64_t begin, uint64_t end) {
+    std::memcpy(image.data() + begin, from + begin * 4, (end - begin) * 4);
+    if (ended) std::memcpy(ended->data() + begin, from + pixels * 4 + begin * 8, (end - begin) * 8);
+  });
   return image;
 }
 

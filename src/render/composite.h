@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -14,8 +15,9 @@
 namespace pointrast {
 
 namespace gpu {
+class Buffer;
 class Context;
-}
+} // namespace gpu
 class PostStage;
 
 class CompositeResolver {
@@ -39,6 +41,9 @@ private:
   gpu::Context& context_;
   uint32_t width_, height_, eyes_;
   std::unique_ptr<PostStage> post_; // made on the first frame that uses it
+  // The resolve stage's buffers, made on its first frame and kept for the next (a viewer resolves every
+  // frame): the words uploaded, on the device, the image and what is read back.
+  std::unique_ptr<gpu::Buffer> upload_, words_, image_, readback_;
 };
 
 // steps per unit of depth of the int40 encoding for these scenes and camera, as the renderer computes it
