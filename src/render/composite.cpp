@@ -80,9 +80,9 @@ std::vector<uint32_t> CompositeResolver::resolve(std::span<const uint64_t> words
   const uint32_t pitch = width_ * eyes_;
   std::vector<PostView> views;
   for (uint32_t e = 0; e < eyes_; ++e)
-    views.push_back({words_->address() + uint64_t(e) * width_ * 8, image_->address() + uint64_t(e) * width_ * 4,
-                     width_, height_, pitch, float(glm::length(camera.target - camera.eye)),
-                     settings.background, ended != nullptr});
+    views.push_back({words_->address() + uint64_t(e) * width_ * 8,
+                     image_->address() + uint64_t(e) * width_ * 4, width_, height_, pitch,
+                     float(glm::length(camera.target - camera.eye)), settings.background, ended != nullptr});
   gpu::TimestampPool timestamps(context_, kPostPasses);
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     timestamps.reset(cmd);
