@@ -79,7 +79,7 @@ public:
   uint32_t symbols() const { return symbols_; }
 
 private:
-  friend class ArithmeticDecoder;
+  template <bool> friend class BasicArithmeticDecoder;
   friend class ArithmeticEncoder;
   POINTRAST_LAZ_NO_COVERAGE void update();
 
@@ -92,10 +92,29 @@ private:
   std::unique_ptr<uint32_t[]> storage_;
 };
 
-class ArithmeticDecoder {
+// Where a decoder checks the end of its input. ArithmeticDecoder, which every caller can use, checks
+// before the bytes of every symbol. UncheckedDecoder never does: a pointwise chunk decodes with it only
+// the points that cannot reach the end of the stream, which it checks once a point (hasRoom), and the
+// last points with an ArithmeticDecoder that continues from the same state.
+template <bool kCheckEnd> class BasicArithmeticDecoder;
+using ArithmeticDecoder = BasicArithmeticDecoder<true>;
+using UncheckedDecoder = BasicArithmeticDecoder<false>;
+
+// Bytes a symbol shifts in: clz(length) / 8, and length >= 1 after any symbol (>= 2^5 after raw bits).
+inline constexpr size_t kMaxBytesPerSymbol = 3;
+
+template <bool kCheckEnd> class BasicArithmeticDecoder {
 public:
+  BasicArithmeticDecoder() = default;
+  // The same stream at the same state, with the other end check.
+  template <bool kOther>
+  explicit BasicArithmeticDecoder(const BasicArithmeticDecoder<kOther>& other)
+      : ptr_(other.ptr_), end_(other.end_), pastEnd_(other.pastEnd_), value_(other.value_),
+        length_(other.length_) {}
+
   // Starts decoding the bytes [begin, end) (reads the first four as the code value).
   void init(const uint8_t* begin, const uint8_t* end) {
+    static_assert(kCheckEnd, "a stream starts with the end checked");
     ptr_ = begin;
     end_ = end;
     pastEnd_ = 0;
@@ -104,6 +123,12 @@ public:
     value_ |= uint32_t(nextByte()) << 16;
     value_ |= uint32_t(nextByte()) << 8;
     value_ |= uint32_t(nextByte());
+  }
+
+  // Whether `symbols` more symbols (raw bits count as one a step) stay inside the input, their
+  // four-byte reads included: what an UncheckedDecoder needs before them.
+  bool hasRoom(size_t symbols) const {
+    return pastEnd_ == 0 && size_t(end_ - ptr_) > kMaxBytesPerSymbol * symbols;
   }
 
   [[gnu::always_inline]] uint32_t decodeBit(BitModel& m) {
@@ -124,9 +149,11 @@ public:
   }
 
   [[gnu::always_inline]] uint32_t decodeSymbol(SymbolModel& m) {
-    uint32_t sym, x, y = length_;
+    uint32_t sym, x, y;
+    const uint32_t* distribution = m.distribution_;
     if (m.decoderTable_) {
-      const uint32_t dv = value_ / (length_ >>= kLengthShift);
+      const uint32_t l = length_ >> kLengthShift;
+      const uint32_t dv = value_ / l;
       // value < length holds for every stream an encoder wrote, which keeps t <= tableSize; corrupt
       // bytes can break it, so the index is clamped rather than trusted.
       uint32_t t = dv >> m.tableShift_;
@@ -135,20 +162,21 @@ public:
       uint32_t n = m.decoderTable_[t + 1] + 1;
       while (n > sym + 1) {
         const uint32_t k = (sym + n) >> 1;
-        if (m.distribution_[k] > dv)
+        if (distribution[k] > dv)
           n = k;
         else
           sym = k;
       }
-      x = m.distribution_[sym] * length_;
-      if (sym != m.lastSymbol_) y = m.distribution_[sym + 1] * length_;
+      x = distribution[sym] * l;
+      y = sym != m.lastSymbol_ ? distribution[sym + 1] * l : length_;
     } else {
       x = sym = 0;
-      length_ >>= kLengthShift;
+      y = length_;
+      const uint32_t l = length_ >> kLengthShift;
       uint32_t n = m.symbols_;
       uint32_t k = n >> 1;
       do {
-        const uint32_t z = length_ * m.distribution_[k];
+        const uint32_t z = l * distribution[k];
         if (z > value_) {
           n = k;
           y = z;
@@ -197,6 +225,8 @@ public:
   const uint8_t* position() const { return ptr_; }
 
 private:
+  template <bool> friend class BasicArithmeticDecoder;
+
   [[gnu::always_inline]] uint8_t nextByte() {
     if (ptr_ < end_) return *ptr_++;
     ++pastEnd_;
@@ -206,7 +236,7 @@ private:
   // them, 0 to 3) without a branch on length, which mispredicts about every third symbol; near the end
   // of the input, byte by byte.
   [[gnu::always_inline]] void normalize() {
-    if (end_ - ptr_ >= 4) [[likely]] {
+    if (!kCheckEnd || end_ - ptr_ >= 4) [[likely]] {
       const uint32_t n = uint32_t(__builtin_clz(length_ | 1)) >> 3;
       uint32_t next;
       std::memcpy(&next, ptr_, 4);

@@ -26,7 +26,9 @@ public:
   // Start of a chunk: every model back to its start state (lazily, at first use).
   void reset();
 
-  [[gnu::always_inline]] int32_t decompress(ArithmeticDecoder& dec, int32_t pred, uint32_t context = 0) {
+  // Decoder: ArithmeticDecoder or UncheckedDecoder.
+  template <class Decoder>
+  [[gnu::always_inline]] int32_t decompress(Decoder& dec, int32_t pred, uint32_t context = 0) {
     uint32_t real = uint32_t(pred) + uint32_t(readCorrector(dec, context));
     if (int32_t(real) < 0)
       real += corrRange_;
@@ -69,7 +71,7 @@ public:
   uint32_t getK() const { return k_; }
 
 private:
-  [[gnu::always_inline]] int32_t readCorrector(ArithmeticDecoder& dec, uint32_t context) {
+  template <class Decoder> [[gnu::always_inline]] int32_t readCorrector(Decoder& dec, uint32_t context) {
     SymbolModel& bitsModel = bitsModels_[context];
     bitsModel.ensureReady();
     k_ = dec.decodeSymbol(bitsModel);

@@ -40,7 +40,7 @@ void Point10Decoder::init(const uint8_t* item) {
   last_[12] = last_[13] = 0;
 }
 
-[[gnu::always_inline]] inline void Point10Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+template <class Decoder> [[gnu::always_inline]] inline void Point10Decoder::read(Decoder& dec, uint8_t* item) {
   // Bits of changedValues: 32 return byte, 16 intensity, 8 classification, 4 scan angle rank,
   // 2 user data, 1 point source id.
   const uint32_t changed = dec.decodeSymbol(changedValues_);
@@ -106,7 +106,7 @@ void GpsTime11Decoder::init(const uint8_t* item) {
   seq_.reset(loadLE<uint64_t>(item));
 }
 
-[[gnu::always_inline]] inline void GpsTime11Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+template <class Decoder> [[gnu::always_inline]] inline void GpsTime11Decoder::read(Decoder& dec, uint8_t* item) {
   for (int hop = 0;; ++hop) {
     if (hop > kMaxSequenceHops) corrupt("its GPS times switch sequences without end");
     if (seq_.diff[seq_.last] == 0) {
@@ -149,7 +149,7 @@ void Rgb12Decoder::init(const uint8_t* item) {
     last_[c] = loadLE<uint16_t>(item + 2 * c);
 }
 
-[[gnu::always_inline]] inline void Rgb12Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+template <class Decoder> [[gnu::always_inline]] inline void Rgb12Decoder::read(Decoder& dec, uint8_t* item) {
   uint16_t rgb[3];
   decodeRgb(dec, byteUsed_, diff_, last_, rgb);
   for (int c = 0; c < 3; ++c) {
@@ -167,7 +167,7 @@ void Byte2Decoder::init(const uint8_t* item) {
   std::memcpy(last_.data(), item, last_.size());
 }
 
-[[gnu::always_inline]] inline void Byte2Decoder::read(ArithmeticDecoder& dec, uint8_t* item) {
+template <class Decoder> [[gnu::always_inline]] inline void Byte2Decoder::read(Decoder& dec, uint8_t* item) {
   for (size_t i = 0; i < last_.size(); ++i) {
     last_[i] = foldByte(int32_t(last_[i]) + int32_t(dec.decodeSymbol(models_[i])));
     item[i] = last_[i];
@@ -183,18 +183,29 @@ PointwiseChunkDecoder::PointwiseChunkDecoder(const Layout& layout) : recordLengt
     if (item.type == ItemType::GpsTime11) {
       gps_ = std::make_unique<GpsTime11Decoder>();
       gpsOffset_ = offset;
+      maxSymbols_ += GpsTime11Decoder::kMaxSymbols;
     } else if (item.type == ItemType::Rgb12) {
       rgb_ = std::make_unique<Rgb12Decoder>();
       rgbOffset_ = offset;
+      maxSymbols_ += Rgb12Decoder::kMaxSymbols;
     } else if (item.type == ItemType::Byte) {
       bytes_ = std::make_unique<Byte2Decoder>(item.size);
       bytesOffset_ = offset;
+      maxSymbols_ += bytes_->maxSymbols();
     }
     offset += item.size;
   }
 }
 
 PointwiseChunkDecoder::~PointwiseChunkDecoder() = default;
+
+template <bool kGps, bool kRgb, bool kBytes, class Decoder>
+[[gnu::always_inline]] inline void PointwiseChunkDecoder::readPoint(Decoder& dec, uint8_t* record) {
+  point_.read(dec, record);
+  if constexpr (kGps) gps_->read(dec, record + gpsOffset_);
+  if constexpr (kRgb) rgb_->read(dec, record + rgbOffset_);
+  if constexpr (kBytes) bytes_->read(dec, record + bytesOffset_);
+}
 
 template <bool kGps, bool kRgb, bool kBytes>
 void PointwiseChunkDecoder::decodeLoop(const uint8_t* data, size_t size, uint64_t count,
@@ -211,12 +222,19 @@ void PointwiseChunkDecoder::decodeLoop(const uint8_t* data, size_t size, uint64_
   // registers instead of round-tripping through memory between symbols.
   ArithmeticDecoder dec;
   dec.init(data + rl, data + size);
-  for (uint64_t i = 1; i < count; ++i) {
-    uint8_t* record = recordSlot(out, i, capacity, rl, count);
-    point_.read(dec, record);
-    if constexpr (kGps) gps_->read(dec, record + gpsOffset_);
-    if constexpr (kRgb) rgb_->read(dec, record + rgbOffset_);
-    if constexpr (kBytes) bytes_->read(dec, record + bytesOffset_);
+  uint64_t i = 1;
+  if (count > 1 && dec.hasRoom(maxSymbols_)) {
+    // While a whole point fits before the end of the stream: no end check a symbol, and no bytes past
+    // the end to count. Its state goes on in the checked coder for the last points.
+    const uint8_t* const lastStart = data + size - kMaxBytesPerSymbol * maxSymbols_ - 1;
+    UncheckedDecoder fast(dec);
+    do {
+      readPoint<kGps, kRgb, kBytes>(fast, recordSlot(out, i, capacity, rl, count));
+    } while (++i < count && fast.position() <= lastStart);
+    dec = ArithmeticDecoder(fast);
+  }
+  for (; i < count; ++i) {
+    readPoint<kGps, kRgb, kBytes>(dec, recordSlot(out, i, capacity, rl, count));
     if (dec.pastEnd() > kPastEndSlack) corrupt("its data ends before its last point");
   }
 }

@@ -42,9 +42,13 @@ private:
 // X, Y, Z, intensity, return bits, classification, scan angle rank, user data, point source id (20 B).
 class Point10Decoder {
 public:
+  // Coded steps a point can take (UncheckedDecoder's bound): the changed-values and return symbols,
+  // intensity and point source id (4 each: k, a corrector symbol, up to two raw-bit steps),
+  // classification, scan angle and user data (1 each), X, Y, Z (4 each).
+  static constexpr size_t kMaxSymbols = 2 + 4 + 4 + 3 + 3 * 4;
   Point10Decoder();
   void init(const uint8_t* item);
-  void read(ArithmeticDecoder& dec, uint8_t* item);
+  template <class Decoder> void read(Decoder& dec, uint8_t* item);
 
 private:
   SymbolModel changedValues_{64};
@@ -73,12 +77,12 @@ struct GpsSequences {
   void reset(uint64_t firstTime) { *this = GpsSequences{0, 0, {firstTime, 0, 0, 0}, {}, {}}; }
   uint64_t current() const { return time[last]; }
   // After a zero difference: a new 32-bit difference.
-  void readFirstDiff(ArithmeticDecoder& dec, IntegerCodec& ic);
+  template <class Decoder> void readFirstDiff(Decoder& dec, IntegerCodec& ic);
   // A full time: the high word predicted by the current time's, the low word raw; starts a sequence.
-  void readFull(ArithmeticDecoder& dec, IntegerCodec& ic);
+  template <class Decoder> void readFull(Decoder& dec, IntegerCodec& ic);
   // Multiplier symbol 0..510 (never 1, which callers handle as "the last difference again").
-  void readMultiple(ArithmeticDecoder& dec, IntegerCodec& ic, uint32_t multi);
-  void readSameDiff(ArithmeticDecoder& dec, IntegerCodec& ic);
+  template <class Decoder> void readMultiple(Decoder& dec, IntegerCodec& ic, uint32_t multi);
+  template <class Decoder> void readSameDiff(Decoder& dec, IntegerCodec& ic);
 };
 
 // Multiplier symbols shared by both generations: 1..499 that multiple of the last difference, 500 a
@@ -87,13 +91,15 @@ struct GpsSequences {
 inline constexpr uint32_t kGpsMulti = 500;
 inline constexpr int32_t kGpsMultiMinus = -10;
 
-[[gnu::always_inline]] inline void GpsSequences::readFirstDiff(ArithmeticDecoder& dec, IntegerCodec& ic) {
+template <class Decoder>
+[[gnu::always_inline]] inline void GpsSequences::readFirstDiff(Decoder& dec, IntegerCodec& ic) {
   diff[last] = ic.decompress(dec, 0, 0);
   time[last] += uint64_t(int64_t(diff[last]));
   extremeCounter[last] = 0;
 }
 
-[[gnu::always_inline]] inline void GpsSequences::readFull(ArithmeticDecoder& dec, IntegerCodec& ic) {
+template <class Decoder>
+[[gnu::always_inline]] inline void GpsSequences::readFull(Decoder& dec, IntegerCodec& ic) {
   next = (next + 1) & 3;
   const uint32_t high = uint32_t(ic.decompress(dec, int32_t(uint32_t(time[last] >> 32)), 8));
   time[next] = (uint64_t(high) << 32) | dec.readInt();
@@ -102,13 +108,14 @@ inline constexpr int32_t kGpsMultiMinus = -10;
   extremeCounter[last] = 0;
 }
 
-[[gnu::always_inline]] inline void GpsSequences::readSameDiff(ArithmeticDecoder& dec, IntegerCodec& ic) {
+template <class Decoder>
+[[gnu::always_inline]] inline void GpsSequences::readSameDiff(Decoder& dec, IntegerCodec& ic) {
   time[last] += uint64_t(int64_t(ic.decompress(dec, diff[last], 1)));
   extremeCounter[last] = 0;
 }
 
-[[gnu::always_inline]] inline void GpsSequences::readMultiple(ArithmeticDecoder& dec, IntegerCodec& ic,
-                                                              uint32_t multi) {
+template <class Decoder>
+[[gnu::always_inline]] inline void GpsSequences::readMultiple(Decoder& dec, IntegerCodec& ic, uint32_t multi) {
   auto countExtreme = [&](int32_t d) {
     if (++extremeCounter[last] > 3) {
       diff[last] = d;
@@ -143,9 +150,12 @@ inline constexpr int kMaxSequenceHops = 4;
 // GPS time as a double (8 B).
 class GpsTime11Decoder {
 public:
+  // Up to five sequence symbols (a fifth switch is corrupt), then a full time: the high word (4 steps)
+  // and the low word raw (2).
+  static constexpr size_t kMaxSymbols = 5 + 4 + 2;
   GpsTime11Decoder();
   void init(const uint8_t* item);
-  void read(ArithmeticDecoder& dec, uint8_t* item);
+  template <class Decoder> void read(Decoder& dec, uint8_t* item);
 
 private:
   SymbolModel multi_;
@@ -158,7 +168,8 @@ private:
 // model the changes of red low/high, green low/high, blue low/high. byteUsed bits: 0/1 red low/high
 // byte changed, 2/3 green, 4/5 blue, 6 the channels differ (else green and blue equal red). Green is
 // predicted by red's change, blue by the mean of red's and green's.
-[[gnu::always_inline]] inline void decodeRgb(ArithmeticDecoder& dec, SymbolModel& byteUsed, SymbolModel* diff,
+template <class Decoder>
+[[gnu::always_inline]] inline void decodeRgb(Decoder& dec, SymbolModel& byteUsed, SymbolModel* diff,
                                              const uint16_t* last, uint16_t* out) {
   const uint32_t sym = dec.decodeSymbol(byteUsed);
   auto low = [](uint32_t v) { return int32_t(v & 0xFF); };
@@ -199,9 +210,10 @@ private:
 // Red, green, blue as 16-bit values (6 B), coded byte by byte with the red change predicting the others.
 class Rgb12Decoder {
 public:
+  static constexpr size_t kMaxSymbols = 7; // byte used, six byte differences
   Rgb12Decoder();
   void init(const uint8_t* item);
-  void read(ArithmeticDecoder& dec, uint8_t* item);
+  template <class Decoder> void read(Decoder& dec, uint8_t* item);
 
 private:
   SymbolModel byteUsed_{128};
@@ -214,8 +226,9 @@ private:
 class Byte2Decoder {
 public:
   explicit Byte2Decoder(uint32_t count);
+  size_t maxSymbols() const { return last_.size(); } // one a byte
   void init(const uint8_t* item);
-  void read(ArithmeticDecoder& dec, uint8_t* item);
+  template <class Decoder> void read(Decoder& dec, uint8_t* item);
 
 private:
   ContextModels models_; // one per byte position, created at first use
@@ -225,7 +238,8 @@ private:
 // A pointwise chunk: the first point raw, then one arithmetic-coded stream of all items of all other
 // points. The items of a point format 0-3 record are fixed (POINT10, then GPSTIME11 and RGB12 where
 // the format has them, then extra bytes), so the loop is compiled once per combination with every item
-// decoder inlined and the coder's state in registers.
+// decoder inlined and the coder's state in registers. The points that cannot reach the end of the
+// stream (all but the last few dozen bytes' worth) decode without an end check per symbol.
 class PointwiseChunkDecoder {
 public:
   explicit PointwiseChunkDecoder(const Layout& layout);
@@ -236,8 +250,10 @@ public:
 private:
   template <bool kGps, bool kRgb, bool kBytes>
   void decodeLoop(const uint8_t* data, size_t size, uint64_t count, std::vector<uint8_t>& out);
+  template <bool kGps, bool kRgb, bool kBytes, class Decoder> void readPoint(Decoder& dec, uint8_t* record);
 
   size_t recordLength_;
+  size_t maxSymbols_ = Point10Decoder::kMaxSymbols; // a point's, all items
   Point10Decoder point_;
   std::unique_ptr<GpsTime11Decoder> gps_;
   std::unique_ptr<Rgb12Decoder> rgb_;
