@@ -194,24 +194,18 @@ public:
     return sym;
   }
 
-  // Raw bits, equiprobable (LASzip readBits: at most 32, values above 19 bits in two steps).
-  uint32_t readBits(uint32_t bits) {
+  // Raw bits, equiprobable (LASzip readBits: at most 32, values above 19 bits in two steps). Not
+  // recursive, so that it inlines: GCC compiled the recursive form out of line, and the coder whose
+  // address that call took lived on the stack, its state stored and loaded around every symbol.
+  [[gnu::always_inline]] uint32_t readBits(uint32_t bits) {
     if (bits > 19) {
       const uint32_t low = readShort();
-      return (readBits(bits - 16) << 16) | low;
+      return (readFewBits(bits - 16) << 16) | low;
     }
-    const uint32_t sym = value_ / (length_ >>= bits);
-    value_ -= length_ * sym;
-    normalize();
-    return sym;
+    return readFewBits(bits);
   }
-  uint32_t readShort() {
-    const uint32_t sym = value_ / (length_ >>= 16);
-    value_ -= length_ * sym;
-    normalize();
-    return sym & 0xFFFF;
-  }
-  uint32_t readInt() {
+  [[gnu::always_inline]] uint32_t readShort() { return readFewBits(16) & 0xFFFF; }
+  [[gnu::always_inline]] uint32_t readInt() {
     const uint32_t low = readShort();
     return (readShort() << 16) | low;
   }
@@ -226,6 +220,14 @@ public:
 
 private:
   template <bool> friend class BasicArithmeticDecoder;
+
+  // 1 to 19 raw bits.
+  [[gnu::always_inline]] uint32_t readFewBits(uint32_t bits) {
+    const uint32_t sym = value_ / (length_ >>= bits);
+    value_ -= length_ * sym;
+    normalize();
+    return sym;
+  }
 
   [[gnu::always_inline]] uint8_t nextByte() {
     if (ptr_ < end_) return *ptr_++;

@@ -225,12 +225,19 @@ void PointwiseChunkDecoder::decodeLoop(const uint8_t* data, size_t size, uint64_
   uint64_t i = 1;
   if (count > 1 && dec.hasRoom(maxSymbols_)) {
     // While a whole point fits before the end of the stream: no end check a symbol, and no bytes past
-    // the end to count. Its state goes on in the checked coder for the last points.
+    // the end to count. Its state goes on in the checked coder for the last points. The output grows
+    // outside the inner loop.
     const uint8_t* const lastStart = data + size - kMaxBytesPerSymbol * maxSymbols_ - 1;
     UncheckedDecoder fast(dec);
     do {
-      readPoint<kGps, kRgb, kBytes>(fast, recordSlot(out, i, capacity, rl, count));
-    } while (++i < count && fast.position() <= lastStart);
+      uint8_t* record = recordSlot(out, i, capacity, rl, count);
+      uint8_t* const recordsEnd = out.data() + capacity * rl;
+      do {
+        readPoint<kGps, kRgb, kBytes>(fast, record);
+        record += rl;
+      } while (record != recordsEnd && fast.position() <= lastStart);
+      i = uint64_t(record - out.data()) / rl;
+    } while (i < count && fast.position() <= lastStart);
     dec = ArithmeticDecoder(fast);
   }
   for (; i < count; ++i) {
