@@ -168,7 +168,12 @@ public:
           sym = k;
       }
       x = distribution[sym] * l;
-      y = sym != m.lastSymbol_ ? distribution[sym + 1] * l : length_;
+      // The last symbol's interval ends at length itself. Its entry sym + 1 is the first count (the
+      // model's storage continues), read and dropped by a conditional move: a branch on it
+      // mispredicts. The empty asm keeps GCC from moving the product into a branch (encodeSymbol).
+      uint32_t next = distribution[sym + 1] * l;
+      asm("" : "+r"(next));
+      y = sym == m.lastSymbol_ ? length_ : next;
     } else {
       x = sym = 0;
       y = length_;
@@ -239,13 +244,19 @@ private:
   // of the input, byte by byte.
   [[gnu::always_inline]] void normalize() {
     if (!kCheckEnd || end_ - ptr_ >= 4) [[likely]] {
-      const uint32_t n = uint32_t(__builtin_clz(length_ | 1)) >> 3;
+      const uint32_t shift = uint32_t(__builtin_clz(length_ | 1)) & 24; // 8 bits a byte shifted in
       uint32_t next;
       std::memcpy(&next, ptr_, 4);
-      const uint64_t v = ((uint64_t(value_) << 32) | __builtin_bswap32(next)) << (8 * n);
-      value_ = uint32_t(v >> 32);
-      length_ <<= 8 * n;
-      ptr_ += n;
+      next = __builtin_bswap32(next);
+#if defined(__x86_64__)
+      // value << shift with the top `shift` bits of next, a shift of 0 included, in one instruction;
+      // GCC compiles the portable form below into five.
+      asm("shldl %%cl, %1, %0" : "+r"(value_) : "r"(next), "c"(shift) : "cc");
+#else
+      value_ = uint32_t(((uint64_t(value_) << 32 | next) << shift) >> 32);
+#endif
+      length_ <<= shift;
+      ptr_ += shift >> 3;
     } else if (length_ < kMinLength) {
       renormalize();
     }
