@@ -27,11 +27,12 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols, ModelUse us
   symbols_ = symbols;
   lastSymbol_ = symbols - 1;
   size_t words = 2 * size_t(symbols);
-  const bool table = symbols > 16 && use == ModelUse::Decode;
+  const bool table = use == ModelUse::Decode;
   if (table) {
-    // A table of at least one entry per symbol: FastAC sizes it for four symbols per entry, but the
-    // bisection within an entry mispredicts, and a finer table costs nothing in exactness (it only
-    // narrows the search; the distribution decides).
+    // A table of at least one entry per symbol: FastAC sizes it for four symbols per entry, and gives
+    // none to alphabets of 16 or fewer, but the bisection within an entry (or over the whole small
+    // alphabet) mispredicts, and a finer table costs nothing in exactness (it only narrows the
+    // search; the distribution decides).
     uint32_t tableBits = 3;
     while (symbols > (1u << tableBits))
       ++tableBits;

@@ -51,14 +51,13 @@ struct BitModel {
   POINTRAST_LAZ_NO_COVERAGE void update();
 };
 
-// Who uses a model: a decoder's models above 16 symbols keep FastAC's decoder table, which every update
-// rebuilds; an encoder's never read it, so theirs have none (their distributions, and so their bytes,
-// are the same).
+// Who uses a model: a decoder's models keep FastAC's decoder table, which every update rebuilds; an
+// encoder's never read it, so theirs have none (their distributions, and so their bytes, are the same).
 enum class ModelUse : uint8_t { Decode, Encode };
 
-// An adaptive model of `symbols` symbols (2..2048). Alphabets above 16 symbols get (for a decoder) a
-// lookup table that maps the top bits of value / length to a first guess, refined by bisection (FastAC's
-// table decoding).
+// An adaptive model of `symbols` symbols (2..2048). A decoder's model has a lookup table that maps the
+// top bits of value / length to a first guess, refined by bisection (FastAC's table decoding, which
+// FastAC keeps for alphabets above 16 symbols; smaller ones bisected the distribution, mispredicting).
 class SymbolModel {
 public:
   SymbolModel() = default;
@@ -85,7 +84,7 @@ private:
 
   uint32_t* distribution_ = nullptr; // symbols_ entries: cumulative probability, 15-bit scale
   uint32_t* symbolCount_ = nullptr;  // symbols_ entries
-  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries, or null (small alphabets, encoders)
+  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries, or null (encoders)
   uint32_t symbols_ = 0, lastSymbol_ = 0, tableSize_ = 0, tableShift_ = 0;
   uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
   bool ready_ = false;
@@ -148,49 +147,31 @@ public:
     return bit;
   }
 
+  // m: a decoder's model (ModelUse::Decode), which always has its decoder table.
   [[gnu::always_inline]] uint32_t decodeSymbol(SymbolModel& m) {
-    uint32_t sym, x, y;
     const uint32_t* distribution = m.distribution_;
-    if (m.decoderTable_) {
-      const uint32_t l = length_ >> kLengthShift;
-      const uint32_t dv = value_ / l;
-      // value < length holds for every stream an encoder wrote, which keeps t <= tableSize; corrupt
-      // bytes can break it, so the index is clamped rather than trusted.
-      uint32_t t = dv >> m.tableShift_;
-      if (t > m.tableSize_) t = m.tableSize_;
-      sym = m.decoderTable_[t];
-      uint32_t n = m.decoderTable_[t + 1] + 1;
-      while (n > sym + 1) {
-        const uint32_t k = (sym + n) >> 1;
-        if (distribution[k] > dv)
-          n = k;
-        else
-          sym = k;
-      }
-      x = distribution[sym] * l;
-      // The last symbol's interval ends at length itself. Its entry sym + 1 is the first count (the
-      // model's storage continues), read and dropped by a conditional move: a branch on it
-      // mispredicts. The empty asm keeps GCC from moving the product into a branch (encodeSymbol).
-      uint32_t next = distribution[sym + 1] * l;
-      asm("" : "+r"(next));
-      y = sym == m.lastSymbol_ ? length_ : next;
-    } else {
-      x = sym = 0;
-      y = length_;
-      const uint32_t l = length_ >> kLengthShift;
-      uint32_t n = m.symbols_;
-      uint32_t k = n >> 1;
-      do {
-        const uint32_t z = l * distribution[k];
-        if (z > value_) {
-          n = k;
-          y = z;
-        } else {
-          sym = k;
-          x = z;
-        }
-      } while ((k = (sym + n) >> 1) != sym);
+    const uint32_t l = length_ >> kLengthShift;
+    const uint32_t dv = value_ / l;
+    // value < length holds for every stream an encoder wrote, which keeps t <= tableSize; corrupt
+    // bytes can break it, so the index is clamped rather than trusted.
+    uint32_t t = dv >> m.tableShift_;
+    if (t > m.tableSize_) t = m.tableSize_;
+    uint32_t sym = m.decoderTable_[t];
+    uint32_t n = m.decoderTable_[t + 1] + 1;
+    while (n > sym + 1) {
+      const uint32_t k = (sym + n) >> 1;
+      if (distribution[k] > dv)
+        n = k;
+      else
+        sym = k;
     }
+    const uint32_t x = distribution[sym] * l;
+    // The last symbol's interval ends at length itself. Its entry sym + 1 is the first count (the
+    // model's storage continues), read and dropped by a conditional move: a branch on it
+    // mispredicts. The empty asm keeps GCC from moving the product into a branch (encodeSymbol).
+    uint32_t next = distribution[sym + 1] * l;
+    asm("" : "+r"(next));
+    const uint32_t y = sym == m.lastSymbol_ ? length_ : next;
     value_ -= x;
     length_ = y - x;
     normalize();

