@@ -144,7 +144,9 @@ size_t Point14Decoder::pastEnd() const {
 }
 
 [[gnu::always_inline]] inline void Point14Decoder::read(uint8_t* item, uint32_t& context) {
-  ArithmeticDecoder& xy = dec_[kXY];
+  // The coordinate layer's coder as a local for the point's symbols (up to a dozen), so that its state
+  // stays in registers between them rather than in this decoder's memory; stored back at the end.
+  ArithmeticDecoder xy = dec_[kXY];
   Point14* last = &contexts_[current_]->last;
 
   // The changed-values symbol, in the context of the last point's return position (bit 0: first,
@@ -203,6 +205,7 @@ size_t Point14Decoder::pastEnd() const {
       c.dy.decompress(xy, c.lastYDiff[xyIndex].get(), (n == 1) + (kBits < 20 ? (kBits & ~1u) : 20));
   last->y = addWrap(last->y, dy);
   c.lastYDiff[xyIndex].add(dy);
+  dec_[kXY] = xy;
 
   if (changed_[kZ]) {
     kBits = (c.dx.getK() + c.dy.getK()) / 2;
