@@ -29,12 +29,13 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols, ModelUse us
   size_t words = 2 * size_t(symbols);
   const bool table = use == ModelUse::Decode;
   if (table) {
-    // A table of at least one entry per symbol: FastAC sizes it for four symbols per entry, and gives
-    // none to alphabets of 16 or fewer, but the bisection within an entry (or over the whole small
-    // alphabet) mispredicts, and a finer table costs nothing in exactness (it only narrows the
-    // search; the distribution decides).
+    // A table of four entries per symbol up to 2^10 entries, and at least one per symbol: FastAC
+    // sizes it for four symbols per entry, and gives none to alphabets of 16 or fewer, but the
+    // bisection within an entry (or over the whole small alphabet) mispredicts, and a finer table
+    // costs nothing in exactness (it only narrows the search; the distribution decides). Each update
+    // refills the table, so a finer one costs instructions there.
     uint32_t tableBits = 3;
-    while (symbols > (1u << tableBits))
+    while (symbols > (1u << tableBits) || (4 * symbols > (1u << tableBits) && tableBits < 10))
       ++tableBits;
     tableSize_ = 1u << tableBits;
     tableShift_ = kLengthShift - tableBits;
