@@ -39,7 +39,7 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::create(uint32_t symbols, ModelUse us
       ++tableBits;
     tableSize_ = 1u << tableBits;
     tableShift_ = kLengthShift - tableBits;
-    words += tableSize_ + 2;
+    words += tableSize_ + 4; // entries 0..tableSize + 1, and two that update() may write and drop
   } else {
     tableSize_ = tableShift_ = 0;
   }
@@ -88,13 +88,23 @@ POINTRAST_LAZ_NO_COVERAGE void SymbolModel::update() {
       sum += symbolCount_[k];
     }
   } else {
+    // Entries s + 1 .. w of the table go to symbol k - 1. They are written four at a time, the first
+    // four whether or not the symbol has any: most have four or fewer, and a loop that stops after a
+    // data-dependent count mispredicted (0.9 times a decoded point of format 3). Entries written
+    // beyond w are written again by the next symbols or by the fill after the loop (w < tableSize,
+    // so the writes stay below tableSize + 4).
     uint32_t s = 0;
     for (uint32_t k = 0; k < symbols_; ++k) {
       distribution_[k] = (scale * sum) >> (31 - kLengthShift);
       sum += symbolCount_[k];
       const uint32_t w = distribution_[k] >> tableShift_;
-      while (s < w)
-        decoderTable_[++s] = k - 1;
+      uint32_t j = s;
+      do {
+        uint32_t* p = decoderTable_ + j + 1;
+        p[0] = p[1] = p[2] = p[3] = k - 1;
+        j += 4;
+      } while (j < w);
+      s = w;
     }
     decoderTable_[0] = 0;
     while (s <= tableSize_)
