@@ -84,7 +84,7 @@ private:
 
   uint32_t* distribution_ = nullptr; // symbols_ entries: cumulative probability, 15-bit scale
   uint32_t* symbolCount_ = nullptr;  // symbols_ entries
-  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries, or null (encoders)
+  uint32_t* decoderTable_ = nullptr; // tableSize_ + 2 entries and 2 spare words, or null (encoders)
   uint32_t symbols_ = 0, lastSymbol_ = 0, tableSize_ = 0, tableShift_ = 0;
   uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
   bool ready_ = false;

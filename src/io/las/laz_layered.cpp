@@ -145,7 +145,7 @@ size_t Point14Decoder::pastEnd() const {
 
 [[gnu::always_inline]] inline void Point14Decoder::read(uint8_t* item, uint32_t& context) {
   // The coordinate layer's coder as a local for the point's symbols (up to a dozen), so that its state
-  // stays in registers between them rather than in this decoder's memory; stored back at the end.
+  // stays in registers between them rather than in this decoder's memory; stored back after Y.
   ArithmeticDecoder xy = dec_[kXY];
   Point14* last = &contexts_[current_]->last;
 

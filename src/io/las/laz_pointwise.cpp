@@ -40,7 +40,8 @@ void Point10Decoder::init(const uint8_t* item) {
   last_[12] = last_[13] = 0;
 }
 
-template <class Decoder> [[gnu::always_inline]] inline void Point10Decoder::read(Decoder& dec, uint8_t* item) {
+template <class Decoder>
+[[gnu::always_inline]] inline void Point10Decoder::read(Decoder& dec, uint8_t* item) {
   // Bits of changedValues: 32 return byte, 16 intensity, 8 classification, 4 scan angle rank,
   // 2 user data, 1 point source id.
   const uint32_t changed = dec.decodeSymbol(changedValues_);
@@ -106,7 +107,8 @@ void GpsTime11Decoder::init(const uint8_t* item) {
   seq_.reset(loadLE<uint64_t>(item));
 }
 
-template <class Decoder> [[gnu::always_inline]] inline void GpsTime11Decoder::read(Decoder& dec, uint8_t* item) {
+template <class Decoder>
+[[gnu::always_inline]] inline void GpsTime11Decoder::read(Decoder& dec, uint8_t* item) {
   for (int hop = 0;; ++hop) {
     if (hop > kMaxSequenceHops) corrupt("its GPS times switch sequences without end");
     if (seq_.diff[seq_.last] == 0) {

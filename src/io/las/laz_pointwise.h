@@ -115,7 +115,8 @@ template <class Decoder>
 }
 
 template <class Decoder>
-[[gnu::always_inline]] inline void GpsSequences::readMultiple(Decoder& dec, IntegerCodec& ic, uint32_t multi) {
+[[gnu::always_inline]] inline void GpsSequences::readMultiple(Decoder& dec, IntegerCodec& ic,
+                                                              uint32_t multi) {
   auto countExtreme = [&](int32_t d) {
     if (++extremeCounter[last] > 3) {
       diff[last] = d;
