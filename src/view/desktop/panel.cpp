@@ -330,7 +330,7 @@ void statistics(const Session& session, const PanelInfo& info) {
   if (ImGui::IsItemHovered() && name != info.input) ImGui::SetTooltip("%s", info.input.c_str());
   ImGui::Text("GPU render  %8.3f ms  (clear + draw + resolve)", s.renderMs);
   if (s.post)
-    ImGui::Text("  resolve stage: splat %.3f, dilate %.3f, compose %.3f ms", s.post->splatMs,
+    ImGui::Text("  resolve stage: splat %6.3f, dilate %6.3f, compose %6.3f ms", s.post->splatMs,
                 s.post->dilateMs, s.post->composeMs);
   ImGui::Text("GPU present %8.3f ms  (image copy + panel)", s.presentMs);
   ImGui::Text("frame (host) %7.2f ms, %llu frames", s.hostMs, static_cast<unsigned long long>(s.frames));
