@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "gpu/context.h"
 
 namespace pointrast::gpu {
@@ -139,17 +140,25 @@ void fullBarrier(VkCommandBuffer cmd) {
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
-void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* destination, uint64_t size) {
+void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* destination, uint64_t size,
+                std::unique_ptr<Buffer>* kept) {
   if (size == 0) return;
-  Buffer staging(context, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::Readback, "readback staging");
+  std::unique_ptr<Buffer> temporary;
+  std::unique_ptr<Buffer>& staging = kept ? *kept : temporary;
+  if (!staging || staging->size() != size)
+    staging = std::make_unique<Buffer>(context, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::Readback,
+                                       "readback staging");
   context.submitAndWait([&](VkCommandBuffer cmd) {
     fullBarrier(cmd);
     VkBufferCopy region{offset, 0, size};
-    vkCmdCopyBuffer(cmd, source.handle(), staging.handle(), 1, &region);
+    vkCmdCopyBuffer(cmd, source.handle(), staging->handle(), 1, &region);
     fullBarrier(cmd);
   });
-  staging.invalidate();
-  std::memcpy(destination, staging.mapped(), size);
+  staging->invalidate();
+  const auto* from = static_cast<const uint8_t*>(staging->mapped());
+  parallelBlocks(size, uint64_t(1) << 21, [&](uint64_t, uint64_t begin, uint64_t end) {
+    std::memcpy(static_cast<uint8_t*>(destination) + begin, from + begin, end - begin);
+  });
 }
 
 void writeBuffer(Context& context, const Buffer& target, uint64_t offset, const void* source, uint64_t size) {

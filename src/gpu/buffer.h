@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "gpu/vulkan_api.h"
@@ -62,8 +63,11 @@ constexpr VkBufferUsageFlags kBufferUsage =
 // of this renderer are few and large, so precise barriers would buy nothing measurable.
 void fullBarrier(VkCommandBuffer cmd);
 
-// Copies size bytes of a Device buffer into host memory through a temporary readback buffer.
-void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* destination, uint64_t size);
+// Copies size bytes of a Device buffer into host memory through a readback buffer: a temporary one, or
+// *kept (made, or remade when its size differs, and left there for the next read: what a caller reading
+// every frame passes). The copy out of it runs on all threads.
+void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* destination, uint64_t size,
+                std::unique_ptr<Buffer>* kept = nullptr);
 // Copies size bytes of host memory into a Device buffer through a temporary upload buffer.
 void writeBuffer(Context& context, const Buffer& target, uint64_t offset, const void* source, uint64_t size);
 

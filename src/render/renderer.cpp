@@ -6,7 +6,6 @@
 #include <cstring>
 
 #include "base/error.h"
-#include "base/parallel.h"
 #include "gpu/buffer.h"
 #include "gpu/context.h"
 #include "gpu/timer.h"
@@ -423,11 +422,8 @@ void Renderer::showComposite(std::span<const uint32_t> image, std::span<const ui
 }
 
 std::vector<uint64_t> Renderer::framebufferWords() {
-  if (!wordsCaptured_)
-    throw InputError("no canonical framebuffer words: the last frame was not rendered with captureWords by a "
-                     "closest-point method");
   std::vector<uint64_t> words(targets_->pixels());
-  gpu::readBuffer(context_, targets_->words, 0, words.data(), words.size() * 8);
+  framebufferWords(words);
   return words;
 }
 
@@ -435,23 +431,9 @@ void Renderer::framebufferWords(std::span<uint64_t> into) {
   if (!wordsCaptured_)
     throw InputError("no canonical framebuffer words: the last frame was not rendered with captureWords by a "
                      "closest-point method");
-  const uint64_t bytes = targets_->pixels() * 8;
-  if (into.size() * 8 != bytes)
+  if (into.size() != targets_->pixels())
     throw InputError("framebuffer words: the destination is not the image's size");
-  if (!wordsReadback_ || wordsReadback_->size() != bytes)
-    wordsReadback_ = std::make_unique<gpu::Buffer>(context_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                   gpu::MemoryKind::Readback, "framebuffer words read back");
-  context_.submitAndWait([&](VkCommandBuffer cmd) {
-    gpu::fullBarrier(cmd);
-    VkBufferCopy region{0, 0, bytes};
-    gpu::vkCmdCopyBuffer(cmd, targets_->words.handle(), wordsReadback_->handle(), 1, &region);
-    gpu::fullBarrier(cmd);
-  });
-  wordsReadback_->invalidate();
-  const uint64_t* from = static_cast<const uint64_t*>(wordsReadback_->mapped());
-  parallelBlocks(into.size(), uint64_t(1) << 18, [&](uint64_t, uint64_t begin, uint64_t end) {
-    std::memcpy(into.data() + begin, from + begin, (end - begin) * 8);
-  });
+  gpu::readBuffer(context_, targets_->words, 0, into.data(), into.size() * 8, &wordsReadback_);
 }
 
 std::vector<uint64_t> Renderer::framebufferWords(uint32_t x, uint32_t y, uint32_t w, uint32_t h) {

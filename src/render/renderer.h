@@ -152,8 +152,8 @@ public:
   // captureWords; for closest-point methods only, or for any method when the resolve stage ran (then the
   // words it ended with, float depth also for int40).
   std::vector<uint64_t> framebufferWords();
-  // The same into `into` (width() x height() words), through a read-back buffer the renderer keeps, on all
-  // threads: what a process of a distributed job reads every frame to composite.
+  // The same into `into` (width() x height() words): what a process of a distributed job reads every frame
+  // to composite. Both read through a read-back buffer the renderer keeps.
   void framebufferWords(std::span<uint64_t> into);
   // The same for the rectangle [x, x + w) x [y, y + h) (inside the image), row by row: what a viewer
   // reads to pick the point under the cursor.
@@ -210,7 +210,7 @@ private:
   std::unique_ptr<Targets> targets_;
   std::map<std::pair<Method, DepthMode>, std::unique_ptr<PointMethod>> methods_;
   std::unique_ptr<PostStage> post_;            // made on the first frame that uses it
-  std::unique_ptr<gpu::Buffer> wordsReadback_; // framebufferWords(into)'s, kept for the next frame
+  std::unique_ptr<gpu::Buffer> wordsReadback_; // framebufferWords()' read-back buffer, kept
   std::map<Method, std::unique_ptr<lod::LodPasses>> lodPasses_;
   bool wordsCaptured_ = false; // the last frame wrote canonical words
   PointMethod* last_ = nullptr; // the method of the last render() frame
