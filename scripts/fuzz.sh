@@ -17,6 +17,7 @@
 #                                                second, coverage (cov / ft) and findings, and updates the
 #                                                table of cumulative executions per target over all runs;
 #                                                the appended block is also kept in BUILD/logs/report.md
+#   scripts/fuzz.sh --build-only                 configures and builds the tree, runs nothing
 #   scripts/fuzz.sh --merge FILE                 appends a block another machine's --report run kept
 #                                                (its BUILD/logs/report.md) to docs/fuzzing.md and updates
 #                                                the cumulative table
@@ -41,6 +42,9 @@
 #   POINTRAST_FUZZ_PREBUILT 1: no configure and no build, the binaries of BUILD/fuzz are run as they are
 #                           (a machine without clang, running what --pack made; a NAME_fuzz.gz there is
 #                           unpacked into NAME_fuzz first)
+#   POINTRAST_FUZZ_TESTS    1: the tree also builds the parser and cloud test binaries (BUILD/tests/io_tests,
+#                           cloud_tests) with the same sanitizers: scripts/test.sh runs them there, so the
+#                           libraries are compiled once for the tests and the fuzz targets
 #   POINTRAST_FUZZ_BUILD    the build tree (default build-fuzz). Its corpus/NAME folders keep what a run
 #                           found, so a later run starts from there.
 #   POINTRAST_DATA_DIR      the shared test data (default ../shared/data beside the checkout)
@@ -92,6 +96,11 @@ if [ "${1:-}" = "--merge" ]; then
   updateCumulative
   echo "fuzz: $block is appended to $docs"
   exit 0
+fi
+buildOnly=""
+if [ "${1:-}" = "--build-only" ]; then
+  buildOnly=1
+  shift
 fi
 until=""
 if [ "${1:-}" = "--until" ]; then
@@ -214,17 +223,22 @@ fi
 if [ "${POINTRAST_FUZZ_PREBUILT:-0}" != 1 ]; then
   launcher=()
   if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-  # -O1 -g without -DNDEBUG: the asserts stay on (a file must never reach one), the stacks stay readable.
+  # -O1 without -DNDEBUG: the asserts stay on (a file must never reach one). Line tables only: a stack
+  # names files and lines, and the tree compiles in less time than with full debug information.
   # The static runtime (libstdc++, libgcc, brotli) lets --pack's binaries run where only the C library is.
+  tests=OFF testTargets=()
+  if [ "${POINTRAST_FUZZ_TESTS:-0}" = 1 ]; then tests=ON testTargets=(io_tests cloud_tests); fi
   CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
-    -DPOINTRAST_FUZZ=ON -DPOINTRAST_TESTS=OFF -DPOINTRAST_STATIC_RUNTIME=ON "${launcher[@]}" >/dev/null
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+    -DPOINTRAST_FUZZ=ON -DPOINTRAST_TESTS="$tests" -DPOINTRAST_STATIC_RUNTIME=ON "${launcher[@]}" >/dev/null
   if [ -n "$pack" ]; then
     cmake --build "$build" -j"$(nproc)" --target $(printf '%s_fuzz ' "${names[@]}")
   else
-    cmake --build "$build" -j"$(nproc)" --target fuzz
+    cmake --build "$build" -j"$(nproc)" --target fuzz "${testTargets[@]}"
   fi
 fi
+if [ -n "$buildOnly" ]; then exit 0; fi
 
 if [ -n "$pack" ]; then
   mkdir -p "$pack/fuzz"
