@@ -328,16 +328,18 @@ void statistics(const Session& session, const PanelInfo& info) {
   ImGui::Text("%s: %s points", name.empty() ? info.input.c_str() : name.c_str(),
               humanCount(double(info.points)).c_str());
   if (ImGui::IsItemHovered() && name != info.input) ImGui::SetTooltip("%s", info.input.c_str());
+  // Times and counts in fixed widths that hold every plausible value (up to 10 s, 10^8 frames): the panel
+  // keeps its width from frame to frame, however slow the device or busy the machine.
   ImGui::Text("GPU render  %8.3f ms  (clear + draw + resolve)", s.renderMs);
   if (s.post)
-    ImGui::Text("  resolve stage: splat %6.3f, dilate %6.3f, compose %6.3f ms", s.post->splatMs,
+    ImGui::Text("  resolve stage: splat %8.3f, dilate %8.3f, compose %8.3f ms", s.post->splatMs,
                 s.post->dilateMs, s.post->composeMs);
   ImGui::Text("GPU present %8.3f ms  (image copy + panel)", s.presentMs);
-  ImGui::Text("frame (host) %7.2f ms, %llu frames", s.hostMs, static_cast<unsigned long long>(s.frames));
-  ImGui::Text("points drawn %s, %s points/s", humanCount(double(s.points)).c_str(),
+  ImGui::Text("frame (host) %8.2f ms, %8llu frames", s.hostMs, static_cast<unsigned long long>(s.frames));
+  ImGui::Text("points drawn %8s, %8s points/s", humanCount(double(s.points)).c_str(),
               humanCount(s.renderMs > 0 ? double(s.points) / (s.renderMs * 1e-3) : 0).c_str());
   if (s.batch && !s.lod)
-    ImGui::Text("batches %s of %s rendered, %s points passed early-z",
+    ImGui::Text("batches %8s of %8s rendered, %8s points passed early-z",
                 humanCount(double(s.batch->batchesRendered)).c_str(),
                 humanCount(double(s.batch->batchesProcessed)).c_str(),
                 humanCount(double(s.batch->pointsRendered)).c_str());
