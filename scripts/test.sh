@@ -2,9 +2,9 @@
 # Checks that every file the docs name exists, then builds pointrast and runs every test: all tests on the
 # default Vulkan device (lavapipe without a GPU) with the Khronos validation layer on, then the parser and
 # data-preparation tests again under AddressSanitizer + UBSan with clang (truncation sweeps must never
-# read out of bounds), and the sphere tests on a newer lavapipe (Mesa 25, Debian 12 backports, unpacked privately)
-# that has mesh shaders and ray tracing, which the system's Mesa 22.3 lacks: there those pipelines are
-# only skipped. Then a tree built with the test-only point method of tests/methods (one table row, one
+# read out of bounds), and the sphere tests on a newer lavapipe (Mesa 25, Debian 12 backports, unpacked
+# privately) that has mesh shaders and ray tracing, which the system's Mesa 22.3 lacks: there those
+# pipelines are only skipped. Then a tree built with the test-only point method of tests/methods (one table row, one
 # shader) checks that the method appears in every generated name list and renders like atomicmin. Last
 # the libFuzzer targets (tests/fuzz), built in the same clang tree as the sanitizer tests (build-fuzz), run
 # for $POINTRAST_FUZZ_SECONDS (120) seconds of wall time in all, shared between them, as many at once as
