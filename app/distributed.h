@@ -61,6 +61,7 @@ struct CompositeStats {
   double compositeMs = 0;           // rank 0: the MIN over all ranks' words (wall clock)
   std::string compositePath;        // how: in shared memory (one host) or by MPI_Reduce
   double resolveMs = 0;             // rank 0: the composited words to the image (wall clock)
+  double resolveFirstMs = 0;        // rank 0, render only: the first resolve, its pipelines made in it
   uint64_t bytesMoved = 0;          // sent to the composite: 8 B a pixel from every rank but 0 (HQS: 32)
   std::optional<PostStats> post;    // the resolve stage on rank 0
   std::vector<std::string> devices; // "host: device" per rank

@@ -1,54 +1,80 @@
 #!/usr/bin/env bash
-# Scaling of distributed rendering (docs/mpi.md) on one host: 1 rank against 2 ranks (one GPU each, or
-# both on the one GPU of a single-GPU host) at 2560x1140, the slowest rank's GPU time and rank 0's
-# composite separately; 2 ranks composite in shared memory (one host) and again by MPI_Reduce (what
-# several hosts use), side by side. Brute force on a generated terrain of POINTS points (default 1G), and,
-# when OCTREE is given, lod on it at full detail.
-#   scripts/bench-mpi.sh PointrastBinary OutDir [POINTS] [OCTREE]
+# Scaling of distributed rendering (docs/mpi.md) on one host at 2560x1140: each run's slowest rank's GPU
+# time, rank 0's read-back, composite and resolve separately, and their sum (a frame's stages one after
+# another, as a viewer runs them). 2 ranks composite in shared memory (one host) or by MPI_Reduce (what
+# several hosts use). With one GPU, ranks share it: their render times are then not a scaling figure.
+#   scripts/bench-mpi.sh PointrastBinary OutDir [RUN...]
+# A RUN is POINTS:RANKS[:COMPOSITE[:METHOD]] on generated terrain (COMPOSITE shared or reduce, METHOD
+# batch-prefetch unless given), or lod:RANKS[:BUDGET] on MPI_OCTREE at full detail (--min-node-px 0),
+# with a node cache of BUDGET per rank (e.g. 8G; the octree's size when not given). Without RUNs:
+# 1G:1 1G:2 1G:2:reduce, and lod:1 lod:2 when MPI_OCTREE is set. Every terrain run uses the first terrain
+# run's camera (make it a 1-rank run: 2 ranks frame the overview from rank 0's share), every lod run the
+# first lod run's.
 # Writes OutDir/mpi-scaling.jsonl (one `render --json` object per run) and OutDir/mpi-scaling.md.
 set -uo pipefail
-pr=$1 out=$2 points=${3:-1G} octree=${4:-}
+pr=$1 out=$2
+shift 2
+runs=("$@")
+if [ ${#runs[@]} -eq 0 ]; then
+  runs=(1G:1 1G:2 1G:2:reduce)
+  [ -n "${MPI_OCTREE:-}" ] && runs+=(lod:1 lod:2)
+fi
 mkdir -p "$out"
 jsonl=$out/mpi-scaling.jsonl md=$out/mpi-scaling.md
 : >"$jsonl"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-view=(--width 2560 --height 1140 --frames "${MPI_FRAMES:-20}" --json -q)
+frames=${MPI_FRAMES:-20}
+view=(--width 2560 --height 1140 --frames "$frames" --json -q)
 field() { grep -o "\"$1\":[^,}]*" <<<"$2" | head -1 | cut -d: -f2; }
+ms() { awk -v v="$1" 'BEGIN { if (v == "") print "-"; else printf "%.2f", v }'; }
 {
   gpus=$(nvidia-smi -L 2>/dev/null | grep -c GPU || true)
-  echo "Host: $(nproc) cores, ${gpus:-?} GPU(s) ($(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null |
-    sort -u | paste -sd, -)); $(mpirun --version 2>/dev/null | head -1); 2560x1140, ${MPI_FRAMES:-20} frames," \
-    "medians. With one GPU, both ranks draw on it: their render times share it, the read-back and composite" \
-    "are what one host pays for any number of GPUs."
+  echo "Host: $(nproc) cores, $(free -g | awk '/Mem:/ { print $2 }') GiB, ${gpus:-?} GPU(s)" \
+    "($(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | sort -u | paste -sd, -));" \
+    "$(mpirun --version 2>/dev/null | head -1); 2560x1140, $frames frames, medians."
   echo
-  echo "| input | method | ranks | points | render ms (slowest rank) | readback ms | composite ms | composite | resolve ms | MB moved |"
-  echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+  echo "| input | method | ranks | points | render ms (slowest rank) | per rank | readback ms | composite ms | composite | resolve ms (first) | frame ms | MB moved | image hash |"
+  echo "| --- | --- | ---: | ---: | ---: | --- | ---: | ---: | --- | ---: | ---: | ---: | --- |"
 } >"$md"
 status=0
-run() { # composite name method ranks args...  (composite: shared or reduce)
-  local composite=$1 name=$2 method=$3 ranks=$4
-  shift 4
-  echo "== $name, $method, $ranks rank(s), composite $composite"
-  local line
-  line=$(POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 timeout 580 \
+# shellcheck disable=SC2034 # the cameras are used through `local -n` in run
+terrain_camera=() lod_camera=()
+run() { # name method ranks composite cameraVar args...
+  local name=$1 method=$2 ranks=$3 composite=$4 var=$5
+  shift 5
+  local -n camera=$var
+  echo "== $name, $method, $ranks rank(s), composite $composite ($(date +%T))"
+  local line start=$SECONDS
+  line=$(POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 timeout "${MPI_RUN_LIMIT:-580}" \
     mpirun --oversubscribe --bind-to none -np "$ranks" "$pr" render "$@" \
-    --method "$method" -o "/tmp/mpi-$ranks.png" "${view[@]}" ${camera[@]+"${camera[@]}"}) || { status=1; return; }
+    --method "$method" -o "$out/mpi-${name// /-}-$method-$ranks-$composite.png" "${view[@]}" ${camera[@]+"${camera[@]}"}) ||
+    { status=1; echo "bench-mpi: $name on $ranks rank(s) failed after $((SECONDS - start)) s"; return; }
   echo "$line" | tee -a "$jsonl"
-  # Every later run of this input uses the first run's camera (the overview of 2 ranks is framed from rank
-  # 0's share), so that the images and times compare.
+  echo "   ($((SECONDS - start)) s with loading)"
   [ ${#camera[@]} -gt 0 ] || read -r -a camera <<<"$(grep -o '"camera":"[^"]*"' <<<"$line" | head -1 | cut -d'"' -f4)"
-  local mb path
+  local mb path per hash
   mb=$(awk -v b="$(field bytes_moved "$line")" 'BEGIN { printf "%.1f", b / 1e6 }')
   path=$(grep -o '"composite_path":"[^"]*"' <<<"$line" | head -1 | cut -d'"' -f4)
-  echo "| $name | $method | $ranks | $(field points "$line") | $(field render_ms "$line") | $(field readback_ms "$line") | $(field composite_ms "$line") | ${path:--} | $(field resolve_ms "$line") | $mb |" >>"$md"
+  [ "$ranks" -gt 1 ] || path=""
+  per=$(grep -o '"rank_render_ms":\[[^]]*\]' <<<"$line" | head -1 | sed 's/.*\[//; s/\]//' |
+    tr ',' '\n' | awk '{ printf "%s%.2f", (NR > 1 ? ", " : ""), $1 }')
+  hash=$(field image_hash "$line" | tr -d '"')
+  echo "| $name | $method | $ranks | $(field points "$line") | $(ms "$(field render_ms "$line")") | $per |" \
+    "$(ms "$(field readback_ms "$line")") | $(ms "$(field composite_ms "$line")") | ${path:--} |" \
+    "$(ms "$(field resolve_ms "$line")") ($(ms "$(field resolve_first_ms "$line")")) |" \
+    "$(ms "$(field frame_ms "$line")") | $mb | \`$hash\` |" >>"$md"
 }
-camera=()
-run shared "terrain $points" batch-prefetch 1 terrain --points "$points"
-run shared "terrain $points" batch-prefetch 2 terrain --points "$points"
-run reduce "terrain $points" batch-prefetch 2 terrain --points "$points"
-if [ -n "$octree" ]; then
-  camera=()
-  for ranks in 1 2; do run shared "$(basename "$octree")" lod "$ranks" "$octree" --min-node-px 0; done
-fi
+for spec in "${runs[@]}"; do
+  IFS=: read -r what ranks composite method <<<"$spec"
+  if [ "$what" = lod ]; then
+    [ -n "${MPI_OCTREE:-}" ] || { echo "bench-mpi: $spec needs MPI_OCTREE"; status=1; continue; }
+    budget=${composite:-$(du -sb "$MPI_OCTREE" | cut -f1)}
+    run "$(basename "$MPI_OCTREE") cache $budget" lod "$ranks" shared lod_camera "$MPI_OCTREE" \
+      --min-node-px 0 --gpu-memory "$budget"
+  else
+    run "terrain $what" "${method:-batch-prefetch}" "$ranks" "${composite:-shared}" terrain_camera \
+      terrain --points "$what"
+  fi
+done
 cat "$md"
 exit $status

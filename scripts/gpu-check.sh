@@ -232,17 +232,29 @@ for what in "$@"; do
       timeout 560 python3 scripts/bench-python.py "$OUT" "$pr" ${PY_POINTS:-100M 1G} || status=1
     ;;
   mpi)
-    # Distributed rendering (docs/mpi.md): 1 rank against 2 ranks at 2560x1140, render and composite ms
-    # apart; brute force on MPI_POINTS (default 1G) generated points, lod on MPI_OCTREE when given. Writes
-    # mpi-scaling.{jsonl,md}. A machine without mpirun takes Debian's Open MPI from .mpirt/ (its .deb files,
-    # carried beside .vkrt/; the binary is built against Debian's libmpi.so.40).
+    # Distributed rendering (docs/mpi.md) at 2560x1140, render, read-back, composite and resolve ms apart
+    # (scripts/bench-mpi.sh): the runs in MPI_RUNS (its RUN syntax; default 1 G points on 1 and 2 ranks).
+    # lod runs read MPI_OCTREE; with MPI_OCTREE_POINTS set and no octree there, it is built first from that
+    # many generated terrain points (LAS, then `pointrast lod`; the LAS is removed after). Writes
+    # mpi-scaling.{jsonl,md} and each run's image. A machine without mpirun takes Debian's Open MPI from
+    # .mpirt/ (its .deb files, carried beside .vkrt/; the binary is built against Debian's libmpi.so.40).
     if ! command -v mpirun >/dev/null && ls .mpirt/*.deb >/dev/null 2>&1; then
       for f in .mpirt/*.deb; do dpkg -x "$f" /; done
       ldconfig
     fi
     mpirun --version | head -1
-    nvidia-smi --query-gpu=index,name --format=csv,noheader
-    timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" "${MPI_POINTS:-1G}" "${MPI_OCTREE:-}" || status=1
+    nvidia-smi --query-gpu=index,name,memory.total --format=csv,noheader
+    if [ -n "${MPI_OCTREE_POINTS:-}" ] && [ ! -f "${MPI_OCTREE:?MPI_OCTREE_POINTS needs MPI_OCTREE}/metadata.json" ]; then
+      start=$SECONDS
+      mkdir -p "$(dirname "$MPI_OCTREE")"
+      $pr generate terrain --points "$MPI_OCTREE_POINTS" --point-format 2 -o "$MPI_OCTREE.las" -q &&
+        $pr lod "$MPI_OCTREE.las" -o "$MPI_OCTREE" --json -q >"$OUT/mpi-octree-build.json" || status=1
+      rm -f "$MPI_OCTREE.las"
+      echo "mpi: generated and built $MPI_OCTREE_POINTS points into $MPI_OCTREE in $((SECONDS - start)) s"
+      du -sh "$MPI_OCTREE"
+    fi
+    # shellcheck disable=SC2086 # MPI_RUNS is a list of runs
+    MPI_OCTREE=${MPI_OCTREE:-} timeout 1500 scripts/bench-mpi.sh "$pr" "$OUT" ${MPI_RUNS:-} || status=1
     ;;
   *)
     echo "unknown check '$what' (tests, mpi, python, filtercost, deviceloss, autzen, lazio, post, viewpath, big, big4g, batch1g, hqs796, sweep, paper2021, paper2022, spheres2023, lodsuite, lod2022, serve, servelod, rendertime, vr2022)"; status=1 ;;
