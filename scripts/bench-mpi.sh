@@ -10,6 +10,9 @@
 # 1G:1 1G:2 1G:2:reduce, and lod:1 lod:2 when MPI_OCTREE is set. Every terrain run uses the first terrain
 # run's camera (make it a 1-rank run: 2 ranks frame the overview from rank 0's share), every lod run the
 # first lod run's.
+# Each closest-point run's composited words are kept (POINTRAST_MPI_WORDS, in MPI_WORDS_DIR or /tmp) and a
+# run of several ranks is compared with the first 1-rank run of its input and method: the pixels whose words
+# differ, and how many of them are depth ties (the same depth, another of the tied points chosen).
 # Writes OutDir/mpi-scaling.jsonl (one `render --json` object per run) and OutDir/mpi-scaling.md.
 set -uo pipefail
 pr=$1 out=$2
@@ -33,10 +36,30 @@ ms() { awk -v v="$1" 'BEGIN { if (v == "") print "-"; else printf "%.2f", v }'; 
     "($(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | sort -u | paste -sd, -));" \
     "$(mpirun --version 2>/dev/null | head -1); 2560x1140, $frames frames, medians."
   echo
-  echo "| input | method | ranks | points | render ms (slowest rank) | per rank | readback ms | composite ms | composite | resolve ms (first) | frame ms | MB moved | image hash |"
-  echo "| --- | --- | ---: | ---: | ---: | --- | ---: | ---: | --- | ---: | ---: | ---: | --- |"
+  echo "| input | method | ranks | points | render ms (slowest rank) | per rank | readback ms | composite ms | composite | resolve ms (first) | frame ms | MB moved | image hash | words unlike 1 rank (ties) |"
+  echo "| --- | --- | ---: | ---: | ---: | --- | ---: | ---: | --- | ---: | ---: | ---: | --- | ---: |"
 } >"$md"
 status=0
+words_dir=${MPI_WORDS_DIR:-/tmp/mpi-words}
+mkdir -p "$words_dir"
+rm -f "$words_dir"/*.reference
+# The pixels whose words differ between two dumps, and how many of those hold the same depth (high 32 bits).
+compare_words() { # REFERENCE OTHER
+  python3 - "$1" "$2" <<'PY'
+import sys
+from array import array
+a, b = array('Q'), array('Q')
+with open(sys.argv[1], 'rb') as f: a.frombytes(f.read())
+with open(sys.argv[2], 'rb') as f: b.frombytes(f.read())
+if len(a) != len(b): sys.exit(f"the dumps differ in size ({len(a)} and {len(b)} words)")
+differ = ties = 0
+for x, y in zip(a, b):
+    if x != y:
+        differ += 1
+        ties += (x >> 32) == (y >> 32)
+print(f"{differ} ({ties})")
+PY
+}
 # shellcheck disable=SC2034 # the cameras are used through `local -n` in run
 terrain_camera=() lod_camera=()
 run() { # name method ranks composite cameraVar args...
@@ -44,8 +67,12 @@ run() { # name method ranks composite cameraVar args...
   shift 5
   local -n camera=$var
   echo "== $name, $method, $ranks rank(s), composite $composite ($(date +%T))"
-  local line start=$SECONDS
-  line=$(POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 timeout "${MPI_RUN_LIMIT:-580}" \
+  local line start=$SECONDS key="${name%% cache *}" words
+  key="${key// /-}-$method" # a lod run compares with the 1-rank run whatever its node cache
+  words="$words_dir/$key-$ranks-$composite.bin"
+  rm -f "$words"
+  line=$(POINTRAST_MPI_WORDS=$words POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 \
+    timeout "${MPI_RUN_LIMIT:-580}" \
     mpirun --oversubscribe --bind-to none -np "$ranks" "$pr" render "$@" \
     --method "$method" -o "$out/mpi-${name// /-}-$method-$ranks-$composite.png" "${view[@]}" ${camera[@]+"${camera[@]}"}) ||
     { status=1; echo "bench-mpi: $name on $ranks rank(s) failed after $((SECONDS - start)) s"; return; }
@@ -59,10 +86,19 @@ run() { # name method ranks composite cameraVar args...
   per=$(grep -o '"rank_render_ms":\[[^]]*\]' <<<"$line" | head -1 | sed 's/.*\[//; s/\]//' |
     tr ',' '\n' | awk '{ printf "%s%.2f", (NR > 1 ? ", " : ""), $1 }')
   hash=$(field image_hash "$line" | tr -d '"')
+  local versus=-
+  if [ -f "$words" ]; then
+    if [ "$ranks" -eq 1 ] && [ ! -f "$words_dir/$key.reference" ]; then
+      cp "$words" "$words_dir/$key.reference"
+    elif [ "$ranks" -gt 1 ] && [ -f "$words_dir/$key.reference" ]; then
+      versus=$(compare_words "$words_dir/$key.reference" "$words") || versus="?"
+    fi
+    rm -f "$words"
+  fi
   echo "| $name | $method | $ranks | $(field points "$line") | $(ms "$(field render_ms "$line")") | $per |" \
     "$(ms "$(field readback_ms "$line")") | $(ms "$(field composite_ms "$line")") | ${path:--} |" \
     "$(ms "$(field resolve_ms "$line")") ($(ms "$(field resolve_first_ms "$line")")) |" \
-    "$(ms "$(field frame_ms "$line")") | $mb | \`$hash\` |" >>"$md"
+    "$(ms "$(field frame_ms "$line")") | $mb | \`$hash\` | $versus |" >>"$md"
 }
 for spec in "${runs[@]}"; do
   IFS=: read -r what ranks composite method <<<"$spec"
