@@ -8,8 +8,8 @@
 # batch-prefetch unless given), or lod:RANKS[:BUDGET] on MPI_OCTREE at full detail (--min-node-px 0),
 # with a node cache of BUDGET per rank (e.g. 8G; the octree's size when not given). Without RUNs:
 # 1G:1 1G:2 1G:2:reduce, and lod:1 lod:2 when MPI_OCTREE is set. Every terrain run uses the first terrain
-# run's camera (make it a 1-rank run: 2 ranks frame the overview from rank 0's share), every lod run the
-# first lod run's.
+# run's camera (make it a 1-rank run: 2 ranks frame the overview from rank 0's share), or MPI_CAMERA's
+# options (--eye ... --target ...) when set; every lod run uses the first lod run's.
 # Each closest-point run's composited words are kept (POINTRAST_MPI_WORDS, in MPI_WORDS_DIR or /tmp) and a
 # run of several ranks is compared with the first 1-rank run of its input and method: the pixels whose words
 # differ, and how many of them are depth ties (the same depth, another of the tied points chosen).
@@ -62,6 +62,8 @@ PY
 }
 # shellcheck disable=SC2034 # the cameras are used through `local -n` in run
 terrain_camera=() lod_camera=()
+# shellcheck disable=SC2034 # likewise
+[ -z "${MPI_CAMERA:-}" ] || read -r -a terrain_camera <<<"$MPI_CAMERA" # the terrain runs' camera, given
 run() { # name method ranks composite cameraVar args...
   local name=$1 method=$2 ranks=$3 composite=$4 var=$5
   shift 5
