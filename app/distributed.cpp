@@ -68,12 +68,22 @@ bool distributedRun() {
   return mpi::Job::get().launched();
 }
 
+// Which device this rank took and why, for announceRanks(): ranks of one host must not share a GPU
+// unawares, and a device's name alone does not say which of several alike it is.
+static std::string chosenDevice;
+
 void chooseRankDevice(gpu::ContextOptions& options) {
   const mpi::Job& job = mpi::Job::get();
   if (!job.launched()) return;
   options.announce = false;
-  if (options.deviceIndex) return;
-  if (const char* env = std::getenv("POINTRAST_DEVICE"); env && *env) return; // the Context reads it
+  if (options.deviceIndex) {
+    chosenDevice = "device " + std::to_string(*options.deviceIndex) + " (--device)";
+    return;
+  }
+  if (const char* env = std::getenv("POINTRAST_DEVICE"); env && *env) {
+    chosenDevice = std::string("device ") + env + " (POINTRAST_DEVICE)";
+    return; // the Context reads it
+  }
   const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
   int best = 0;
   for (const gpu::DeviceInfo& d : devices)
@@ -81,7 +91,9 @@ void chooseRankDevice(gpu::ContextOptions& options) {
   std::vector<uint32_t> candidates;
   for (uint32_t i = 0; i < devices.size(); ++i)
     if (gpu::deviceTypeRank(devices[i].type) == best) candidates.push_back(i);
-  if (!candidates.empty()) options.deviceIndex = candidates[job.localRank() % candidates.size()];
+  if (candidates.empty()) return;
+  options.deviceIndex = candidates[job.localRank() % candidates.size()];
+  chosenDevice = "device " + std::to_string(*options.deviceIndex) + " of " + std::to_string(devices.size());
 }
 
 std::vector<std::string> announceRanks(const gpu::Context& context, bool quiet) {
@@ -89,7 +101,8 @@ std::vector<std::string> announceRanks(const gpu::Context& context, bool quiet) 
   char host[256] = {};
   if (gethostname(host, sizeof host - 1) != 0) std::snprintf(host, sizeof host, "unknown host");
   const std::string mine = std::string(host) + ": " + context.info().name + " (" + context.info().typeName +
-                           ")" + (context.validationEnabled() ? ", validation on" : "");
+                           ")" + (chosenDevice.empty() ? "" : ", " + chosenDevice) +
+                           (context.validationEnabled() ? ", validation on" : "");
   std::vector<std::string> all = job.gatherText(mine);
   if (job.root() && !quiet)
     for (size_t r = 0; r < all.size(); ++r)

@@ -13,6 +13,8 @@
 # Each closest-point run's composited words are kept (POINTRAST_MPI_WORDS, in MPI_WORDS_DIR or /tmp) and a
 # run of several ranks is compared with the first 1-rank run of its input and method: the pixels whose words
 # differ, and how many of them are depth ties (the same depth, another of the tied points chosen).
+# Where nvidia-smi is, each GPU's SM clock is sampled every 100 ms during a run, and the table gives each
+# GPU's median clock over the samples where it was at least half busy (a rank timed at a low clock shows).
 # Writes OutDir/mpi-scaling.jsonl (one `render --json` object per run) and OutDir/mpi-scaling.md.
 set -uo pipefail
 pr=$1 out=$2
@@ -36,8 +38,8 @@ ms() { awk -v v="$1" 'BEGIN { if (v == "") print "-"; else printf "%.2f", v }'; 
     "($(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | sort -u | paste -sd, -));" \
     "$(mpirun --version 2>/dev/null | head -1); 2560x1140, $frames frames, medians."
   echo
-  echo "| input | method | ranks | points | render ms (slowest rank) | per rank | readback ms | composite ms | composite | resolve ms (first) | frame ms | MB moved | image hash | words unlike 1 rank (ties) |"
-  echo "| --- | --- | ---: | ---: | ---: | --- | ---: | ---: | --- | ---: | ---: | ---: | --- | ---: |"
+  echo "| input | method | ranks | points | render ms (slowest rank) | per rank | readback ms | composite ms | composite | resolve ms (first) | frame ms | MB moved | image hash | words unlike 1 rank (ties) | SM MHz while busy, per GPU |"
+  echo "| --- | --- | ---: | ---: | ---: | --- | ---: | ---: | --- | ---: | ---: | ---: | --- | ---: | --- |"
 } >"$md"
 status=0
 words_dir=${MPI_WORDS_DIR:-/tmp/mpi-words}
@@ -60,6 +62,20 @@ for x, y in zip(a, b):
 print(f"{differ} ({ties})")
 PY
 }
+# Each GPU's median SM clock over the samples of CSV (index, clock, utilization) where it was >= 50 % busy.
+busy_clocks() { # CSV
+  python3 - "$1" <<'PY'
+import sys, statistics
+clocks = {}
+for line in open(sys.argv[1]):
+    try:
+        index, clock, busy = (int(v) for v in line.split(','))
+    except ValueError:
+        continue
+    if busy >= 50: clocks.setdefault(index, []).append(clock)
+print(', '.join(f"{i}: {statistics.median(c):.0f}" for i, c in sorted(clocks.items())) or '-')
+PY
+}
 # shellcheck disable=SC2034 # the cameras are used through `local -n` in run
 terrain_camera=() lod_camera=()
 # shellcheck disable=SC2034 # likewise
@@ -73,11 +89,23 @@ run() { # name method ranks composite cameraVar args...
   key="${key// /-}-$method" # a lod run compares with the 1-rank run whatever its node cache
   words="$words_dir/$key-$ranks-$composite.bin"
   rm -f "$words"
+  local clocks="$out/clocks-${name// /-}-$method-$ranks-$composite.csv" sampler=""
+  if command -v nvidia-smi >/dev/null; then
+    nvidia-smi --query-gpu=index,clocks.sm,utilization.gpu --format=csv,noheader,nounits -lms 100 >"$clocks" &
+    sampler=$!
+  fi
   line=$(POINTRAST_MPI_WORDS=$words POINTRAST_MPI_COMPOSITE=$composite POINTRAST_VALIDATION=0 \
     timeout "${MPI_RUN_LIMIT:-580}" \
     mpirun --oversubscribe --bind-to none -np "$ranks" "$pr" render "$@" \
     --method "$method" -o "$out/mpi-${name// /-}-$method-$ranks-$composite.png" "${view[@]}" ${camera[@]+"${camera[@]}"}) ||
-    { status=1; echo "bench-mpi: $name on $ranks rank(s) failed after $((SECONDS - start)) s"; return; }
+    { status=1; echo "bench-mpi: $name on $ranks rank(s) failed after $((SECONDS - start)) s"
+      [ -z "$sampler" ] || kill "$sampler"; return; }
+  local busy=-
+  if [ -n "$sampler" ]; then
+    kill "$sampler"
+    wait "$sampler" 2>/dev/null
+    busy=$(busy_clocks "$clocks")
+  fi
   echo "$line" | tee -a "$jsonl"
   echo "   ($((SECONDS - start)) s with loading)"
   [ ${#camera[@]} -gt 0 ] || read -r -a camera <<<"$(grep -o '"camera":"[^"]*"' <<<"$line" | head -1 | cut -d'"' -f4)"
@@ -100,7 +128,7 @@ run() { # name method ranks composite cameraVar args...
   echo "| $name | $method | $ranks | $(field points "$line") | $(ms "$(field render_ms "$line")") | $per |" \
     "$(ms "$(field readback_ms "$line")") | $(ms "$(field composite_ms "$line")") | ${path:--} |" \
     "$(ms "$(field resolve_ms "$line")") ($(ms "$(field resolve_first_ms "$line")")) |" \
-    "$(ms "$(field frame_ms "$line")") | $mb | \`$hash\` | $versus |" >>"$md"
+    "$(ms "$(field frame_ms "$line")") | $mb | \`$hash\` | $versus | $busy |" >>"$md"
 }
 for spec in "${runs[@]}"; do
   IFS=: read -r what ranks composite method <<<"$spec"

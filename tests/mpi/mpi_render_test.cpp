@@ -94,6 +94,15 @@ TEST(MpiRender, AtomicMinComposesTheOneRankFrameExactly) {
   EXPECT_EQ(three.json["mpi"]["rank_render_ms"].size(), 3u);
   EXPECT_EQ(three.json["mpi"]["bytes_moved"], 2u * 240 * 160 * 8);
   EXPECT_GE(three.json["mpi"]["composite_ms"].get<double>(), 0.0);
+  // A frame's stages one after another; every rank says which device it took.
+  const nlohmann::json& stages = three.json["mpi"];
+  EXPECT_NEAR(stages["frame_ms"].get<double>(),
+              stages["render_ms"].get<double>() + stages["readback_ms"].get<double>() +
+                  stages["composite_ms"].get<double>() + stages["resolve_ms"].get<double>(),
+              1e-6);
+  EXPECT_GT(stages["resolve_first_ms"].get<double>(), 0.0);
+  for (const auto& device : stages["devices"])
+    EXPECT_NE(device.get<std::string>().find(", device "), std::string::npos) << device;
   // And one rank under mpirun is today's render.
   const pointrast::test::CliResult plain = runPointrast("render " + terrain("plain.png") + " --json -q");
   ASSERT_EQ(plain.exitCode, 0) << plain.err;
