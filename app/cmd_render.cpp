@@ -503,10 +503,11 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings,
   FrameStats stats = draw(drawn);
   // Loading the nodes is seconds of host work, in which GPU clocks fall to idle, so a frame that is one
   // resident pass is timed again with settled clocks, as the point methods are; its loading figures stay
-  // the first frame's. A frame drawn in passes streams every time and keeps its one timing.
+  // the first frame's. A frame drawn in passes streams every time and keeps its one timing (its clocks are
+  // reported unsettled); a software device is always settled.
+  bool settled = !settlesClocks(context);
   if (stats.lod && stats.lod->passes == 1 && settleClocksWith(context, drawn, draw)) {
     const std::optional<lod::LodStats> loaded = stats.lod;
-    bool settled = true;
     stats = timeSettled(context, drawn, draw, settled);
     stats.lod = loaded;
     warnUnsettled(settled, stats.medianMs, stats.minMs);
@@ -536,6 +537,7 @@ int runRenderOctree(const RenderArgs& a, RenderSettings settings,
       a, context, pixels,
       [&] {
         nlohmann::json j = octreeJson(context, settings, octree, colors, stats, camera, a, pixels);
+        j["clocks_settled"] = settled;
         if (distributed) j["mpi"] = compositeJson(composite); // batch and LOD counts are rank 0's
         if (!a.pick.empty()) {
           const PixelPos pixel = parsePick(a.pick, a.width, a.height);

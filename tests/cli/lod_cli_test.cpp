@@ -63,6 +63,7 @@ TEST(LodCli, RendersEveryPointOfAnOctreeInOnePassOrMany) {
   EXPECT_TRUE(w["lod_stats"]["converged"]);
   EXPECT_GT(w["lod_stats"]["bytes_streamed"], 0);
   EXPECT_GT(w["batch_stats"]["batches_processed"], 0);
+  EXPECT_TRUE(w["clocks_settled"].is_boolean()) << w; // settled, or not where the GPU's clocks never did
   EXPECT_TRUE(fs::exists(png));
 
   // A node cache of 192 KiB (three pages): many passes, the same image.
@@ -71,6 +72,7 @@ TEST(LodCli, RendersEveryPointOfAnOctreeInOnePassOrMany) {
   const nlohmann::json p = nlohmann::json::parse(parts.out);
   EXPECT_GT(p["lod_stats"]["passes"], 1);
   EXPECT_EQ(p["lod_stats"]["cache_bytes"], 3 * 65536);
+  EXPECT_TRUE(p["clocks_settled"].is_boolean()) << p;
   EXPECT_EQ(p["image_hash"], w["image_hash"]);
 
   const CliResult hqs = runPointrast(base + " --method lod-hqs --min-node-px 0 --gpu-memory 192k");
