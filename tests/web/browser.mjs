@@ -4,7 +4,6 @@
 // that would reach out turned off, and a fresh profile in a temporary folder.
 //
 //   node browser.mjs SCENARIO URL OUTDIR [JSON-ARGS]
-import { chromium } from 'playwright-core';
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -12,6 +11,26 @@ import { join } from 'node:path';
 const [scenario, url, outdir, argsText] = process.argv.slice(2);
 const args = argsText ? JSON.parse(argsText) : {};
 const TIMEOUT = 120000;
+
+// Chromium's own output (its stderr and playwright's record of the process, which playwright writes to
+// this process's stderr under DEBUG=pw:browser) is kept, not printed, to say why should the browser go
+// away in the middle of a scenario.
+const browserLog = [];
+const keep = (text) => {
+  for (const line of text.split('\n')) // the debug lines carry their time; chromium's D-Bus noise is left out
+    if (line.trim() && !line.includes('ERROR:dbus/')) browserLog.push(line);
+  browserLog.splice(0, Math.max(0, browserLog.length - 80));
+};
+process.env.DEBUG = [process.env.DEBUG, 'pw:browser'].filter(Boolean).join(',');
+const stderrWrite = process.stderr.write.bind(process.stderr);
+process.stderr.write = (chunk, ...rest) => {
+  if (!String(chunk).includes('pw:browser')) return stderrWrite(chunk, ...rest); // node's own errors
+  keep(String(chunk));
+  const done = rest.find((r) => typeof r === 'function');
+  if (done) done();
+  return true;
+};
+const { chromium } = await import('playwright-core');
 
 async function launch(viewport) {
   const profile = mkdtempSync(join(tmpdir(), 'pointrast-chromium-'));
@@ -22,6 +41,7 @@ async function launch(viewport) {
     executablePath: process.env.POINTRAST_CHROMIUM || '/usr/bin/chromium',
     headless: true, args: flags, viewport, deviceScaleFactor: 1, timeout: TIMEOUT,
   });
+  context.on('close', () => keep(`${new Date().toISOString()} the browser context closed`));
   context.setDefaultTimeout(TIMEOUT);
   return { context, close: async () => { await context.close(); rmSync(profile, { recursive: true, force: true }); } };
 }
@@ -42,6 +62,7 @@ async function open(context, target) {
   const page = await context.newPage();
   const errors = [];
   page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('crash', () => errors.push('the page crashed'));
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
   const response = await page.goto(target);
   return { page, errors, status: response ? response.status() : 0 };
@@ -296,12 +317,13 @@ const scenarios = {
 };
 
 const viewport = { width: args.viewportWidth || 640, height: args.viewportHeight || 480 };
-const browser = await launch(viewport);
+let browser = null;
 let result;
 try {
+  browser = await launch(viewport);
   result = await scenarios[scenario](browser.context);
 } catch (error) {
-  result = { failure: String(error && error.stack || error) };
+  result = { failure: String(error && error.stack || error) + '\nchromium, last lines:\n' + browserLog.join('\n') };
 }
-await browser.close();
+if (browser) await browser.close().catch((error) => keep(`closing the browser: ${error}`));
 console.log(JSON.stringify(result));
