@@ -37,7 +37,9 @@ protected:
   // and compares the page's picture and downloads with `pointrast profile`'s.
   void drawAndCompare(const std::string& input, const std::string& serveOptions, const Json& pixels,
                       const std::string& name) {
-    ServeProcess server("'" + input + "' " + serveOptions);
+    // The server's temporary files in a folder of this test's own (tests beside it export too).
+    const auto tmp = scratchDir(name + "_tmp");
+    ServeProcess server("'" + input + "' " + serveOptions, "env TMPDIR='" + tmp.string() + "'");
     ASSERT_TRUE(server.listening()) << server.stderrText();
     const auto dir = scratchDir(name);
     const std::string size = "600x300";
@@ -109,7 +111,7 @@ protected:
     for (const Json& e : server.events())
       cuts += e.value("event", "") == "profile" ? 1 : 0;
     EXPECT_EQ(cuts, pixels.size() - 1 + 2);
-    EXPECT_EQ(commandOutput("ls -d \"${TMPDIR:-/tmp}\"/pointrast-export-* 2>/dev/null"), "");
+    EXPECT_EQ(commandOutput("ls -d '" + tmp.string() + "'/pointrast-export-* 2>/dev/null"), "");
     EXPECT_EQ(server.stop(), 0) << server.stderrText();
     const auto exit = server.exitEvent();
     ASSERT_TRUE(exit);
