@@ -237,9 +237,10 @@ Quantization chooseQuantization(const std::filesystem::path& path, const Bounds&
     q.offset[a] = bounds.min[a];
     double scale = 1.0;
     if (extent > 0) {
-      // The smallest power of ten with extent / scale <= kQuantSteps; log10 only gives the start.
-      int k = static_cast<int>(std::ceil(std::log10(extent / kQuantSteps)));
-      k = std::clamp(k, -300, 300);
+      // The smallest power of ten with extent / scale <= kQuantSteps; log10 only gives the start. The
+      // logarithms are taken apart: a subnormal extent divided by kQuantSteps is 0, whose log is -inf.
+      double start = std::ceil(std::log10(extent) - std::log10(kQuantSteps));
+      int k = static_cast<int>(std::clamp(start, -300.0, 300.0));
       while (k > -300 && extent / std::pow(10.0, k - 1) <= kQuantSteps)
         --k;
       while (k < 300 && extent / std::pow(10.0, k) > kQuantSteps)

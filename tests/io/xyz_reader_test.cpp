@@ -192,6 +192,16 @@ TEST(XyzReader, NonFiniteIntensitiesStayInRange) {
   EXPECT_EQ(cloud.intensity[3], 65535);
 }
 
+// Points a subnormal distance apart: the extent divided by the quantization steps is 0 and its log -inf,
+// which was converted to an integer (undefined behaviour, found by xyz_fuzz). They read, in range.
+TEST(XyzReader, SubnormalExtentIsQuantized) {
+  PointCloud cloud = readText("0 0 0\n4.9e-322 0 0\n");
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_GT(cloud.scale.x, 0.0);
+  EXPECT_LE(cloud.scale.x, 1e-299);
+  EXPECT_TRUE(std::isfinite(cloud.bounds.max.x));
+}
+
 TEST(XyzReader, OnlyTextExtensionsAreTriedAsText) {
   iotest::TempDir dir;
   for (const char* name : {"a.xyz", "a.TXT", "a.csv", "a.pts"}) {
