@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,11 +21,13 @@
 #include "base/progress.h"
 #include "cli_util.h"
 #include "commands.h"
+#include "gpu/context.h"
 #include "io/format_table.h"
 #include "io/output_check.h"
 #include "io/copc_ept/copc_writer.h"
 #include "io/potree/lod_potree.h"
 #include "io/writer.h"
+#include "render/gpu_indexer.h"
 
 namespace pointrast::app {
 
@@ -34,6 +37,7 @@ struct LodArgs {
   std::vector<std::string> inputs;
   std::string output, memory, leafPoints = "20k", encoding = "default", colorFilter = "average";
   std::string format; // potree or copc; empty: by the output's name (".laz": copc)
+  std::string indexOn = "cpu";
   double spacing = 0;
   unsigned threads = 0;
   bool noColorFilter = false;
@@ -86,7 +90,13 @@ double perSecond(double count, double seconds) {
   return seconds > 0 ? count / seconds : 0;
 }
 
-nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
+// Where the index phase ran: the device and how many chunks it took (the CPU takes the ones it cannot).
+struct IndexDevice {
+  std::string name;
+  render::GpuIndexer::Stats stats;
+};
+
+nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r, const IndexDevice* device) {
   const io::LodBuildReport& b = r.build;
   nlohmann::json j;
   j["command"] = "lod";
@@ -108,6 +118,13 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
   j["format"] = a.format;
   j["encoding"] = a.encoding;
   j["color_filter"] = a.colorFilter;
+  j["index_on"] = a.indexOn;
+  if (device) {
+    j["index_device"] = device->name;
+    j["index_gpu_chunks"] = device->stats.gpuChunks;
+    j["index_cpu_chunks"] = device->stats.cpuChunks;
+    j["index_device_seconds"] = device->stats.deviceSeconds;
+  }
   nlohmann::json phases = nlohmann::json::array();
   for (const lod::LodPhase& p : b.phases) {
     nlohmann::json q;
@@ -124,7 +141,7 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r) {
   return j;
 }
 
-void printSummary(const LodArgs& a, const io::PotreeBuildReport& r) {
+void printSummary(const LodArgs& a, const io::PotreeBuildReport& r, const IndexDevice* device) {
   const io::LodBuildReport& b = r.build;
   std::printf("%s: %s points in %s nodes, %d levels, %.1f MB, in %.2f s (%s points/s; %s, %u threads)\n",
               a.output.c_str(), humanCount(double(b.octree.points)).c_str(),
@@ -142,6 +159,10 @@ void printSummary(const LodArgs& a, const io::PotreeBuildReport& r) {
     else
       std::printf("   cpu %7.3f s\n", p.cpuSeconds);
   }
+  if (device)
+    std::printf("  index on %s: %llu chunks (%llu on the CPU), %.3f s of device work\n", device->name.c_str(),
+                static_cast<unsigned long long>(device->stats.gpuChunks),
+                static_cast<unsigned long long>(device->stats.cpuChunks), device->stats.deviceSeconds);
 }
 
 int runLod(LodArgs a) {
@@ -167,12 +188,25 @@ int runLod(LodArgs a) {
     throw InputError("--format expects potree or copc, got '" + a.format + "'");
   if (a.format == "copc" && a.encoding != "default")
     throw InputError("--encoding applies to Potree output; COPC nodes are LAZ");
+  if (a.indexOn != "cpu" && a.indexOn != "gpu")
+    throw InputError("--index-on expects cpu or gpu, got '" + a.indexOn + "'");
   // From here on a signal asks the build to stop: the check below already writes (a probe file it removes).
   gInterrupted = false;
   options.cancel = &gInterrupted;
   InterruptGuard guard;
   // Refused before any point is read: a mistake in the output's name should not cost a read of the input.
   checkOutputFolder(a.output);
+
+  // The device for the index phase, before any point is read: a machine without one says so at once.
+  std::unique_ptr<gpu::Context> context;
+  std::unique_ptr<render::GpuIndexer> indexer;
+  if (a.indexOn == "gpu") {
+    gpu::ContextOptions device;
+    device.announce = !a.quiet && !a.json;
+    context = std::make_unique<gpu::Context>(device);
+    indexer = std::make_unique<render::GpuIndexer>(*context);
+    options.indexer = indexer.get();
+  }
 
   std::vector<std::filesystem::path> inputs(a.inputs.begin(), a.inputs.end());
   io::PotreeBuildReport report;
@@ -188,10 +222,12 @@ int runLod(LodArgs a) {
     std::fprintf(stderr, "pointrast: interrupted; %s was not written\n", a.output.c_str());
     return 130;
   }
+  std::optional<IndexDevice> device;
+  if (indexer) device = IndexDevice{context->info().name, indexer->stats()};
   if (a.json)
-    std::printf("%s\n", jsonText(toJson(a, report)).c_str());
+    std::printf("%s\n", jsonText(toJson(a, report, device ? &*device : nullptr)).c_str());
   else if (!a.quiet)
-    printSummary(a, report);
+    printSummary(a, report, device ? &*device : nullptr);
   return 0;
 }
 
@@ -226,6 +262,11 @@ Command addLod(CLI::App& app) {
       "--memory and --threads are. The folder appears only when complete: an error or Ctrl-C leaves\n"
       "nothing behind (a second Ctrl-C stops at once).\n"
       "\n"
+      "With --index-on gpu the index phase (sorting each chunk's points into nodes and choosing every\n"
+      "level's subsample) runs on the Vulkan device, one chunk at a time, while the CPU lays out, encodes\n"
+      "and writes the nodes; the octree is the same byte for byte. Grids with unequal scales on the axes\n"
+      "are indexed on the CPU.\n"
+      "\n"
       "An output named *.laz (or --format copc) is one COPC 1.0 file instead of a folder: the same nodes\n"
       "and points, each node a LAZ chunk (point format 6, 7 with color), the inputs' WKT coordinate\n"
       "system kept; `info` says whether its inner nodes hold averaged colors.\n"
@@ -258,6 +299,10 @@ Command addLod(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-color-filter", a->noColorFilter,
                 "The same as --color-filter none: every point keeps its own color (an exact round trip)");
+  cmd->add_option("--index-on", a->indexOn,
+                  "Where the points are sorted and subsampled: cpu, or gpu (the Vulkan device: the best one, "
+                  "or POINTRAST_DEVICE); the octree is the same byte for byte")
+      ->capture_default_str();
   cmd->add_flag("--json", a->json,
                 "Print one JSON object: points, nodes, levels, bytes, phases with seconds");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress lines or summary");

@@ -209,9 +209,14 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
         const std::span<LodItem> items = loaded.items;
         const LodChunk& chunk = chunks[i];
         assert(items.size() == chunk.points);
-        indexChunk(*result, scratch, grid, chunk.key, items.data(), items.size(),
-                   counts.data() + chunk.firstCell, static_cast<size_t>(chunk.endCell - chunk.firstCell),
-                   params, loaded.tails);
+        const uint64_t* cellCounts = counts.data() + chunk.firstCell;
+        const size_t cells = static_cast<size_t>(chunk.endCell - chunk.firstCell);
+        if (options.indexer)
+          options.indexer->index(*result, scratch, grid, chunk.key, items.data(), items.size(), cellCounts,
+                                 cells, params, loaded.tails);
+        else
+          indexChunk(*result, scratch, grid, chunk.key, items.data(), items.size(), cellCounts, cells, params,
+                     loaded.tails);
         assembler.prepare(*result);
         if (progress) progress->advance(items.size());
         lock.lock();

@@ -24,6 +24,7 @@ struct LodRunOptions {
   const std::atomic<bool>* cancel = nullptr; // set from elsewhere (a signal): the build throws Interrupted
   bool progress = true;                      // progress lines on a terminal
   uint64_t chunkPoints = 0;                  // chunk size limit; 0: chosen from the count and threads
+  ChunkIndexer* indexer = nullptr;           // indexes the chunks (the GPU); null: indexChunk on the CPU
 };
 
 struct LodPhase {

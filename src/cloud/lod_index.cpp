@@ -247,4 +247,144 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
   if (taken < count) indexer.node(chunk.level, 0, count);
 }
 
+namespace {
+
+// indexChunk's node walk over another indexer's result: the same nodes in the same order, the same
+// records (a taken point with the color it took), the same tails.
+class IndexedAssembler {
+public:
+  IndexedAssembler(ChunkNodes& out, const LodItem* items, const uint32_t* levels, const uint32_t* colors,
+                   const LodParams& params, const uint8_t* tails)
+      : out_(out), items_(items), levels_(levels), colors_(colors), params_(params), tails_(tails) {}
+
+  void put(PointRecord* dst, uint8_t* dstTails, size_t at, size_t k, bool taken) const {
+    dst[at] = items_[k].record;
+    if (taken) {
+      dst[at].rgb[0] = static_cast<uint16_t>(colors_[2 * k] & 0xFFFFu);
+      dst[at].rgb[1] = static_cast<uint16_t>(colors_[2 * k] >> 16);
+      dst[at].rgb[2] = static_cast<uint16_t>(colors_[2 * k + 1] & 0xFFFFu);
+    }
+    if (tails_) {
+      const uint32_t n = params_.tailBytes;
+      std::memcpy(dstTails + at * n, tails_ + items_[k].ref * n, n);
+    }
+  }
+
+  void node(int level, size_t begin, size_t end) {
+    ChunkNodes::Node n;
+    n.key = keyOfCode(items_[begin].code, level);
+    n.first = used_;
+    PointRecord* const start = out_.records.data() + used_;
+    uint8_t* const startTails = tails_ ? out_.tails.data() + used_ * params_.tailBytes : nullptr;
+    size_t written = 0;
+    if (end - begin > params_.leafPoints && level < kMaxLevel) {
+      const int childShift = 3 * (kCodeLevels - level - 1);
+      uint64_t left[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+      const uint32_t here = static_cast<uint32_t>(level);
+      for (size_t k = begin; k < end; ++k) {
+        const uint32_t taken = levels_[k];
+        if (taken == here)
+          put(start, startTails, written++, k, true);
+        else if (taken > here) // kNotTakenLevel included
+          ++left[(untagged(items_[k].code) >> childShift) & 7];
+      }
+      n.count = written;
+      used_ += written;
+      size_t childBegin = begin;
+      for (int c = 0; c < 8 && childBegin < end; ++c) {
+        const uint64_t childCell = untagged(items_[childBegin].code) >> childShift;
+        if ((childCell & 7) != uint64_t(c)) continue;
+        const size_t childEnd =
+            static_cast<size_t>(std::partition_point(items_ + childBegin, items_ + end,
+                                                     [&](const LodItem& e) {
+                                                       return untagged(e.code) >> childShift == childCell;
+                                                     }) -
+                                items_);
+        if (left[c] > 0) node(level + 1, childBegin, childEnd);
+        childBegin = childEnd;
+      }
+    } else {
+      for (size_t k = begin; k < end; ++k)
+        if (levels_[k] == kNotTakenLevel) put(start, startTails, written++, k, false);
+      n.count = written;
+      used_ += written;
+    }
+    assert(n.count > 0);
+    out_.nodes.push_back(n);
+  }
+
+private:
+  ChunkNodes& out_;
+  uint64_t used_ = 0;
+  const LodItem* items_;
+  const uint32_t* levels_;
+  const uint32_t* colors_;
+  const LodParams& params_;
+  const uint8_t* tails_;
+};
+
+} // namespace
+
+bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count, IndexScratch& scratch) {
+  bool any = false;
+  std::vector<uint32_t> places;
+  for (size_t i = 0; i + 1 < count;) {
+    size_t end = i + 1;
+    while (end < count && untagged(items[end].code) == untagged(items[i].code))
+      ++end;
+    if (end - i > 1) {
+      any = true;
+      // Sort the run's positions by their items, then move items and order along.
+      const size_t n = end - i;
+      places.resize(n);
+      for (size_t k = 0; k < n; ++k)
+        places[k] = static_cast<uint32_t>(k);
+      std::sort(places.begin(), places.end(),
+                [&](uint32_t a, uint32_t b) { return itemLess(items[i + a], items[i + b]); });
+      if (scratch.items.size() < n) scratch.items.resize(n);
+      if (scratch.counts.size() < n) scratch.counts.resize(n);
+      for (size_t k = 0; k < n; ++k) {
+        scratch.items[k] = items[i + places[k]];
+        scratch.counts[k] = order[i + places[k]];
+      }
+      for (size_t k = 0; k < n; ++k) {
+        items[i + k] = scratch.items[k];
+        order[i + k] = static_cast<uint32_t>(scratch.counts[k]);
+      }
+    }
+    i = end;
+  }
+  return any;
+}
+
+void assembleIndexedChunk(ChunkNodes& out, const NodeKey& chunk, LodItem* items, size_t count,
+                          const uint32_t* takenLevels, const uint32_t* colors, const LodParams& params,
+                          const uint8_t* tails) {
+  assert((tails != nullptr) == (params.tailBytes > 0));
+  out.chunk = chunk;
+  out.topCounts.assign(static_cast<size_t>(chunk.level), 0);
+  out.nodes.clear();
+  if (count == 0) return;
+  if (out.records.size() < count) out.records.resize(count);
+  if (out.top.size() < count) out.top.resize(count);
+  const size_t tailBytes = size_t(count) * params.tailBytes;
+  if (out.tails.size() < tailBytes) out.tails.resize(tailBytes);
+  if (out.topTails.size() < tailBytes) out.topTails.resize(tailBytes);
+
+  // The ancestors' subsamples, level after level, each in sorted order.
+  const uint32_t levels = static_cast<uint32_t>(chunk.level);
+  for (size_t k = 0; k < count; ++k)
+    if (takenLevels[k] < levels) ++out.topCounts[takenLevels[k]];
+  std::vector<uint64_t> at(levels + 1, 0);
+  for (uint32_t l = 0; l < levels; ++l)
+    at[l + 1] = at[l] + out.topCounts[l];
+  IndexedAssembler assembler(out, items, takenLevels, colors, params, tails);
+  for (size_t k = 0; k < count; ++k)
+    if (takenLevels[k] < levels)
+      assembler.put(out.top.data(), tails ? out.topTails.data() : nullptr, at[takenLevels[k]]++, k, true);
+  if (at[levels] < count) assembler.node(chunk.level, 0, count);
+  for (size_t k = 0; k < count; ++k)
+    if (takenLevels[k] != kNotTakenLevel) items[k].code |= kTakenBit;
+}
+
 } // namespace pointrast::lod

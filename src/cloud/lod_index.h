@@ -91,4 +91,29 @@ void indexChunk(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, con
 // in which the codes may differ (the others are equal). For a cell's items, and for tests.
 void sortItems(LodItem* items, size_t count, int freeBits, IndexScratch& scratch);
 
+// Indexes chunks elsewhere than indexChunk's CPU code (the GPU: render/gpu_indexer.h) with the same
+// result, byte for byte, and the same contract. Called from every indexing thread at once.
+class ChunkIndexer {
+public:
+  virtual ~ChunkIndexer() = default;
+  virtual void index(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, const NodeKey& chunk,
+                     LodItem* items, size_t count, const uint64_t* cellCounts, size_t cells,
+                     const LodParams& params, const uint8_t* tails) = 0;
+};
+
+// The pieces another indexer needs to give indexChunk's result from its own sort and subsamples.
+//
+// The taken level of a point no subsample took: it stays in its leaf.
+inline constexpr uint32_t kNotTakenLevel = 0xFFFFFFFFu;
+// Items sorted by code alone, ties in any order, into the canonical order (lod_index.h's top): each run
+// of equal codes sorted by record bytes and ref, `order` (each item's place in some other array) moved
+// with its item. True when there was such a run (the order may have changed).
+bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count, IndexScratch& scratch);
+// The chunk's nodes from its items in canonical order and, for each, the level whose subsample took it
+// (kNotTakenLevel: none) and the color it took (rgb[0] | rgb[1] << 16, rgb[2]; averaged where colors
+// are filtered); marks the taken items as indexChunk does. The other arguments are indexChunk's.
+void assembleIndexedChunk(ChunkNodes& out, const NodeKey& chunk, LodItem* items, size_t count,
+                          const uint32_t* takenLevels, const uint32_t* colors, const LodParams& params,
+                          const uint8_t* tails = nullptr);
+
 } // namespace pointrast::lod

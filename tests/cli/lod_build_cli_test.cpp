@@ -98,6 +98,53 @@ TEST(LodBuildCli, SameBytesFromOneAndTwoThreadsAndWithLittleMemory) {
   EXPECT_EQ(nlohmann::json::parse(info.out)["points"], 300000) << info.out;
 }
 
+// The index phase on the Vulkan device (lavapipe here) writes the CPU's bytes: a real scan in memory as
+// Potree and as COPC, and generated terrain out of core; the JSON says the device took the chunks.
+TEST(LodBuildCli, GpuIndexWritesTheSameBytes) {
+  POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
+  const fs::path terrain = fresh("lod_gpu_terrain.las");
+  ASSERT_EQ(runPointrast("generate terrain --points 60k -q -o " + terrain.string()).exitCode, 0);
+  struct Case {
+    fs::path input;
+    std::string name, options;
+    bool outOfCore;
+  };
+  const Case cases[] = {{kAutzen, "o", " --leaf-points 5k", false},
+                        {kAutzen, "o.copc.laz", " --leaf-points 5k", false},
+                        {terrain, "o", " --leaf-points 2k --memory 2M", true}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.input.string() + c.options + " -o " + c.name);
+    const fs::path cpu = fresh("lod_index_cpu"), gpu = fresh("lod_index_gpu");
+    fs::create_directories(cpu);
+    fs::create_directories(gpu);
+    const auto onCpu =
+        runPointrast("lod " + c.input.string() + c.options + " --json -o " + (cpu / c.name).string());
+    ASSERT_EQ(onCpu.exitCode, 0) << onCpu.err;
+    const auto onGpu = runPointrast("lod " + c.input.string() + c.options + " --json --index-on gpu -o " +
+                                    (gpu / c.name).string());
+    ASSERT_EQ(onGpu.exitCode, 0) << onGpu.err;
+    EXPECT_EQ(onGpu.err.find("Validation"), std::string::npos) << onGpu.err;
+    const nlohmann::json j = nlohmann::json::parse(onGpu.out);
+    EXPECT_EQ(j["index_on"], "gpu");
+    EXPECT_GT(j["index_gpu_chunks"].get<int>(), 0);
+    EXPECT_EQ(j["index_cpu_chunks"].get<int>(), 0);
+    EXPECT_EQ(j["out_of_core"].get<bool>(), c.outOfCore);
+    EXPECT_EQ(nlohmann::json::parse(onCpu.out)["index_on"], "cpu");
+    if (fs::is_directory(cpu / c.name)) {
+      for (const char* file : {"octree.bin", "hierarchy.bin"})
+        EXPECT_EQ(bytesOf(gpu / c.name / file), bytesOf(cpu / c.name / file)) << file;
+      EXPECT_EQ(fs::file_size(gpu / c.name / "metadata.json"), fs::file_size(cpu / c.name / "metadata.json"));
+    } else {
+      EXPECT_EQ(bytesOf(gpu / c.name), bytesOf(cpu / c.name));
+    }
+  }
+  const auto wrong =
+      runPointrast("lod " + terrain.string() + " --index-on tpu -o " + fresh("lod_tpu").string());
+  EXPECT_EQ(wrong.exitCode, 1);
+  EXPECT_NE(wrong.err.find("--index-on expects cpu or gpu"), std::string::npos) << wrong.err;
+  EXPECT_FALSE(fs::exists(fresh("lod_tpu")));
+}
+
 TEST(LodBuildCli, MistakesGiveOneLineAndWriteNothing) {
   POINTRAST_REQUIRE_DATA("las/autzen_trim.las");
   const fs::path dir = fresh("lod_errors");

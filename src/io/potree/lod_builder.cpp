@@ -162,6 +162,7 @@ OctreeBuilder::OctreeBuilder(const std::vector<std::filesystem::path>& inputs, c
   s.run.threads = s.threads;
   s.run.cancel = options.cancel;
   s.run.progress = options.progress;
+  s.run.indexer = options.indexer;
   s.params.leafPoints = std::max<uint64_t>(options.leafPoints, 1);
   s.params.averageColors = options.averageColors;
   s.params.tailBytes = s.inputs.tail().bytes();

@@ -33,6 +33,7 @@ struct LodBuildOptions {
   bool averageColors = true;    // inner nodes' colors: averages of the points they stand for
   bool progress = true;         // progress lines on stderr when it is a terminal
   const std::atomic<bool>* cancel = nullptr; // when set (by a signal handler), the build throws Interrupted
+  lod::ChunkIndexer* indexer = nullptr;      // indexes the chunks (the GPU); null: on the CPU
 };
 
 // Half of the physical memory, or of the control group's limit where that is lower.

@@ -1,0 +1,13 @@
+#version 460
+// The points in sorted order (sorted[i] = items[order[i]]), none taken yet.
+#include "lod_index.inc.glsl"
+
+layout(local_size_x = kIndexGroupSize) in;
+layout(push_constant) uniform Push { IndexLevelPush pc; };
+
+void main() {
+  const uint i = linearInvocation(pc.groupsX, kIndexGroupSize);
+  if (i >= pc.count) return;
+  IndexItems(pc.sorted).v[i] = IndexItems(pc.items).v[UintArray(pc.order).v[i]];
+  UintArray(pc.taken).v[i] = kNotTaken;
+}

@@ -1,0 +1,182 @@
+#include "render/gpu_indexer.h"
+
+#include <chrono>
+#include <cstddef>
+#include <cstring>
+#include <vector>
+
+#include "base/error.h"
+#include "gpu/context.h"
+#include "lod_index_shared.h"
+
+namespace pointrast::render {
+
+namespace shared = pointrast::shared;
+
+// The passes read the builder's items as they are (lod::LodItem) and mark levels as the CPU expects.
+static_assert(sizeof(shared::IndexItem) == sizeof(lod::LodItem));
+static_assert(offsetof(shared::IndexItem, code) == offsetof(lod::LodItem, code));
+static_assert(offsetof(shared::IndexItem, x) == offsetof(lod::LodItem, record) + offsetof(PointRecord, x));
+static_assert(offsetof(shared::IndexItem, rg) == offsetof(lod::LodItem, record) + offsetof(PointRecord, rgb));
+static_assert(offsetof(shared::IndexItem, bIntensity) ==
+              offsetof(lod::LodItem, record) + offsetof(PointRecord, rgb) + 4);
+static_assert(offsetof(shared::IndexItem, ref) == offsetof(lod::LodItem, ref));
+static_assert(shared::kNotTaken == lod::kNotTakenLevel);
+static_assert(shared::kIndexCodeLevels == uint32_t(lod::kCodeLevels));
+static_assert(sizeof(shared::RadixPush) == 64);
+static_assert(sizeof(shared::IndexLevelPush) == 96 && offsetof(shared::IndexLevelPush, qmin) == 56 &&
+              offsetof(shared::IndexLevelPush, count) == 68);
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+} // namespace
+
+GpuIndexer::GpuIndexer(gpu::Context& context)
+    : context_(context), histogram_(context, "lod_index_histogram.comp"),
+      scan_(context, "lod_index_scan.comp"), scatter_(context, "lod_index_scatter.comp"),
+      gather_(context, "lod_index_gather.comp"), level_(context, "lod_index_level.comp") {}
+
+GpuIndexer::~GpuIndexer() = default;
+
+GpuIndexer::Stats GpuIndexer::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+void GpuIndexer::reserve(size_t count) {
+  if (count <= capacity_) return;
+  // Room for a quarter more than asked, so that chunks a little larger do not reallocate each time.
+  const size_t n = count + count / 4;
+  const uint64_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
+  capacity_ = 0;
+  auto make = [&](uint64_t bytes, const char* name) {
+    return gpu::Buffer(context_, bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, name);
+  };
+  items_ = gpu::Buffer();
+  sorted_ = gpu::Buffer();
+  items_ = make(n * sizeof(lod::LodItem), "index items");
+  sorted_ = make(n * sizeof(lod::LodItem), "index sorted items");
+  for (int b = 0; b < 2; ++b) {
+    keys_[b] = make(n * sizeof(uint64_t), "index keys");
+    values_[b] = make(n * sizeof(uint32_t), "index order");
+  }
+  taken_ = make(n * sizeof(uint32_t), "index taken levels");
+  colors_ = make(n * 2 * sizeof(uint32_t), "index colors");
+  buckets_ = make(tiles * 256 * sizeof(uint32_t), "index histogram");
+  capacity_ = n;
+}
+
+bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& grid,
+                               const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
+                               const lod::LodParams& params, uint32_t* order, uint32_t* levels,
+                               uint32_t* colors) {
+  std::lock_guard lock(mutex_);
+  try {
+    reserve(count);
+  } catch (const UnsupportedError&) {
+    return false;
+  }
+  const auto start = Clock::now();
+  gpu::writeBuffer(context_, items_, 0, items, count * sizeof(lod::LodItem));
+
+  // The radix sort on the bits the chunk's codes may differ in, 8 at a time from the lowest: stable
+  // passes, so the points end sorted by code, equal codes in the order they came.
+  const uint32_t n = static_cast<uint32_t>(count);
+  const uint32_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
+  const int freeBits = 3 * (lod::kCodeLevels - chunk.level);
+  const int passes = (freeBits + int(shared::kRadixBits) - 1) / int(shared::kRadixBits);
+  const gpu::Grid tileGrid = gpu::gridFor(uint64_t(tiles) * shared::kIndexGroupSize, shared::kIndexGroupSize);
+  int current = 0; // the keys_/values_ pair holding the pass's result
+  context_.submitAndWait([&](VkCommandBuffer cmd) {
+    for (int p = 0; p < passes; ++p) {
+      shared::RadixPush push{};
+      const int in = p % 2, out = 1 - in;
+      push.keysIn = keys_[in].address();
+      push.valuesIn = values_[in].address();
+      push.keysOut = keys_[out].address();
+      push.valuesOut = values_[out].address();
+      push.histogram = buckets_.address();
+      push.items = p == 0 ? items_.address() : 0; // the first pass reads the codes from the items
+      push.count = n;
+      push.shift = uint32_t(p) * shared::kRadixBits;
+      push.tiles = tiles;
+      push.groupsX = tileGrid.x;
+      histogram_.dispatch(cmd, tileGrid.x, tileGrid.y, push);
+      gpu::fullBarrier(cmd);
+      scan_.dispatch(cmd, 1, 1, push);
+      gpu::fullBarrier(cmd);
+      scatter_.dispatch(cmd, tileGrid.x, tileGrid.y, push);
+      gpu::fullBarrier(cmd);
+      current = out;
+    }
+  });
+  gpu::readBuffer(context_, values_[current], 0, order, count * sizeof(uint32_t), &readback_);
+
+  // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
+  // end sorted in place, as indexChunk leaves them.
+  if (scratch.items.size() < count) scratch.items.resize(count);
+  for (size_t i = 0; i < count; ++i)
+    scratch.items[i] = items[order[i]];
+  std::memcpy(static_cast<void*>(items), scratch.items.data(), count * sizeof(lod::LodItem));
+  if (lod::orderEqualCodes(items, order, count, scratch))
+    gpu::writeBuffer(context_, values_[current], 0, order, count * sizeof(uint32_t));
+
+  // The levels' subsamples, from the root down. Levels whose nodes are all leaves find nothing to do.
+  shared::IndexLevelPush push{};
+  push.items = items_.address();
+  push.order = values_[current].address();
+  push.sorted = sorted_.address();
+  push.taken = taken_.address();
+  push.colors = colors_.address();
+  push.leafPoints = params.leafPoints;
+  push.edgeQuanta = grid.edgeQuanta;
+  for (int a = 0; a < 3; ++a)
+    push.qmin[a] = grid.qmin[a];
+  push.count = n;
+  push.chunkLevel = uint32_t(chunk.level);
+  push.averageColors = params.averageColors ? 1u : 0u;
+  const gpu::Grid pointGrid = gpu::gridFor(count, shared::kIndexGroupSize);
+  push.groupsX = pointGrid.x;
+  context_.submitAndWait([&](VkCommandBuffer cmd) {
+    gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
+    gpu::fullBarrier(cmd);
+    for (int level = 0; level < lod::kMaxLevel; ++level) {
+      push.level = uint32_t(level);
+      push.cellLevel = uint32_t(grid.sampleLevel(level));
+      level_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
+      gpu::fullBarrier(cmd);
+    }
+  });
+  gpu::readBuffer(context_, taken_, 0, levels, count * sizeof(uint32_t), &readback_);
+  gpu::readBuffer(context_, colors_, 0, colors, count * 2 * sizeof(uint32_t), &readback_);
+  stats_.deviceSeconds += since(start);
+  ++stats_.gpuChunks;
+  stats_.gpuPoints += count;
+  return true;
+}
+
+void GpuIndexer::index(lod::ChunkNodes& out, lod::IndexScratch& scratch, const lod::LodGrid& grid,
+                       const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
+                       const uint64_t* cellCounts, size_t cells, const lod::LodParams& params,
+                       const uint8_t* tails) {
+  if (grid.isotropic && count > 0 && count < size_t(UINT32_MAX)) {
+    std::vector<uint32_t> order(count), levels(count), colors(2 * count);
+    if (indexOnDevice(scratch, grid, chunk, items, count, params, order.data(), levels.data(),
+                      colors.data())) {
+      lod::assembleIndexedChunk(out, chunk, items, count, levels.data(), colors.data(), params, tails);
+      return;
+    }
+  }
+  lod::indexChunk(out, scratch, grid, chunk, items, count, cellCounts, cells, params, tails);
+  std::lock_guard lock(mutex_);
+  ++stats_.cpuChunks;
+  stats_.cpuPoints += count;
+}
+
+} // namespace pointrast::render

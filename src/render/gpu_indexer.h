@@ -1,0 +1,59 @@
+// The octree builder's index phase on the GPU (cloud/lod_index.h has the rules it keeps): each chunk's
+// points sorted by Morton code with a radix sort, then every level's subsample chosen in parallel over
+// the grid's cells (one thread walks each cell's run of sorted points). The CPU puts equal codes into
+// their canonical order between the two and lays out the nodes from the levels the points were taken
+// at, so the octree is the one indexChunk makes, byte for byte.
+//
+// One chunk is on the device at a time; the indexing threads wait for it in turn and lay out their
+// nodes, encode and write meanwhile. Chunks the GPU path does not cover are indexed on the CPU: a grid
+// with unequal scales on its axes (its distances are weighted in double), chunks of more than 2^32 - 1
+// points, and chunks whose buffers the device cannot hold.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+
+#include "cloud/lod_index.h"
+#include "gpu/buffer.h"
+#include "gpu/program.h"
+
+namespace pointrast::gpu {
+class Context;
+}
+
+namespace pointrast::render {
+
+class GpuIndexer : public lod::ChunkIndexer {
+public:
+  explicit GpuIndexer(gpu::Context& context);
+  ~GpuIndexer() override;
+
+  void index(lod::ChunkNodes& out, lod::IndexScratch& scratch, const lod::LodGrid& grid,
+             const lod::NodeKey& chunk, lod::LodItem* items, size_t count, const uint64_t* cellCounts,
+             size_t cells, const lod::LodParams& params, const uint8_t* tails) override;
+
+  struct Stats {
+    uint64_t gpuChunks = 0, cpuChunks = 0; // chunks indexed on each
+    uint64_t gpuPoints = 0, cpuPoints = 0;
+    double deviceSeconds = 0; // wall time of the device's work (submissions and transfers), summed
+  };
+  Stats stats() const;
+
+private:
+  // Sorts and subsamples on the device; false when its buffers cannot be had (the CPU takes the chunk).
+  bool indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& grid, const lod::NodeKey& chunk,
+                     lod::LodItem* items, size_t count, const lod::LodParams& params, uint32_t* order,
+                     uint32_t* levels, uint32_t* colors);
+  void reserve(size_t count);
+
+  gpu::Context& context_;
+  gpu::ComputeProgram histogram_, scan_, scatter_, gather_, level_;
+  mutable std::mutex mutex_; // one chunk on the device at a time; guards the buffers and stats
+  size_t capacity_ = 0;
+  gpu::Buffer items_, sorted_, keys_[2], values_[2], taken_, colors_, buckets_;
+  std::unique_ptr<gpu::Buffer> readback_;
+  Stats stats_;
+};
+
+} // namespace pointrast::render
