@@ -11,7 +11,9 @@
 # Environment: POINTRAST_BIN (default .gpu/bin/pointrast, else build-rel/pointrast), OUT (default
 # ./gpu-out), WORK (scratch folder for inputs and octrees, default /tmp/pointrast-lod-bench), LOD_ARGS (extra
 # `pointrast lod` arguments), KEEP=1 (keep the generated LAS files), LOD_FORMAT=copc (a COPC file out instead
-# of the Potree folder; the runs and report are then named copc-lod-build).
+# of the Potree folder; the runs and report are then named copc-lod-build), LOD_INDEX (where the index phase
+# runs, `--index-on`: "cpu" by default; "cpu gpu" builds each size both ways, one after the other, from the
+# same cached LAS, and checks that the two octrees are the same bytes).
 # Space: N points need 26 N bytes of LAS plus 24 N of octree at once (1 G: 26 + 24 GB; each octree is
 # deleted after its run; a size that does not fit the free space of WORK is skipped, saying so) and about
 # 58 N bytes of memory to build in memory (1 G: 58 GB, under the default --memory of half the RAM on a
@@ -68,15 +70,25 @@ run() {
     fi
     echo "== reading $las once (page cache)"
     cat "$las" >/dev/null
-    rm -rf "$octree"
-    echo "== pointrast lod $size${cores:+ on $cores cores}"
-    local json
-    # shellcheck disable=SC2086
-    json=$(/usr/bin/time -f "lod: %e s, %M KB" "${pin[@]}" "$PR" lod "$las" -o "$octree" --json \
-      ${cores:+--threads $cores} ${LOD_ARGS:-})
-    printf '{"size":"%s","cores":%s,"machine":%s,"build":%s}\n' "$size" "${cores:-$(nproc)}" "$(machine_json)" \
-      "$json" | tee -a "$OUT/$name.jsonl"
-    rm -rf "$octree"
+    local index reference="" same
+    for index in ${LOD_INDEX:-cpu}; do
+      rm -rf "$octree"
+      echo "== pointrast lod $size${cores:+ on $cores cores}, index on $index"
+      local json
+      # shellcheck disable=SC2086
+      json=$(/usr/bin/time -f "lod: %e s, %M KB" "${pin[@]}" "$PR" lod "$las" -o "$octree" --json \
+        --index-on "$index" ${cores:+--threads $cores} ${LOD_ARGS:-})
+      # The same octree whichever device indexed it: the first build's checksum against the others'.
+      local sum
+      if [ -d "$octree" ]; then sum=$(cat "$octree/octree.bin" "$octree/hierarchy.bin" | md5sum | cut -c1-32)
+      else sum=$(md5sum < "$octree" | cut -c1-32); fi
+      [ -n "$reference" ] || reference=$sum
+      same=true
+      [ "$sum" = "$reference" ] || { same=false; echo "== $size: the octree indexed on $index differs" >&2; }
+      printf '{"size":"%s","cores":%s,"index":"%s","same_as_first":%s,"machine":%s,"build":%s}\n' "$size" \
+        "${cores:-$(nproc)}" "$index" "$same" "$(machine_json)" "$json" | tee -a "$OUT/$name.jsonl"
+      rm -rf "$octree"
+    done
     [ "${KEEP:-0}" = 1 ] || rm -f "$las"
   done
 }
@@ -102,8 +114,8 @@ if runs:
     mc = runs[0]["machine"]
     lines += [f"Machine: {mc['cores']} cores ({mc['cpu']}), {mc['memory_bytes'] / 2**30:.0f} GiB, GPU {mc['gpu']}, "
               f"kernel {mc['kernel']}, dirty_ratio {mc['dirty_ratio']} %.", ""]
-lines += ["| points | cores | total s | points/s | points/s per core | octree GB | in memory | threads | vs PotreeConverter 2 poisson | vs random |",
-          "| ---: | ---: | ---: | ---: | ---: | ---: | :---: | ---: | ---: | ---: |"]
+lines += ["| points | cores | index on | total s | points/s | points/s per core | octree GB | in memory | threads | vs PotreeConverter 2 poisson | vs random |",
+          "| ---: | ---: | --- | ---: | ---: | ---: | ---: | :---: | ---: | ---: | ---: |"]
 def anchor(r):
     # PotreeConverter 2 on 2 cores was measured on the 2-core development machine (1.5 M points/s, poisson);
     # on all cores, on this machine (7.7 M poisson, 14.3 M random).
@@ -112,13 +124,15 @@ for r in runs:
     b = r["build"]
     pps = b["points_per_second"]
     poisson, rnd = anchor(r)
-    lines.append(f"| {b['points']:,} | {r.get('cores', '')} | {b['seconds']:.2f} | {m(pps)} | {m(pps / b['threads'])} | "
+    index = r.get("index", "cpu") + ("" if r.get("same_as_first", True) else " (**differs**)")
+    lines.append(f"| {b['points']:,} | {r.get('cores', '')} | {index} | {b['seconds']:.2f} | {m(pps)} | {m(pps / b['threads'])} | "
                  f"{b['bytes'] / 1e9:.1f} | {'no' if b['out_of_core'] else 'yes'} | {b['threads']} | "
                  f"{pps / poisson:.1f}x | {f'{pps / rnd:.1f}x' if rnd else '-'} |")
 for r in runs:
     b = r["build"]
     cores = f" on {r['cores']} cores" if r.get("cores") else ""
-    lines += ["", f"## {r['size']} points{cores}: phases", "",
+    device = f", index on {b['index_device']} ({b['index_gpu_chunks']} chunks; {b['index_cpu_chunks']} on the CPU; {b['index_device_seconds']:.2f} s of device work)" if b.get("index_device") else ""
+    lines += ["", f"## {r['size']} points{cores}{device}: phases", "",
               "| phase | seconds | CPU seconds | points/s | points/s per core |", "| --- | ---: | ---: | ---: | ---: |"]
     for p in b["phases"]:
         if p["overlapped"]:

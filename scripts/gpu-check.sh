@@ -7,6 +7,7 @@
 # SUITE_VIEWS (batch1g);
 # BIG4G_METHOD (default batch).
 # OCTREE_CACHE: the octree cache of lodsuite and lod2022 (default /tmp/octrees: on the machine's disk).
+# LOD_SIZES, LOD_INDEX (lod: the sizes, and "cpu gpu" to build each on the CPU and with the GPU index phase).
 #   scripts/gpu-check.sh tests big    # tests + the 1.2-billion-point equivalence run
 #   scripts/gpu-check.sh lazio        # LAZ decoding throughput (bench-io) on 1, 8 and all cores
 set -uo pipefail
