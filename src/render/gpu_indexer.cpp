@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "gpu/context.h"
 #include "lod_index_shared.h"
 
@@ -55,22 +56,47 @@ void GpuIndexer::reserve(size_t count) {
   const size_t n = count + count / 4;
   const uint64_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
   capacity_ = 0;
-  auto make = [&](uint64_t bytes, const char* name) {
-    return gpu::Buffer(context_, bytes, gpu::kBufferUsage, gpu::MemoryKind::Device, name);
+  auto make = [&](uint64_t bytes, gpu::MemoryKind kind, const char* name) {
+    return gpu::Buffer(context_, bytes, gpu::kBufferUsage, kind, name);
   };
-  items_ = gpu::Buffer();
-  sorted_ = gpu::Buffer();
-  items_ = make(n * sizeof(lod::LodItem), "index items");
-  sorted_ = make(n * sizeof(lod::LodItem), "index sorted items");
+  // The old buffers go first: their memory may be needed for the new ones.
+  for (gpu::Buffer* b : {&items_, &sorted_, &keys_[0], &keys_[1], &values_[0], &values_[1], &taken_, &colors_,
+                         &buckets_, &upload_, &download_})
+    *b = gpu::Buffer();
+  const gpu::MemoryKind device = gpu::MemoryKind::Device;
+  items_ = make(n * sizeof(lod::LodItem), device, "index items");
+  sorted_ = make(n * sizeof(lod::LodItem), device, "index sorted items");
   for (int b = 0; b < 2; ++b) {
-    keys_[b] = make(n * sizeof(uint64_t), "index keys");
-    values_[b] = make(n * sizeof(uint32_t), "index order");
+    keys_[b] = make(n * sizeof(uint64_t), device, "index keys");
+    values_[b] = make(n * sizeof(uint32_t), device, "index order");
   }
-  taken_ = make(n * sizeof(uint32_t), "index taken levels");
-  colors_ = make(n * 2 * sizeof(uint32_t), "index colors");
-  buckets_ = make(tiles * 256 * sizeof(uint32_t), "index histogram");
+  taken_ = make(n * sizeof(uint32_t), device, "index taken levels");
+  colors_ = make(n * 2 * sizeof(uint32_t), device, "index colors");
+  buckets_ = make(tiles * 256 * sizeof(uint32_t), device, "index histogram");
+  // Staging kept from chunk to chunk: the items (or the order) up; the order, or the levels and colors,
+  // down.
+  upload_ = make(n * sizeof(lod::LodItem), gpu::MemoryKind::Upload, "index upload");
+  download_ = make(n * 3 * sizeof(uint32_t), gpu::MemoryKind::Readback, "index download");
   capacity_ = n;
 }
+
+namespace {
+
+void copyBuffer(VkCommandBuffer cmd, const gpu::Buffer& from, const gpu::Buffer& to, uint64_t toOffset,
+                uint64_t size) {
+  const VkBufferCopy region{0, toOffset, size};
+  gpu::vkCmdCopyBuffer(cmd, from.handle(), to.handle(), 1, &region);
+}
+
+// Host copies to and from mapped staging, on all threads (the memory bandwidth of one core is far below
+// the bus's).
+void copyOnAllThreads(void* to, const void* from, uint64_t size) {
+  parallelBlocks(size, uint64_t(1) << 21, [&](uint64_t, uint64_t begin, uint64_t end) {
+    std::memcpy(static_cast<uint8_t*>(to) + begin, static_cast<const uint8_t*>(from) + begin, end - begin);
+  });
+}
+
+} // namespace
 
 bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& grid,
                                const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
@@ -83,17 +109,20 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
     return false;
   }
   const auto start = Clock::now();
-  gpu::writeBuffer(context_, items_, 0, items, count * sizeof(lod::LodItem));
+  copyOnAllThreads(upload_.mapped(), items, count * sizeof(lod::LodItem));
 
-  // The radix sort on the bits the chunk's codes may differ in, 8 at a time from the lowest: stable
-  // passes, so the points end sorted by code, equal codes in the order they came.
+  // Up, then the radix sort on the bits the chunk's codes may differ in, 8 at a time from the lowest:
+  // stable passes, so the points end sorted by code, equal codes in the order they came. The order down.
   const uint32_t n = static_cast<uint32_t>(count);
   const uint32_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
   const int freeBits = 3 * (lod::kCodeLevels - chunk.level);
   const int passes = (freeBits + int(shared::kRadixBits) - 1) / int(shared::kRadixBits);
   const gpu::Grid tileGrid = gpu::gridFor(uint64_t(tiles) * shared::kIndexGroupSize, shared::kIndexGroupSize);
-  int current = 0; // the keys_/values_ pair holding the pass's result
+  const int current = passes % 2; // the keys_/values_ pair the last pass writes
   context_.submitAndWait([&](VkCommandBuffer cmd) {
+    gpu::fullBarrier(cmd);
+    copyBuffer(cmd, upload_, items_, 0, count * sizeof(lod::LodItem));
+    gpu::fullBarrier(cmd);
     for (int p = 0; p < passes; ++p) {
       shared::RadixPush push{};
       const int in = p % 2, out = 1 - in;
@@ -113,21 +142,27 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
       gpu::fullBarrier(cmd);
       scatter_.dispatch(cmd, tileGrid.x, tileGrid.y, push);
       gpu::fullBarrier(cmd);
-      current = out;
     }
+    copyBuffer(cmd, values_[current], download_, 0, count * sizeof(uint32_t));
+    gpu::fullBarrier(cmd);
   });
-  gpu::readBuffer(context_, values_[current], 0, order, count * sizeof(uint32_t), &readback_);
+  download_.invalidate();
+  copyOnAllThreads(order, download_.mapped(), count * sizeof(uint32_t));
 
   // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
   // end sorted in place, as indexChunk leaves them.
   if (scratch.items.size() < count) scratch.items.resize(count);
-  for (size_t i = 0; i < count; ++i)
-    scratch.items[i] = items[order[i]];
-  std::memcpy(static_cast<void*>(items), scratch.items.data(), count * sizeof(lod::LodItem));
-  if (lod::orderEqualCodes(items, order, count, scratch))
-    gpu::writeBuffer(context_, values_[current], 0, order, count * sizeof(uint32_t));
+  lod::LodItem* const sortedItems = scratch.items.data();
+  parallelBlocks(count, uint64_t(1) << 16, [&](uint64_t, uint64_t begin, uint64_t end) {
+    for (uint64_t i = begin; i < end; ++i)
+      sortedItems[i] = items[order[i]];
+  });
+  copyOnAllThreads(items, sortedItems, count * sizeof(lod::LodItem));
+  const bool reordered = lod::orderEqualCodes(items, order, count, scratch);
+  if (reordered) copyOnAllThreads(upload_.mapped(), order, count * sizeof(uint32_t));
 
-  // The levels' subsamples, from the root down. Levels whose nodes are all leaves find nothing to do.
+  // The order up where it changed, the points gathered in sorted order, the levels' subsamples from the
+  // root down (levels whose nodes are all leaves find nothing to do), the levels and colors down.
   shared::IndexLevelPush push{};
   push.items = items_.address();
   push.order = values_[current].address();
@@ -144,6 +179,11 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   const gpu::Grid pointGrid = gpu::gridFor(count, shared::kIndexGroupSize);
   push.groupsX = pointGrid.x;
   context_.submitAndWait([&](VkCommandBuffer cmd) {
+    if (reordered) {
+      gpu::fullBarrier(cmd);
+      copyBuffer(cmd, upload_, values_[current], 0, count * sizeof(uint32_t));
+    }
+    gpu::fullBarrier(cmd);
     gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
     gpu::fullBarrier(cmd);
     for (int level = 0; level < lod::kMaxLevel; ++level) {
@@ -152,9 +192,14 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
       level_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
       gpu::fullBarrier(cmd);
     }
+    copyBuffer(cmd, taken_, download_, 0, count * sizeof(uint32_t));
+    copyBuffer(cmd, colors_, download_, count * sizeof(uint32_t), count * 2 * sizeof(uint32_t));
+    gpu::fullBarrier(cmd);
   });
-  gpu::readBuffer(context_, taken_, 0, levels, count * sizeof(uint32_t), &readback_);
-  gpu::readBuffer(context_, colors_, 0, colors, count * 2 * sizeof(uint32_t), &readback_);
+  download_.invalidate();
+  const auto* down = static_cast<const uint8_t*>(download_.mapped());
+  copyOnAllThreads(levels, down, count * sizeof(uint32_t));
+  copyOnAllThreads(colors, down + count * sizeof(uint32_t), count * 2 * sizeof(uint32_t));
   stats_.deviceSeconds += since(start);
   ++stats_.gpuChunks;
   stats_.gpuPoints += count;

@@ -52,7 +52,7 @@ private:
   mutable std::mutex mutex_; // one chunk on the device at a time; guards the buffers and stats
   size_t capacity_ = 0;
   gpu::Buffer items_, sorted_, keys_[2], values_[2], taken_, colors_, buckets_;
-  std::unique_ptr<gpu::Buffer> readback_;
+  gpu::Buffer upload_, download_; // staging, host-visible
   Stats stats_;
 };
 
