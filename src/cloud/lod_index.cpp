@@ -34,6 +34,23 @@ void insertionSort(LodItem* a, size_t n) {
 
 constexpr size_t kInsertionSortItems = 24;
 
+// Calls visit(c, begin, end) for each child c of a node whose sorted items are [begin, end) and that
+// holds some of them: its range, in child order. childShift: 3 * (kCodeLevels - level - 1).
+template <class Visit>
+void forEachChild(const LodItem* items, size_t begin, size_t end, int childShift, Visit&& visit) {
+  size_t childBegin = begin;
+  for (int c = 0; c < 8 && childBegin < end; ++c) {
+    const uint64_t childCell = untagged(items[childBegin].code) >> childShift;
+    if ((childCell & 7) != uint64_t(c)) continue;
+    const size_t childEnd = static_cast<size_t>(
+        std::partition_point(items + childBegin, items + end,
+                             [&](const LodItem& e) { return untagged(e.code) >> childShift == childCell; }) -
+        items);
+    visit(c, childBegin, childEnd);
+    childBegin = childEnd;
+  }
+}
+
 class Indexer {
 public:
   Indexer(ChunkNodes& out, LodItem* items, const LodGrid& grid, const LodParams& params, const uint8_t* tails)
@@ -128,19 +145,9 @@ public:
       n.count = static_cast<uint64_t>(subsample(level, begin, end, start, tailsAt(used_), left) - start);
       used_ += n.count;
       const int childShift = 3 * (kCodeLevels - level - 1);
-      size_t childBegin = begin;
-      for (int c = 0; c < 8 && childBegin < end; ++c) {
-        const uint64_t childCell = untagged(items_[childBegin].code) >> childShift;
-        if ((childCell & 7) != uint64_t(c)) continue;
-        const size_t childEnd =
-            static_cast<size_t>(std::partition_point(items_ + childBegin, items_ + end,
-                                                     [&](const LodItem& e) {
-                                                       return untagged(e.code) >> childShift == childCell;
-                                                     }) -
-                                items_);
+      forEachChild(items_, begin, end, childShift, [&](int c, size_t childBegin, size_t childEnd) {
         if (left[c] > 0) node(level + 1, childBegin, childEnd);
-        childBegin = childEnd;
-      }
+      });
     } else {
       PointRecord* dst = start;
       uint8_t* const dstTails = tailsAt(used_);
@@ -290,19 +297,9 @@ public:
       }
       n.count = written;
       used_ += written;
-      size_t childBegin = begin;
-      for (int c = 0; c < 8 && childBegin < end; ++c) {
-        const uint64_t childCell = untagged(items_[childBegin].code) >> childShift;
-        if ((childCell & 7) != uint64_t(c)) continue;
-        const size_t childEnd =
-            static_cast<size_t>(std::partition_point(items_ + childBegin, items_ + end,
-                                                     [&](const LodItem& e) {
-                                                       return untagged(e.code) >> childShift == childCell;
-                                                     }) -
-                                items_);
+      forEachChild(items_, begin, end, childShift, [&](int c, size_t childBegin, size_t childEnd) {
         if (left[c] > 0) node(level + 1, childBegin, childEnd);
-        childBegin = childEnd;
-      }
+      });
     } else {
       for (size_t k = begin; k < end; ++k)
         if (levels_[k] == kNotTakenLevel) put(start, startTails, written++, k, false);
