@@ -12,14 +12,6 @@ using namespace pointrast;
 using namespace pointrast::lodtest;
 using lod::NodeKey;
 
-std::vector<PointRecord> terrainRecords(uint64_t n, uint64_t seed = 3) {
-  GenerateOptions options;
-  options.points = n;
-  options.seed = seed;
-  options.progress = false;
-  return recordsOf(generateScene(Scene::Terrain, options));
-}
-
 TEST(LodGrid, CubeHoldsEveryPointAndCodesNestLevels) {
   std::vector<PointRecord> records = terrainRecords(20'000);
   lod::LodGrid grid = gridOf(records);
@@ -145,24 +137,7 @@ TEST(LodBuild, SameBytesWhateverThreadsChunksPiecesAndInputOrder) {
 
 // A lattice with random colors on a coarse grid (4 cells per node edge), so cells hold many points.
 TEST(LodBuild, InnerColorsAreTheAveragesOfThePointsTheyStandFor) {
-  std::vector<PointRecord> records;
-  std::mt19937_64 rng(5);
-  for (int x = 0; x < 40; ++x)
-    for (int y = 0; y < 40; ++y)
-      for (int z = 0; z < 3; ++z) {
-        PointRecord r;
-        r.x = x * 10 + int(rng() % 5);
-        r.y = y * 10 + int(rng() % 5);
-        r.z = z * 7;
-        r.rgb[0] = uint16_t(rng() % 65536);
-        r.rgb[1] = uint16_t(rng() % 256);
-        r.rgb[2] = uint16_t(x * 6);
-        r.intensity = uint16_t(rng());
-        r.classification = uint8_t(x % 3);
-        r.returnNumber = 1;
-        r.pointSourceId = uint16_t(y);
-        records.push_back(r);
-      }
+  const std::vector<PointRecord> records = latticeRecords(40);
   // Equal scales (integer distances) and a finer z scale (weighted distances).
   for (glm::dvec3 scale : {glm::dvec3(0.01), glm::dvec3(0.01, 0.01, 0.001)}) {
     lod::LodGrid grid = gridOf(records, scale, glm::dvec3(100, 200, 0), 2);

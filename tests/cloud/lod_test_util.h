@@ -6,6 +6,7 @@
 #include <array>
 #include <cstring>
 #include <map>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -73,6 +74,39 @@ inline std::vector<PointRecord> recordsOf(const PointCloud& cloud) {
     r.pointSourceId = static_cast<uint16_t>(i % 7);
   }
   return out;
+}
+
+// Records of generated terrain (`n` points).
+inline std::vector<PointRecord> terrainRecords(uint64_t n, uint64_t seed = 3) {
+  GenerateOptions options;
+  options.points = n;
+  options.seed = seed;
+  options.progress = false;
+  return recordsOf(generateScene(Scene::Terrain, options));
+}
+
+// A side x side x 3 lattice, 10 units apart with up to 4 units of jitter, random colors, intensities, and
+// classes, returns and sources by row: on a coarse grid (4 cells per node edge) cells hold many points.
+inline std::vector<PointRecord> latticeRecords(int side) {
+  std::vector<PointRecord> records;
+  std::mt19937_64 rng(5);
+  for (int x = 0; x < side; ++x)
+    for (int y = 0; y < side; ++y)
+      for (int z = 0; z < 3; ++z) {
+        PointRecord r;
+        r.x = x * 10 + int(rng() % 5);
+        r.y = y * 10 + int(rng() % 5);
+        r.z = z * 7;
+        r.rgb[0] = uint16_t(rng() % 65536);
+        r.rgb[1] = uint16_t(rng() % 256);
+        r.rgb[2] = uint16_t(x * 6);
+        r.intensity = uint16_t(rng());
+        r.classification = uint8_t(x % 3);
+        r.returnNumber = 1;
+        r.pointSourceId = uint16_t(y);
+        records.push_back(r);
+      }
+  return records;
 }
 
 // Cuts records into pieces of `size` (the shape readers deliver).

@@ -74,16 +74,8 @@ protected:
   }
 };
 
-std::vector<PointRecord> terrainRecords(uint64_t n) {
-  GenerateOptions options;
-  options.points = n;
-  options.seed = 9;
-  options.progress = false;
-  return recordsOf(generateScene(Scene::Terrain, options));
-}
-
 TEST_F(GpuIndexTest, TerrainOnManyChunksAndThreads) {
-  const std::vector<PointRecord> records = terrainRecords(40'000);
+  const std::vector<PointRecord> records = terrainRecords(40'000, 9);
   const lod::LodGrid grid = gridOf(records);
   for (bool average : {true, false}) {
     lod::LodParams params;
@@ -119,21 +111,7 @@ TEST_F(GpuIndexTest, CopiesOfPointsDownToTheDeepestLevel) {
 // A lattice on a coarse grid (4 cells per node edge): cells hold many points, colors average over them;
 // with tails (the attributes beyond the record) carried beside the points.
 TEST_F(GpuIndexTest, CrowdedCellsAverageColorsAndCarryTails) {
-  std::vector<PointRecord> records;
-  std::mt19937_64 rng(5);
-  for (int x = 0; x < 30; ++x)
-    for (int y = 0; y < 30; ++y)
-      for (int z = 0; z < 3; ++z) {
-        PointRecord r;
-        r.x = x * 10 + int(rng() % 5);
-        r.y = y * 10 + int(rng() % 5);
-        r.z = z * 7;
-        r.rgb[0] = uint16_t(rng() % 65536);
-        r.rgb[1] = uint16_t(rng() % 256);
-        r.rgb[2] = uint16_t(x * 6);
-        r.intensity = uint16_t(rng());
-        records.push_back(r);
-      }
+  const std::vector<PointRecord> records = latticeRecords(30);
   const lod::LodGrid grid = gridOf(records, glm::dvec3(0.01), glm::dvec3(100, 200, 0), 2);
   for (bool average : {true, false}) {
     lod::LodParams params;
@@ -152,7 +130,7 @@ TEST_F(GpuIndexTest, CrowdedCellsAverageColorsAndCarryTails) {
 
 // Unequal scales weigh distances in double: those grids are indexed on the CPU, with the same result.
 TEST_F(GpuIndexTest, UnequalScalesStayOnTheCpu) {
-  const std::vector<PointRecord> records = terrainRecords(5'000);
+  const std::vector<PointRecord> records = terrainRecords(5'000, 9);
   const lod::LodGrid grid = gridOf(records, glm::dvec3(0.01, 0.01, 0.001));
   ASSERT_FALSE(grid.isotropic);
   lod::LodParams params;
