@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "base/error.h"
-#include "base/parallel.h"
+#include "base/parallel_copy.h"
 #include "gpu/context.h"
 
 namespace pointrast::gpu {
@@ -155,10 +155,7 @@ void readBuffer(Context& context, const Buffer& source, uint64_t offset, void* d
     fullBarrier(cmd);
   });
   staging->invalidate();
-  const auto* from = static_cast<const uint8_t*>(staging->mapped());
-  parallelBlocks(size, uint64_t(1) << 21, [&](uint64_t, uint64_t begin, uint64_t end) {
-    std::memcpy(static_cast<uint8_t*>(destination) + begin, from + begin, end - begin);
-  });
+  copyOnAllThreads(destination, staging->mapped(), size);
 }
 
 void writeBuffer(Context& context, const Buffer& target, uint64_t offset, const void* source, uint64_t size) {

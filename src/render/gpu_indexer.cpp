@@ -7,6 +7,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/parallel_copy.h"
 #include "gpu/context.h"
 #include "lod_index_shared.h"
 
@@ -86,14 +87,6 @@ void copyBuffer(VkCommandBuffer cmd, const gpu::Buffer& from, const gpu::Buffer&
                 uint64_t size) {
   const VkBufferCopy region{0, toOffset, size};
   gpu::vkCmdCopyBuffer(cmd, from.handle(), to.handle(), 1, &region);
-}
-
-// Host copies to and from mapped staging, on all threads (the memory bandwidth of one core is far below
-// the bus's).
-void copyOnAllThreads(void* to, const void* from, uint64_t size) {
-  parallelBlocks(size, uint64_t(1) << 21, [&](uint64_t, uint64_t begin, uint64_t end) {
-    std::memcpy(static_cast<uint8_t*>(to) + begin, static_cast<const uint8_t*>(from) + begin, end - begin);
-  });
 }
 
 } // namespace
