@@ -22,9 +22,9 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "gpu/context.h"
+#include "io/copc_ept/copc_writer.h"
 #include "io/format_table.h"
 #include "io/output_check.h"
-#include "io/copc_ept/copc_writer.h"
 #include "io/potree/lod_potree.h"
 #include "io/writer.h"
 #include "render/gpu_indexer.h"
@@ -124,6 +124,13 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r, const In
     j["index_gpu_chunks"] = device->stats.gpuChunks;
     j["index_cpu_chunks"] = device->stats.cpuChunks;
     j["index_device_seconds"] = device->stats.deviceSeconds;
+    const render::GpuIndexer::Stats& st = device->stats;
+    j["index_device_steps"] = {{"stage", st.stageSeconds},
+                               {"sort", st.sortSeconds},
+                               {"order", st.orderSeconds},
+                               {"levels", st.levelSeconds},
+                               {"read", st.readSeconds}};
+    j["index_wait_seconds"] = st.waitSeconds;
   }
   nlohmann::json phases = nlohmann::json::array();
   for (const lod::LodPhase& p : b.phases) {
@@ -153,7 +160,8 @@ void printSummary(const LodArgs& a, const io::PotreeBuildReport& r, const IndexD
                 humanCount(perSecond(double(p.points), p.seconds)).c_str());
     if (p.overlapped && p.bytes && &p != &b.phases.front())
       std::printf("   (during index; %.3f s over all threads; %.1f MB, %.0f MB/s of index's time)\n",
-                  p.threadSeconds, double(p.bytes) / 1e6, perSecond(double(p.bytes), (&p - 1)->seconds) / 1e6);
+                  p.threadSeconds, double(p.bytes) / 1e6,
+                  perSecond(double(p.bytes), (&p - 1)->seconds) / 1e6);
     else if (p.overlapped)
       std::printf("   (during index; %.3f s over all threads)\n", p.threadSeconds);
     else

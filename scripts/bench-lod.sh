@@ -13,7 +13,9 @@
 # `pointrast lod` arguments), KEEP=1 (keep the generated LAS files), LOD_FORMAT=copc (a COPC file out instead
 # of the Potree folder; the runs and report are then named copc-lod-build), LOD_INDEX (where the index phase
 # runs, `--index-on`: "cpu" by default; "cpu gpu" builds each size both ways, one after the other, from the
-# same cached LAS, and checks that the two octrees are the same bytes).
+# same cached LAS, and checks that the two octrees are the same bytes), LOD_OUT_DIR (where the octrees go,
+# default WORK: /dev/shm builds with the points and the octree in memory), LOD_DISK (the size of the file
+# that measures WORK's write bandwidth first, default 8G; 0 skips it).
 # Space: N points need 26 N bytes of LAS plus 24 N of octree at once (1 G: 26 + 24 GB; each octree is
 # deleted after its run; a size that does not fit the free space of WORK is skipped, saying so) and about
 # 58 N bytes of memory to build in memory (1 G: 58 GB, under the default --memory of half the RAM on a
@@ -45,17 +47,47 @@ count_of() {
   python3 -c "import sys; s = sys.argv[1]; k = {'K': 1e3, 'M': 1e6, 'G': 1e9}.get(s[-1:].upper()); print(int(float(s[:-1]) * k if k else int(s)))" "$1"
 }
 
+# One checksum of files' bytes, hashed in 1 GiB slices on all cores (an octree of 24 GB in seconds, not
+# the minute of one md5sum): the md5 of each slice's md5, in order.
+checksum() {
+  local f size slices
+  for f in "$@"; do
+    size=$(stat -c %s "$f")
+    slices=$(((size + (1 << 30) - 1) >> 30))
+    [ "$slices" -gt 0 ] || slices=1
+    # shellcheck disable=SC2016 # expanded by the inner shell
+    seq 0 $((slices - 1)) | xargs -P "$(nproc)" -I{} sh -c \
+      'printf "%s %s\n" {} "$(dd if="$1" bs=1M skip=$(({} * 1024)) count=1024 status=none | md5sum | cut -c1-32)"' _ "$f" |
+      sort -n
+  done | md5sum | cut -c1-32
+}
+
+# The disk's sequential write bandwidth in WORK (bench-io --disk: plain, and with the octree writer's
+# write-behind), into $OUT/$name-disk.json; LOD_DISK sets the file's size (default 8G, 0 to skip).
+disk() {
+  local laz="" f
+  [ "${LOD_DISK:-8G}" != 0 ] || return 0
+  for f in .gpu/data/laz/autzen_trim.laz ../shared/data/laz/autzen_trim.laz; do
+    [ -f "$f" ] && { laz=$f; break; }
+  done
+  [ -n "$laz" ] || { echo "== no autzen_trim.laz for bench-io: the disk is not measured"; return 0; }
+  echo "== the disk's sequential write bandwidth in $WORK (${LOD_DISK:-8G})"
+  "$PR" bench-io "$laz" --threads all --repeats 1 --no-read-cloud --no-encode --disk "${LOD_DISK:-8G}" \
+    --disk-dir "$WORK" --out "$OUT" --name "$name-disk" --quiet >/dev/null
+}
+
 run() {
   local sizes=("$@")
   [ ${#sizes[@]} -gt 0 ] || sizes=(10M/2 100M 1G)
   mkdir -p "$WORK"
+  disk
   for spec in "${sizes[@]}"; do
     local size=${spec%/*} cores="" pin=()
     if [ "$spec" != "$size" ]; then
       cores=${spec#*/}
       pin=(taskset -c "0-$((cores - 1))")
     fi
-    local las=$WORK/terrain-$size.las octree=$WORK/octree-$size$ext
+    local las=$WORK/terrain-$size.las octree=${LOD_OUT_DIR:-$WORK}/octree-$size$ext
     local need free
     need=$(($(count_of "$size") * 52)) # 26 B of LAS + 24 B of octree a point, and 2 B of slack
     [ -f "$las" ] && need=$((need - $(stat -c %s "$las")))
@@ -80,13 +112,14 @@ run() {
         --index-on "$index" ${cores:+--threads $cores} ${LOD_ARGS:-})
       # The same octree whichever device indexed it: the first build's checksum against the others'.
       local sum
-      if [ -d "$octree" ]; then sum=$(cat "$octree/octree.bin" "$octree/hierarchy.bin" | md5sum | cut -c1-32)
-      else sum=$(md5sum < "$octree" | cut -c1-32); fi
+      if [ -d "$octree" ]; then sum=$(checksum "$octree/octree.bin" "$octree/hierarchy.bin")
+      else sum=$(checksum "$octree"); fi
       [ -n "$reference" ] || reference=$sum
       same=true
       [ "$sum" = "$reference" ] || { same=false; echo "== $size: the octree indexed on $index differs" >&2; }
-      printf '{"size":"%s","cores":%s,"index":"%s","same_as_first":%s,"machine":%s,"build":%s}\n' "$size" \
-        "${cores:-$(nproc)}" "$index" "$same" "$(machine_json)" "$json" | tee -a "$OUT/$name.jsonl"
+      printf '{"size":"%s","cores":%s,"index":"%s","same_as_first":%s,"out_dir":"%s","machine":%s,"build":%s}\n' \
+        "$size" "${cores:-$(nproc)}" "$index" "$same" "${LOD_OUT_DIR:-$WORK}" "$(machine_json)" "$json" |
+        tee -a "$OUT/$name.jsonl"
       rm -rf "$octree"
     done
     [ "${KEEP:-0}" = 1 ] || rm -f "$las"
@@ -114,8 +147,24 @@ if runs:
     mc = runs[0]["machine"]
     lines += [f"Machine: {mc['cores']} cores ({mc['cpu']}), {mc['memory_bytes'] / 2**30:.0f} GiB, GPU {mc['gpu']}, "
               f"kernel {mc['kernel']}, dirty_ratio {mc['dirty_ratio']} %.", ""]
-lines += ["| points | cores | index on | total s | points/s | points/s per core | octree GB | in memory | threads | vs PotreeConverter 2 poisson | vs random |",
-          "| ---: | ---: | --- | ---: | ---: | ---: | ---: | :---: | ---: | ---: | ---: |"]
+# The disk's sequential write bandwidth, measured in the same run (bench-io --disk), where it was.
+disk = {}
+try:
+    for d in json.load(open(out_json[:-len(".json")] + "-disk.json"))["disk_write"]["runs"]:
+        disk[d["mode"]] = d["bytes_per_s"]
+except (OSError, KeyError, ValueError):
+    pass
+best_disk = max(disk.values()) if disk else None
+if disk:
+    lines += ["Disk (the build's output folder), sequential write until fdatasync: " +
+              ", ".join(f"{mode} {v / 1e6:,.0f} MB/s" for mode, v in disk.items()) +
+              ". `disk floor` is the octree's bytes over the faster of the two: the least time the disk "
+              "allows the build, and `points/s the disk allows` the points over it.", ""]
+lines += ["`after read` times the build from the points in memory (the total less the read phase: counting, "
+          "chunking, distributing, indexing with the writes, commit).", ""]
+lines += ["| points | cores | index on | total s | points/s | after read: s | points/s | points/s per core | octree GB | "
+          "written MB/s over index | disk floor s | points/s the disk allows | in memory | threads | vs PotreeConverter 2 poisson | vs random |",
+          "| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | :---: | ---: | ---: | ---: |"]
 def anchor(r):
     # PotreeConverter 2 on 2 cores was measured on the 2-core development machine (1.5 M points/s, poisson);
     # on all cores, on this machine (7.7 M poisson, 14.3 M random).
@@ -125,13 +174,28 @@ for r in runs:
     pps = b["points_per_second"]
     poisson, rnd = anchor(r)
     index = r.get("index", "cpu") + ("" if r.get("same_as_first", True) else " (**differs**)")
-    lines.append(f"| {b['points']:,} | {r.get('cores', '')} | {index} | {b['seconds']:.2f} | {m(pps)} | {m(pps / b['threads'])} | "
-                 f"{b['bytes'] / 1e9:.1f} | {'no' if b['out_of_core'] else 'yes'} | {b['threads']} | "
+    phase = {p["name"]: p for p in b["phases"]}
+    after = b["seconds"] - phase["read"]["seconds"] if "read" in phase else b["seconds"]
+    index_s = phase["index"]["seconds"] if "index" in phase else 0
+    in_memory = r.get("out_dir", "").startswith("/dev/shm")
+    if in_memory: index += ", octree to /dev/shm"
+    floor = b["bytes"] / best_disk if best_disk and not in_memory else None
+    lines.append(f"| {b['points']:,} | {r.get('cores', '')} | {index} | {b['seconds']:.2f} | {m(pps)} | "
+                 f"{after:.2f} | {m(b['points'] / after)} | {m(pps / b['threads'])} | "
+                 f"{b['bytes'] / 1e9:.1f} | {b['bytes'] / index_s / 1e6 if index_s else 0:,.0f} | "
+                 f"{f'{floor:.2f}' if floor else '-'} | {m(b['points'] / floor) if floor else '-'} | "
+                 f"{'no' if b['out_of_core'] else 'yes'} | {b['threads']} | "
                  f"{pps / poisson:.1f}x | {f'{pps / rnd:.1f}x' if rnd else '-'} |")
 for r in runs:
     b = r["build"]
     cores = f" on {r['cores']} cores" if r.get("cores") else ""
-    device = f", index on {b['index_device']} ({b['index_gpu_chunks']} chunks; {b['index_cpu_chunks']} on the CPU; {b['index_device_seconds']:.2f} s of device work)" if b.get("index_device") else ""
+    device = ""
+    if b.get("index_device"):
+        st = b.get("index_device_steps", {})
+        steps = ", ".join(f"{k} {st[k]:.2f}" for k in ("stage", "sort", "order", "levels", "read") if k in st)
+        device = (f", index on {b['index_device']} ({b['index_gpu_chunks']} chunks; {b['index_cpu_chunks']} on the CPU; "
+                  f"{b['index_device_seconds']:.2f} s of device work: {steps}; threads waited "
+                  f"{b.get('index_wait_seconds', 0):.2f} s for the device, summed)")
     lines += ["", f"## {r['size']} points{cores}{device}: phases", "",
               "| phase | seconds | CPU seconds | points/s | points/s per core |", "| --- | ---: | ---: | ---: | ---: |"]
     for p in b["phases"]:

@@ -95,7 +95,9 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
                                const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
                                const lod::LodParams& params, uint32_t* order, uint32_t* levels,
                                uint32_t* colors) {
+  const auto asked = Clock::now();
   std::lock_guard lock(mutex_);
+  stats_.waitSeconds += since(asked);
   try {
     reserve(count);
   } catch (const UnsupportedError&) {
@@ -103,6 +105,14 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   }
   const auto start = Clock::now();
   copyOnAllThreads(upload_.mapped(), items, count * sizeof(lod::LodItem));
+  auto step = Clock::now();
+  // Adds the time since the last step's end to `seconds`.
+  auto lap = [&](double& seconds) {
+    const auto now = Clock::now();
+    seconds += std::chrono::duration<double>(now - step).count();
+    step = now;
+  };
+  stats_.stageSeconds += since(start);
 
   // Up, then the radix sort on the bits the chunk's codes may differ in, 8 at a time from the lowest:
   // stable passes, so the points end sorted by code, equal codes in the order they came. The order down.
@@ -141,6 +151,7 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   });
   download_.invalidate();
   copyOnAllThreads(order, download_.mapped(), count * sizeof(uint32_t));
+  lap(stats_.sortSeconds);
 
   // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
   // end sorted in place, as indexChunk leaves them.
@@ -153,6 +164,7 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   copyOnAllThreads(items, sortedItems, count * sizeof(lod::LodItem));
   const bool reordered = lod::orderEqualCodes(items, order, count, scratch);
   if (reordered) copyOnAllThreads(upload_.mapped(), order, count * sizeof(uint32_t));
+  lap(stats_.orderSeconds);
 
   // The order up where it changed, the points gathered in sorted order, the levels' subsamples from the
   // root down (levels whose nodes are all leaves find nothing to do), the levels and colors down.
@@ -190,9 +202,11 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
     gpu::fullBarrier(cmd);
   });
   download_.invalidate();
+  lap(stats_.levelSeconds);
   const auto* down = static_cast<const uint8_t*>(download_.mapped());
   copyOnAllThreads(levels, down, count * sizeof(uint32_t));
   copyOnAllThreads(colors, down + count * sizeof(uint32_t), count * 2 * sizeof(uint32_t));
+  lap(stats_.readSeconds);
   stats_.deviceSeconds += since(start);
   ++stats_.gpuChunks;
   stats_.gpuPoints += count;

@@ -37,6 +37,11 @@ public:
     uint64_t gpuChunks = 0, cpuChunks = 0; // chunks indexed on each
     uint64_t gpuPoints = 0, cpuPoints = 0;
     double deviceSeconds = 0; // wall time of the device's work (submissions and transfers), summed
+    // deviceSeconds in its steps: the items into staging; the sort's submission (upload, radix passes,
+    // the order down); the CPU's part between (items into sorted order, equal codes); the levels'
+    // submission; the levels and colors out of staging.
+    double stageSeconds = 0, sortSeconds = 0, orderSeconds = 0, levelSeconds = 0, readSeconds = 0;
+    double waitSeconds = 0; // the indexing threads' time waiting for the device, summed
   };
   Stats stats() const;
 
