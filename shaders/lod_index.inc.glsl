@@ -21,3 +21,34 @@ uint compactBits3(uint64_t v) {
   v = (v ^ (v >> 32)) & 0x00000000001FFFFFul;
   return uint(v);
 }
+
+// The cells' sums of a level pass (IndexLevelPush::cells), each an array of pc.count entries.
+Uint64Array cellNearest(IndexLevelPush pc) { return Uint64Array(pc.cells); }
+Uint64Array cellSums(IndexLevelPush pc) { return Uint64Array(pc.cells + 8ul * pc.count); } // r, g, b
+UintArray cellReached(IndexLevelPush pc) { return UintArray(pc.cells + 32ul * pc.count); }
+UintArray cellBest(IndexLevelPush pc) { return UintArray(pc.cells + 36ul * pc.count); }
+UintArray cellFirst(IndexLevelPush pc) { return UintArray(pc.cells + 40ul * pc.count); }
+
+// The sorted point's cell of the pass's grid.
+uint64_t cellOf(IndexLevelPush pc, uint i) {
+  return untaggedCode(IndexItems(pc.sorted).v[i].code) >> (3 * (kIndexCodeLevels - pc.cellLevel));
+}
+
+// Twice the center of a grid cell, in quanta: 2 qmin + (2 i + 1) * E / 2^level, rounded
+// (LodGrid::cellCenter).
+i64vec3 cellCenter2(IndexLevelPush pc, uint64_t cell) {
+  const uint index[3] = uint[3](compactBits3(cell >> 2), compactBits3(cell >> 1), compactBits3(cell));
+  int64_t c[3];
+  for (int a = 0; a < 3; ++a) {
+    const int64_t num = (2 * int64_t(index[a]) + 1) * pc.edgeQuanta;
+    c[a] = 2 * int64_t(pc.qmin[a]) + ((num + ((int64_t(1) << pc.cellLevel) >> 1)) >> pc.cellLevel);
+  }
+  return i64vec3(c[0], c[1], c[2]);
+}
+
+// The squared distance of a point (twice its coordinates) to twice a cell's center: exact integers.
+uint64_t distanceTo(IndexItem p, i64vec3 center2) {
+  const int64_t d[3] = int64_t[3](2 * int64_t(p.x) - center2.x, 2 * int64_t(p.y) - center2.y,
+                                   2 * int64_t(p.z) - center2.z);
+  return uint64_t(d[0] * d[0]) + uint64_t(d[1] * d[1]) + uint64_t(d[2] * d[2]);
+}

@@ -1,5 +1,5 @@
 #version 460
-// The points in sorted order (sorted[i] = items[order[i]]), none taken yet.
+// The points in sorted order (sorted[i] = items[order[i]]), none taken yet, every cell's sums empty.
 #include "lod_index.inc.glsl"
 
 layout(local_size_x = kIndexGroupSize) in;
@@ -10,4 +10,9 @@ void main() {
   if (i >= pc.count) return;
   IndexItems(pc.sorted).v[i] = IndexItems(pc.items).v[UintArray(pc.order).v[i]];
   UintArray(pc.taken).v[i] = kNotTaken;
+  cellNearest(pc).v[i] = ~0ul;
+  for (int c = 0; c < 3; ++c)
+    cellSums(pc).v[3 * i + c] = 0ul;
+  cellReached(pc).v[i] = 0u;
+  cellBest(pc).v[i] = kNotTaken;
 }

@@ -46,7 +46,12 @@ struct RadixPush {
   uint groupsX;
 };
 
-// One level's subsample over the sorted points (or the gather that makes their sorted copy).
+// One level's subsample over the sorted points (or the gather that makes their sorted copy). The cells'
+// sums live in `cells`, arrays of count entries one after the other: the nearest untaken point's distance
+// (uint64_t), the sums of its untaken points' red, green and blue (3 x uint64_t), their number (uint), the
+// first untaken point at the nearest distance (uint), and each point's cell's first point (uint). A
+// cell's entries sit at its first point's place; every entry starts empty (the gather sets them) and a
+// cell's first point empties them again after its level.
 struct IndexLevelPush {
   uint64_t items;  // IndexItem[count], in the order the builder gave them
   uint64_t order;  // uint[count]: the sorted points' places in items
@@ -63,6 +68,7 @@ struct IndexLevelPush {
   uint averageColors;
   uint groupsX;
   uint pad;
+  uint64_t cells; // the cells' sums (above): 44 bytes a point
 };
 
 PR_NAMESPACE_END

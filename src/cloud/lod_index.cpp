@@ -1,11 +1,15 @@
 #include "cloud/lod_index.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cassert>
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <vector>
+
+#include "base/parallel.h"
 
 namespace pointrast::lod {
 
@@ -322,36 +326,49 @@ private:
 
 } // namespace
 
-bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count, IndexScratch& scratch) {
-  bool any = false;
-  std::vector<uint32_t> places;
-  for (size_t i = 0; i + 1 < count;) {
-    size_t end = i + 1;
-    while (end < count && untagged(items[end].code) == untagged(items[i].code))
-      ++end;
-    if (end - i > 1) {
-      any = true;
-      // Sort the run's positions by their items, then move items and order along.
-      const size_t n = end - i;
-      places.resize(n);
-      for (size_t k = 0; k < n; ++k)
-        places[k] = static_cast<uint32_t>(k);
-      std::sort(places.begin(), places.end(),
-                [&](uint32_t a, uint32_t b) { return itemLess(items[i + a], items[i + b]); });
-      if (scratch.items.size() < n) scratch.items.resize(n);
-      if (scratch.counts.size() < n) scratch.counts.resize(n);
-      for (size_t k = 0; k < n; ++k) {
-        scratch.items[k] = items[i + places[k]];
-        scratch.counts[k] = order[i + places[k]];
-      }
-      for (size_t k = 0; k < n; ++k) {
-        items[i + k] = scratch.items[k];
-        order[i + k] = static_cast<uint32_t>(scratch.counts[k]);
-      }
-    }
-    i = end;
+bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count, IndexScratch&) {
+  // In blocks on all threads, each a whole number of runs: the blocks' bounds first, moved forward to the
+  // next run's start (read before any thread writes).
+  const size_t kBlock = size_t(1) << 18;
+  std::vector<size_t> bounds{0};
+  for (size_t b = kBlock; b < count; b += kBlock) {
+    size_t i = std::max(b, bounds.back());
+    while (i < count && untagged(items[i].code) == untagged(items[i - 1].code))
+      ++i;
+    if (i < count && i > bounds.back()) bounds.push_back(i);
   }
-  return any;
+  bounds.push_back(count);
+  std::atomic<bool> any{false};
+  parallelBlocks(bounds.size() - 1, 1, [&](uint64_t block, uint64_t, uint64_t) {
+    std::vector<uint32_t> places;
+    std::vector<LodItem> runItems;
+    std::vector<uint32_t> runOrder;
+    for (size_t i = bounds[block], end = bounds[block + 1]; i < end;) {
+      size_t stop = i + 1;
+      while (stop < end && untagged(items[stop].code) == untagged(items[i].code))
+        ++stop;
+      if (stop - i > 1) {
+        any.store(true, std::memory_order_relaxed);
+        // Sort the run's positions by their items, then move items and order along.
+        const size_t n = stop - i;
+        places.resize(n);
+        for (size_t k = 0; k < n; ++k)
+          places[k] = static_cast<uint32_t>(k);
+        std::sort(places.begin(), places.end(),
+                  [&](uint32_t a, uint32_t b) { return itemLess(items[i + a], items[i + b]); });
+        runItems.resize(n);
+        runOrder.resize(n);
+        for (size_t k = 0; k < n; ++k) {
+          runItems[k] = items[i + places[k]];
+          runOrder[k] = order[i + places[k]];
+        }
+        std::copy(runItems.begin(), runItems.end(), items + i);
+        std::copy(runOrder.begin(), runOrder.end(), order + i);
+      }
+      i = stop;
+    }
+  });
+  return any.load();
 }
 
 void assembleIndexedChunk(ChunkNodes& out, const NodeKey& chunk, LodItem* items, size_t count,

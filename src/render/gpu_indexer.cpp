@@ -26,8 +26,12 @@ static_assert(offsetof(shared::IndexItem, ref) == offsetof(lod::LodItem, ref));
 static_assert(shared::kNotTaken == lod::kNotTakenLevel);
 static_assert(shared::kIndexCodeLevels == uint32_t(lod::kCodeLevels));
 static_assert(sizeof(shared::RadixPush) == 64);
-static_assert(sizeof(shared::IndexLevelPush) == 96 && offsetof(shared::IndexLevelPush, qmin) == 56 &&
-              offsetof(shared::IndexLevelPush, count) == 68);
+static_assert(sizeof(shared::IndexLevelPush) == 104 && offsetof(shared::IndexLevelPush, qmin) == 56 &&
+              offsetof(shared::IndexLevelPush, count) == 68 && offsetof(shared::IndexLevelPush, cells) == 96);
+// The cells' sums (IndexLevelPush::cells): 8 + 24 + 4 + 4 + 4 bytes a point.
+constexpr uint64_t kCellBytesPerPoint = 44;
+// Staging down: the order and the sorted points after the sort; the levels and colors after the passes.
+constexpr uint64_t kDownloadBytesPerPoint = sizeof(uint32_t) + sizeof(lod::LodItem);
 
 namespace {
 
@@ -42,7 +46,8 @@ double since(Clock::time_point start) {
 GpuIndexer::GpuIndexer(gpu::Context& context)
     : context_(context), histogram_(context, "lod_index_histogram.comp"),
       scan_(context, "lod_index_scan.comp"), scatter_(context, "lod_index_scatter.comp"),
-      gather_(context, "lod_index_gather.comp"), level_(context, "lod_index_level.comp") {}
+      gather_(context, "lod_index_gather.comp"), cells_(context, "lod_index_cells.comp"),
+      best_(context, "lod_index_best.comp"), level_(context, "lod_index_level.comp") {}
 
 GpuIndexer::~GpuIndexer() = default;
 
@@ -62,7 +67,7 @@ void GpuIndexer::reserve(size_t count) {
   };
   // The old buffers go first: their memory may be needed for the new ones.
   for (gpu::Buffer* b : {&items_, &sorted_, &keys_[0], &keys_[1], &values_[0], &values_[1], &taken_, &colors_,
-                         &buckets_, &upload_, &download_})
+                         &cellSums_, &buckets_, &upload_, &download_})
     *b = gpu::Buffer();
   const gpu::MemoryKind device = gpu::MemoryKind::Device;
   items_ = make(n * sizeof(lod::LodItem), device, "index items");
@@ -73,11 +78,12 @@ void GpuIndexer::reserve(size_t count) {
   }
   taken_ = make(n * sizeof(uint32_t), device, "index taken levels");
   colors_ = make(n * 2 * sizeof(uint32_t), device, "index colors");
+  cellSums_ = make(n * kCellBytesPerPoint, device, "index cells");
   buckets_ = make(tiles * 256 * sizeof(uint32_t), device, "index histogram");
-  // Staging kept from chunk to chunk: the items (or the order) up; the order, or the levels and colors,
-  // down.
+  // Staging kept from chunk to chunk: the items (or the order) up; the order and the sorted points, or
+  // the levels and colors, down.
   upload_ = make(n * sizeof(lod::LodItem), gpu::MemoryKind::Upload, "index upload");
-  download_ = make(n * 3 * sizeof(uint32_t), gpu::MemoryKind::Readback, "index download");
+  download_ = make(n * kDownloadBytesPerPoint, gpu::MemoryKind::Readback, "index download");
   capacity_ = n;
 }
 
@@ -115,65 +121,22 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   stats_.stageSeconds += since(start);
 
   // Up, then the radix sort on the bits the chunk's codes may differ in, 8 at a time from the lowest:
-  // stable passes, so the points end sorted by code, equal codes in the order they came. The order down.
+  // stable passes, so the points end sorted by code, equal codes in the order they came. The points
+  // gathered in that order; the order and the sorted points down.
   const uint32_t n = static_cast<uint32_t>(count);
   const uint32_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
   const int freeBits = 3 * (lod::kCodeLevels - chunk.level);
   const int passes = (freeBits + int(shared::kRadixBits) - 1) / int(shared::kRadixBits);
   const gpu::Grid tileGrid = gpu::gridFor(uint64_t(tiles) * shared::kIndexGroupSize, shared::kIndexGroupSize);
   const int current = passes % 2; // the keys_/values_ pair the last pass writes
-  context_.submitAndWait([&](VkCommandBuffer cmd) {
-    gpu::fullBarrier(cmd);
-    copyBuffer(cmd, upload_, items_, 0, count * sizeof(lod::LodItem));
-    gpu::fullBarrier(cmd);
-    for (int p = 0; p < passes; ++p) {
-      shared::RadixPush push{};
-      const int in = p % 2, out = 1 - in;
-      push.keysIn = keys_[in].address();
-      push.valuesIn = values_[in].address();
-      push.keysOut = keys_[out].address();
-      push.valuesOut = values_[out].address();
-      push.histogram = buckets_.address();
-      push.items = p == 0 ? items_.address() : 0; // the first pass reads the codes from the items
-      push.count = n;
-      push.shift = uint32_t(p) * shared::kRadixBits;
-      push.tiles = tiles;
-      push.groupsX = tileGrid.x;
-      histogram_.dispatch(cmd, tileGrid.x, tileGrid.y, push);
-      gpu::fullBarrier(cmd);
-      scan_.dispatch(cmd, 1, 1, push);
-      gpu::fullBarrier(cmd);
-      scatter_.dispatch(cmd, tileGrid.x, tileGrid.y, push);
-      gpu::fullBarrier(cmd);
-    }
-    copyBuffer(cmd, values_[current], download_, 0, count * sizeof(uint32_t));
-    gpu::fullBarrier(cmd);
-  });
-  download_.invalidate();
-  copyOnAllThreads(order, download_.mapped(), count * sizeof(uint32_t));
-  lap(stats_.sortSeconds);
 
-  // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
-  // end sorted in place, as indexChunk leaves them.
-  if (scratch.items.size() < count) scratch.items.resize(count);
-  lod::LodItem* const sortedItems = scratch.items.data();
-  parallelBlocks(count, uint64_t(1) << 16, [&](uint64_t, uint64_t begin, uint64_t end) {
-    for (uint64_t i = begin; i < end; ++i)
-      sortedItems[i] = items[order[i]];
-  });
-  copyOnAllThreads(items, sortedItems, count * sizeof(lod::LodItem));
-  const bool reordered = lod::orderEqualCodes(items, order, count, scratch);
-  if (reordered) copyOnAllThreads(upload_.mapped(), order, count * sizeof(uint32_t));
-  lap(stats_.orderSeconds);
-
-  // The order up where it changed, the points gathered in sorted order, the levels' subsamples from the
-  // root down (levels whose nodes are all leaves find nothing to do), the levels and colors down.
   shared::IndexLevelPush push{};
   push.items = items_.address();
   push.order = values_[current].address();
   push.sorted = sorted_.address();
   push.taken = taken_.address();
   push.colors = colors_.address();
+  push.cells = cellSums_.address();
   push.leafPoints = params.leafPoints;
   push.edgeQuanta = grid.edgeQuanta;
   for (int a = 0; a < 3; ++a)
@@ -183,29 +146,77 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   push.averageColors = params.averageColors ? 1u : 0u;
   const gpu::Grid pointGrid = gpu::gridFor(count, shared::kIndexGroupSize);
   push.groupsX = pointGrid.x;
+  const uint64_t orderBytes = count * sizeof(uint32_t), itemBytes = count * sizeof(lod::LodItem);
+
+  context_.submitAndWait([&](VkCommandBuffer cmd) {
+    gpu::fullBarrier(cmd);
+    copyBuffer(cmd, upload_, items_, 0, itemBytes);
+    gpu::fullBarrier(cmd);
+    for (int p = 0; p < passes; ++p) {
+      shared::RadixPush radix{};
+      const int in = p % 2, out = 1 - in;
+      radix.keysIn = keys_[in].address();
+      radix.valuesIn = values_[in].address();
+      radix.keysOut = keys_[out].address();
+      radix.valuesOut = values_[out].address();
+      radix.histogram = buckets_.address();
+      radix.items = p == 0 ? items_.address() : 0; // the first pass reads the codes from the items
+      radix.count = n;
+      radix.shift = uint32_t(p) * shared::kRadixBits;
+      radix.tiles = tiles;
+      radix.groupsX = tileGrid.x;
+      histogram_.dispatch(cmd, tileGrid.x, tileGrid.y, radix);
+      gpu::fullBarrier(cmd);
+      scan_.dispatch(cmd, 1, 1, radix);
+      gpu::fullBarrier(cmd);
+      scatter_.dispatch(cmd, tileGrid.x, tileGrid.y, radix);
+      gpu::fullBarrier(cmd);
+    }
+    gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
+    gpu::fullBarrier(cmd);
+    copyBuffer(cmd, values_[current], download_, 0, orderBytes);
+    copyBuffer(cmd, sorted_, download_, orderBytes, itemBytes);
+    gpu::fullBarrier(cmd);
+  });
+  download_.invalidate();
+  const auto* down = static_cast<const uint8_t*>(download_.mapped());
+  copyOnAllThreads(order, down, orderBytes);
+  copyOnAllThreads(items, down + orderBytes, itemBytes);
+  lap(stats_.sortSeconds);
+
+  // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
+  // end sorted in place, as indexChunk leaves them; where the order changed it goes up and the points
+  // are gathered again.
+  const bool reordered = lod::orderEqualCodes(items, order, count, scratch);
+  if (reordered) copyOnAllThreads(upload_.mapped(), order, orderBytes);
+  lap(stats_.orderSeconds);
+
+  // Each level's subsample from the root down, three passes a level (levels whose nodes are all leaves
+  // find nothing to take), then the levels and colors down.
   context_.submitAndWait([&](VkCommandBuffer cmd) {
     if (reordered) {
       gpu::fullBarrier(cmd);
-      copyBuffer(cmd, upload_, values_[current], 0, count * sizeof(uint32_t));
+      copyBuffer(cmd, upload_, values_[current], 0, orderBytes);
+      gpu::fullBarrier(cmd);
+      gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
     }
-    gpu::fullBarrier(cmd);
-    gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
     gpu::fullBarrier(cmd);
     for (int level = 0; level < lod::kMaxLevel; ++level) {
       push.level = uint32_t(level);
       push.cellLevel = uint32_t(grid.sampleLevel(level));
-      level_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
-      gpu::fullBarrier(cmd);
+      for (gpu::ComputeProgram* pass : {&cells_, &best_, &level_}) {
+        pass->dispatch(cmd, pointGrid.x, pointGrid.y, push);
+        gpu::fullBarrier(cmd);
+      }
     }
-    copyBuffer(cmd, taken_, download_, 0, count * sizeof(uint32_t));
-    copyBuffer(cmd, colors_, download_, count * sizeof(uint32_t), count * 2 * sizeof(uint32_t));
+    copyBuffer(cmd, taken_, download_, 0, orderBytes);
+    copyBuffer(cmd, colors_, download_, orderBytes, 2 * orderBytes);
     gpu::fullBarrier(cmd);
   });
   download_.invalidate();
   lap(stats_.levelSeconds);
-  const auto* down = static_cast<const uint8_t*>(download_.mapped());
-  copyOnAllThreads(levels, down, count * sizeof(uint32_t));
-  copyOnAllThreads(colors, down + count * sizeof(uint32_t), count * 2 * sizeof(uint32_t));
+  copyOnAllThreads(levels, down, orderBytes);
+  copyOnAllThreads(colors, down + orderBytes, 2 * orderBytes);
   lap(stats_.readSeconds);
   stats_.deviceSeconds += since(start);
   ++stats_.gpuChunks;

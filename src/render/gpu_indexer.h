@@ -53,10 +53,10 @@ private:
   void reserve(size_t count);
 
   gpu::Context& context_;
-  gpu::ComputeProgram histogram_, scan_, scatter_, gather_, level_;
+  gpu::ComputeProgram histogram_, scan_, scatter_, gather_, cells_, best_, level_;
   mutable std::mutex mutex_; // one chunk on the device at a time; guards the buffers and stats
   size_t capacity_ = 0;
-  gpu::Buffer items_, sorted_, keys_[2], values_[2], taken_, colors_, buckets_;
+  gpu::Buffer items_, sorted_, keys_[2], values_[2], taken_, colors_, cellSums_, buckets_;
   gpu::Buffer upload_, download_; // staging, host-visible
   Stats stats_;
 };
