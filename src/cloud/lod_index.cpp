@@ -326,7 +326,7 @@ private:
 
 } // namespace
 
-bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count, IndexScratch&) {
+bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count) {
   // In blocks on all threads, each a whole number of runs: the blocks' bounds first, moved forward to the
   // next run's start (read before any thread writes).
   const size_t kBlock = size_t(1) << 18;

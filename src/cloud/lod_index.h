@@ -107,8 +107,8 @@ public:
 inline constexpr uint32_t kNotTakenLevel = 0xFFFFFFFFu;
 // Items sorted by code alone, ties in any order, into the canonical order (lod_index.h's top): each run
 // of equal codes sorted by record bytes and ref, `order` (each item's place in some other array) moved
-// with its item. True when there was such a run (the order may have changed).
-bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count, IndexScratch& scratch);
+// with its item. True when there was such a run (the order may have changed). Runs on all threads.
+bool orderEqualCodes(LodItem* items, uint32_t* order, size_t count);
 // The chunk's nodes from its items in canonical order and, for each, the level whose subsample took it
 // (kNotTakenLevel: none) and the color it took (rgb[0] | rgb[1] << 16, rgb[2]; averaged where colors
 // are filtered); marks the taken items as indexChunk does. The other arguments are indexChunk's.

@@ -47,7 +47,12 @@ GpuIndexer::GpuIndexer(gpu::Context& context)
     : context_(context), histogram_(context, "lod_index_histogram.comp"),
       scan_(context, "lod_index_scan.comp"), scatter_(context, "lod_index_scatter.comp"),
       gather_(context, "lod_index_gather.comp"), cells_(context, "lod_index_cells.comp"),
-      best_(context, "lod_index_best.comp"), level_(context, "lod_index_level.comp") {}
+      best_(context, "lod_index_best.comp"), level_(context, "lod_index_level.comp") {
+  for (size_t i = 0; i < kSlots; ++i) {
+    slots_.push_back(std::make_unique<Slot>());
+    free_.push_back(slots_.back().get());
+  }
+}
 
 GpuIndexer::~GpuIndexer() = default;
 
@@ -56,35 +61,62 @@ GpuIndexer::Stats GpuIndexer::stats() const {
   return stats_;
 }
 
-void GpuIndexer::reserve(size_t count) {
-  if (count <= capacity_) return;
-  // Room for a quarter more than asked, so that chunks a little larger do not reallocate each time.
-  const size_t n = count + count / 4;
-  const uint64_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
-  capacity_ = 0;
-  auto make = [&](uint64_t bytes, gpu::MemoryKind kind, const char* name) {
-    return gpu::Buffer(context_, bytes, gpu::kBufferUsage, kind, name);
-  };
-  // The old buffers go first: their memory may be needed for the new ones.
-  for (gpu::Buffer* b : {&items_, &sorted_, &keys_[0], &keys_[1], &values_[0], &values_[1], &taken_, &colors_,
-                         &cellSums_, &buckets_, &upload_, &download_})
-    *b = gpu::Buffer();
-  const gpu::MemoryKind device = gpu::MemoryKind::Device;
-  items_ = make(n * sizeof(lod::LodItem), device, "index items");
-  sorted_ = make(n * sizeof(lod::LodItem), device, "index sorted items");
-  for (int b = 0; b < 2; ++b) {
-    keys_[b] = make(n * sizeof(uint64_t), device, "index keys");
-    values_[b] = make(n * sizeof(uint32_t), device, "index order");
+// One chunk's buffers: on the device, and staging kept from chunk to chunk.
+struct GpuIndexer::Slot {
+  size_t capacity = 0;
+  gpu::Buffer items, sorted, keys[2], values[2], taken, colors, cells, buckets;
+  gpu::Buffer upload, download;
+
+  void reserve(gpu::Context& context, size_t count) {
+    if (count <= capacity) return;
+    // Room for a quarter more than asked, so that chunks a little larger do not reallocate each time.
+    const size_t n = count + count / 4;
+    const uint64_t tiles = (n + shared::kRadixTileItems - 1) / shared::kRadixTileItems;
+    capacity = 0;
+    auto make = [&](uint64_t bytes, gpu::MemoryKind kind, const char* name) {
+      return gpu::Buffer(context, bytes, gpu::kBufferUsage, kind, name);
+    };
+    // The old buffers go first: their memory may be needed for the new ones.
+    for (gpu::Buffer* b : {&items, &sorted, &keys[0], &keys[1], &values[0], &values[1], &taken, &colors,
+                           &cells, &buckets, &upload, &download})
+      *b = gpu::Buffer();
+    const gpu::MemoryKind device = gpu::MemoryKind::Device;
+    items = make(n * sizeof(lod::LodItem), device, "index items");
+    sorted = make(n * sizeof(lod::LodItem), device, "index sorted items");
+    for (int b = 0; b < 2; ++b) {
+      keys[b] = make(n * sizeof(uint64_t), device, "index keys");
+      values[b] = make(n * sizeof(uint32_t), device, "index order");
+    }
+    taken = make(n * sizeof(uint32_t), device, "index taken levels");
+    colors = make(n * 2 * sizeof(uint32_t), device, "index colors");
+    cells = make(n * kCellBytesPerPoint, device, "index cells");
+    buckets = make(tiles * 256 * sizeof(uint32_t), device, "index histogram");
+    // The items (or the order) up; the order and the sorted points, or the levels and colors, down.
+    upload = make(n * sizeof(lod::LodItem), gpu::MemoryKind::Upload, "index upload");
+    download = make(n * kDownloadBytesPerPoint, gpu::MemoryKind::Readback, "index download");
+    capacity = n;
   }
-  taken_ = make(n * sizeof(uint32_t), device, "index taken levels");
-  colors_ = make(n * 2 * sizeof(uint32_t), device, "index colors");
-  cellSums_ = make(n * kCellBytesPerPoint, device, "index cells");
-  buckets_ = make(tiles * 256 * sizeof(uint32_t), device, "index histogram");
-  // Staging kept from chunk to chunk: the items (or the order) up; the order and the sorted points, or
-  // the levels and colors, down.
-  upload_ = make(n * sizeof(lod::LodItem), gpu::MemoryKind::Upload, "index upload");
-  download_ = make(n * kDownloadBytesPerPoint, gpu::MemoryKind::Readback, "index download");
-  capacity_ = n;
+};
+
+GpuIndexer::Slot& GpuIndexer::acquire() {
+  std::unique_lock lock(mutex_);
+  freed_.wait(lock, [&] { return !free_.empty(); });
+  Slot* slot = free_.back();
+  free_.pop_back();
+  return *slot;
+}
+
+void GpuIndexer::release(Slot& slot) {
+  {
+    std::lock_guard lock(mutex_);
+    free_.push_back(&slot);
+  }
+  freed_.notify_one();
+}
+
+void GpuIndexer::submit(const std::function<void(VkCommandBuffer)>& record) {
+  std::lock_guard lock(deviceMutex_);
+  context_.submitAndWait(record);
 }
 
 namespace {
@@ -97,20 +129,25 @@ void copyBuffer(VkCommandBuffer cmd, const gpu::Buffer& from, const gpu::Buffer&
 
 } // namespace
 
-bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& grid,
-                               const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
-                               const lod::LodParams& params, uint32_t* order, uint32_t* levels,
+bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chunk, lod::LodItem* items,
+                               size_t count, const lod::LodParams& params, uint32_t* order, uint32_t* levels,
                                uint32_t* colors) {
   const auto asked = Clock::now();
-  std::lock_guard lock(mutex_);
-  stats_.waitSeconds += since(asked);
+  Slot& slot = acquire();
+  struct Release {
+    GpuIndexer& indexer;
+    Slot& slot;
+    ~Release() { indexer.release(slot); }
+  } releaseLater{*this, slot};
+  Stats times;
+  times.waitSeconds = since(asked);
   try {
-    reserve(count);
+    slot.reserve(context_, count);
   } catch (const UnsupportedError&) {
     return false;
   }
   const auto start = Clock::now();
-  copyOnAllThreads(upload_.mapped(), items, count * sizeof(lod::LodItem));
+  copyOnAllThreads(slot.upload.mapped(), items, count * sizeof(lod::LodItem));
   auto step = Clock::now();
   // Adds the time since the last step's end to `seconds`.
   auto lap = [&](double& seconds) {
@@ -118,7 +155,7 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
     seconds += std::chrono::duration<double>(now - step).count();
     step = now;
   };
-  stats_.stageSeconds += since(start);
+  times.stageSeconds = since(start);
 
   // Up, then the radix sort on the bits the chunk's codes may differ in, 8 at a time from the lowest:
   // stable passes, so the points end sorted by code, equal codes in the order they came. The points
@@ -128,15 +165,15 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   const int freeBits = 3 * (lod::kCodeLevels - chunk.level);
   const int passes = (freeBits + int(shared::kRadixBits) - 1) / int(shared::kRadixBits);
   const gpu::Grid tileGrid = gpu::gridFor(uint64_t(tiles) * shared::kIndexGroupSize, shared::kIndexGroupSize);
-  const int current = passes % 2; // the keys_/values_ pair the last pass writes
+  const int current = passes % 2; // the slot.keys/slot.values pair the last pass writes
 
   shared::IndexLevelPush push{};
-  push.items = items_.address();
-  push.order = values_[current].address();
-  push.sorted = sorted_.address();
-  push.taken = taken_.address();
-  push.colors = colors_.address();
-  push.cells = cellSums_.address();
+  push.items = slot.items.address();
+  push.order = slot.values[current].address();
+  push.sorted = slot.sorted.address();
+  push.taken = slot.taken.address();
+  push.colors = slot.colors.address();
+  push.cells = slot.cells.address();
   push.leafPoints = params.leafPoints;
   push.edgeQuanta = grid.edgeQuanta;
   for (int a = 0; a < 3; ++a)
@@ -148,19 +185,19 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
   push.groupsX = pointGrid.x;
   const uint64_t orderBytes = count * sizeof(uint32_t), itemBytes = count * sizeof(lod::LodItem);
 
-  context_.submitAndWait([&](VkCommandBuffer cmd) {
+  submit([&](VkCommandBuffer cmd) {
     gpu::fullBarrier(cmd);
-    copyBuffer(cmd, upload_, items_, 0, itemBytes);
+    copyBuffer(cmd, slot.upload, slot.items, 0, itemBytes);
     gpu::fullBarrier(cmd);
     for (int p = 0; p < passes; ++p) {
       shared::RadixPush radix{};
       const int in = p % 2, out = 1 - in;
-      radix.keysIn = keys_[in].address();
-      radix.valuesIn = values_[in].address();
-      radix.keysOut = keys_[out].address();
-      radix.valuesOut = values_[out].address();
-      radix.histogram = buckets_.address();
-      radix.items = p == 0 ? items_.address() : 0; // the first pass reads the codes from the items
+      radix.keysIn = slot.keys[in].address();
+      radix.valuesIn = slot.values[in].address();
+      radix.keysOut = slot.keys[out].address();
+      radix.valuesOut = slot.values[out].address();
+      radix.histogram = slot.buckets.address();
+      radix.items = p == 0 ? slot.items.address() : 0; // the first pass reads the codes from the items
       radix.count = n;
       radix.shift = uint32_t(p) * shared::kRadixBits;
       radix.tiles = tiles;
@@ -174,29 +211,29 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
     }
     gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
     gpu::fullBarrier(cmd);
-    copyBuffer(cmd, values_[current], download_, 0, orderBytes);
-    copyBuffer(cmd, sorted_, download_, orderBytes, itemBytes);
+    copyBuffer(cmd, slot.values[current], slot.download, 0, orderBytes);
+    copyBuffer(cmd, slot.sorted, slot.download, orderBytes, itemBytes);
     gpu::fullBarrier(cmd);
   });
-  download_.invalidate();
-  const auto* down = static_cast<const uint8_t*>(download_.mapped());
+  slot.download.invalidate();
+  const auto* down = static_cast<const uint8_t*>(slot.download.mapped());
   copyOnAllThreads(order, down, orderBytes);
   copyOnAllThreads(items, down + orderBytes, itemBytes);
-  lap(stats_.sortSeconds);
+  lap(times.sortSeconds);
 
   // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
   // end sorted in place, as indexChunk leaves them; where the order changed it goes up and the points
   // are gathered again.
-  const bool reordered = lod::orderEqualCodes(items, order, count, scratch);
-  if (reordered) copyOnAllThreads(upload_.mapped(), order, orderBytes);
-  lap(stats_.orderSeconds);
+  const bool reordered = lod::orderEqualCodes(items, order, count);
+  if (reordered) copyOnAllThreads(slot.upload.mapped(), order, orderBytes);
+  lap(times.orderSeconds);
 
   // Each level's subsample from the root down, three passes a level (levels whose nodes are all leaves
   // find nothing to take), then the levels and colors down.
-  context_.submitAndWait([&](VkCommandBuffer cmd) {
+  submit([&](VkCommandBuffer cmd) {
     if (reordered) {
       gpu::fullBarrier(cmd);
-      copyBuffer(cmd, upload_, values_[current], 0, orderBytes);
+      copyBuffer(cmd, slot.upload, slot.values[current], 0, orderBytes);
       gpu::fullBarrier(cmd);
       gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
     }
@@ -209,18 +246,26 @@ bool GpuIndexer::indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& g
         gpu::fullBarrier(cmd);
       }
     }
-    copyBuffer(cmd, taken_, download_, 0, orderBytes);
-    copyBuffer(cmd, colors_, download_, orderBytes, 2 * orderBytes);
+    copyBuffer(cmd, slot.taken, slot.download, 0, orderBytes);
+    copyBuffer(cmd, slot.colors, slot.download, orderBytes, 2 * orderBytes);
     gpu::fullBarrier(cmd);
   });
-  download_.invalidate();
-  lap(stats_.levelSeconds);
+  slot.download.invalidate();
+  lap(times.levelSeconds);
   copyOnAllThreads(levels, down, orderBytes);
   copyOnAllThreads(colors, down + orderBytes, 2 * orderBytes);
-  lap(stats_.readSeconds);
-  stats_.deviceSeconds += since(start);
-  ++stats_.gpuChunks;
+  lap(times.readSeconds);
+  times.deviceSeconds = since(start);
+  std::lock_guard lock(mutex_);
+  stats_.gpuChunks += 1;
   stats_.gpuPoints += count;
+  stats_.deviceSeconds += times.deviceSeconds;
+  stats_.stageSeconds += times.stageSeconds;
+  stats_.sortSeconds += times.sortSeconds;
+  stats_.orderSeconds += times.orderSeconds;
+  stats_.levelSeconds += times.levelSeconds;
+  stats_.readSeconds += times.readSeconds;
+  stats_.waitSeconds += times.waitSeconds;
   return true;
 }
 
@@ -230,8 +275,7 @@ void GpuIndexer::index(lod::ChunkNodes& out, lod::IndexScratch& scratch, const l
                        const uint8_t* tails) {
   if (grid.isotropic && count > 0 && count < size_t(UINT32_MAX)) {
     std::vector<uint32_t> order(count), levels(count), colors(2 * count);
-    if (indexOnDevice(scratch, grid, chunk, items, count, params, order.data(), levels.data(),
-                      colors.data())) {
+    if (indexOnDevice(grid, chunk, items, count, params, order.data(), levels.data(), colors.data())) {
       lod::assembleIndexedChunk(out, chunk, items, count, levels.data(), colors.data(), params, tails);
       return;
     }

@@ -4,15 +4,19 @@
 // their canonical order between the two and lays out the nodes from the levels the points were taken
 // at, so the octree is the one indexChunk makes, byte for byte.
 //
-// One chunk is on the device at a time; the indexing threads wait for it in turn and lay out their
-// nodes, encode and write meanwhile. Chunks the GPU path does not cover are indexed on the CPU: a grid
-// with unequal scales on its axes (its distances are weighted in double), chunks of more than 2^32 - 1
-// points, and chunks whose buffers the device cannot hold.
+// Two chunks are in flight at a time, each with buffers of its own (a slot), so that one chunk's host
+// copies and equal-code ordering run while the other's submission runs; submissions go to the device one
+// at a time. The other indexing threads lay out their nodes, encode and write meanwhile. Chunks the GPU path
+// does not cover are indexed on the CPU: a grid with unequal scales on its axes (its distances are weighted
+// in double), chunks of more than 2^32 - 1 points, and chunks whose buffers the device cannot hold.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "cloud/lod_index.h"
 #include "gpu/buffer.h"
@@ -41,23 +45,28 @@ public:
     // the order down); the CPU's part between (items into sorted order, equal codes); the levels'
     // submission; the levels and colors out of staging.
     double stageSeconds = 0, sortSeconds = 0, orderSeconds = 0, levelSeconds = 0, readSeconds = 0;
-    double waitSeconds = 0; // the indexing threads' time waiting for the device, summed
+    double waitSeconds = 0; // the indexing threads' time waiting for a free slot, summed
   };
   Stats stats() const;
 
 private:
+  struct Slot;
+  static constexpr size_t kSlots = 2;
+
   // Sorts and subsamples on the device; false when its buffers cannot be had (the CPU takes the chunk).
-  bool indexOnDevice(lod::IndexScratch& scratch, const lod::LodGrid& grid, const lod::NodeKey& chunk,
-                     lod::LodItem* items, size_t count, const lod::LodParams& params, uint32_t* order,
-                     uint32_t* levels, uint32_t* colors);
-  void reserve(size_t count);
+  bool indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
+                     const lod::LodParams& params, uint32_t* order, uint32_t* levels, uint32_t* colors);
+  Slot& acquire(); // waits for a free slot
+  void release(Slot& slot);
+  void submit(const std::function<void(VkCommandBuffer)>& record); // one at a time, waits for it
 
   gpu::Context& context_;
   gpu::ComputeProgram histogram_, scan_, scatter_, gather_, cells_, best_, level_;
-  mutable std::mutex mutex_; // one chunk on the device at a time; guards the buffers and stats
-  size_t capacity_ = 0;
-  gpu::Buffer items_, sorted_, keys_[2], values_[2], taken_, colors_, cellSums_, buckets_;
-  gpu::Buffer upload_, download_; // staging, host-visible
+  std::mutex deviceMutex_;   // one submission at a time: the context's queue and command pool
+  mutable std::mutex mutex_; // guards free_ and stats_
+  std::condition_variable freed_;
+  std::vector<std::unique_ptr<Slot>> slots_;
+  std::vector<Slot*> free_;
   Stats stats_;
 };
 
