@@ -28,6 +28,7 @@ Uint64Array cellSums(IndexLevelPush pc) { return Uint64Array(pc.cells + 8ul * pc
 UintArray cellReached(IndexLevelPush pc) { return UintArray(pc.cells + 32ul * pc.count); }
 UintArray cellBest(IndexLevelPush pc) { return UintArray(pc.cells + 36ul * pc.count); }
 UintArray cellFirst(IndexLevelPush pc) { return UintArray(pc.cells + 40ul * pc.count); }
+UintArray equalCodesFlag(IndexLevelPush pc) { return UintArray(pc.cells + 44ul * pc.count); } // one uint
 
 // The sorted point's cell of the pass's grid.
 uint64_t cellOf(IndexLevelPush pc, uint i) {

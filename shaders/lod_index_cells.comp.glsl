@@ -13,6 +13,7 @@ shared uint64_t nearestHere[kIndexGroupSize];
 shared uint64_t sumsHere[3][kIndexGroupSize];
 shared uint reachedHere[kIndexGroupSize];
 shared uint firstHere[kIndexGroupSize];
+shared uint firstOfFirstCell; // the workgroup's first cell's first point
 
 // The first sorted point whose cell is at least `cell`, in [lo, hi).
 uint firstOfCell(uint lo, uint hi, uint64_t cell) {
@@ -36,10 +37,14 @@ void main() {
   // Past the end: a cell above every code, so that the sorted order holds in cellsHere.
   const uint64_t cell = valid ? cellOf(pc, i) : ~0ul;
   cellsHere[t] = cell;
+  if (t == 0) {
+    // Where the workgroup's first cell started before it: a binary search over the sorted points.
+    firstOfFirstCell = base;
+    if (base > 0 && cellOf(pc, base - 1) == cell) firstOfFirstCell = firstOfCell(0, base - 1, cell);
+  }
   barrier();
 
-  // The cell's first point: within the workgroup by a binary search over its cells; before it by one
-  // over the sorted points, where the workgroup's first cell started earlier.
+  // The cell's first point: within the workgroup by a binary search over its cells, or the first cell's.
   uint lo = 0, hi = t;
   while (lo < hi) {
     const uint mid = (lo + hi) / 2;
@@ -48,8 +53,7 @@ void main() {
     else
       hi = mid;
   }
-  uint first = base + lo;
-  if (lo == 0 && base > 0 && cellOf(pc, base - 1) == cell) first = firstOfCell(0, base - 1, cell);
+  const uint first = lo == 0 ? firstOfFirstCell : base + lo;
   if (valid) cellFirst(pc).v[i] = first;
 
   // The point's share: its distance and color where no level above took it.

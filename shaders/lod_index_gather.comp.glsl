@@ -1,5 +1,6 @@
 #version 460
-// The points in sorted order (sorted[i] = items[order[i]]), none taken yet, every cell's sums empty.
+// The points in sorted order (sorted[i] = items[order[i]]), none taken yet, every cell's sums empty; the
+// flag raised where two sorted points share a code (the CPU then puts them in canonical order).
 #include "lod_index.inc.glsl"
 
 layout(local_size_x = kIndexGroupSize) in;
@@ -15,4 +16,7 @@ void main() {
     cellSums(pc).v[3 * i + c] = 0ul;
   cellReached(pc).v[i] = 0u;
   cellBest(pc).v[i] = kNotTaken;
+  if (pc.keys != 0 && i > 0 &&
+      untaggedCode(Uint64Array(pc.keys).v[i]) == untaggedCode(Uint64Array(pc.keys).v[i - 1]))
+    atomicOr(equalCodesFlag(pc).v[0], 1u);
 }

@@ -6,6 +6,10 @@
 // in inner nodes: above the chunk's level every node is; from there on a node is inner when its cube
 // holds more than leafPoints points, which two binary searches over the sorted codes count. The grid is
 // isotropic (equal scales), so distances are exact integers.
+//
+// The node's first point is found by galloping back from the cell's (then a binary search), so that the
+// many small nodes of the fine levels cost a few reads; it holds more than leafPoints points when the
+// point leafPoints after its first is still in it.
 #include "lod_index.inc.glsl"
 
 layout(local_size_x = kIndexGroupSize) in;
@@ -40,9 +44,18 @@ void main() {
     const uint cellShift = 3 * (kIndexCodeLevels - pc.cellLevel);
     const uint nodeShift = 3 * (kIndexCodeLevels - pc.level);
     const uint64_t node = (untaggedCode(items.v[i].code) >> cellShift) >> (nodeShift - cellShift);
-    const uint first = lowerBound(items, 0, i, nodeShift, node);
-    const uint end = lowerBound(items, i, pc.count, nodeShift, node + 1);
-    if (uint64_t(end - first) <= pc.leafPoints) return; // a leaf: its points stay
+    uint lo = 0, hi = i; // items[hi] is in the node
+    for (uint step = 1; step != 0 && step <= hi; step *= 2) {
+      if ((untaggedCode(items.v[hi - step].code) >> nodeShift) < node) {
+        lo = hi - step + 1;
+        break;
+      }
+      hi -= step;
+    }
+    const uint first = lowerBound(items, lo, hi, nodeShift, node);
+    const uint64_t probe = uint64_t(first) + pc.leafPoints;
+    if (probe >= pc.count || (untaggedCode(items.v[uint(probe)].code) >> nodeShift) != node)
+      return; // a leaf (at most leafPoints points): its points stay
   }
   UintArray(pc.taken).v[best] = pc.level;
   const IndexItem p = IndexItems(pc.sorted).v[best];

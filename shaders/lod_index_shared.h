@@ -51,7 +51,8 @@ struct RadixPush {
 // (uint64_t), the sums of its untaken points' red, green and blue (3 x uint64_t), their number (uint), the
 // first untaken point at the nearest distance (uint), and each point's cell's first point (uint). A
 // cell's entries sit at its first point's place; every entry starts empty (the gather sets them) and a
-// cell's first point empties them again after its level.
+// cell's first point empties them again after its level. After the arrays, one uint: not 0 when two
+// sorted points share a code (set by the gather).
 struct IndexLevelPush {
   uint64_t items;  // IndexItem[count], in the order the builder gave them
   uint64_t order;  // uint[count]: the sorted points' places in items
@@ -68,7 +69,8 @@ struct IndexLevelPush {
   uint averageColors;
   uint groupsX;
   uint pad;
-  uint64_t cells; // the cells' sums (above): 44 bytes a point
+  uint64_t cells; // the cells' sums (above): 44 bytes a point, and the flag
+  uint64_t keys;  // uint64_t[count]: the sorted codes (the radix sort's last keys), read by the gather
 };
 
 PR_NAMESPACE_END

@@ -26,10 +26,11 @@ static_assert(offsetof(shared::IndexItem, ref) == offsetof(lod::LodItem, ref));
 static_assert(shared::kNotTaken == lod::kNotTakenLevel);
 static_assert(shared::kIndexCodeLevels == uint32_t(lod::kCodeLevels));
 static_assert(sizeof(shared::RadixPush) == 64);
-static_assert(sizeof(shared::IndexLevelPush) == 104 && offsetof(shared::IndexLevelPush, qmin) == 56 &&
+static_assert(sizeof(shared::IndexLevelPush) == 112 && offsetof(shared::IndexLevelPush, qmin) == 56 &&
               offsetof(shared::IndexLevelPush, count) == 68 && offsetof(shared::IndexLevelPush, cells) == 96);
-// The cells' sums (IndexLevelPush::cells): 8 + 24 + 4 + 4 + 4 bytes a point.
+// The cells' sums (IndexLevelPush::cells): 8 + 24 + 4 + 4 + 4 bytes a point, then the equal-codes flag.
 constexpr uint64_t kCellBytesPerPoint = 44;
+constexpr uint64_t kFlagBytes = 16;
 // Staging down: the order and the sorted points after the sort; the levels and colors after the passes.
 constexpr uint64_t kDownloadBytesPerPoint = sizeof(uint32_t) + sizeof(lod::LodItem);
 
@@ -89,11 +90,11 @@ struct GpuIndexer::Slot {
     }
     taken = make(n * sizeof(uint32_t), device, "index taken levels");
     colors = make(n * 2 * sizeof(uint32_t), device, "index colors");
-    cells = make(n * kCellBytesPerPoint, device, "index cells");
+    cells = make(n * kCellBytesPerPoint + kFlagBytes, device, "index cells");
     buckets = make(tiles * 256 * sizeof(uint32_t), device, "index histogram");
     // The items (or the order) up; the order and the sorted points, or the levels and colors, down.
     upload = make(n * sizeof(lod::LodItem), gpu::MemoryKind::Upload, "index upload");
-    download = make(n * kDownloadBytesPerPoint, gpu::MemoryKind::Readback, "index download");
+    download = make(n * kDownloadBytesPerPoint + kFlagBytes, gpu::MemoryKind::Readback, "index download");
     capacity = n;
   }
 };
@@ -122,8 +123,8 @@ void GpuIndexer::submit(const std::function<void(VkCommandBuffer)>& record) {
 namespace {
 
 void copyBuffer(VkCommandBuffer cmd, const gpu::Buffer& from, const gpu::Buffer& to, uint64_t toOffset,
-                uint64_t size) {
-  const VkBufferCopy region{0, toOffset, size};
+                uint64_t size, uint64_t fromOffset = 0) {
+  const VkBufferCopy region{fromOffset, toOffset, size};
   gpu::vkCmdCopyBuffer(cmd, from.handle(), to.handle(), 1, &region);
 }
 
@@ -174,6 +175,7 @@ bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chu
   push.taken = slot.taken.address();
   push.colors = slot.colors.address();
   push.cells = slot.cells.address();
+  push.keys = slot.keys[current].address();
   push.leafPoints = params.leafPoints;
   push.edgeQuanta = grid.edgeQuanta;
   for (int a = 0; a < 3; ++a)
@@ -184,6 +186,7 @@ bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chu
   const gpu::Grid pointGrid = gpu::gridFor(count, shared::kIndexGroupSize);
   push.groupsX = pointGrid.x;
   const uint64_t orderBytes = count * sizeof(uint32_t), itemBytes = count * sizeof(lod::LodItem);
+  const uint64_t flagOffset = count * kCellBytesPerPoint; // in the cells' buffer and in staging
 
   submit([&](VkCommandBuffer cmd) {
     gpu::fullBarrier(cmd);
@@ -209,25 +212,34 @@ bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chu
       scatter_.dispatch(cmd, tileGrid.x, tileGrid.y, radix);
       gpu::fullBarrier(cmd);
     }
+    gpu::vkCmdFillBuffer(cmd, slot.cells.handle(), flagOffset, sizeof(uint32_t), 0);
+    gpu::fullBarrier(cmd);
     gather_.dispatch(cmd, pointGrid.x, pointGrid.y, push);
     gpu::fullBarrier(cmd);
     copyBuffer(cmd, slot.values[current], slot.download, 0, orderBytes);
     copyBuffer(cmd, slot.sorted, slot.download, orderBytes, itemBytes);
+    copyBuffer(cmd, slot.cells, slot.download, flagOffset, sizeof(uint32_t), flagOffset);
     gpu::fullBarrier(cmd);
   });
   slot.download.invalidate();
   const auto* down = static_cast<const uint8_t*>(slot.download.mapped());
-  copyOnAllThreads(order, down, orderBytes);
+  uint32_t equalCodes = 0;
+  std::memcpy(&equalCodes, down + flagOffset, sizeof equalCodes);
   copyOnAllThreads(items, down + orderBytes, itemBytes);
   lap(times.sortSeconds);
 
-  // Equal codes into canonical order (by record bytes, then ref), on the CPU: they are few. The items
-  // end sorted in place, as indexChunk leaves them; where the order changed it goes up and the points
-  // are gathered again.
-  const bool reordered = lod::orderEqualCodes(items, order, count);
+  // Equal codes into canonical order (by record bytes, then ref), on the CPU, where the gather found
+  // any: they are few. The items end sorted in place, as indexChunk leaves them; where the order changed
+  // it goes up and the points are gathered again.
+  bool reordered = false;
+  if (equalCodes != 0) {
+    copyOnAllThreads(order, down, orderBytes);
+    reordered = lod::orderEqualCodes(items, order, count);
+  }
   if (reordered) copyOnAllThreads(slot.upload.mapped(), order, orderBytes);
   lap(times.orderSeconds);
 
+  push.keys = 0; // the flag is read already
   // Each level's subsample from the root down, three passes a level (levels whose nodes are all leaves
   // find nothing to take), then the levels and colors down.
   submit([&](VkCommandBuffer cmd) {

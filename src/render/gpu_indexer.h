@@ -4,8 +4,8 @@
 // their canonical order between the two and lays out the nodes from the levels the points were taken
 // at, so the octree is the one indexChunk makes, byte for byte.
 //
-// Two chunks are in flight at a time, each with buffers of its own (a slot), so that one chunk's host
-// copies and equal-code ordering run while the other's submission runs; submissions go to the device one
+// Three chunks are in flight at a time, each with buffers of its own (a slot), so that chunks' host
+// copies and equal-code ordering run while another's submission runs; submissions go to the device one
 // at a time. The other indexing threads lay out their nodes, encode and write meanwhile. Chunks the GPU path
 // does not cover are indexed on the CPU: a grid with unequal scales on its axes (its distances are weighted
 // in double), chunks of more than 2^32 - 1 points, and chunks whose buffers the device cannot hold.
@@ -51,7 +51,7 @@ public:
 
 private:
   struct Slot;
-  static constexpr size_t kSlots = 2;
+  static constexpr size_t kSlots = 3;
 
   // Sorts and subsamples on the device; false when its buffers cannot be had (the CPU takes the chunk).
   bool indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
