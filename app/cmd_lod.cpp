@@ -131,6 +131,7 @@ nlohmann::json toJson(const LodArgs& a, const io::PotreeBuildReport& r, const In
                                {"levels", st.levelSeconds},
                                {"read", st.readSeconds}};
     j["index_wait_seconds"] = st.waitSeconds;
+    j["index_device_busy_seconds"] = st.busySeconds;
   }
   nlohmann::json phases = nlohmann::json::array();
   for (const lod::LodPhase& p : b.phases) {

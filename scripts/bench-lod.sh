@@ -194,8 +194,9 @@ for r in runs:
         st = b.get("index_device_steps", {})
         steps = ", ".join(f"{k} {st[k]:.2f}" for k in ("stage", "sort", "order", "levels", "read") if k in st)
         device = (f", index on {b['index_device']} ({b['index_gpu_chunks']} chunks; {b['index_cpu_chunks']} on the CPU; "
-                  f"{b['index_device_seconds']:.2f} s of device work: {steps}; threads waited "
-                  f"{b.get('index_wait_seconds', 0):.2f} s for the device, summed)")
+                  f"{b['index_device_seconds']:.2f} s in its steps, summed over the chunks in flight: {steps}; "
+                  f"submissions {b.get('index_device_busy_seconds', 0):.2f} s (one at a time: the device's busy time); "
+                  f"threads waited {b.get('index_wait_seconds', 0):.2f} s for a free slot, summed)")
     lines += ["", f"## {r['size']} points{cores}{device}: phases", "",
               "| phase | seconds | CPU seconds | points/s | points/s per core |", "| --- | ---: | ---: | ---: | ---: |"]
     for p in b["phases"]:

@@ -117,7 +117,11 @@ void GpuIndexer::release(Slot& slot) {
 
 void GpuIndexer::submit(const std::function<void(VkCommandBuffer)>& record) {
   std::lock_guard lock(deviceMutex_);
+  const auto start = Clock::now();
   context_.submitAndWait(record);
+  const double seconds = since(start);
+  std::lock_guard statsLock(mutex_);
+  stats_.busySeconds += seconds;
 }
 
 namespace {

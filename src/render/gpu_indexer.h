@@ -36,6 +36,8 @@ public:
   void index(lod::ChunkNodes& out, lod::IndexScratch& scratch, const lod::LodGrid& grid,
              const lod::NodeKey& chunk, lod::LodItem* items, size_t count, const uint64_t* cellCounts,
              size_t cells, const lod::LodParams& params, const uint8_t* tails) override;
+  // Chunks of up to 4 M points in memory: each costs the device about 90 dispatches and two waits.
+  uint64_t chunkPointsCap() const override { return uint64_t(1) << 22; }
 
   struct Stats {
     uint64_t gpuChunks = 0, cpuChunks = 0; // chunks indexed on each
@@ -46,6 +48,8 @@ public:
     // submission; the levels and colors out of staging.
     double stageSeconds = 0, sortSeconds = 0, orderSeconds = 0, levelSeconds = 0, readSeconds = 0;
     double waitSeconds = 0; // the indexing threads' time waiting for a free slot, summed
+    double busySeconds =
+        0; // the submissions from start to finish, summed: one at a time, the device's busy time
   };
   Stats stats() const;
 
