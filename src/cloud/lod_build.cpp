@@ -282,9 +282,9 @@ LodPhase writePhase(const IndexTimes& times, uint64_t points) {
   return p;
 }
 
-uint64_t inMemoryChunkLimit(uint64_t points, unsigned threads, uint64_t leafPoints, uint64_t cap) {
+uint64_t inMemoryChunkLimit(uint64_t points, unsigned threads, uint64_t leafPoints) {
   const uint64_t perThread = points / (uint64_t(std::max(threads, 1u)) * 4) + 1;
-  return std::max<uint64_t>({leafPoints, 1, std::min<uint64_t>(perThread, cap ? cap : uint64_t(1) << 20)});
+  return std::max<uint64_t>({leafPoints, 1, std::min<uint64_t>(perThread, uint64_t(1) << 20)});
 }
 
 LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams& params, NodeSink& sink,
@@ -298,10 +298,8 @@ LodBuildStats buildInMemory(Pieces pieces, const LodGrid& grid, const LodParams&
   stats.phases.push_back(clock.done("count", n));
 
   clock = PhaseClock();
-  const uint64_t chunkLimit =
-      options.chunkPoints ? std::max(options.chunkPoints, params.leafPoints)
-                          : inMemoryChunkLimit(n, threads, params.leafPoints,
-                                               options.indexer ? options.indexer->chunkPointsCap() : 0);
+  const uint64_t chunkLimit = options.chunkPoints ? std::max(options.chunkPoints, params.leafPoints)
+                                                  : inMemoryChunkLimit(n, threads, params.leafPoints);
   const std::vector<LodChunk> chunks = planChunks(counts, grid.countLevel(), chunkLimit);
   stats.chunks = chunks.size();
   stats.phases.push_back(clock.done("chunk", n));

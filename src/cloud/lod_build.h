@@ -102,9 +102,8 @@ IndexTimes indexChunks(const std::vector<LodChunk>& chunks, const std::vector<ui
 LodPhase writePhase(const IndexTimes& times, uint64_t points);
 
 // Chunk size for points in memory: small enough for every thread to get several chunks, no smaller than
-// a leaf (planChunks' guarantee) and at most `cap` points (0: 1 M, so that a thread's scratch stays
-// ~100 MB; an indexer may ask for more, ChunkIndexer::chunkPointsCap).
-uint64_t inMemoryChunkLimit(uint64_t points, unsigned threads, uint64_t leafPoints, uint64_t cap = 0);
+// a leaf (planChunks' guarantee) and at most 1 M points (a thread's scratch stays ~100 MB).
+uint64_t inMemoryChunkLimit(uint64_t points, unsigned threads, uint64_t leafPoints);
 
 struct LodBuildStats {
   AssembleStats octree;

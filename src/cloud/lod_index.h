@@ -99,9 +99,6 @@ public:
   virtual void index(ChunkNodes& out, IndexScratch& scratch, const LodGrid& grid, const NodeKey& chunk,
                      LodItem* items, size_t count, const uint64_t* cellCounts, size_t cells,
                      const LodParams& params, const uint8_t* tails) = 0;
-  // The largest chunk it prefers in an in-memory build (0: the builder's choice): a device indexes a few
-  // large chunks faster than many small ones.
-  virtual uint64_t chunkPointsCap() const { return 0; }
 };
 
 // The pieces another indexer needs to give indexChunk's result from its own sort and subsamples.

@@ -36,8 +36,6 @@ public:
   void index(lod::ChunkNodes& out, lod::IndexScratch& scratch, const lod::LodGrid& grid,
              const lod::NodeKey& chunk, lod::LodItem* items, size_t count, const uint64_t* cellCounts,
              size_t cells, const lod::LodParams& params, const uint8_t* tails) override;
-  // Chunks of up to 4 M points in memory: each costs the device about 90 dispatches and two waits.
-  uint64_t chunkPointsCap() const override { return uint64_t(1) << 22; }
 
   struct Stats {
     uint64_t gpuChunks = 0, cpuChunks = 0; // chunks indexed on each

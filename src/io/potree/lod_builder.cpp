@@ -170,8 +170,7 @@ OctreeBuilder::OctreeBuilder(const std::vector<std::filesystem::path>& inputs, c
   s.params.tailBytes = s.inputs.tail().bytes();
   s.memory = options.memoryBytes ? options.memoryBytes : defaultBuildMemory();
   const uint64_t n = s.inputs.points();
-  s.inMemoryChunk = lod::inMemoryChunkLimit(n, s.threads, s.params.leafPoints,
-                                            options.indexer ? options.indexer->chunkPointsCap() : 0);
+  s.inMemoryChunk = lod::inMemoryChunkLimit(n, s.threads, s.params.leafPoints);
   const uint64_t need = n * s.inMemoryBytesPerPoint() +
                         uint64_t(s.threads) * s.inMemoryChunk * s.indexBytesPerPoint() + kFixedBytes;
   s.inMemory = need <= s.memory;
