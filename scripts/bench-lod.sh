@@ -145,7 +145,8 @@ lines = ["# Octree build throughput (`pointrast lod`)", "",
          "of it), so the phases above it add up to the total.", ""]
 if runs:
     mc = runs[0]["machine"]
-    lines += [f"Machine: {mc['cores']} cores ({mc['cpu']}), {mc['memory_bytes'] / 2**30:.0f} GiB, GPU {mc['gpu']}, "
+    gpu = mc["gpu"].split(": ", 1)[-1] # nvidia-smi -L: "GPU 0: NAME"
+    lines += [f"Machine: {mc['cores']} cores ({mc['cpu']}), {mc['memory_bytes'] / 2**30:.0f} GiB, GPU {gpu}, "
               f"kernel {mc['kernel']}, dirty_ratio {mc['dirty_ratio']} %.", ""]
 # The disk's sequential write bandwidth, measured in the same run (bench-io --disk), where it was.
 disk = {}
@@ -195,7 +196,8 @@ for r in runs:
         steps = ", ".join(f"{k} {st[k]:.2f}" for k in ("stage", "sort", "order", "levels", "read") if k in st)
         device = (f", index on {b['index_device']} ({b['index_gpu_chunks']} chunks; {b['index_cpu_chunks']} on the CPU; "
                   f"{b['index_device_seconds']:.2f} s in its steps, summed over the chunks in flight: {steps}; "
-                  f"submissions {b.get('index_device_busy_seconds', 0):.2f} s (one at a time: the device's busy time); "
+                  + (f"submissions {b['index_device_busy_seconds']:.2f} s (one at a time: the device's busy time); "
+                     if "index_device_busy_seconds" in b else "") +
                   f"threads waited {b.get('index_wait_seconds', 0):.2f} s for a free slot, summed)")
     lines += ["", f"## {r['size']} points{cores}{device}: phases", "",
               "| phase | seconds | CPU seconds | points/s | points/s per core |", "| --- | ---: | ---: | ---: | ---: |"]

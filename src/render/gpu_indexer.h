@@ -1,8 +1,9 @@
 // The octree builder's index phase on the GPU (cloud/lod_index.h has the rules it keeps): each chunk's
 // points sorted by Morton code with a radix sort, then every level's subsample chosen in parallel over
-// the grid's cells (one thread walks each cell's run of sorted points). The CPU puts equal codes into
-// their canonical order between the two and lays out the nodes from the levels the points were taken
-// at, so the octree is the one indexChunk makes, byte for byte.
+// the points (each adds its distance and color to its grid cell with atomics; the cell's first point
+// marks the choice). The CPU puts equal codes into their canonical order between the two and lays out
+// the nodes from the levels the points were taken at, so the octree is the one indexChunk makes, byte for
+// byte.
 //
 // Three chunks are in flight at a time, each with buffers of its own (a slot), so that chunks' host
 // copies and equal-code ordering run while another's submission runs; submissions go to the device one
