@@ -22,6 +22,11 @@ uint compactBits3(uint64_t v) {
   return uint(v);
 }
 
+// The first point of this workgroup (kIndexGroupSize points a workgroup, on a grid groupsX wide).
+uint groupBase(uint groupsX) {
+  return (gl_WorkGroupID.y * groupsX + gl_WorkGroupID.x) * kIndexGroupSize;
+}
+
 // The cells' sums of a level pass (IndexLevelPush::cells), each an array of pc.count entries.
 Uint64Array cellNearest(IndexLevelPush pc) { return Uint64Array(pc.cells); }
 Uint64Array cellSums(IndexLevelPush pc) { return Uint64Array(pc.cells + 8ul * pc.count); } // r, g, b

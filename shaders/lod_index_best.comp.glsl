@@ -11,11 +11,8 @@ shared uint candidates[kIndexGroupSize];
 shared uint firstHere[kIndexGroupSize];
 
 void main() {
-  const uint t = gl_LocalInvocationIndex;
-  const uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
-  const uint base = group * kIndexGroupSize;
+  const uint base = groupBase(pc.groupsX), t = gl_LocalInvocationIndex, i = base + t;
   if (base >= pc.count) return; // the whole workgroup: no barrier is skipped by part of it
-  const uint i = base + t;
   const bool valid = i < pc.count;
   uint first = 0, candidate = kNotTaken;
   if (valid) {

@@ -28,11 +28,8 @@ uint firstOfCell(uint lo, uint hi, uint64_t cell) {
 }
 
 void main() {
-  const uint t = gl_LocalInvocationIndex;
-  const uint group = gl_WorkGroupID.y * pc.groupsX + gl_WorkGroupID.x;
-  const uint base = group * kIndexGroupSize;
+  const uint base = groupBase(pc.groupsX), t = gl_LocalInvocationIndex, i = base + t;
   if (base >= pc.count) return; // the whole workgroup: no barrier is skipped by part of it
-  const uint i = base + t;
   const bool valid = i < pc.count;
   // Past the end: a cell above every code, so that the sorted order holds in cellsHere.
   const uint64_t cell = valid ? cellOf(pc, i) : ~0ul;
