@@ -9,7 +9,10 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <system_error>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -340,16 +343,28 @@ IoBenchRun runIoBench(const IoBenchConfig& config, bool progress) {
       benchFile(input, input.filename().string());
       continue;
     }
-    for (int format : config.pointFormats) {
-      // The same points in another point format, coded by pointrast's LAZ encoder.
-      std::filesystem::create_directories(config.workDir);
-      const std::string name = input.stem().string() + "-pf" + std::to_string(format) + ".laz";
-      const std::filesystem::path converted = config.workDir / name;
-      io::LasConvertOptions options;
-      options.pointFormat = format;
-      io::convertLasFile(input, converted, options);
-      benchFile(converted, name);
-      std::filesystem::remove(converted);
+    // The same points in other point formats, coded by pointrast's LAZ encoder: every conversion first,
+    // so that a format the points cannot take (colors into point format 6) stops the run before anything
+    // is timed.
+    std::filesystem::create_directories(config.workDir);
+    std::vector<std::pair<std::filesystem::path, std::string>> converted;
+    try {
+      for (int format : config.pointFormats) {
+        const std::string name = input.stem().string() + "-pf" + std::to_string(format) + ".laz";
+        converted.emplace_back(config.workDir / name, name);
+        io::LasConvertOptions options;
+        options.pointFormat = format;
+        io::convertLasFile(input, converted.back().first, options);
+      }
+      for (const auto& [path, name] : converted) {
+        benchFile(path, name);
+        std::filesystem::remove(path);
+      }
+    } catch (...) {
+      std::error_code ignored;
+      for (const auto& entry : converted)
+        std::filesystem::remove(entry.first, ignored);
+      throw;
     }
   }
   if (config.diskBytes) {

@@ -3,6 +3,7 @@
 // threshold: a shared CI machine gives no stable one.
 #include <filesystem>
 #include <string>
+#include <system_error>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -84,6 +85,22 @@ TEST(IoBench, EncodingCanBeLeftOut) {
       ioRunJson(run, "pointrast bench-io simple.laz --no-encode", "2026-01-01T00:00:00Z");
   EXPECT_FALSE(j["results"][0].contains("encode")) << j.dump();
   EXPECT_EQ(ioMarkdownReport(run, "c", "d").find("Encoding the same"), std::string::npos);
+}
+
+// A point format the points cannot take (simple.laz has colors; point format 6 has none) stops the run
+// before any file is timed, and leaves no converted file behind.
+TEST(IoBench, AFormatThePointsCannotTakeStopsBeforeAnyTiming) {
+  POINTRAST_REQUIRE_DATA("laz/simple.laz");
+  IoBenchConfig config = smallConfig("bad-format");
+  config.pointFormats = {3, 6};
+  config.threads = {1};
+  testing::internal::CaptureStderr();
+  EXPECT_ANY_THROW(runIoBench(config, true));
+  const std::string progress = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(progress.find("points/s"), std::string::npos) << progress;
+  std::error_code error;
+  EXPECT_TRUE(!fs::exists(config.workDir) || fs::is_empty(config.workDir, error)) << config.workDir;
+  fs::remove_all(config.workDir);
 }
 
 } // namespace
