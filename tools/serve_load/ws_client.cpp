@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 
@@ -26,7 +27,9 @@ int connectTcp(const std::string& host, uint16_t port) {
   int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return -1;
   if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+    const int error = errno; // the caller reports it
     ::close(fd);
+    errno = error;
     return -1;
   }
   int one = 1;
@@ -126,8 +129,12 @@ bool Client::connect(const std::string& host, uint16_t port, const std::string& 
   closed_ = false;
   response_ = {};
   buffered_.clear();
+  failure_.clear();
   fd_ = connectTcp(host, port);
-  if (fd_ < 0) return false;
+  if (fd_ < 0) {
+    failure_ = std::string("tcp: ") + std::strerror(errno);
+    return false;
+  }
   // The key is any 16 bytes in base64; the server's accept value is not checked (we are the test).
   std::string request = "GET " + target + " HTTP/1.1\r\nHost: " + host + ":" + std::to_string(port) +
                         "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
@@ -135,10 +142,16 @@ bool Client::connect(const std::string& host, uint16_t port, const std::string& 
   for (const std::string& h : headers)
     request += h + "\r\n";
   request += "\r\n";
-  if (!writeAll(fd_, request.data(), request.size())) return false;
+  if (!writeAll(fd_, request.data(), request.size())) {
+    failure_ = std::string("tcp: sending the upgrade: ") + std::strerror(errno);
+    close();
+    return false;
+  }
   std::string all;
   size_t headLength = readHead(fd_, all, clockSeconds() + timeoutSeconds);
   if (headLength == 0) {
+    failure_ =
+        "no answer to the upgrade (" + std::to_string(all.size()) + " bytes before the connection ended)";
     close();
     return false;
   }
@@ -146,6 +159,7 @@ bool Client::connect(const std::string& host, uint16_t port, const std::string& 
   response_.status = statusOf(response_.head);
   buffered_.assign(all.begin() + long(headLength), all.end());
   if (response_.status != 101) {
+    failure_ = "status " + std::to_string(response_.status);
     response_.body = all.substr(headLength);
     close();
     return false;

@@ -37,10 +37,15 @@ public:
   Client& operator=(const Client&) = delete;
 
   // Connects and asks for the upgrade of `target` ("/ws?token=..."). Returns whether the server switched
-  // protocols; otherwise response() holds what it said.
+  // protocols; otherwise response() holds what it said and failure() why the upgrade did not happen.
   bool connect(const std::string& host, uint16_t port, const std::string& target,
                const std::vector<std::string>& headers = {}, double timeoutSeconds = 10);
   const HttpResponse& response() const { return response_; }
+  // Why the last connect failed: the TCP connection ("tcp: " and the system's reason), no answer, or the
+  // answer's status; empty after a successful one.
+  const std::string& failure() const { return failure_; }
+  // Whether the last connect failed before the server answered anything (a TCP-level failure).
+  bool failedBeforeAnswer() const { return failure_.rfind("tcp: ", 0) == 0; }
 
   bool sendText(std::string_view text);
   // A raw frame: first byte (FIN, RSV, opcode) as given, payload masked unless `masked` is false, the length
@@ -61,6 +66,7 @@ private:
   int fd_ = -1;
   bool closed_ = false;
   HttpResponse response_;
+  std::string failure_;
   std::vector<uint8_t> buffered_; // bytes read past the upgrade response
   uint32_t maskState_ = 0x12345678u;
 };
