@@ -35,9 +35,36 @@ UintArray cellBest(IndexLevelPush pc) { return UintArray(pc.cells + 36ul * pc.co
 UintArray cellFirst(IndexLevelPush pc) { return UintArray(pc.cells + 40ul * pc.count); }
 UintArray equalCodesFlag(IndexLevelPush pc) { return UintArray(pc.cells + 44ul * pc.count); } // one uint
 
+// A point's entries emptied: no distance, no sums, no choice (by the gather, and by a cell's first point
+// after its level).
+void emptyCell(IndexLevelPush pc, uint i) {
+  cellNearest(pc).v[i] = ~0ul;
+  for (int c = 0; c < 3; ++c)
+    cellSums(pc).v[3 * i + c] = 0ul;
+  cellReached(pc).v[i] = 0u;
+  cellBest(pc).v[i] = kNotTaken;
+}
+
+// The first sorted point whose code >> shift is at least `key`, in [lo, hi) (hi if none).
+uint firstAtLeast(IndexItems items, uint lo, uint hi, uint shift, uint64_t key) {
+  while (lo < hi) {
+    const uint mid = lo + (hi - lo) / 2;
+    if ((untaggedCode(items.v[mid].code) >> shift) < key)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+// The shift that turns a code into its cell of the pass's grid.
+uint cellShiftOf(IndexLevelPush pc) {
+  return 3 * (kIndexCodeLevels - pc.cellLevel);
+}
+
 // The sorted point's cell of the pass's grid.
 uint64_t cellOf(IndexLevelPush pc, uint i) {
-  return untaggedCode(IndexItems(pc.sorted).v[i].code) >> (3 * (kIndexCodeLevels - pc.cellLevel));
+  return untaggedCode(IndexItems(pc.sorted).v[i].code) >> cellShiftOf(pc);
 }
 
 // Twice the center of a grid cell, in quanta: 2 qmin + (2 i + 1) * E / 2^level, rounded

@@ -15,18 +15,6 @@ shared uint reachedHere[kIndexGroupSize];
 shared uint firstHere[kIndexGroupSize];
 shared uint firstOfFirstCell; // the workgroup's first cell's first point
 
-// The first sorted point whose cell is at least `cell`, in [lo, hi).
-uint firstOfCell(uint lo, uint hi, uint64_t cell) {
-  while (lo < hi) {
-    const uint mid = lo + (hi - lo) / 2;
-    if (cellOf(pc, mid) < cell)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo;
-}
-
 void main() {
   const uint base = groupBase(pc.groupsX), t = gl_LocalInvocationIndex, i = base + t;
   if (base >= pc.count) return; // the whole workgroup: no barrier is skipped by part of it
@@ -37,7 +25,8 @@ void main() {
   if (t == 0) {
     // Where the workgroup's first cell started before it: a binary search over the sorted points.
     firstOfFirstCell = base;
-    if (base > 0 && cellOf(pc, base - 1) == cell) firstOfFirstCell = firstOfCell(0, base - 1, cell);
+    if (base > 0 && cellOf(pc, base - 1) == cell)
+      firstOfFirstCell = firstAtLeast(IndexItems(pc.sorted), 0, base - 1, cellShiftOf(pc), cell);
   }
   barrier();
 

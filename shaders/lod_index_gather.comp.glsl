@@ -11,11 +11,7 @@ void main() {
   if (i >= pc.count) return;
   IndexItems(pc.sorted).v[i] = IndexItems(pc.items).v[UintArray(pc.order).v[i]];
   UintArray(pc.taken).v[i] = kNotTaken;
-  cellNearest(pc).v[i] = ~0ul;
-  for (int c = 0; c < 3; ++c)
-    cellSums(pc).v[3 * i + c] = 0ul;
-  cellReached(pc).v[i] = 0u;
-  cellBest(pc).v[i] = kNotTaken;
+  emptyCell(pc, i);
   if (pc.keys != 0 && i > 0 &&
       untaggedCode(Uint64Array(pc.keys).v[i]) == untaggedCode(Uint64Array(pc.keys).v[i - 1]))
     atomicOr(equalCodesFlag(pc).v[0], 1u);

@@ -4,46 +4,26 @@
 // one nearest the cell's center, the first in sorted order on a tie) taken at this level and gives it
 // the average color of the points it stands for, then empties the cell's sums for the next level. Only
 // in inner nodes: above the chunk's level every node is; from there on a node is inner when its cube
-// holds more than leafPoints points, which two binary searches over the sorted codes count. The grid is
-// isotropic (equal scales), so distances are exact integers.
-//
-// The node's first point is found by galloping back from the cell's (then a binary search), so that the
-// many small nodes of the fine levels cost a few reads; it holds more than leafPoints points when the
-// point leafPoints after its first is still in it.
+// holds more than leafPoints points: when the point leafPoints after its first is still in it. The node's
+// first point is found by galloping back from the cell's (then a binary search), so that the many small
+// nodes of the fine levels cost a few reads. The grid is isotropic (equal scales), so distances are
+// exact integers.
 #include "lod_index.inc.glsl"
 
 layout(local_size_x = kIndexGroupSize) in;
 layout(push_constant) uniform Push { IndexLevelPush pc; };
-
-// The first sorted point whose code >> shift is at least `key`, in [lo, hi).
-uint lowerBound(IndexItems items, uint lo, uint hi, uint shift, uint64_t key) {
-  while (lo < hi) {
-    const uint mid = lo + (hi - lo) / 2;
-    if ((untaggedCode(items.v[mid].code) >> shift) < key)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo;
-}
 
 void main() {
   const uint i = linearInvocation(pc.groupsX, kIndexGroupSize);
   if (i >= pc.count || cellFirst(pc).v[i] != i) return; // not a cell's first point
   const uint reached = cellReached(pc).v[i], best = cellBest(pc).v[i];
   const uint64_t sum[3] = uint64_t[3](cellSums(pc).v[3 * i], cellSums(pc).v[3 * i + 1], cellSums(pc).v[3 * i + 2]);
-  // Empty for the next level, whose cells start here too.
-  cellNearest(pc).v[i] = ~0ul;
-  for (int c = 0; c < 3; ++c)
-    cellSums(pc).v[3 * i + c] = 0ul;
-  cellReached(pc).v[i] = 0u;
-  cellBest(pc).v[i] = kNotTaken;
+  emptyCell(pc, i); // for the next level, whose cells start here too
   if (reached == 0) return; // every point of the cell was taken above
   if (pc.level >= pc.chunkLevel) {
     IndexItems items = IndexItems(pc.sorted);
-    const uint cellShift = 3 * (kIndexCodeLevels - pc.cellLevel);
     const uint nodeShift = 3 * (kIndexCodeLevels - pc.level);
-    const uint64_t node = (untaggedCode(items.v[i].code) >> cellShift) >> (nodeShift - cellShift);
+    const uint64_t node = untaggedCode(items.v[i].code) >> nodeShift;
     uint lo = 0, hi = i; // items[hi] is in the node
     for (uint step = 1; step != 0 && step <= hi; step *= 2) {
       if ((untaggedCode(items.v[hi - step].code) >> nodeShift) < node) {
@@ -52,7 +32,7 @@ void main() {
       }
       hi -= step;
     }
-    const uint first = lowerBound(items, lo, hi, nodeShift, node);
+    const uint first = firstAtLeast(items, lo, hi, nodeShift, node);
     const uint64_t probe = uint64_t(first) + pc.leafPoints;
     if (probe >= pc.count || (untaggedCode(items.v[uint(probe)].code) >> nodeShift) != node)
       return; // a leaf (at most leafPoints points): its points stay
