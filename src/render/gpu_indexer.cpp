@@ -272,16 +272,10 @@ bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chu
   copyOnAllThreads(colors, down + orderBytes, 2 * orderBytes);
   lap(times.readSeconds);
   times.deviceSeconds = since(start);
+  times.gpuChunks = 1;
+  times.gpuPoints = count;
   std::lock_guard lock(mutex_);
-  stats_.gpuChunks += 1;
-  stats_.gpuPoints += count;
-  stats_.deviceSeconds += times.deviceSeconds;
-  stats_.stageSeconds += times.stageSeconds;
-  stats_.sortSeconds += times.sortSeconds;
-  stats_.orderSeconds += times.orderSeconds;
-  stats_.levelSeconds += times.levelSeconds;
-  stats_.readSeconds += times.readSeconds;
-  stats_.waitSeconds += times.waitSeconds;
+  stats_ += times;
   return true;
 }
 

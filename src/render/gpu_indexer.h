@@ -43,12 +43,28 @@ public:
     uint64_t gpuPoints = 0, cpuPoints = 0;
     double deviceSeconds = 0; // wall time of the device's work (submissions and transfers), summed
     // deviceSeconds in its steps: the items into staging; the sort's submission (upload, radix passes,
-    // the order down); the CPU's part between (items into sorted order, equal codes); the levels'
-    // submission; the levels and colors out of staging.
+    // gather, the sorted points down) and their copy out; the equal-code pass where codes repeat; the
+    // levels' submission; the levels and colors out of staging.
     double stageSeconds = 0, sortSeconds = 0, orderSeconds = 0, levelSeconds = 0, readSeconds = 0;
     double waitSeconds = 0; // the indexing threads' time waiting for a free slot, summed
-    double busySeconds =
-        0; // the submissions from start to finish, summed: one at a time, the device's busy time
+    // The submissions from start to finish, summed: they run one at a time, so the device's busy time.
+    double busySeconds = 0;
+
+    Stats& operator+=(const Stats& o) {
+      gpuChunks += o.gpuChunks;
+      cpuChunks += o.cpuChunks;
+      gpuPoints += o.gpuPoints;
+      cpuPoints += o.cpuPoints;
+      deviceSeconds += o.deviceSeconds;
+      stageSeconds += o.stageSeconds;
+      sortSeconds += o.sortSeconds;
+      orderSeconds += o.orderSeconds;
+      levelSeconds += o.levelSeconds;
+      readSeconds += o.readSeconds;
+      waitSeconds += o.waitSeconds;
+      busySeconds += o.busySeconds;
+      return *this;
+    }
   };
   Stats stats() const;
 
