@@ -135,7 +135,7 @@ void copyBuffer(VkCommandBuffer cmd, const gpu::Buffer& from, const gpu::Buffer&
 } // namespace
 
 bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chunk, lod::LodItem* items,
-                               size_t count, const lod::LodParams& params, uint32_t* order, uint32_t* levels,
+                               size_t count, const lod::LodParams& params, uint32_t* levels,
                                uint32_t* colors) {
   const auto asked = Clock::now();
   Slot& slot = acquire();
@@ -237,10 +237,11 @@ bool GpuIndexer::indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chu
   // it goes up and the points are gathered again.
   bool reordered = false;
   if (equalCodes != 0) {
-    copyOnAllThreads(order, down, orderBytes);
-    reordered = lod::orderEqualCodes(items, order, count);
+    std::vector<uint32_t> order(count);
+    copyOnAllThreads(order.data(), down, orderBytes);
+    reordered = lod::orderEqualCodes(items, order.data(), count);
+    if (reordered) copyOnAllThreads(slot.upload.mapped(), order.data(), orderBytes);
   }
-  if (reordered) copyOnAllThreads(slot.upload.mapped(), order, orderBytes);
   lap(times.orderSeconds);
 
   push.keys = 0; // the flag is read already
@@ -284,8 +285,8 @@ void GpuIndexer::index(lod::ChunkNodes& out, lod::IndexScratch& scratch, const l
                        const uint64_t* cellCounts, size_t cells, const lod::LodParams& params,
                        const uint8_t* tails) {
   if (grid.isotropic && count > 0 && count < size_t(UINT32_MAX)) {
-    std::vector<uint32_t> order(count), levels(count), colors(2 * count);
-    if (indexOnDevice(grid, chunk, items, count, params, order.data(), levels.data(), colors.data())) {
+    std::vector<uint32_t> levels(count), colors(2 * count);
+    if (indexOnDevice(grid, chunk, items, count, params, levels.data(), colors.data())) {
       lod::assembleIndexedChunk(out, chunk, items, count, levels.data(), colors.data(), params, tails);
       return;
     }

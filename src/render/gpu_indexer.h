@@ -74,7 +74,7 @@ private:
 
   // Sorts and subsamples on the device; false when its buffers cannot be had (the CPU takes the chunk).
   bool indexOnDevice(const lod::LodGrid& grid, const lod::NodeKey& chunk, lod::LodItem* items, size_t count,
-                     const lod::LodParams& params, uint32_t* order, uint32_t* levels, uint32_t* colors);
+                     const lod::LodParams& params, uint32_t* levels, uint32_t* colors);
   Slot& acquire(); // waits for a free slot
   void release(Slot& slot);
   void submit(const std::function<void(VkCommandBuffer)>& record); // one at a time, waits for it
