@@ -18,8 +18,9 @@
 # that measures WORK's write bandwidth first, default 8G; 0 skips it).
 # Space: N points need 26 N bytes of LAS plus 24 N of octree at once (1 G: 26 + 24 GB; each octree is
 # deleted after its run; a size that does not fit the free space of WORK is skipped, saying so) and about
-# 58 N bytes of memory to build in memory (1 G: 58 GB, under the default --memory of half the RAM on a
-# 128 GB machine); above that the build runs out of core, and says so.
+# 56 N bytes of memory by the builder's estimate to build in memory (1 G: 56 GB, under the default --memory
+# of half the RAM on a 128 GB machine; about 42 GB resident measured); above that the build runs out of
+# core, and says so.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${OUT:-$PWD/gpu-out}
@@ -178,9 +179,9 @@ for r in runs:
     phase = {p["name"]: p for p in b["phases"]}
     after = b["seconds"] - phase["read"]["seconds"] if "read" in phase else b["seconds"]
     index_s = phase["index"]["seconds"] if "index" in phase else 0
-    in_memory = r.get("out_dir", "").startswith("/dev/shm")
-    if in_memory: index += ", octree to /dev/shm"
-    floor = b["bytes"] / best_disk if best_disk and not in_memory else None
+    octree_in_ram = r.get("out_dir", "").startswith("/dev/shm")
+    if octree_in_ram: index += ", octree to /dev/shm"
+    floor = b["bytes"] / best_disk if best_disk and not octree_in_ram else None
     lines.append(f"| {b['points']:,} | {r.get('cores', '')} | {index} | {b['seconds']:.2f} | {m(pps)} | "
                  f"{after:.2f} | {m(b['points'] / after)} | {m(pps / b['threads'])} | "
                  f"{b['bytes'] / 1e9:.1f} | {b['bytes'] / index_s / 1e6 if index_s else 0:,.0f} | "

@@ -360,10 +360,9 @@ TEST(Serve, TenThousandHostileMessagesLeaveItAnswering) {
   Client ws;
   while (hostile < kHostile) {
     if (!ws.open()) {
-      // Thousands of loopback connections a second can meet a transient TCP-level failure on a loaded
-      // machine (the test's own closed connections wait out TIME_WAIT); such a connect is tried again a
-      // few times, 50 ms apart, and counted. A server that answers an upgrade with anything else, or
-      // stops accepting, fails the test.
+      // Thousands of loopback connections a second met a TCP-level failure once on a loaded CI machine
+      // (its cause not found); such a connect is tried again a few times, 50 ms apart, and counted. A
+      // server that answers an upgrade with anything else, or stops accepting, fails the test.
       bool connected = ws.connect("127.0.0.1", server.port(), "/ws");
       for (int retry = 0; !connected && ws.failedBeforeAnswer() && retry < 10; ++retry) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
